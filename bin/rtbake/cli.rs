@@ -1,0 +1,175 @@
+//! Shared command-line plumbing: output context, exit codes, `--params FILE` expansion, atomic output.
+
+use std::ffi::OsString;
+use std::path::Path;
+
+/// Global output settings.
+pub struct Ctx {
+    pub json: bool,
+    pub quiet: bool,
+}
+
+impl Ctx {
+    /// Human message on stderr (suppressed by --quiet).
+    pub fn info(&self, msg: impl AsRef<str>) {
+        if !self.quiet {
+            eprintln!("{}", msg.as_ref());
+        }
+    }
+
+    /// Prints a JSON value on stdout (one object, pretty, trailing newline).
+    pub fn emit_json(&self, v: &serde_json::Value) {
+        println!("{}", serde_json::to_string_pretty(v).expect("JSON values serialise"));
+    }
+
+    /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
+    #[allow(dead_code)]
+    pub fn progress(&self, len: u64, msg: &str) -> indicatif::ProgressBar {
+        use std::io::IsTerminal;
+        if self.quiet || !std::io::stderr().is_terminal() {
+            return indicatif::ProgressBar::hidden();
+        }
+        let pb = indicatif::ProgressBar::new(len);
+        pb.set_message(msg.to_string());
+        pb
+    }
+}
+
+/// Marks an error as bad usage / bad input (exit code 2).
+#[derive(Debug)]
+pub struct Usage(pub anyhow::Error);
+
+impl std::fmt::Display for Usage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl std::error::Error for Usage {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
+/// Wraps any error as bad input (exit 2).
+pub fn usage<E: Into<anyhow::Error>>(e: E) -> anyhow::Error {
+    anyhow::Error::new(Usage(e.into()))
+}
+
+/// Bad input with a message.
+pub fn usage_msg(msg: impl Into<String>) -> anyhow::Error {
+    usage(anyhow::anyhow!(msg.into()))
+}
+
+/// True if the error (or any cause) is bad input: a `Usage` marker or a library `InvalidInput`.
+pub fn is_usage(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<Usage>().is_some()
+        || e.chain().any(|c| c.is::<Usage>() || c.is::<rtbake::error::InvalidInput>())
+}
+
+/// Prints `error: …` with its cause chain and exits 2 (bad input) or 1 (runtime failure).
+pub fn exit_with(e: &anyhow::Error) -> ! {
+    let mut msg = format!("error: {e}");
+    let mut last = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if !last.contains(&c) {
+            msg.push_str(&format!("\n  caused by: {c}"));
+        }
+        last = c;
+    }
+    eprintln!("{msg}");
+    std::process::exit(if is_usage(e) { 2 } else { 1 });
+}
+
+/// Expands `--params FILE` (a JSON object of flag names to values) into flags inserted right after the
+/// deepest subcommand on the command line, so flags given explicitly (which come later) override the file.
+/// `true` → `--flag`, `false`/`null` → omitted, arrays → comma-separated, objects → rejected.
+pub fn expand_params_file<C: clap::CommandFactory>(argv: Vec<OsString>) -> anyhow::Result<Vec<OsString>> {
+    let Some(pos) = argv.iter().position(|a| a == "--params" || a.to_string_lossy().starts_with("--params=")) else {
+        return Ok(argv);
+    };
+    let arg = argv[pos].to_string_lossy().into_owned();
+    let (file, consumed) = if let Some(v) = arg.strip_prefix("--params=") {
+        (v.to_string(), 1)
+    } else {
+        let v = argv.get(pos + 1).ok_or_else(|| usage_msg("--params needs a FILE"))?;
+        (v.to_string_lossy().into_owned(), 2)
+    };
+    let text = std::fs::read_to_string(&file).map_err(|e| usage(anyhow::anyhow!("--params {file}: {e}")))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| usage(anyhow::anyhow!("--params {file}: malformed JSON: {e}")))?;
+    let obj = json.as_object().ok_or_else(|| usage_msg(format!("--params {file}: expected a JSON object")))?;
+    let mut flags: Vec<OsString> = Vec::new();
+    for (k, v) in obj {
+        let name = format!("--{}", k.replace('_', "-"));
+        match v {
+            serde_json::Value::Bool(true) => flags.push(name.into()),
+            serde_json::Value::Bool(false) | serde_json::Value::Null => {}
+            serde_json::Value::Number(n) => flags.extend([name.into(), n.to_string().into()]),
+            serde_json::Value::String(s) => flags.extend([name.into(), s.into()]),
+            serde_json::Value::Array(items) => {
+                let parts: Result<Vec<String>, _> = items
+                    .iter()
+                    .map(|i| match i {
+                        serde_json::Value::Number(n) => Ok(n.to_string()),
+                        serde_json::Value::String(s) => Ok(s.clone()),
+                        _ => Err(usage_msg(format!("--params {file}: \"{k}\" must be an array of numbers or strings"))),
+                    })
+                    .collect();
+                flags.extend([name.into(), parts?.join(",").into()]);
+            }
+            serde_json::Value::Object(_) => {
+                return Err(usage_msg(format!("--params {file}: \"{k}\" must not be an object")));
+            }
+        }
+    }
+    let mut rest: Vec<OsString> = argv.clone();
+    rest.drain(pos..pos + consumed);
+    // Find the deepest subcommand token.
+    let mut cmd = C::command();
+    let mut insert_at = 1;
+    for (i, a) in rest.iter().enumerate().skip(1) {
+        let s = a.to_string_lossy();
+        if let Some(sub) = cmd.find_subcommand(s.as_ref()).cloned() {
+            cmd = sub;
+            insert_at = i + 1;
+        }
+    }
+    let mut out = rest[..insert_at].to_vec();
+    out.extend(flags);
+    out.extend_from_slice(&rest[insert_at..]);
+    Ok(out)
+}
+
+/// Parses a comma-separated list of floats, naming the flag in errors.
+#[allow(dead_code)]
+pub fn parse_f64_list(flag: &str, s: &str) -> anyhow::Result<Vec<f64>> {
+    s.split(',')
+        .map(|t| {
+            let t = t.trim();
+            t.parse::<f64>().map_err(|_| usage_msg(format!("{flag}: '{t}' is not a number (expected a comma-separated list)")))
+        })
+        .collect()
+}
+
+/// Parses exactly three comma-separated floats (R,G,B).
+#[allow(dead_code)]
+pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
+    let v = parse_f64_list(flag, s)?;
+    if v.len() != 3 {
+        return Err(usage_msg(format!("{flag}: expected three comma-separated values R,G,B, got {}", v.len())));
+    }
+    Ok([v[0], v[1], v[2]])
+}
+
+/// Checks that an output directory exists (or can be created) and is writable, before any work.
+#[allow(dead_code)]
+pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
+    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}

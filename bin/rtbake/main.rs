@@ -1,0 +1,100 @@
+//! `rtbake`: command-line glue over the `rtbake` library. Parsing happens in two layers: clap turns flags into
+//! raw arguments, each subcommand validates them into library settings; no maths lives here.
+//!
+//! Exit codes: 0 success, 1 runtime failure, 2 bad usage or input.
+
+mod aa;
+mod bake;
+mod cli;
+mod fit;
+mod kernel;
+mod maps;
+mod profile;
+mod run;
+mod skin_color;
+mod transmittance;
+
+use clap::{Parser, Subcommand};
+use cli::Ctx;
+
+#[derive(Parser)]
+#[command(
+    name = "rtbake",
+    version,
+    about = "Bake and verify lookup tables for real-time skin rendering and morphological antialiasing (Jimenez 2012)",
+    propagate_version = true,
+    args_override_self = true
+)]
+struct Cli {
+    /// Machine-readable JSON results on stdout (human messages stay on stderr).
+    #[arg(long, global = true)]
+    json: bool,
+    /// No progress bars or informational messages.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    /// Read parameters from a JSON object {"flag-name": value, ...}; flags given on the command line override it.
+    #[arg(long, global = true, value_name = "FILE")]
+    params: Option<std::path::PathBuf>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bake assets (all by default) into baked/ (or --out DIR) and update the manifest.
+    Bake(bake::BakeArgs),
+    /// Recompute every file listed in the manifest and compare; report missing, extra, modified or corrupted files.
+    Verify(bake::VerifyArgs),
+    /// List the bakeable assets.
+    Assets,
+    /// Generate SMAA / MLAA lookup textures, including variants (other distances, subsample offsets).
+    Aa(aa::AaArgs),
+    /// Evaluate a diffusion profile R(r) (and T(r) for slabs and layer stacks).
+    Profile(profile::ProfileArgs),
+    /// Fit diffusion profiles: sums of Gaussians, or the separable-SSS kernel.
+    #[command(subcommand)]
+    Fit(fit::FitCommand),
+    /// Generate separable-SSS kernel taps from strength and falloff.
+    Kernel(kernel::KernelArgs),
+    /// Evaluate or bake the transmittance table T(s) (thesis eq. 5.12).
+    Transmittance(transmittance::TransmittanceArgs),
+    /// Evaluate the spectral two-layer skin model (melanin × hemoglobin → RGB albedo).
+    SkinColor(skin_color::SkinColorArgs),
+    /// Facial appearance maps: hemoglobin scale/bias rig, wrinkle maps.
+    #[command(subcommand)]
+    Maps(maps::MapsCommand),
+    /// Run the GPU runtime (or its CPU reference with --cpu) on images.
+    #[command(subcommand)]
+    Run(run::RunCommand),
+}
+
+fn main() {
+    let argv = match cli::expand_params_file::<Cli>(std::env::args_os().collect()) {
+        Ok(a) => a,
+        Err(e) => cli::exit_with(&e),
+    };
+    let parsed = match Cli::try_parse_from(argv) {
+        Ok(c) => c,
+        Err(e) => {
+            // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
+            e.exit();
+        }
+    };
+    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet };
+    let result = match parsed.command {
+        Command::Bake(a) => bake::run_bake(a, &ctx),
+        Command::Verify(a) => bake::run_verify(a, &ctx),
+        Command::Assets => bake::run_assets(&ctx),
+        Command::Aa(a) => aa::run(a, &ctx),
+        Command::Profile(a) => profile::run(a, &ctx),
+        Command::Fit(c) => fit::run(c, &ctx),
+        Command::Kernel(a) => kernel::run(a, &ctx),
+        Command::Transmittance(a) => transmittance::run(a, &ctx),
+        Command::SkinColor(a) => skin_color::run(a, &ctx),
+        Command::Maps(c) => maps::run(c, &ctx),
+        Command::Run(c) => run::run(c, &ctx),
+    };
+    if let Err(e) = result {
+        cli::exit_with(&e);
+    }
+}

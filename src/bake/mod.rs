@@ -1,0 +1,186 @@
+//! The bake registry: every asset rtbake can write into `baked/`, with the files it produces.
+//!
+//! An [`Asset`] is a pure function from its JSON parameters to a list of [`BakedFile`]s (bytes + metadata);
+//! it never touches the file system. `crate::manifest` writes them atomically and records them, and
+//! `verify` re-runs the same function from the manifest's parameters and compares.
+//!
+//! Each area registers its assets in its own file (`aa.rs`, `sss.rs`, …) through an `assets()` function
+//! collected by [`registry`].
+
+use crate::image_buf::Image;
+use crate::io::{self, exr::ExrPrecision, PixelFormat};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// Metadata recorded in the manifest for one file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileMeta {
+    /// What the file is: `lut`, `preview`, `c-header`, `rust-source`, `shader-include`, `json`, `csv`, `plot`.
+    pub kind: String,
+    /// Container: `raw`, `dds`, `ktx2`, `png`, `exr`, `c`, `rust`, `hlsl`, `glsl`, `wgsl`, `json`, `csv`, `svg`.
+    pub format: String,
+    /// GPU texel format of the payload where it has one.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pixel_format: Option<PixelFormat>,
+    pub width: u32,
+    pub height: u32,
+    pub channels: u32,
+    /// `u8`, `u16`, `f16`, `f32`, or `text`.
+    pub sample_type: String,
+    /// `linear` for every data texture; `srgb` only for labelled viewing previews; `n/a` for text.
+    pub color_space: String,
+    /// Texel / index convention (how a shader maps coordinates to parameters), in words and formulas.
+    pub convention: String,
+    /// Absolute tolerance used by `verify` for float payloads (None: must be byte-identical).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub verify_tolerance: Option<f64>,
+}
+
+impl FileMeta {
+    /// Metadata of a text file (sources, JSON, CSV).
+    pub fn text(kind: &str, format: &str, convention: &str) -> Self {
+        Self {
+            kind: kind.into(),
+            format: format.into(),
+            pixel_format: None,
+            width: 0,
+            height: 0,
+            channels: 0,
+            sample_type: "text".into(),
+            color_space: "n/a".into(),
+            convention: convention.into(),
+            verify_tolerance: None,
+        }
+    }
+}
+
+/// One output file: path relative to the bake directory, its bytes and its metadata.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedFile {
+    pub path: String,
+    pub bytes: Vec<u8>,
+    pub meta: FileMeta,
+}
+
+/// Errors while baking an asset.
+#[derive(Debug, thiserror::Error)]
+pub enum BakeError {
+    #[error(transparent)]
+    Invalid(#[from] crate::error::InvalidInput),
+    #[error(transparent)]
+    Io(#[from] io::IoError),
+    #[error("{0}")]
+    Other(String),
+}
+
+/// A bakeable asset.
+pub struct Asset {
+    /// Name used on the command line (`rtbake bake NAME`) and in the manifest.
+    pub name: &'static str,
+    pub summary: &'static str,
+    /// Parameters of the default bake (embedded defaults).
+    pub default_params: fn() -> Value,
+    /// Pure function: parameters → files. Must be deterministic for any thread count.
+    pub bake: fn(&Value) -> Result<Vec<BakedFile>, BakeError>,
+}
+
+/// Every registered asset, in bake order.
+pub fn registry() -> Vec<Asset> {
+    let mut v = Vec::new();
+    v.extend(aa::assets());
+    v
+}
+
+pub mod aa;
+
+/// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
+/// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
+pub fn unorm8_texture_files(stem: &str, img: &Image<u8>, kind: &str, convention: &str) -> Result<Vec<BakedFile>, BakeError> {
+    let pf = PixelFormat::unorm8_for(img.channels);
+    let meta = |format: &str| FileMeta {
+        kind: kind.into(),
+        format: format.into(),
+        pixel_format: pf,
+        width: img.width,
+        height: img.height,
+        channels: img.channels,
+        sample_type: "u8".into(),
+        color_space: "linear".into(),
+        convention: convention.into(),
+        verify_tolerance: None,
+    };
+    let mut png_meta = meta("png");
+    if img.channels == 2 {
+        png_meta.convention = format!("{convention}; PNG stores R as gray and G as alpha");
+    }
+    Ok(vec![
+        BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") },
+        BakedFile { path: format!("{stem}.dds"), bytes: io::dds::encode_u8(img)?, meta: meta("dds") },
+        BakedFile { path: format!("{stem}.ktx2"), bytes: io::ktx2::encode_u8(img)?, meta: meta("ktx2") },
+        BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: png_meta },
+    ])
+}
+
+/// Writes a linear float texture as EXR f32 (`{stem}.exr`), EXR f16 (`{stem}_f16.exr`), KTX2 half floats
+/// (`{stem}.ktx2`) and an 8-bit sRGB-encoded viewing preview (`{stem}_preview_srgb.png`, labelled `srgb`).
+/// `tolerance` is the absolute tolerance `verify` allows on the float payloads.
+pub fn float_texture_files(
+    stem: &str,
+    img: &Image<f32>,
+    kind: &str,
+    convention: &str,
+    tolerance: f64,
+) -> Result<Vec<BakedFile>, BakeError> {
+    let meta = |format: &str, pf: Option<PixelFormat>, st: &str, cs: &str, tol: Option<f64>| FileMeta {
+        kind: kind.into(),
+        format: format.into(),
+        pixel_format: pf,
+        width: img.width,
+        height: img.height,
+        channels: if format == "ktx2" { pf.map(|p| p.channels()).unwrap_or(img.channels) } else { img.channels },
+        sample_type: st.into(),
+        color_space: cs.into(),
+        convention: convention.into(),
+        verify_tolerance: tol,
+    };
+    let half_tol = tolerance.max(1e-3);
+    let mut preview = meta("png", None, "u8", "srgb", Some(1.0));
+    preview.kind = "preview".into();
+    preview.convention = format!("{convention}; 8-bit sRGB-encoded for viewing only, do not sample as linear data");
+    Ok(vec![
+        BakedFile {
+            path: format!("{stem}.exr"),
+            bytes: io::exr::encode(img, ExrPrecision::F32)?,
+            meta: meta("exr", None, "f32", "linear", Some(tolerance)),
+        },
+        BakedFile {
+            path: format!("{stem}_f16.exr"),
+            bytes: io::exr::encode(img, ExrPrecision::F16)?,
+            meta: meta("exr", None, "f16", "linear", Some(half_tol)),
+        },
+        BakedFile {
+            path: format!("{stem}.ktx2"),
+            bytes: io::ktx2::encode_f16(img)?,
+            meta: meta("ktx2", PixelFormat::f16_for(img.channels), "f16", "linear", Some(half_tol)),
+        },
+        BakedFile { path: format!("{stem}_preview_srgb.png"), bytes: io::png::encode_srgb_preview(img)?, meta: preview },
+    ])
+}
+
+/// A pretty-printed JSON file (stable key order, trailing newline).
+pub fn json_file(path: &str, value: &Value, kind: &str, convention: &str) -> BakedFile {
+    let mut text = serde_json::to_string_pretty(value).expect("JSON values always serialise");
+    text.push('\n');
+    BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, "json", convention) }
+}
+
+/// A text file (source, CSV, SVG …).
+pub fn text_file(path: &str, text: String, kind: &str, format: &str, convention: &str) -> BakedFile {
+    BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, format, convention) }
+}
+
+/// Deserialises asset parameters, naming the asset in the error.
+pub fn parse_params<T: serde::de::DeserializeOwned>(asset: &str, params: &Value) -> Result<T, BakeError> {
+    serde_json::from_value(params.clone())
+        .map_err(|e| BakeError::Invalid(crate::error::InvalidInput::new(format!("{asset} parameters"), e.to_string())))
+}

@@ -1,0 +1,49 @@
+//! Diffusion profiles (thesis ch. 2 and 5.2; `specs/diffusion.md`).
+//!
+//! Units everywhere: lengths in mm, coefficients in mm⁻¹, radial profiles R(r), T(r) in mm⁻²
+//! (fraction of incident power per unit area). These modules know nothing about files or the GPU.
+
+pub mod dipole;
+pub mod materials;
+pub mod multipole;
+pub mod sum_of_gaussians;
+
+/// An RGB radial diffusion profile R(r) in mm⁻² (r in mm), with its total ∫₀^∞ 2πr R(r) dr.
+///
+/// Implemented by the dipole, the multipole, layered stacks and sums of Gaussians, so fitting,
+/// separable kernels and transmittance can consume any of them.
+pub trait RadialProfile: Sync {
+    /// R(r) per channel, mm⁻².
+    fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3];
+    /// ∫₀^∞ 2πr R(r) dr per channel (dimensionless).
+    fn total_reflectance(&self) -> [f64; 3];
+}
+
+/// Which polynomial approximates the average diffuse Fresnel reflectance Fdr(η).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FdrForm {
+    /// Donner & Jensen 2005: the η ≥ 1 polynomial with full digits plus the η < 1 form for internal interfaces.
+    #[default]
+    Dj05,
+    /// Jensen et al. 2001 as printed (−1.440, 0.710, 0.668, 0.0636), η < 1 form as DJ05.
+    Jensen01,
+}
+
+/// Average diffuse Fresnel reflectance Fdr(η), η = n_inside / n_outside (`specs/diffusion.md`).
+pub fn fdr(eta: f64, form: FdrForm) -> f64 {
+    if eta >= 1.0 {
+        match form {
+            FdrForm::Dj05 => -1.4399 / (eta * eta) + 0.7099 / eta + 0.6681 + 0.0636 * eta,
+            FdrForm::Jensen01 => -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta,
+        }
+    } else {
+        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
+    }
+}
+
+/// Boundary coefficient A = (1 + Fdr)/(1 − Fdr).
+pub fn boundary_a(eta: f64, form: FdrForm) -> f64 {
+    let f = fdr(eta, form);
+    (1.0 + f) / (1.0 - f)
+}

@@ -1,0 +1,197 @@
+//! Multipole diffusion for a slab of finite thickness (Donner & Jensen, "Light Diffusion in Multi-Layered
+//! Translucent Materials", SIGGRAPH 2005, "DJ05"; thesis §2; `specs/diffusion.md`).
+//!
+//! Slab 0 ≤ z ≤ d (z downwards), relative index η0 at the top face and ηd at the bottom face.
+//! zb0 = 2A(η0)D, zbd = 2A(ηd)D, l = 1/σt′, L = d + zb0 + zbd; image pairs i = −n..n:
+//! zr,i = 2iL + l, zv,i = 2iL − l − 2zb0.
+//!
+//! Hankel transforms (radial frequency k in mm⁻¹, s = sqrt(σtr² + k²)):
+//!   R̂(k) = (α′/2) Σi [ sgn(zr,i) e^(−|zr,i| s) − sgn(zv,i) e^(−|zv,i| s) ]
+//!   T̂(k) = (α′/2) Σi [ sgn(d − zr,i) e^(−|d − zr,i| s) − sgn(d − zv,i) e^(−|d − zv,i| s) ]
+//! The exact infinite series is geometric in q = e^(−2Ls); it is evaluated here in a form that neither
+//! overflows for large s nor cancels for s → 0 (where it tends to Ohm's law T = (l + zb0)/L).
+
+use super::{boundary_a, FdrForm};
+use crate::error::{check_non_negative, check_positive, InvalidInput};
+
+/// How the image series is summed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum Series {
+    /// Closed-form infinite series (default).
+    #[default]
+    Exact,
+    /// i = −pairs..=pairs (DJ05 customarily used pairs = 5, i.e. 11 dipoles).
+    Truncated { pairs: u32 },
+}
+
+/// One channel of a slab.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slab {
+    pub sigma_a_per_mm: f64,
+    pub sigma_s_prime_per_mm: f64,
+    pub thickness_mm: f64,
+    /// n_slab / n_above.
+    pub eta_top: f64,
+    /// n_slab / n_below.
+    pub eta_bottom: f64,
+    pub fdr_form: FdrForm,
+}
+
+impl Slab {
+    /// Validates the coefficients and the diffusion validity condition d > 1/σt′.
+    pub fn new(
+        sigma_a_per_mm: f64,
+        sigma_s_prime_per_mm: f64,
+        thickness_mm: f64,
+        eta_top: f64,
+        eta_bottom: f64,
+        fdr_form: FdrForm,
+    ) -> Result<Self, InvalidInput> {
+        check_non_negative("sigma_a", sigma_a_per_mm, "mm^-1")?;
+        check_positive("sigma_s_prime", sigma_s_prime_per_mm, "mm^-1")?;
+        check_positive("thickness_mm", thickness_mm, "mm")?;
+        check_positive("eta_top", eta_top, "relative index")?;
+        check_positive("eta_bottom", eta_bottom, "relative index")?;
+        let l = 1.0 / (sigma_a_per_mm + sigma_s_prime_per_mm);
+        if thickness_mm <= l {
+            return Err(InvalidInput::new(
+                "thickness_mm",
+                format!(
+                    "must exceed the mean free path 1/sigma_t' = {l:.6} mm (diffusion source must lie inside the slab), got {thickness_mm}"
+                ),
+            ));
+        }
+        Ok(Self { sigma_a_per_mm, sigma_s_prime_per_mm, thickness_mm, eta_top, eta_bottom, fdr_form })
+    }
+
+    /// The same slab lit from below (face indices swapped): gives R↑, T↑.
+    pub fn flipped(&self) -> Self {
+        Self { eta_top: self.eta_bottom, eta_bottom: self.eta_top, ..*self }
+    }
+
+    pub fn sigma_t_prime(&self) -> f64 {
+        self.sigma_a_per_mm + self.sigma_s_prime_per_mm
+    }
+    pub fn albedo_prime(&self) -> f64 {
+        self.sigma_s_prime_per_mm / self.sigma_t_prime()
+    }
+    pub fn sigma_tr(&self) -> f64 {
+        (3.0 * self.sigma_a_per_mm * self.sigma_t_prime()).sqrt()
+    }
+
+    /// (l, zb0, zbd, L) in mm.
+    pub fn geometry_mm(&self) -> (f64, f64, f64, f64) {
+        let st = self.sigma_t_prime();
+        let dcoef = 1.0 / (3.0 * st);
+        let zb0 = 2.0 * boundary_a(self.eta_top, self.fdr_form) * dcoef;
+        let zbd = 2.0 * boundary_a(self.eta_bottom, self.fdr_form) * dcoef;
+        let l = 1.0 / st;
+        (l, zb0, zbd, self.thickness_mm + zb0 + zbd)
+    }
+
+    /// (R̂(k), T̂(k)) for radial frequency k (mm⁻¹). At k = 0 these are the total reflectance and transmittance.
+    pub fn hankel_rt(&self, k_per_mm: f64, series: Series) -> (f64, f64) {
+        let s = (self.sigma_tr().powi(2) + k_per_mm * k_per_mm).sqrt();
+        match series {
+            Series::Exact => self.hankel_exact(s),
+            Series::Truncated { pairs } => self.hankel_truncated(s, pairs as i64),
+        }
+    }
+
+    /// Total diffuse reflectance and transmittance (R̂(0), T̂(0)).
+    pub fn totals(&self, series: Series) -> (f64, f64) {
+        self.hankel_rt(0.0, series)
+    }
+
+    fn hankel_truncated(&self, s: f64, n: i64) -> (f64, f64) {
+        let (l, zb0, _, big_l) = self.geometry_mm();
+        let d = self.thickness_mm;
+        let e = |z: f64| z.signum() * (-z.abs() * s).exp();
+        let (mut r, mut t) = (0.0, 0.0);
+        for i in -n..=n {
+            let zr = 2.0 * i as f64 * big_l + l;
+            let zv = 2.0 * i as f64 * big_l - l - 2.0 * zb0;
+            r += e(zr) - e(zv);
+            t += e(d - zr) - e(d - zv);
+        }
+        let h = 0.5 * self.albedo_prime();
+        (h * r, h * t)
+    }
+
+    fn hankel_exact(&self, s: f64) -> (f64, f64) {
+        let (l, zb0, _, big_l) = self.geometry_mm();
+        let d = self.thickness_mm;
+        let a = l;
+        let b = l + 2.0 * zb0;
+        let ar = d - l;
+        let av = d + l + 2.0 * zb0;
+        // g·(e^(−xs) − e^(xs)) with g = q/(1 − q), q = e^(−2Ls), for 0 ≤ x ≤ 2L.
+        let g_diff = |x: f64| -> f64 {
+            let two_ls = 2.0 * big_l * s;
+            if two_ls == 0.0 {
+                -x / big_l
+            } else if two_ls < 50.0 {
+                -2.0 * (x * s).sinh() / two_ls.exp_m1()
+            } else {
+                let q = (-two_ls).exp();
+                ((-(2.0 * big_l + x) * s).exp() - (-(2.0 * big_l - x) * s).exp()) / (1.0 - q)
+            }
+        };
+        // e^(−xs)(1 + g) − e^(xs) g
+        let term = |x: f64| (-x * s).exp() + g_diff(x);
+        let h = 0.5 * self.albedo_prime();
+        let r = term(a) + term(b);
+        let t = ar.signum() * (-ar.abs() * s).exp() + g_diff(ar) - term(av);
+        (h * r, h * t)
+    }
+}
+
+/// Validates a slab and returns it, naming the layer in errors (`layers[i].field`).
+pub fn slab_for_layer(
+    index: usize,
+    sigma_a_per_mm: f64,
+    sigma_s_prime_per_mm: f64,
+    thickness_mm: f64,
+    eta_top: f64,
+    eta_bottom: f64,
+    fdr_form: FdrForm,
+) -> Result<Slab, InvalidInput> {
+    Slab::new(sigma_a_per_mm, sigma_s_prime_per_mm, thickness_mm, eta_top, eta_bottom, fdr_form)
+        .map_err(|e| InvalidInput::new(format!("layers[{index}].{}", e.param), e.message))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn skinlike(d: f64, sigma_a: f64) -> Slab {
+        Slab::new(sigma_a, 1.5, d, 1.4, 1.4, FdrForm::Dj05).unwrap()
+    }
+
+    #[test]
+    fn exact_series_matches_long_truncated_sum() {
+        let slab = skinlike(0.8, 0.02);
+        for k in [0.0, 0.3, 2.0, 40.0] {
+            let (re, te) = slab.hankel_rt(k, Series::Exact);
+            let (rt, tt) = slab.hankel_rt(k, Series::Truncated { pairs: 4000 });
+            assert!((re - rt).abs() < 1e-9 * rt.abs().max(1e-12), "k={k} R {re} vs {rt}");
+            assert!((te - tt).abs() < 1e-9 * tt.abs().max(1e-12), "k={k} T {te} vs {tt}");
+        }
+    }
+
+    #[test]
+    fn non_absorbing_slab_obeys_ohms_law() {
+        let slab = skinlike(2.0, 0.0);
+        let (r, t) = slab.totals(Series::Exact);
+        let (l, zb0, _, big_l) = slab.geometry_mm();
+        assert!((r + t - 1.0).abs() < 1e-12, "R+T = {}", r + t);
+        assert!((t - (l + zb0) / big_l).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rejects_slab_thinner_than_mean_free_path() {
+        let err = Slab::new(0.1, 0.9, 0.5, 1.4, 1.4, FdrForm::Dj05).unwrap_err();
+        assert_eq!(err.param, "thickness_mm");
+    }
+}

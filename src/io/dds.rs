@@ -1,0 +1,120 @@
+//! DDS with the DX10 extended header (via `ddsfile`): real two-channel formats, unlike the 24-bit RGB files
+//! upstream SMAA ships labelled as R8G8. Supported: `R8_UNORM`, `R8G8_UNORM`, `R8G8B8A8_UNORM`,
+//! `R16G16B16A16_FLOAT`, `R32G32B32A32_FLOAT`. Data textures are non-sRGB.
+
+use super::{IoError, PixelFormat};
+use crate::image_buf::Image;
+use ddsfile::{AlphaMode, D3D10ResourceDimension, Dds, DxgiFormat, NewDxgiParams};
+
+fn dxgi(format: PixelFormat) -> Result<DxgiFormat, IoError> {
+    Ok(match format {
+        PixelFormat::R8Unorm => DxgiFormat::R8_UNorm,
+        PixelFormat::R8G8Unorm => DxgiFormat::R8G8_UNorm,
+        PixelFormat::R8G8B8A8Unorm => DxgiFormat::R8G8B8A8_UNorm,
+        PixelFormat::R16G16B16A16Sfloat => DxgiFormat::R16G16B16A16_Float,
+        PixelFormat::R32G32B32A32Sfloat => DxgiFormat::R32G32B32A32_Float,
+        other => return Err(IoError::Unsupported { what: "dds", detail: format!("{other:?}") }),
+    })
+}
+
+fn build(width: u32, height: u32, format: PixelFormat, payload: Vec<u8>) -> Result<Vec<u8>, IoError> {
+    let mut dds = Dds::new_dxgi(NewDxgiParams {
+        height,
+        width,
+        depth: None,
+        format: dxgi(format)?,
+        mipmap_levels: None,
+        array_layers: None,
+        caps2: None,
+        is_cubemap: false,
+        resource_dimension: D3D10ResourceDimension::Texture2D,
+        alpha_mode: AlphaMode::Unknown,
+    })
+    .map_err(|e| IoError::Unsupported { what: "dds", detail: e.to_string() })?;
+    if dds.data.len() != payload.len() {
+        return Err(IoError::Unsupported { what: "dds", detail: format!("payload {} != {}", payload.len(), dds.data.len()) });
+    }
+    dds.data = payload;
+    let mut out = Vec::new();
+    dds.write(&mut out).map_err(|e| IoError::Unsupported { what: "dds", detail: e.to_string() })?;
+    Ok(out)
+}
+
+/// 8-bit UNORM texture with 1, 2 or 4 channels.
+pub fn encode_u8(img: &Image<u8>) -> Result<Vec<u8>, IoError> {
+    let format = PixelFormat::unorm8_for(img.channels)
+        .ok_or(IoError::Unsupported { what: "dds", detail: format!("{} channels of u8", img.channels) })?;
+    build(img.width, img.height, format, img.data.clone())
+}
+
+/// Pads 1–4 channels to RGBA (missing colour channels 0, alpha 1).
+pub fn to_rgba(img: &Image<f32>) -> Vec<f32> {
+    let c = img.channels as usize;
+    let mut out = Vec::with_capacity(img.data.len() / c * 4);
+    for px in img.data.chunks_exact(c) {
+        for k in 0..4 {
+            out.push(if k < c { px[k] } else if k == 3 { 1.0 } else { 0.0 });
+        }
+    }
+    out
+}
+
+/// Float texture as `R16G16B16A16_FLOAT` (`half = true`) or `R32G32B32A32_FLOAT`; 1–3 channels are padded
+/// to RGBA (missing colour channels 0, alpha 1).
+pub fn encode_f32(img: &Image<f32>, half: bool) -> Result<Vec<u8>, IoError> {
+    let rgba = to_rgba(img);
+    if half {
+        let h: Vec<half::f16> = rgba.iter().map(|&v| half::f16::from_f32(v)).collect();
+        build(img.width, img.height, PixelFormat::R16G16B16A16Sfloat, bytemuck::cast_slice(&h).to_vec())
+    } else {
+        build(img.width, img.height, PixelFormat::R32G32B32A32Sfloat, bytemuck::cast_slice(&rgba).to_vec())
+    }
+}
+
+/// Reads a DDS back: (format, width, height, payload bytes).
+pub fn decode(bytes: &[u8], path: &str) -> Result<(PixelFormat, u32, u32, Vec<u8>), IoError> {
+    let err = |d: String| IoError::Decode { path: path.to_string(), detail: d };
+    let dds = Dds::read(bytes).map_err(|e| err(e.to_string()))?;
+    let format = match dds.get_dxgi_format() {
+        Some(DxgiFormat::R8_UNorm) => PixelFormat::R8Unorm,
+        Some(DxgiFormat::R8G8_UNorm) => PixelFormat::R8G8Unorm,
+        Some(DxgiFormat::R8G8B8A8_UNorm) => PixelFormat::R8G8B8A8Unorm,
+        Some(DxgiFormat::R16G16B16A16_Float) => PixelFormat::R16G16B16A16Sfloat,
+        Some(DxgiFormat::R32G32B32A32_Float) => PixelFormat::R32G32B32A32Sfloat,
+        other => return Err(err(format!("unsupported DXGI format {other:?}"))),
+    };
+    let data = dds.get_data(0).map_err(|e| err(e.to_string()))?.to_vec();
+    Ok((format, dds.get_width(), dds.get_height(), data))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rg8_round_trips_with_dx10_header() {
+        let img = Image::from_vec(4, 3, 2, (0..24u8).collect());
+        let bytes = encode_u8(&img).unwrap();
+        assert_eq!(&bytes[84..88], b"DX10");
+        let (f, w, h, data) = decode(&bytes, "t").unwrap();
+        assert_eq!((f, w, h), (PixelFormat::R8G8Unorm, 4, 3));
+        assert_eq!(data, img.data);
+        // DXGI_FORMAT_R8G8_UNORM = 49 right after the pixel-format block.
+        assert_eq!(u32::from_le_bytes(bytes[128..132].try_into().unwrap()), 49);
+    }
+
+    #[test]
+    fn r8_and_float_formats_round_trip() {
+        let img = Image::from_vec(2, 2, 1, vec![1u8, 2, 3, 4]);
+        assert_eq!(decode(&encode_u8(&img).unwrap(), "t").unwrap().0, PixelFormat::R8Unorm);
+        let f = Image::from_vec(2, 1, 3, vec![0.5f32, 0.25, 2.0, -1.0, 0.0, 7.5]);
+        let (fmt, _, _, data) = decode(&encode_f32(&f, false).unwrap(), "t").unwrap();
+        assert_eq!(fmt, PixelFormat::R32G32B32A32Sfloat);
+        let back: &[f32] = bytemuck::cast_slice(&data);
+        assert_eq!(back, &[0.5, 0.25, 2.0, 1.0, -1.0, 0.0, 7.5, 1.0]);
+        let (fmt, _, _, data) = decode(&encode_f32(&f, true).unwrap(), "t").unwrap();
+        assert_eq!(fmt, PixelFormat::R16G16B16A16Sfloat);
+        let back: Vec<f32> = data.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect();
+        assert_eq!(back, vec![0.5, 0.25, 2.0, 1.0, -1.0, 0.0, 7.5, 1.0]);
+    }
+}

@@ -1,0 +1,191 @@
+//! KTX 2.0 writer (Khronos KTX File Format Specification 2.0, with a Khronos Data Format basic descriptor).
+//!
+//! No crate writes KTX2, so this module does; every file is validated by reading it back with the `ktx2`
+//! crate in the tests. Single level, single layer, no supercompression, `KHR_DF_TRANSFER_LINEAR`,
+//! BT.709 primaries, RGBSDA colour model. Formats: `R8_UNORM`, `R8G8_UNORM`, `R8G8B8A8_UNORM`,
+//! `R16_SFLOAT`, `R16G16_SFLOAT`, `R16G16B16A16_SFLOAT`, `R32_SFLOAT`, `R32G32B32A32_SFLOAT`.
+
+use super::{IoError, PixelFormat};
+use crate::image_buf::Image;
+
+/// VkFormat enum value.
+pub fn vk_format(format: PixelFormat) -> u32 {
+    match format {
+        PixelFormat::R8Unorm => 9,
+        PixelFormat::R8G8Unorm => 16,
+        PixelFormat::R8G8B8A8Unorm => 37,
+        PixelFormat::R16Sfloat => 76,
+        PixelFormat::R16G16Sfloat => 83,
+        PixelFormat::R16G16B16A16Sfloat => 97,
+        PixelFormat::R32Sfloat => 100,
+        PixelFormat::R32G32B32A32Sfloat => 109,
+    }
+}
+
+const IDENTIFIER: [u8; 12] = [0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, b'\r', b'\n', 0x1A, b'\n'];
+const WRITER: &str = concat!("rtbake ", env!("CARGO_PKG_VERSION"));
+
+fn align(v: usize, a: usize) -> usize {
+    v.div_ceil(a) * a
+}
+
+fn dfd(format: PixelFormat) -> Vec<u8> {
+    let channels = format.channels();
+    let bpt = format.bytes_per_texel();
+    let comp_bytes = bpt / channels;
+    let is_float = !format.is_unorm8();
+    let block_size = 24 + 16 * channels;
+    let mut b = Vec::new();
+    b.extend_from_slice(&(4 + block_size).to_le_bytes()); // dfdTotalSize
+    b.extend_from_slice(&0u32.to_le_bytes()); // vendorId = KHR, descriptorType = basic
+    b.extend_from_slice(&2u16.to_le_bytes()); // versionNumber
+    b.extend_from_slice(&(block_size as u16).to_le_bytes());
+    b.extend_from_slice(&[1, 1, 1, 0]); // colorModel RGBSDA, primaries BT709, transfer LINEAR, flags straight alpha
+    b.extend_from_slice(&[0, 0, 0, 0]); // texelBlockDimension 1x1x1x1 (stored minus one)
+    let mut planes = [0u8; 8];
+    planes[0] = bpt as u8;
+    b.extend_from_slice(&planes);
+    for c in 0..channels {
+        let channel_id: u8 = if c == 3 { 15 } else { c as u8 };
+        let flags: u8 = if is_float { 0x80 | 0x40 } else { 0 };
+        b.extend_from_slice(&((c * comp_bytes * 8) as u16).to_le_bytes());
+        b.push((comp_bytes * 8 - 1) as u8);
+        b.push(channel_id | flags);
+        b.extend_from_slice(&[0, 0, 0, 0]);
+        let (lower, upper) = if is_float { (0xBF80_0000u32, 0x3F80_0000u32) } else { (0, 255) };
+        b.extend_from_slice(&lower.to_le_bytes());
+        b.extend_from_slice(&upper.to_le_bytes());
+    }
+    b
+}
+
+fn kvd() -> Vec<u8> {
+    let mut entry = b"KTXwriter\0".to_vec();
+    entry.extend_from_slice(WRITER.as_bytes());
+    entry.push(0);
+    let mut b = (entry.len() as u32).to_le_bytes().to_vec();
+    b.extend_from_slice(&entry);
+    while b.len() % 4 != 0 {
+        b.push(0);
+    }
+    b
+}
+
+/// Assembles a KTX2 file from raw little-endian level-0 texels.
+pub fn encode_raw(width: u32, height: u32, format: PixelFormat, payload: &[u8]) -> Result<Vec<u8>, IoError> {
+    let expected = width as usize * height as usize * format.bytes_per_texel() as usize;
+    if payload.len() != expected {
+        return Err(IoError::Unsupported { what: "ktx2", detail: format!("payload {} bytes, expected {expected}", payload.len()) });
+    }
+    let type_size = if format.is_unorm8() { 1 } else { format.bytes_per_texel() / format.channels() };
+    let dfd = dfd(format);
+    let kvd = kvd();
+    let header_len = 12 + 9 * 4 + 4 * 4 + 2 * 8; // identifier + header fields + index
+    let level_index_len = 3 * 8;
+    let dfd_off = header_len + level_index_len;
+    let kvd_off = dfd_off + dfd.len();
+    let data_align = {
+        let bpt = format.bytes_per_texel() as usize;
+        // lcm(4, texel block size)
+        let g = gcd(4, bpt);
+        4 * bpt / g
+    };
+    let data_off = align(kvd_off + kvd.len(), data_align);
+
+    let mut out = Vec::with_capacity(data_off + payload.len());
+    out.extend_from_slice(&IDENTIFIER);
+    for v in [vk_format(format), type_size, width, height, 0, 0, 1, 1, 0] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [dfd_off as u32, dfd.len() as u32, kvd_off as u32, kvd.len() as u32] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&0u64.to_le_bytes()); // sgdByteOffset
+    out.extend_from_slice(&0u64.to_le_bytes()); // sgdByteLength
+    for v in [data_off as u64, payload.len() as u64, payload.len() as u64] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&dfd);
+    out.extend_from_slice(&kvd);
+    out.resize(data_off, 0);
+    out.extend_from_slice(payload);
+    Ok(out)
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// 8-bit UNORM texture with 1, 2 or 4 channels.
+pub fn encode_u8(img: &Image<u8>) -> Result<Vec<u8>, IoError> {
+    let format = PixelFormat::unorm8_for(img.channels)
+        .ok_or(IoError::Unsupported { what: "ktx2", detail: format!("{} channels of u8", img.channels) })?;
+    encode_raw(img.width, img.height, format, &img.data)
+}
+
+/// Float texture stored as half floats: 1 → R16, 2 → RG16, 3 or 4 → RGBA16 (3 padded with alpha 1).
+pub fn encode_f16(img: &Image<f32>) -> Result<Vec<u8>, IoError> {
+    let format = PixelFormat::f16_for(img.channels)
+        .ok_or(IoError::Unsupported { what: "ktx2", detail: format!("{} channels", img.channels) })?;
+    let samples: Vec<f32> = if img.channels == 3 { super::dds::to_rgba(img) } else { img.data.clone() };
+    let h: Vec<half::f16> = samples.iter().map(|&v| half::f16::from_f32(v)).collect();
+    encode_raw(img.width, img.height, format, bytemuck::cast_slice(&h))
+}
+
+/// Reads a KTX2 back with the `ktx2` crate: (vkFormat, width, height, level-0 bytes, transfer is linear).
+pub fn decode(bytes: &[u8], path: &str) -> Result<(u32, u32, u32, Vec<u8>, bool), IoError> {
+    let err = |d: String| IoError::Decode { path: path.to_string(), detail: d };
+    let reader = ktx2::Reader::new(bytes).map_err(|e| err(e.to_string()))?;
+    let header = reader.header();
+    let format = header.format.map(|f| f.value()).unwrap_or(0);
+    let level = reader.levels().next().ok_or_else(|| err("no mip level".into()))?;
+    let linear = reader.transfer_function() == Some(ktx2::TransferFunction::Linear);
+    Ok((format, header.pixel_width, header.pixel_height, level.data.to_vec(), linear))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rg8_reads_back_with_ktx2_crate() {
+        let img = Image::from_vec(5, 3, 2, (0..30u8).collect());
+        let bytes = encode_u8(&img).unwrap();
+        let reader = ktx2::Reader::new(&bytes[..]).unwrap();
+        let h = reader.header();
+        assert_eq!(h.format, Some(ktx2::Format::R8G8_UNORM));
+        assert_eq!((h.pixel_width, h.pixel_height, h.type_size), (5, 3, 1));
+        assert_eq!(reader.transfer_function(), Some(ktx2::TransferFunction::Linear));
+        assert_eq!(reader.color_model(), Some(ktx2::ColorModel::RGBSDA));
+        assert_eq!(reader.writer().map(|w| w.trim_end_matches(char::from(0))), Some(WRITER));
+        assert_eq!(reader.levels().next().unwrap().data, &img.data[..]);
+        let basic = reader.basic_dfd().unwrap();
+        assert_eq!(basic.sample_information.len(), 2);
+    }
+
+    #[test]
+    fn rgba16f_reads_back_and_is_aligned() {
+        let img = Image::from_vec(2, 2, 3, vec![0.5f32, 1.0, 2.0, 0.0, 0.25, 8.0, 1.0, 1.0, 1.0, 0.125, 0.0, 3.0]);
+        let bytes = encode_f16(&img).unwrap();
+        let (fmt, w, h, data, linear) = decode(&bytes, "t").unwrap();
+        assert_eq!((fmt, w, h, linear), (97, 2, 2, true));
+        let back: Vec<f32> = data.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect();
+        assert_eq!(&back[0..4], &[0.5, 1.0, 2.0, 1.0]);
+        assert_eq!(back.len(), 16);
+        let reader = ktx2::Reader::new(&bytes[..]).unwrap();
+        assert_eq!(reader.header().type_size, 2);
+        let sample = reader.basic_dfd().unwrap().sample_information[0];
+        assert_eq!(sample.bit_length.get(), 16);
+    }
+
+    #[test]
+    fn r8_reads_back() {
+        let img = Image::from_vec(2, 2, 1, vec![9u8, 8, 7, 6]);
+        let (fmt, _, _, data, _) = decode(&encode_u8(&img).unwrap(), "t").unwrap();
+        assert_eq!((fmt, data), (9, img.data));
+    }
+}
