@@ -10,3 +10,4 @@ pub mod diffusion;
 pub mod error;
 pub mod image_buf;
 pub mod io;
+pub mod manifest;

@@ -63,8 +63,7 @@ pub fn usage_msg(msg: impl Into<String>) -> anyhow::Error {
 
 /// True if the error (or any cause) is bad input: a `Usage` marker or a library `InvalidInput`.
 pub fn is_usage(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<Usage>().is_some()
-        || e.chain().any(|c| c.is::<Usage>() || c.is::<rtbake::error::InvalidInput>())
+    e.downcast_ref::<Usage>().is_some() || e.chain().any(|c| c.is::<Usage>() || c.is::<rtbake::error::InvalidInput>())
 }
 
 /// Prints `error: …` with its cause chain and exits 2 (bad input) or 1 (runtime failure).
@@ -148,7 +147,8 @@ pub fn parse_f64_list(flag: &str, s: &str) -> anyhow::Result<Vec<f64>> {
     s.split(',')
         .map(|t| {
             let t = t.trim();
-            t.parse::<f64>().map_err(|_| usage_msg(format!("{flag}: '{t}' is not a number (expected a comma-separated list)")))
+            t.parse::<f64>()
+                .map_err(|_| usage_msg(format!("{flag}: '{t}' is not a number (expected a comma-separated list)")))
         })
         .collect()
 }
@@ -166,7 +166,8 @@ pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
 /// Checks that an output directory exists (or can be created) and is writable, before any work.
 #[allow(dead_code)]
 pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
     let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
     std::fs::write(&probe, b"")
         .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))?;

@@ -95,7 +95,12 @@ pub mod aa;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
-pub fn unorm8_texture_files(stem: &str, img: &Image<u8>, kind: &str, convention: &str) -> Result<Vec<BakedFile>, BakeError> {
+pub fn unorm8_texture_files(
+    stem: &str,
+    img: &Image<u8>,
+    kind: &str,
+    convention: &str,
+) -> Result<Vec<BakedFile>, BakeError> {
     let pf = PixelFormat::unorm8_for(img.channels);
     let meta = |format: &str| FileMeta {
         kind: kind.into(),
@@ -163,7 +168,11 @@ pub fn float_texture_files(
             bytes: io::ktx2::encode_f16(img)?,
             meta: meta("ktx2", PixelFormat::f16_for(img.channels), "f16", "linear", Some(half_tol)),
         },
-        BakedFile { path: format!("{stem}_preview_srgb.png"), bytes: io::png::encode_srgb_preview(img)?, meta: preview },
+        BakedFile {
+            path: format!("{stem}_preview_srgb.png"),
+            bytes: io::png::encode_srgb_preview(img)?,
+            meta: preview,
+        },
     ])
 }
 

@@ -24,7 +24,12 @@ pub struct Dipole {
 
 impl Dipole {
     /// Validates the coefficients (σa ≥ 0, σs′ > 0, η > 0, all finite).
-    pub fn new(sigma_a_per_mm: f64, sigma_s_prime_per_mm: f64, eta: f64, fdr_form: FdrForm) -> Result<Self, InvalidInput> {
+    pub fn new(
+        sigma_a_per_mm: f64,
+        sigma_s_prime_per_mm: f64,
+        eta: f64,
+        fdr_form: FdrForm,
+    ) -> Result<Self, InvalidInput> {
         check_non_negative("sigma_a", sigma_a_per_mm, "mm^-1")?;
         check_positive("sigma_s_prime", sigma_s_prime_per_mm, "mm^-1")?;
         check_positive("eta", eta, "relative index")?;

@@ -32,7 +32,10 @@ fn build(width: u32, height: u32, format: PixelFormat, payload: Vec<u8>) -> Resu
     })
     .map_err(|e| IoError::Unsupported { what: "dds", detail: e.to_string() })?;
     if dds.data.len() != payload.len() {
-        return Err(IoError::Unsupported { what: "dds", detail: format!("payload {} != {}", payload.len(), dds.data.len()) });
+        return Err(IoError::Unsupported {
+            what: "dds",
+            detail: format!("payload {} != {}", payload.len(), dds.data.len()),
+        });
     }
     dds.data = payload;
     let mut out = Vec::new();
@@ -53,7 +56,13 @@ pub fn to_rgba(img: &Image<f32>) -> Vec<f32> {
     let mut out = Vec::with_capacity(img.data.len() / c * 4);
     for px in img.data.chunks_exact(c) {
         for k in 0..4 {
-            out.push(if k < c { px[k] } else if k == 3 { 1.0 } else { 0.0 });
+            out.push(if k < c {
+                px[k]
+            } else if k == 3 {
+                1.0
+            } else {
+                0.0
+            });
         }
     }
     out

@@ -41,8 +41,14 @@ pub fn encode(img: &Image<f32>, precision: ExrPrecision) -> std::result::Result<
             AnyChannel::new(*name, samples)
         })
         .collect();
-    let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
-    let layer = Layer::new((img.width as usize, img.height as usize), LayerAttributes::default(), encoding, AnyChannels::sort(list));
+    let encoding =
+        Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+    let layer = Layer::new(
+        (img.width as usize, img.height as usize),
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(list),
+    );
     let image = exr::image::Image::from_layer(layer);
     let mut cursor = std::io::Cursor::new(Vec::new());
     image
@@ -73,9 +79,13 @@ pub fn decode(bytes: &[u8], path: &str) -> std::result::Result<(Image<f32>, ExrP
         vec![&chans[0]]
     } else {
         let names = channel_names(chans.len() as u32).map_err(|e| err(e.to_string()))?;
-        names.iter().map(|n| find(n).ok_or_else(|| err(format!("missing channel {n}")))).collect::<std::result::Result<_, _>>()?
+        names
+            .iter()
+            .map(|n| find(n).ok_or_else(|| err(format!("missing channel {n}"))))
+            .collect::<std::result::Result<_, _>>()?
     };
-    let precision = if matches!(order[0].sample_data, FlatSamples::F16(_)) { ExrPrecision::F16 } else { ExrPrecision::F32 };
+    let precision =
+        if matches!(order[0].sample_data, FlatSamples::F16(_)) { ExrPrecision::F16 } else { ExrPrecision::F32 };
     let planes: Vec<Vec<f32>> = order.iter().map(|c| c.sample_data.values_as_f32().collect()).collect();
     let n = planes.len();
     let mut data = Vec::with_capacity(w * h * n);

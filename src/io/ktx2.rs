@@ -75,7 +75,10 @@ fn kvd() -> Vec<u8> {
 pub fn encode_raw(width: u32, height: u32, format: PixelFormat, payload: &[u8]) -> Result<Vec<u8>, IoError> {
     let expected = width as usize * height as usize * format.bytes_per_texel() as usize;
     if payload.len() != expected {
-        return Err(IoError::Unsupported { what: "ktx2", detail: format!("payload {} bytes, expected {expected}", payload.len()) });
+        return Err(IoError::Unsupported {
+            what: "ktx2",
+            detail: format!("payload {} bytes, expected {expected}", payload.len()),
+        });
     }
     let type_size = if format.is_unorm8() { 1 } else { format.bytes_per_texel() / format.channels() };
     let dfd = dfd(format);

@@ -99,7 +99,10 @@ pub fn decode(bytes: &[u8], path: &str) -> Result<DecodedPng, IoError> {
         D::ImageRgb16(b) => DecodedPng::U16(Image::from_vec(w, h, 3, b.into_raw())),
         D::ImageRgba16(b) => DecodedPng::U16(Image::from_vec(w, h, 4, b.into_raw())),
         other => {
-            return Err(IoError::Decode { path: path.to_string(), detail: format!("unsupported PNG layout {:?}", other.color()) })
+            return Err(IoError::Decode {
+                path: path.to_string(),
+                detail: format!("unsupported PNG layout {:?}", other.color()),
+            })
         }
     })
 }

@@ -1,0 +1,138 @@
+//! `baked/manifest.json`: what every baked file is, how it was made, and its sha256 (`specs/outputs.md`).
+//!
+//! Written deterministically: stable key order, no timestamps, entries sorted by path. Re-baking an unchanged
+//! tree changes no byte of any file; only `git_revision` follows the source tree it was baked from.
+
+use crate::bake::{BakedFile, FileMeta};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+pub const MANIFEST_NAME: &str = "manifest.json";
+pub const SCHEMA: &str = "rtbake-manifest/1";
+
+/// One file of the bake.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Entry {
+    /// Path relative to the bake directory, `/`-separated.
+    pub path: String,
+    /// Asset that produced it (`rtbake assets`).
+    pub asset: String,
+    #[serde(flatten)]
+    pub meta: FileMeta,
+    pub size_bytes: u64,
+    pub sha256: String,
+}
+
+/// Parameters and model options of one asset, shared by all its files.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AssetRecord {
+    pub name: String,
+    pub params: Value,
+}
+
+/// The whole manifest.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub schema: String,
+    pub tool: String,
+    pub tool_version: String,
+    /// `git describe --always --dirty` of the tree that baked it, or `unknown`.
+    pub git_revision: String,
+    pub conventions: Value,
+    pub assets: Vec<AssetRecord>,
+    pub files: Vec<Entry>,
+}
+
+/// Errors reading a manifest.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    #[error("{path}: cannot read manifest: {source}")]
+    Read { path: String, source: std::io::Error },
+    #[error("{path}: corrupted or hand-edited manifest: {detail}")]
+    Parse { path: String, detail: String },
+}
+
+/// Lower-case hex sha256 of `bytes`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    let digest = Sha256::digest(bytes);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The project-wide conventions recorded in every manifest.
+pub fn conventions() -> Value {
+    serde_json::json!({
+        "row_order": "top row first (texcoord v = 0 is the first stored row, D3D convention)",
+        "units": "lengths in mm, coefficients in mm^-1, radial profiles in mm^-2",
+        "color_space": "data textures are linear; only files with color_space = srgb are sRGB-encoded previews",
+        "determinism": "same bytes for any thread count and across runs",
+    })
+}
+
+impl Manifest {
+    pub fn new(git_revision: String) -> Self {
+        Self {
+            schema: SCHEMA.into(),
+            tool: "rtbake".into(),
+            tool_version: env!("CARGO_PKG_VERSION").into(),
+            git_revision,
+            conventions: conventions(),
+            assets: Vec::new(),
+            files: Vec::new(),
+        }
+    }
+
+    /// Replaces (or adds) an asset and its files; keeps assets and files sorted.
+    pub fn set_asset(&mut self, name: &str, params: Value, files: &[BakedFile]) {
+        self.assets.retain(|a| a.name != name);
+        self.files.retain(|f| f.asset != name);
+        self.assets.push(AssetRecord { name: name.into(), params });
+        for f in files {
+            self.files.push(Entry {
+                path: f.path.clone(),
+                asset: name.into(),
+                meta: f.meta.clone(),
+                size_bytes: f.bytes.len() as u64,
+                sha256: sha256_hex(&f.bytes),
+            });
+        }
+        self.assets.sort_by(|a, b| a.name.cmp(&b.name));
+        self.files.sort_by(|a, b| a.path.cmp(&b.path));
+    }
+
+    /// Deterministic text (pretty JSON, trailing newline).
+    pub fn to_text(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("manifest serialises");
+        s.push('\n');
+        s
+    }
+
+    pub fn parse(text: &str, path: &str) -> Result<Self, ManifestError> {
+        let m: Manifest = serde_json::from_str(text)
+            .map_err(|e| ManifestError::Parse { path: path.into(), detail: e.to_string() })?;
+        if m.schema != SCHEMA {
+            return Err(ManifestError::Parse {
+                path: path.into(),
+                detail: format!("schema {:?}, expected {SCHEMA:?}", m.schema),
+            });
+        }
+        Ok(m)
+    }
+
+    /// Reads `dir/manifest.json`.
+    pub fn load(dir: &Path) -> Result<Self, ManifestError> {
+        let path = dir.join(MANIFEST_NAME);
+        let p = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| ManifestError::Read { path: p.clone(), source: e })?;
+        Self::parse(&text, &p)
+    }
+
+    pub fn entry(&self, path: &str) -> Option<&Entry> {
+        self.files.iter().find(|f| f.path == path)
+    }
+
+    pub fn asset_params(&self, name: &str) -> Option<&Value> {
+        self.assets.iter().find(|a| a.name == name).map(|a| &a.params)
+    }
+}
