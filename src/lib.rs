@@ -6,6 +6,7 @@
 
 pub mod aa;
 pub mod bake;
+pub mod baked_dir;
 pub mod diffusion;
 pub mod error;
 pub mod image_buf;

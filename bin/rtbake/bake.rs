@@ -1,35 +1,181 @@
 //! `rtbake bake`, `rtbake verify`, `rtbake assets`.
 
-use crate::cli::{usage_msg, Ctx};
-use std::path::PathBuf;
+use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::baked_dir::{self, FileStatus};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct BakeArgs {
-    /// Assets to bake (default: all; see `rtbake assets`).
+    /// Assets to bake (default: all; `rtbake assets` lists them). Other assets already in the directory are kept.
     pub assets: Vec<String>,
-    /// Output directory.
-    #[arg(long, default_value = "baked")]
+    /// Output directory (created if missing; must be empty or an rtbake bake directory).
+    #[arg(long, default_value = "baked", value_name = "DIR")]
     pub out: PathBuf,
+    /// JSON object {"ASSET": {parameters…}} merged over each asset's embedded defaults.
+    #[arg(long, value_name = "FILE")]
+    pub asset_params: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
 pub struct VerifyArgs {
     /// Bake directory holding manifest.json.
-    #[arg(long, default_value = "baked")]
+    #[arg(long, default_value = "baked", value_name = "DIR")]
     pub dir: PathBuf,
 }
 
-pub fn run_bake(_a: BakeArgs, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("not implemented yet"))
+/// `git rev-parse --short=12 HEAD`, with `-dirty` when sources differ from it; `unknown` outside a checkout.
+fn git_revision() -> String {
+    let run = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .stderr(std::process::Stdio::null())
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match run(&["rev-parse", "--short=12", "HEAD"]) {
+        Some(rev) if !rev.is_empty() => {
+            let dirty = run(&["status", "--porcelain", "--", "src", "bin", "Cargo.toml", "Cargo.lock"])
+                .is_some_and(|s| !s.is_empty());
+            if dirty {
+                format!("{rev}-dirty")
+            } else {
+                rev
+            }
+        }
+        _ => "unknown".into(),
+    }
 }
 
-pub fn run_verify(_a: VerifyArgs, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("not implemented yet"))
+fn merge(base: &mut Value, over: &Value) {
+    match (base, over) {
+        (Value::Object(b), Value::Object(o)) => {
+            for (k, v) in o {
+                merge(b.entry(k.clone()).or_insert(Value::Null), v);
+            }
+        }
+        (b, o) => *b = o.clone(),
+    }
+}
+
+pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    let registry = rtbake::bake::registry();
+    let names: Vec<&str> = registry.iter().map(|x| x.name).collect();
+    for n in &a.assets {
+        if !names.contains(&n.as_str()) {
+            return Err(usage_msg(format!("unknown asset {n:?}; known assets: {}", names.join(", "))));
+        }
+    }
+    let overrides: Value = match &a.asset_params {
+        None => Value::Object(Default::default()),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| usage(anyhow::anyhow!("--asset-params {}: {e}", p.display())))?;
+            let v: Value = serde_json::from_str(&text)
+                .map_err(|e| usage(anyhow::anyhow!("--asset-params {}: malformed JSON: {e}", p.display())))?;
+            let obj = v.as_object().ok_or_else(|| usage_msg(format!("--asset-params {}: expected a JSON object", p.display())))?;
+            for k in obj.keys() {
+                if !names.contains(&k.as_str()) {
+                    return Err(usage_msg(format!("--asset-params {}: unknown asset {k:?}", p.display())));
+                }
+            }
+            v
+        }
+    };
+    let selected: Vec<&rtbake::bake::Asset> =
+        registry.iter().filter(|x| a.assets.is_empty() || a.assets.iter().any(|n| n == x.name)).collect();
+    let jobs: Vec<(&rtbake::bake::Asset, Value)> = selected
+        .iter()
+        .map(|asset| {
+            let mut p = (asset.default_params)();
+            if let Some(o) = overrides.get(asset.name) {
+                merge(&mut p, o);
+            }
+            (*asset, p)
+        })
+        .collect();
+    check_out_dir(&a.out)?;
+    let pb = ctx.progress(1, "baking");
+    let t0 = std::time::Instant::now();
+    let summary = baked_dir::bake_into(&a.out, &jobs, &git_revision()).map_err(classify)?;
+    pb.finish_and_clear();
+    if ctx.json {
+        ctx.emit_json(&serde_json::to_value(&summary)?);
+    }
+    ctx.info(format!(
+        "baked {} asset(s), {} files ({:.1} KiB) into {} in {:.2} s",
+        summary.assets.len(),
+        summary.files_written,
+        summary.bytes_written as f64 / 1024.0,
+        summary.dir,
+        t0.elapsed().as_secs_f64()
+    ));
+    Ok(())
+}
+
+/// Bad parameters and unusable directories are the user's to fix (exit 2); I/O failures are runtime (exit 1).
+fn classify(e: baked_dir::BakeDirError) -> anyhow::Error {
+    use baked_dir::BakeDirError as E;
+    match e {
+        E::Asset { source: rtbake::bake::BakeError::Invalid(_), .. } | E::Unusable { .. } | E::Manifest(_) => usage(e),
+        other => anyhow::Error::new(other),
+    }
+}
+
+fn check_out_dir(dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(usage_msg(format!("--out {}: exists and is not a directory", dir.display())));
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let probe_dir = if dir.exists() { dir } else { parent };
+    if !probe_dir.exists() {
+        std::fs::create_dir_all(probe_dir)
+            .map_err(|e| usage(anyhow::anyhow!("--out {}: cannot create directory: {e}", dir.display())))?;
+    }
+    let probe = probe_dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| usage(anyhow::anyhow!("--out {}: not writable: {e}", dir.display())))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+pub fn run_verify(a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    if let Some(note) = baked_dir::recover(&a.dir) {
+        ctx.info(note);
+    }
+    if !a.dir.join(rtbake::manifest::MANIFEST_NAME).exists() {
+        return Err(usage_msg(format!("--dir {}: no manifest.json (not a bake directory)", a.dir.display())));
+    }
+    let registry = rtbake::bake::registry();
+    let report = baked_dir::verify(&a.dir, &registry).map_err(anyhow::Error::new)?;
+    if ctx.json {
+        ctx.emit_json(&serde_json::to_value(&report)?);
+    }
+    for f in &report.files {
+        if f.status != FileStatus::Ok {
+            eprintln!("{:<10} {}  {}", format!("{:?}", f.status).to_uppercase(), f.path, f.detail);
+        }
+    }
+    if report.is_ok() {
+        ctx.info(format!("verify: {} files OK in {}", report.files.len(), report.dir));
+        Ok(())
+    } else {
+        Err(anyhow::anyhow!("verify: {} of {} files failed in {}", report.problems, report.files.len(), report.dir))
+    }
 }
 
 pub fn run_assets(ctx: &Ctx) -> anyhow::Result<()> {
-    for a in rtbake::bake::registry() {
-        ctx.info(format!("{:<28} {}", a.name, a.summary));
+    let registry = rtbake::bake::registry();
+    if ctx.json {
+        let list: Vec<Value> = registry
+            .iter()
+            .map(|a| serde_json::json!({"name": a.name, "summary": a.summary, "default_params": (a.default_params)()}))
+            .collect();
+        ctx.emit_json(&Value::Array(list));
+    } else {
+        for a in &registry {
+            println!("{:<28} {}", a.name, a.summary);
+        }
     }
     Ok(())
 }

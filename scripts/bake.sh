@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Regenerates every committed asset in baked/ from the embedded defaults, then verifies the result.
+# This is the one command that produced the repository's baked/ directory.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo run --release -- bake --out baked "$@"
+cargo run --release -- verify --dir baked
