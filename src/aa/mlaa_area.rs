@@ -75,12 +75,12 @@ pub enum MlaaAreaError {
 pub fn validate(version: MlaaVersion, n: u32) -> Result<u32, InvalidInput> {
     let (lo, hi, odd) = version.accepted();
     let flag = "--max-distance";
-    let parity = if odd { " (odd)" } else { "" };
+    let kind = if odd { "an odd" } else { "an" };
     if n < lo || n > hi || (odd && n % 2 == 0) {
         return Err(InvalidInput::new(
             flag,
             format!(
-                "for MLAA {} must be an{parity} integer in {lo}..={hi} texels per cell (published: {:?}), got {n}",
+                "for MLAA {} must be {kind} integer in {lo}..={hi} texels per cell (published: {:?}), got {n}",
                 version.label(),
                 version.published()
             ),

@@ -16,8 +16,8 @@
 //! `SMAA_AREATEX_SUBTEX_SIZE = 1/7`, i.e. it assumes `5n = 4m` and `5n·7 = height`; variants that break this need
 //! matching shader constants (recorded in the manifest convention).
 
-use super::smaa_area_diag::diag_area;
-use super::smaa_area_ortho::ortho_area;
+use super::smaa_area_diag::{diag_areas_all_patterns, diag_cell};
+use super::smaa_area_ortho::{ortho_area, Area2};
 use super::unorm8_trunc;
 use crate::error::{check_range, check_size, InvalidInput};
 use crate::image_buf::Image;
@@ -120,56 +120,59 @@ impl SmaaAreaParams {
     }
 }
 
-/// Which part of the texture a texel belongs to, with its coverage inputs.
-enum Texel {
-    Ortho { e1: u8, e2: u8, left: u32, right: u32, slice: usize },
-    Diag { e1: u8, e2: u8, left: u32, right: u32, slice: usize },
-    Empty,
-}
-
-fn classify(p: &SmaaAreaParams, x: u32, y: u32) -> Texel {
+/// Orthogonal texel `(x, y)` (with `x < 5n`): `(e1, e2, left, right, slice)`, or None for unused cells/slices.
+fn ortho_texel(p: &SmaaAreaParams, x: u32, y: u32) -> Option<(u8, u8, u32, u32, usize)> {
     let n = p.ortho_max_distance;
-    let m = p.diag_max_distance;
-    if x < 5 * n {
-        let slice = (y / (5 * n)) as usize;
-        let (cx, cy) = (x / n, (y % (5 * n)) / n);
-        if slice >= p.ortho_offsets.len() || cx == 2 || cy == 2 {
-            return Texel::Empty;
-        }
-        let (i, j) = (x % n, y % n);
-        Texel::Ortho { e1: cx as u8, e2: cy as u8, left: i * i, right: j * j, slice }
-    } else {
-        let x = x - 5 * n;
-        let slice = (y / (4 * m)) as usize;
-        if slice >= p.diag_offsets.len() {
-            return Texel::Empty;
-        }
-        let (cx, cy) = (x / m, (y % (4 * m)) / m);
-        Texel::Diag { e1: cx as u8, e2: cy as u8, left: x % m, right: y % m, slice }
+    let slice = (y / (5 * n)) as usize;
+    let (cx, cy) = (x / n, (y % (5 * n)) / n);
+    if slice >= p.ortho_offsets.len() || cx == 2 || cy == 2 {
+        return None;
     }
+    let (i, j) = (x % n, y % n);
+    Some((cx as u8, cy as u8, i * i, j * j, slice))
 }
 
 /// The SMAA area texture (RG8, top row first). Deterministic for any rayon thread count: every texel is computed
-/// independently.
+/// independently (orthogonal half in parallel over rows, diagonal half over (slice, right distance) groups whose
+/// results are then placed sequentially).
 pub fn smaa_area_texture(params: &SmaaAreaParams) -> Result<Image<u8>, SmaaAreaError> {
     let (w, h) = params.validate()?;
     let mut img = Image::<u8>::new(w, h, 2);
+    let n = params.ortho_max_distance;
+    let m = params.diag_max_distance;
+
     img.data.par_chunks_mut(2 * w as usize).enumerate().for_each(|(y, row)| {
-        for x in 0..w {
-            let (r, g) = match classify(params, x, y as u32) {
-                Texel::Ortho { e1, e2, left, right, slice } => {
-                    ortho_area(e1, e2, left, right, params.ortho_offsets[slice], params.u_smoothing)
-                }
-                Texel::Diag { e1, e2, left, right, slice } => {
-                    let o = params.diag_offsets[slice];
-                    diag_area(e1, e2, left, right, (o[0], o[1]))
-                }
-                Texel::Empty => continue,
-            };
-            row[2 * x as usize] = unorm8_trunc(r);
-            row[2 * x as usize + 1] = unorm8_trunc(g);
+        for x in 0..5 * n {
+            if let Some((e1, e2, left, right, slice)) = ortho_texel(params, x, y as u32) {
+                let (r, g) = ortho_area(e1, e2, left, right, params.ortho_offsets[slice], params.u_smoothing);
+                row[2 * x as usize] = unorm8_trunc(r);
+                row[2 * x as usize + 1] = unorm8_trunc(g);
+            }
         }
     });
+
+    // Diagonal half: one group per (slice, right), all left distances and all 16 patterns.
+    let groups = params.diag_offsets.len() * m as usize;
+    let blocks: Vec<Vec<[Area2; 16]>> = (0..groups)
+        .into_par_iter()
+        .map(|g| {
+            let (slice, right) = (g / m as usize, (g % m as usize) as u32);
+            let o = params.diag_offsets[slice];
+            (0..m).map(|left| diag_areas_all_patterns(left, right, (o[0], o[1]))).collect()
+        })
+        .collect();
+    for (g, block) in blocks.iter().enumerate() {
+        let (slice, right) = ((g / m as usize) as u32, (g % m as usize) as u32);
+        for (left, areas) in block.iter().enumerate() {
+            for (pattern, &(r, gr)) in areas.iter().enumerate() {
+                let (e1, e2) = diag_cell(pattern as u8);
+                let x = 5 * n + m * e1 as u32 + left as u32;
+                let y = 4 * m * slice + m * e2 as u32 + right;
+                img.set(x, y, 0, unorm8_trunc(r));
+                img.set(x, y, 1, unorm8_trunc(gr));
+            }
+        }
+    }
     Ok(img)
 }
 
