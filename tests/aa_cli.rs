@@ -34,7 +34,8 @@ fn bad_distances_are_refused() {
     refused(&["mlaa-v1.4", "--max-distance", "0"], "--max-distance");
     refused(&["mlaa-v1.4", "--max-distance", "16"], "odd");
     refused(&["mlaa-v1.3", "--max-distance", "1000000"], "--max-distance");
-    refused(&["mlaa-v2", "--max-distance", "-3"], "--max-distance");
+    refused(&["mlaa-v2", "--max-distance=-3"], "--max-distance");
+    refused(&["mlaa-v1.4", "--max-distance", "abc"], "--max-distance");
     refused(&["smaa-area", "--ortho-max-distance", "0"], "--ortho-max-distance");
     refused(&["smaa-area", "--diag-max-distance", "1000000"], "--diag-max-distance");
 }

@@ -115,3 +115,61 @@ fn smaa_area_texture_is_the_same_on_one_thread() {
     let many = smaa_area_texture(&SmaaAreaParams::default()).unwrap();
     assert_eq!(one, many);
 }
+
+/// The spec: the v2.8 texture differs from the current one in 408 texels, all in the orthogonal U cells (1,1) and
+/// (3,3) of subsample slices with short lines (U smoothing only acts for d < 32).
+#[test]
+fn u_smoothing_changes_only_short_u_cells() {
+    let cur = smaa_area_texture(&SmaaAreaParams::default()).unwrap();
+    let old = smaa_area_texture(&SmaaAreaParams::v2_8()).unwrap();
+    let mut texels = 0;
+    for y in 0..cur.height {
+        for x in 0..cur.width {
+            if (0..2).any(|c| cur.get(x, y, c) != old.get(x, y, c)) {
+                texels += 1;
+                let cell = (x / 16, (y % 80) / 16);
+                assert!(x < 80 && (cell == (1, 1) || cell == (3, 3)), "texel ({x},{y}) outside the U cells");
+                let (left, right) = ((x % 16).pow(2), (y % 16).pow(2));
+                assert!(left + right + 1 < 32, "texel ({x},{y}) has d >= 32");
+            }
+        }
+    }
+    assert_eq!(texels, 408);
+}
+
+/// Every `.bin` the registered `aa` assets bake with their default parameters is a published payload.
+#[test]
+fn baked_assets_match_reference() {
+    let Some(dir) = reference_dir() else { return };
+    let map = [
+        ("aa/smaa/AreaTex.bin", "smaa/AreaTex_RG8_160x560.bin"),
+        ("aa/smaa/AreaTex_v2.8.bin", "smaa/AreaTex_v2.8_RG8_160x560.bin"),
+        ("aa/smaa/SearchTex.bin", "smaa/SearchTex_R8_64x16.bin"),
+        ("aa/smaa/SearchTex_v2.8.bin", "smaa/SearchTex_v2.8_R8_66x33.bin"),
+        ("aa/smaa/SearchTex_logical_precrop.bin", "smaa/SearchTex_logical_precrop_R8_66x33.bin"),
+        ("aa/mlaa/AreaTex_MLAAv2.bin", "mlaa/AreaTex_MLAAv2_RG8_75x75.bin"),
+    ];
+    let mut expected: HashMap<String, String> = map.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect();
+    for (v, ns) in [("v1.4", &[9, 17, 33, 65, 129][..]), ("v1.3", &[9, 16, 32][..])] {
+        for n in ns {
+            expected
+                .insert(format!("aa/mlaa/AreaMap{n}_{v}.bin"), format!("mlaa/AreaMap{n}_{v}_RG8_{0}x{0}.bin", 5 * n));
+        }
+    }
+    let mut seen = 0;
+    for asset in
+        rtbake::bake::registry().into_iter().filter(|a| a.name.starts_with("smaa-") || a.name.starts_with("mlaa-"))
+    {
+        for f in (asset.bake)(&(asset.default_params)()).unwrap() {
+            if !f.path.ends_with(".bin") {
+                continue;
+            }
+            let reference =
+                expected.get(&f.path).unwrap_or_else(|| panic!("{}: unexpected .bin {}", asset.name, f.path));
+            let (folder, name) = reference.split_once('/').unwrap();
+            assert_eq!(Some(&hex_sha256(&f.bytes)), sums(&dir.join(folder)).get(name), "{} vs {reference}", f.path);
+            seen += 1;
+        }
+    }
+    assert_eq!(seen, expected.len(), "every published texture is baked");
+}

@@ -157,7 +157,9 @@ fn check_applicable(a: &AaArgs) -> anyhow::Result<()> {
     }
     if let Some(stem) = &a.stem {
         if stem.is_empty() || stem.contains(['/', '\\']) || stem.starts_with('.') {
-            return Err(usage_msg(format!("--stem must be a plain file name without '/' or a leading '.', got {stem:?}")));
+            return Err(usage_msg(format!(
+                "--stem must be a plain file name without '/' or a leading '.', got {stem:?}"
+            )));
         }
     }
     Ok(())
@@ -267,7 +269,8 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }));
     }
     if ctx.json {
-        ctx.emit_json(&serde_json::json!({ "texture": format!("{:?}", a.texture), "files": written }));
+        let name = clap::ValueEnum::to_possible_value(&a.texture).map(|v| v.get_name().to_string());
+        ctx.emit_json(&serde_json::json!({ "texture": name, "out": a.out.display().to_string(), "files": written }));
     }
     Ok(())
 }

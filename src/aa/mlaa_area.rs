@@ -76,7 +76,7 @@ pub fn validate(version: MlaaVersion, n: u32) -> Result<u32, InvalidInput> {
     let (lo, hi, odd) = version.accepted();
     let flag = "--max-distance";
     let kind = if odd { "an odd" } else { "an" };
-    if n < lo || n > hi || (odd && n % 2 == 0) {
+    if n < lo || n > hi || (odd && n.is_multiple_of(2)) {
         return Err(InvalidInput::new(
             flag,
             format!(

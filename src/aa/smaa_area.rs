@@ -27,7 +27,8 @@ use serde::{Deserialize, Serialize};
 /// Upstream orthogonal subsample offsets (pixels), slice order 0..6: 1x → 0; S2x/T2x → 1, 2; 4x → 3..6.
 pub const DEFAULT_ORTHO_OFFSETS: [f64; 7] = [0.0, -0.25, 0.25, -0.125, 0.125, -0.375, 0.375];
 /// Upstream diagonal subsample offsets `(x, y)` (pixels), slice order 0..4.
-pub const DEFAULT_DIAG_OFFSETS: [[f64; 2]; 5] = [[0.0, 0.0], [0.25, -0.25], [-0.25, 0.25], [0.125, -0.125], [-0.125, 0.125]];
+pub const DEFAULT_DIAG_OFFSETS: [[f64; 2]; 5] =
+    [[0.0, 0.0], [0.25, -0.25], [-0.25, 0.25], [0.125, -0.125], [-0.125, 0.125]];
 /// Upstream orthogonal cell size (`SMAA_AREATEX_MAX_DISTANCE`).
 pub const DEFAULT_ORTHO_MAX_DISTANCE: u32 = 16;
 /// Upstream diagonal cell size (`SMAA_AREATEX_MAX_DISTANCE_DIAG`).

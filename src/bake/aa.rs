@@ -103,7 +103,12 @@ pub fn smaa_area_convention(p: &SmaaAreaParams, width: u32, height: u32) -> Stri
 
 /// Files of an SMAA area texture under `stem` (`stem.bin`, …); with `sources`, also the upstream-compatible C header
 /// `stem.h` (`AREATEX_*`, `areaTexBytes`) and Rust source `stem.rs` (`AREATEX_*`, `AREATEX_BYTES`).
-pub fn smaa_area_files(stem: &str, params: &SmaaAreaParams, sources: bool, from: &str) -> Result<Vec<BakedFile>, BakeError> {
+pub fn smaa_area_files(
+    stem: &str,
+    params: &SmaaAreaParams,
+    sources: bool,
+    from: &str,
+) -> Result<Vec<BakedFile>, BakeError> {
     let img = smaa_area_texture(params)?;
     let convention = smaa_area_convention(params, img.width, img.height);
     texture_with_sources(stem, &img, &convention, sources.then_some(("AREATEX", "areaTexBytes")), from)
@@ -146,7 +151,9 @@ pub fn search_files(kind: SearchKind, stem: &str, sources: bool, from: &str) -> 
 pub fn mlaa_convention(version: MlaaVersion, n: u32) -> String {
     let (dist, plus) = match version {
         MlaaVersion::V2 => ("quadratic: texel i <-> distance i^2 px (look up with sqrt(distance))", "v1.4 \"+\" rule"),
-        MlaaVersion::V1_4 => ("linear 0..N-1 px", "a \"+\" end (4) counts only against a single crossing edge, as its opposite"),
+        MlaaVersion::V1_4 => {
+            ("linear 0..N-1 px", "a \"+\" end (4) counts only against a single crossing edge, as its opposite")
+        }
         MlaaVersion::V1_3 => ("linear 0..N-1 px", "a \"+\" end (4) adds its half to both R and G"),
     };
     format!(
@@ -171,7 +178,13 @@ pub fn mlaa_stem(version: MlaaVersion, n: u32) -> String {
 
 /// Files of an MLAA area map under `stem`; with `sources`, also `stem.h` (`AREAMAP_*`, `areaMapBytes`) and
 /// `stem.rs` (`AREAMAP_*`, `AREAMAP_BYTES`).
-pub fn mlaa_files(version: MlaaVersion, n: u32, stem: &str, sources: bool, from: &str) -> Result<Vec<BakedFile>, BakeError> {
+pub fn mlaa_files(
+    version: MlaaVersion,
+    n: u32,
+    stem: &str,
+    sources: bool,
+    from: &str,
+) -> Result<Vec<BakedFile>, BakeError> {
     let img = mlaa_area_map(version, n)?;
     texture_with_sources(stem, &img, &mlaa_convention(version, n), sources.then_some(("AREAMAP", "areaMapBytes")), from)
 }
@@ -323,5 +336,28 @@ mod tests {
         let conv = smaa_area_convention(&SmaaAreaParams::default(), 160, 560);
         assert!(conv.contains("SMAA_AREATEX_MAX_DISTANCE 16") && conv.contains("SMAA_AREATEX_MAX_DISTANCE_DIAG 20"));
         assert!(conv.contains("(80.0 / 560.0)") && !conv.contains("NOTE"));
+    }
+
+    #[test]
+    fn containers_hold_the_raw_bytes_as_linear_unorm() {
+        use crate::io::{self, png::DecodedPng, PixelFormat};
+        let mut files = search_files(SearchKind::Current, "s", false, "test").unwrap();
+        files.extend(mlaa_files(MlaaVersion::V1_4, 9, "m", false, "test").unwrap());
+        for stem in ["s", "m"] {
+            let get = |ext: &str| files.iter().find(|f| f.path == format!("{stem}.{ext}")).unwrap();
+            let raw = &get("bin").bytes;
+            let (pf, w, h, dds) = io::dds::decode(&get("dds").bytes, "dds").unwrap();
+            let want_pf = if stem == "s" { PixelFormat::R8Unorm } else { PixelFormat::R8G8Unorm };
+            assert_eq!(pf, want_pf);
+            assert_eq!((w as usize * h as usize * pf.channels() as usize, &dds), (raw.len(), raw));
+            let (vk, _, _, ktx, linear) = io::ktx2::decode(&get("ktx2").bytes, "ktx2").unwrap();
+            assert_eq!(vk, io::ktx2::vk_format(want_pf));
+            assert!(linear, "KTX2 transfer function must be linear, not sRGB");
+            assert_eq!(&ktx, raw);
+            match io::png::decode(&get("png").bytes, "png").unwrap() {
+                DecodedPng::U8(img) => assert_eq!(&img.data, raw),
+                DecodedPng::U16(_) => panic!("8-bit PNG expected"),
+            }
+        }
     }
 }
