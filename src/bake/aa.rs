@@ -86,12 +86,17 @@ pub fn smaa_area_convention(p: &SmaaAreaParams, width: u32, height: u32) -> Stri
          ({w_o} + {m}*e1, {s_d}*k + {m}*e2), e in 0..3; texel (i, j) = left i, right j px (linear). R = coverage on the \
          negative side of the edge, G = positive side; value floor(255*area). U-shape smoothing {smooth}. Shader \
          constants: SMAA_AREATEX_MAX_DISTANCE {n}, SMAA_AREATEX_MAX_DISTANCE_DIAG {m}, SMAA_AREATEX_PIXEL_SIZE \
-         (1.0 / float2({width}.0, {height}.0)), SMAA_AREATEX_SUBTEX_SIZE ({s_o}.0 / {height}.0){note}",
+         (1.0 / float2({width}.0, {height}.0)), SMAA_AREATEX_SUBTEX_SIZE {subtex}{note}",
         w_o = 5 * n,
         s_o = 5 * n,
         s_d = 4 * m,
         ko = p.ortho_offsets.len(),
         kd = p.diag_offsets.len(),
+        subtex = if height % (5 * n) == 0 {
+            format!("(1.0 / {}.0)", height / (5 * n))
+        } else {
+            format!("({}.0 / {height}.0)", 5 * n)
+        },
         smooth = if p.u_smoothing { "on (SMAA 2.8+, distance 32)" } else { "off (v2.8 texture)" },
         note = if 5 * n == 4 * m {
             ""
@@ -335,7 +340,7 @@ mod tests {
         assert!(rs.contains("pub const SEARCHTEX_BYTES: [u8; 1024]"));
         let conv = smaa_area_convention(&SmaaAreaParams::default(), 160, 560);
         assert!(conv.contains("SMAA_AREATEX_MAX_DISTANCE 16") && conv.contains("SMAA_AREATEX_MAX_DISTANCE_DIAG 20"));
-        assert!(conv.contains("(80.0 / 560.0)") && !conv.contains("NOTE"));
+        assert!(conv.contains("SMAA_AREATEX_SUBTEX_SIZE (1.0 / 7.0)") && !conv.contains("NOTE"));
     }
 
     #[test]
