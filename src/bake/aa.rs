@@ -17,6 +17,7 @@ use super::{parse_params, text_file, unorm8_texture_files, Asset, BakeError, Bak
 use crate::aa::mlaa_area::{mlaa_area_map, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
 use crate::aa::smaa_search;
+use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::io::source::{c_header_u8, rust_source_u8};
 use serde::{Deserialize, Serialize};
@@ -92,7 +93,7 @@ pub fn smaa_area_convention(p: &SmaaAreaParams, width: u32, height: u32) -> Stri
         s_d = 4 * m,
         ko = p.ortho_offsets.len(),
         kd = p.diag_offsets.len(),
-        subtex = if height % (5 * n) == 0 {
+        subtex = if height.is_multiple_of(5 * n) {
             format!("(1.0 / {}.0)", height / (5 * n))
         } else {
             format!("({}.0 / {height}.0)", 5 * n)
@@ -221,7 +222,14 @@ fn mlaa_defaults(version: MlaaVersion) -> Value {
 fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: MlaaBakeParams = parse_params(asset, params)?;
     if p.max_distances.is_empty() {
-        return Err(crate::error::InvalidInput::new("max_distances", "must list at least one cell size").into());
+        return Err(InvalidInput::new("max_distances", "must list at least one cell size").into());
+    }
+    for (i, &n) in p.max_distances.iter().enumerate() {
+        let field = format!("max_distances[{i}]");
+        crate::aa::mlaa_area::validate(version, n).map_err(|e| InvalidInput::new(&field, e.message))?;
+        if p.max_distances[..i].contains(&n) {
+            return Err(InvalidInput::new(field, format!("repeats cell size {n}")).into());
+        }
     }
     let mut files = Vec::new();
     for &n in &p.max_distances {
@@ -323,6 +331,9 @@ mod tests {
         let a = assets().into_iter().find(|a| a.name == "mlaa-v1.4").unwrap();
         let e = (a.bake)(&serde_json::json!({"max_distances": [16]})).unwrap_err();
         assert!(matches!(e, BakeError::Invalid(_)) && e.to_string().contains("odd"), "{e}");
+        assert!(e.to_string().starts_with("max_distances[0]"), "{e}");
+        let e = (a.bake)(&serde_json::json!({"max_distances": [9, 9]})).unwrap_err();
+        assert!(e.to_string().contains("repeats"), "{e}");
         let a = assets().into_iter().find(|a| a.name == "smaa-area").unwrap();
         let mut p = json(SmaaAreaParams::default());
         p["ortho_offsets"] = serde_json::json!([0.0, 0.7]);
