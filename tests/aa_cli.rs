@@ -123,3 +123,25 @@ fn default_run_matches_the_library_and_writes_headers() {
     let h = std::fs::read_to_string(tmp.path().join("SearchTex.h")).unwrap();
     assert!(h.contains("#define SEARCHTEX_WIDTH 64") && h.contains("searchTexBytes"));
 }
+
+#[test]
+fn no_u_smoothing_flag_gives_the_v2_8_texture() {
+    let tmp = tempfile::tempdir().unwrap();
+    let a = tmp.path().join("a");
+    let b = tmp.path().join("b");
+    let o = rtbake(&["aa", "smaa-area", "--no-u-smoothing", "--format", "bin", "--out", a.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rtbake(&["aa", "smaa-area-v2.8", "--format", "bin", "--out", b.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let smoothed_off = std::fs::read(a.join("AreaTex.bin")).unwrap();
+    assert_eq!(smoothed_off, std::fs::read(b.join("AreaTex_v2.8.bin")).unwrap());
+    // And that is the published v2.8 payload when the reference folder is present.
+    let reference = std::env::var_os("RTBAKE_REFERENCE_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"))
+        .join("smaa/AreaTex_v2.8_RG8_160x560.bin");
+    match std::fs::read(&reference) {
+        Ok(want) => assert!(smoothed_off == want, "differs from {}", reference.display()),
+        Err(_) => eprintln!("{} not found; published-bytes comparison skipped", reference.display()),
+    }
+}

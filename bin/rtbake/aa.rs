@@ -203,6 +203,23 @@ fn smaa_params(a: &AaArgs) -> anyhow::Result<SmaaAreaParams> {
     Ok(p)
 }
 
+/// The canonical command line reproducing an SMAA area texture (recorded in generated sources).
+fn smaa_command(name: &str, p: &SmaaAreaParams) -> String {
+    let ortho: Vec<String> = p.ortho_offsets.iter().map(|o| o.to_string()).collect();
+    let diag: Vec<String> = p.diag_offsets.iter().map(|o| format!("{}:{}", o[0], o[1])).collect();
+    let mut cmd = format!(
+        "rtbake aa {name} --ortho-max-distance {} --diag-max-distance {} --ortho-offsets={} --diag-offsets={}",
+        p.ortho_max_distance,
+        p.diag_max_distance,
+        ortho.join(","),
+        diag.join(",")
+    );
+    if !p.u_smoothing && name == "smaa-area" {
+        cmd.push_str(" --no-u-smoothing");
+    }
+    cmd
+}
+
 fn default_mlaa_n(v: MlaaVersion) -> u32 {
     match v {
         MlaaVersion::V1_4 => 33,
@@ -221,13 +238,14 @@ fn bake_err(e: BakeError) -> anyhow::Error {
 
 pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     check_applicable(&a)?;
-    let from = "`rtbake aa` (see the manifest convention for parameters)";
+    let name = clap::ValueEnum::to_possible_value(&a.texture).map(|v| v.get_name().to_string()).unwrap_or_default();
     // Everything is computed and validated before the output directory is touched.
     let files: Vec<BakedFile> = match a.texture {
         AaTexture::SmaaArea | AaTexture::SmaaAreaV28 => {
             let p = smaa_params(&a)?;
             let default_stem = if a.texture == AaTexture::SmaaArea { "AreaTex" } else { "AreaTex_v2.8" };
-            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, true, from).map_err(bake_err)?
+            let from = format!("`{}`", smaa_command(&name, &p));
+            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, true, &from).map_err(bake_err)?
         }
         AaTexture::SmaaSearch | AaTexture::SmaaSearchV28 | AaTexture::SmaaSearchPrecrop => {
             let (kind, stem) = match a.texture {
@@ -235,13 +253,15 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 AaTexture::SmaaSearchV28 => (SearchKind::V2_8, "SearchTex_v2.8"),
                 _ => (SearchKind::LogicalPrecrop, "SearchTex_logical_precrop"),
             };
-            search_files(kind, a.stem.as_deref().unwrap_or(stem), true, from).map_err(bake_err)?
+            search_files(kind, a.stem.as_deref().unwrap_or(stem), true, &format!("`rtbake aa {name}`"))
+                .map_err(bake_err)?
         }
         AaTexture::MlaaV14 | AaTexture::MlaaV13 | AaTexture::MlaaV2 => {
             let v = mlaa_version(a.texture).expect("MLAA texture");
             let n = a.max_distance.unwrap_or(default_mlaa_n(v));
             let stem = a.stem.clone().unwrap_or_else(|| mlaa_stem(v, n));
-            mlaa_files(v, n, &stem, true, from).map_err(bake_err)?
+            let from = format!("`rtbake aa {name} --max-distance {n}`");
+            mlaa_files(v, n, &stem, true, &from).map_err(bake_err)?
         }
     };
     let all = a.format.contains(&AaFormat::All);
@@ -269,7 +289,6 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }));
     }
     if ctx.json {
-        let name = clap::ValueEnum::to_possible_value(&a.texture).map(|v| v.get_name().to_string());
         ctx.emit_json(&serde_json::json!({ "texture": name, "out": a.out.display().to_string(), "files": written }));
     }
     Ok(())

@@ -17,6 +17,7 @@ use super::{parse_params, text_file, unorm8_texture_files, Asset, BakeError, Bak
 use crate::aa::mlaa_area::{mlaa_area_map, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
 use crate::aa::smaa_search;
+use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::io::source::{c_header_u8, rust_source_u8};
 use serde::{Deserialize, Serialize};
@@ -86,12 +87,17 @@ pub fn smaa_area_convention(p: &SmaaAreaParams, width: u32, height: u32) -> Stri
          ({w_o} + {m}*e1, {s_d}*k + {m}*e2), e in 0..3; texel (i, j) = left i, right j px (linear). R = coverage on the \
          negative side of the edge, G = positive side; value floor(255*area). U-shape smoothing {smooth}. Shader \
          constants: SMAA_AREATEX_MAX_DISTANCE {n}, SMAA_AREATEX_MAX_DISTANCE_DIAG {m}, SMAA_AREATEX_PIXEL_SIZE \
-         (1.0 / float2({width}.0, {height}.0)), SMAA_AREATEX_SUBTEX_SIZE ({s_o}.0 / {height}.0){note}",
+         (1.0 / float2({width}.0, {height}.0)), SMAA_AREATEX_SUBTEX_SIZE {subtex}{note}",
         w_o = 5 * n,
         s_o = 5 * n,
         s_d = 4 * m,
         ko = p.ortho_offsets.len(),
         kd = p.diag_offsets.len(),
+        subtex = if height.is_multiple_of(5 * n) {
+            format!("(1.0 / {}.0)", height / (5 * n))
+        } else {
+            format!("({}.0 / {height}.0)", 5 * n)
+        },
         smooth = if p.u_smoothing { "on (SMAA 2.8+, distance 32)" } else { "off (v2.8 texture)" },
         note = if 5 * n == 4 * m {
             ""
@@ -216,7 +222,14 @@ fn mlaa_defaults(version: MlaaVersion) -> Value {
 fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: MlaaBakeParams = parse_params(asset, params)?;
     if p.max_distances.is_empty() {
-        return Err(crate::error::InvalidInput::new("max_distances", "must list at least one cell size").into());
+        return Err(InvalidInput::new("max_distances", "must list at least one cell size").into());
+    }
+    for (i, &n) in p.max_distances.iter().enumerate() {
+        let field = format!("max_distances[{i}]");
+        crate::aa::mlaa_area::validate(version, n).map_err(|e| InvalidInput::new(&field, e.message))?;
+        if p.max_distances[..i].contains(&n) {
+            return Err(InvalidInput::new(field, format!("repeats cell size {n}")).into());
+        }
     }
     let mut files = Vec::new();
     for &n in &p.max_distances {
@@ -318,6 +331,9 @@ mod tests {
         let a = assets().into_iter().find(|a| a.name == "mlaa-v1.4").unwrap();
         let e = (a.bake)(&serde_json::json!({"max_distances": [16]})).unwrap_err();
         assert!(matches!(e, BakeError::Invalid(_)) && e.to_string().contains("odd"), "{e}");
+        assert!(e.to_string().starts_with("max_distances[0]"), "{e}");
+        let e = (a.bake)(&serde_json::json!({"max_distances": [9, 9]})).unwrap_err();
+        assert!(e.to_string().contains("repeats"), "{e}");
         let a = assets().into_iter().find(|a| a.name == "smaa-area").unwrap();
         let mut p = json(SmaaAreaParams::default());
         p["ortho_offsets"] = serde_json::json!([0.0, 0.7]);
@@ -335,7 +351,7 @@ mod tests {
         assert!(rs.contains("pub const SEARCHTEX_BYTES: [u8; 1024]"));
         let conv = smaa_area_convention(&SmaaAreaParams::default(), 160, 560);
         assert!(conv.contains("SMAA_AREATEX_MAX_DISTANCE 16") && conv.contains("SMAA_AREATEX_MAX_DISTANCE_DIAG 20"));
-        assert!(conv.contains("(80.0 / 560.0)") && !conv.contains("NOTE"));
+        assert!(conv.contains("SMAA_AREATEX_SUBTEX_SIZE (1.0 / 7.0)") && !conv.contains("NOTE"));
     }
 
     #[test]
