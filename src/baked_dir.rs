@@ -109,8 +109,7 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
     // 1. Compute everything in memory (pure; a bad parameter writes nothing).
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
     for (asset, params) in jobs {
-        let files =
-            (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
+        let files = (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
         produced.push((asset, params, files));
     }
     // 2. Existing state.
@@ -119,8 +118,9 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
     if dir.exists() && old_manifest.is_none() && !list_files(dir)?.is_empty() {
         return Err(BakeDirError::Unusable {
             path: dir.display().to_string(),
-            detail: "exists, is not empty and has no manifest.json: refusing to bake into a directory rtbake does not own"
-                .into(),
+            detail:
+                "exists, is not empty and has no manifest.json: refusing to bake into a directory rtbake does not own"
+                    .into(),
         });
     }
     let mut manifest = old_manifest.clone().unwrap_or_else(|| Manifest::new(git_revision.into()));
@@ -251,7 +251,11 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
     let on_disk = list_files(dir)?;
     let mut reports: BTreeMap<String, FileReport> = BTreeMap::new();
     let mut set = |path: &str, status: FileStatus, detail: String| {
-        let e = reports.entry(path.to_string()).or_insert(FileReport { path: path.into(), status: FileStatus::Ok, detail: String::new() });
+        let e = reports.entry(path.to_string()).or_insert(FileReport {
+            path: path.into(),
+            status: FileStatus::Ok,
+            detail: String::new(),
+        });
         if e.status == FileStatus::Ok {
             e.status = status;
             e.detail = detail;
@@ -268,7 +272,12 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
                     set(
                         &entry.path,
                         FileStatus::Modified,
-                        format!("sha256 {sha} ({} bytes), manifest says {} ({} bytes)", b.len(), entry.sha256, entry.size_bytes),
+                        format!(
+                            "sha256 {sha} ({} bytes), manifest says {} ({} bytes)",
+                            b.len(),
+                            entry.sha256,
+                            entry.size_bytes
+                        ),
                     );
                 } else {
                     set(&entry.path, FileStatus::Ok, String::new());
@@ -307,7 +316,9 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
         }
         for f in &files {
             match manifest.entry(&f.path) {
-                None => set(&f.path, FileStatus::Unlisted, format!("asset {} produces it, manifest lacks it", record.name)),
+                None => {
+                    set(&f.path, FileStatus::Unlisted, format!("asset {} produces it, manifest lacks it", record.name))
+                }
                 Some(entry) => {
                     if let Some(disk) = bytes_of.get(&f.path) {
                         if let Err(why) = compare(entry, disk, &f.bytes) {
@@ -358,7 +369,9 @@ fn compare(entry: &Entry, disk: &[u8], fresh: &[u8]) -> Result<(), String> {
 fn decode_samples(entry: &Entry, bytes: &[u8]) -> Result<Vec<f64>, String> {
     let path = entry.path.as_str();
     match entry.meta.format.as_str() {
-        "exr" => io::exr::decode(bytes, path).map(|(img, _)| img.data.iter().map(|&v| v as f64).collect()).map_err(|e| e.to_string()),
+        "exr" => io::exr::decode(bytes, path)
+            .map(|(img, _)| img.data.iter().map(|&v| v as f64).collect())
+            .map_err(|e| e.to_string()),
         "ktx2" => {
             let (_, _, _, data, _) = io::ktx2::decode(bytes, path).map_err(|e| e.to_string())?;
             Ok(payload_samples(&data, &entry.meta.sample_type))
@@ -429,12 +442,7 @@ mod tests {
     }
 
     fn registry() -> Vec<Asset> {
-        vec![Asset {
-            name: "ramp",
-            summary: "test",
-            default_params: || serde_json::json!({"size": 8}),
-            bake: ramp,
-        }]
+        vec![Asset { name: "ramp", summary: "test", default_params: || serde_json::json!({"size": 8}), bake: ramp }]
     }
 
     fn baked(dir: &Path) -> Vec<Asset> {

@@ -21,7 +21,10 @@ fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
             if e.path().is_dir() {
                 walk(base, &e.path(), out);
             } else {
-                out.push((e.path().strip_prefix(base).unwrap().display().to_string(), std::fs::read(e.path()).unwrap()));
+                out.push((
+                    e.path().strip_prefix(base).unwrap().display().to_string(),
+                    std::fs::read(e.path()).unwrap(),
+                ));
             }
         }
     }

@@ -74,13 +74,16 @@ fn baked_aa_textures_equal_the_golden_files() {
         assert!(ours == theirs, "baked/{mine} differs from {golden}");
         // The DDS/KTX2/PNG siblings carry the same payload.
         let stem = mine.trim_end_matches(".bin");
-        let (_, _, _, dds) = rtbake::io::dds::decode(&std::fs::read(baked.join(format!("{stem}.dds"))).unwrap(), stem).unwrap();
+        let (_, _, _, dds) =
+            rtbake::io::dds::decode(&std::fs::read(baked.join(format!("{stem}.dds"))).unwrap(), stem).unwrap();
         assert!(dds == theirs, "baked/{stem}.dds payload differs from {golden}");
         let (_, _, _, ktx, linear) =
             rtbake::io::ktx2::decode(&std::fs::read(baked.join(format!("{stem}.ktx2"))).unwrap(), stem).unwrap();
         assert!(ktx == theirs && linear, "baked/{stem}.ktx2 payload differs from {golden} or is not linear");
         match rtbake::io::png::decode(&std::fs::read(baked.join(format!("{stem}.png"))).unwrap(), stem).unwrap() {
-            rtbake::io::png::DecodedPng::U8(img) => assert!(img.data == theirs, "baked/{stem}.png differs from {golden}"),
+            rtbake::io::png::DecodedPng::U8(img) => {
+                assert!(img.data == theirs, "baked/{stem}.png differs from {golden}")
+            }
             _ => panic!("baked/{stem}.png is not 8-bit"),
         }
     }
@@ -96,7 +99,12 @@ fn every_asset_bakes_identically_with_one_thread_or_two() {
         let b = two.install(|| (asset.bake)(&params)).unwrap();
         assert_eq!(a.len(), b.len(), "{}", asset.name);
         for (x, y) in a.iter().zip(&b) {
-            assert!(x.path == y.path && x.bytes == y.bytes, "{}: {} differs between 1 and 2 threads", asset.name, x.path);
+            assert!(
+                x.path == y.path && x.bytes == y.bytes,
+                "{}: {} differs between 1 and 2 threads",
+                asset.name,
+                x.path
+            );
         }
     }
 }

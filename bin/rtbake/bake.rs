@@ -71,10 +71,13 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let overrides: Value = match &a.asset_params {
         None => Value::Object(Default::default()),
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| usage(anyhow::anyhow!("--asset-params {}: {e}", p.display())))?;
+            let text = std::fs::read_to_string(p)
+                .map_err(|e| usage(anyhow::anyhow!("--asset-params {}: {e}", p.display())))?;
             let v: Value = serde_json::from_str(&text)
                 .map_err(|e| usage(anyhow::anyhow!("--asset-params {}: malformed JSON: {e}", p.display())))?;
-            let obj = v.as_object().ok_or_else(|| usage_msg(format!("--asset-params {}: expected a JSON object", p.display())))?;
+            let obj = v
+                .as_object()
+                .ok_or_else(|| usage_msg(format!("--asset-params {}: expected a JSON object", p.display())))?;
             for k in obj.keys() {
                 if !names.contains(&k.as_str()) {
                     return Err(usage_msg(format!("--asset-params {}: unknown asset {k:?}", p.display())));

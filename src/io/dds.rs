@@ -55,15 +55,9 @@ pub fn to_rgba(img: &Image<f32>) -> Vec<f32> {
     let c = img.channels as usize;
     let mut out = Vec::with_capacity(img.data.len() / c * 4);
     for px in img.data.chunks_exact(c) {
-        for k in 0..4 {
-            out.push(if k < c {
-                px[k]
-            } else if k == 3 {
-                1.0
-            } else {
-                0.0
-            });
-        }
+        let mut texel = [0.0, 0.0, 0.0, 1.0];
+        texel[..c].copy_from_slice(px);
+        out.extend_from_slice(&texel);
     }
     out
 }

@@ -65,7 +65,7 @@ fn kvd() -> Vec<u8> {
     entry.push(0);
     let mut b = (entry.len() as u32).to_le_bytes().to_vec();
     b.extend_from_slice(&entry);
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     b
