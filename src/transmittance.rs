@@ -86,6 +86,7 @@ pub fn evaluate(sum: &RgbGaussians, s_mm: &[f64], form: TransmittanceForm) -> Re
 
 /// Table settings.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TableSettings {
     /// Texels along s (`--samples`, 2..=16384).
     pub samples: u32,

@@ -22,6 +22,7 @@ pub const DEFAULT_GAMMA: f64 = 0.001;
 
 /// Stretch-factor constants (eq. 4.1–4.4).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StretchParams {
     /// Global SSS level α (`--alpha`).
     pub alpha: f64,

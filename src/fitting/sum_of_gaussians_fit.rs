@@ -34,6 +34,7 @@ pub const COUNT_RANGE: std::ops::RangeInclusive<usize> = 2..=8;
 
 /// Fit settings (validated by [`FitSettings::validate`]).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FitSettings {
     /// Number of Gaussians k (`--count`, 2..=8).
     pub count: usize,
@@ -182,7 +183,7 @@ fn splitmix64(state: &mut u64) -> f64 {
 }
 
 /// Energy quantile radius: smallest r with ∫₀^r 2πr|R| dr ≥ p·total (summed over the targets, each normalised).
-fn quantile_radius(grid: &RadialGrid, targets: &[Vec<f64>], p: f64) -> f64 {
+pub(crate) fn quantile_radius(grid: &RadialGrid, targets: &[Vec<f64>], p: f64) -> f64 {
     let dens: Vec<f64> = (0..grid.len())
         .map(|j| {
             targets
