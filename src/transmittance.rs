@@ -108,7 +108,9 @@ impl TableSettings {
         check_range("--samples", self.samples, 2, MAX_SAMPLES, "texels")?;
         check_range("--height", self.height, 1, MAX_SAMPLES, "texels")?;
         check_positive("--s-max", self.s_max_mm, "mm")?;
-        check_range("--s-max", self.s_max_mm, f64::MIN_POSITIVE, MAX_S_MAX_MM, "mm")?;
+        if self.s_max_mm > MAX_S_MAX_MM {
+            return Err(InvalidInput::new("--s-max", format!("must be in (0, {MAX_S_MAX_MM}] mm, got {}", self.s_max_mm)));
+        }
         Ok(())
     }
 

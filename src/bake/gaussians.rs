@@ -114,7 +114,7 @@ pub fn fit_provenance(source: Value, settings: &FitSettings) -> Value {
             "shared_variances": settings.shared_variances,
             "normalize": settings.normalize,
             "starts": settings.starts,
-            "quadrature": "trapezoid in ln r, r = 1e-4..1e3 mm, 16 nodes per decade, exact left tail",
+            "quadrature": "trapezoid in ln r, r = 1e-5..1e3 mm, 16 nodes per decade (129 nodes), trapezoid continued to r -> 0",
             "error_metric": "relative RMS sqrt(int r (R - fit)^2 dr / int r R^2 dr), percent",
         }
     })
