@@ -223,7 +223,13 @@ impl LinePlot {
             MARGIN_T - 14.0,
             esc(&self.title)
         );
-        let _ = writeln!(s, r#"<text x="{:.2}" y="{:.2}" text-anchor="middle">{}</text>"#, (ax0 + ax1) / 2.0, h - 10.0, esc(&self.x_label));
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.2}" y="{:.2}" text-anchor="middle">{}</text>"#,
+            (ax0 + ax1) / 2.0,
+            h - 10.0,
+            esc(&self.x_label)
+        );
         let _ = writeln!(
             s,
             r#"<text transform="translate(14,{:.2}) rotate(-90)" text-anchor="middle">{}</text>"#,

@@ -10,7 +10,7 @@
 //! **Table convention** (node-inclusive): texel i of n holds s = s_max·i/(n − 1); a shader samples with linear
 //! filtering at u = s/s_max·(n − 1)/n + 0.5/n (clamp to edge). The optional 2-D variant repeats the row h times.
 
-use crate::error::{check_range, check_positive, InvalidInput};
+use crate::error::{check_positive, check_range, InvalidInput};
 use crate::fitting::RgbGaussians;
 use crate::image_buf::ImageF32;
 
@@ -109,7 +109,10 @@ impl TableSettings {
         check_range("--height", self.height, 1, MAX_SAMPLES, "texels")?;
         check_positive("--s-max", self.s_max_mm, "mm")?;
         if self.s_max_mm > MAX_S_MAX_MM {
-            return Err(InvalidInput::new("--s-max", format!("must be in (0, {MAX_S_MAX_MM}] mm, got {}", self.s_max_mm)));
+            return Err(InvalidInput::new(
+                "--s-max",
+                format!("must be in (0, {MAX_S_MAX_MM}] mm, got {}", self.s_max_mm),
+            ));
         }
         Ok(())
     }
@@ -136,9 +139,8 @@ impl TableSettings {
 pub fn table(sum: &RgbGaussians, settings: &TableSettings) -> Result<ImageF32, TransmittanceError> {
     settings.validate()?;
     let n = settings.samples;
-    let row: Vec<f32> = (0..n)
-        .flat_map(|i| transmittance(sum, settings.s_of_texel(i), settings.form).map(|t| t as f32))
-        .collect();
+    let row: Vec<f32> =
+        (0..n).flat_map(|i| transmittance(sum, settings.s_of_texel(i), settings.form).map(|t| t as f32)).collect();
     let mut data = Vec::with_capacity(row.len() * settings.height as usize);
     for _ in 0..settings.height {
         data.extend_from_slice(&row);

@@ -32,10 +32,12 @@ fn preset_asset_writes_json_includes_and_plots_for_both_presets() {
     assert!((inc[3].as_f64().unwrap() - 1.7343).abs() < 1e-12);
     assert!((json["std_devs"][3].as_f64().unwrap() - 1.7343f64.sqrt()).abs() < 1e-12);
     assert_eq!(json["blend_weights"][0], serde_json::json!([1.0, 1.0, 1.0]));
-    let hlsl = String::from_utf8(files.iter().find(|f| f.path == "sss/gaussians/deon6.hlsl").unwrap().bytes.clone()).unwrap();
+    let hlsl =
+        String::from_utf8(files.iter().find(|f| f.path == "sss/gaussians/deon6.hlsl").unwrap().bytes.clone()).unwrap();
     assert!(hlsl.contains("static const int SSS_GAUSSIAN_COUNT = 6;"));
     assert!(hlsl.contains("static const float SSS_VARIANCES[6] = { 0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41 };"));
-    let wgsl = String::from_utf8(files.iter().find(|f| f.path == "sss/gaussians/deon6.wgsl").unwrap().bytes.clone()).unwrap();
+    let wgsl =
+        String::from_utf8(files.iter().find(|f| f.path == "sss/gaussians/deon6.wgsl").unwrap().bytes.clone()).unwrap();
     assert!(wgsl.contains("const SSS_BLEND_WEIGHTS: array<vec3<f32>, 6>"));
 }
 

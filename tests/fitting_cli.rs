@@ -70,10 +70,8 @@ fn fit_per_channel_json_contract_and_out_files() {
         std::fs::read_dir(&out_dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
     let stem = "fit_deon6_k3_per_channel";
-    let expect: Vec<String> = [".glsl", ".hlsl", ".json", ".wgsl", "_plot.png", "_plot.svg"]
-        .iter()
-        .map(|s| format!("{stem}{s}"))
-        .collect();
+    let expect: Vec<String> =
+        [".glsl", ".hlsl", ".json", ".wgsl", "_plot.png", "_plot.svg"].iter().map(|s| format!("{stem}{s}")).collect();
     assert_eq!(names, expect);
     let file: Value = serde_json::from_slice(&std::fs::read(out_dir.join(format!("{stem}.json"))).unwrap()).unwrap();
     assert_eq!(file["variances"], v["variances"]);

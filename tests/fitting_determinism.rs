@@ -24,7 +24,8 @@ fn fit_asset_bytes_are_identical_for_one_and_two_threads() {
     let a = in_pool(1, || (asset.bake)(&params).unwrap());
     let b = in_pool(2, || (asset.bake)(&params).unwrap());
     assert_eq!(a, b);
-    let json: serde_json::Value = serde_json::from_slice(&a.iter().find(|f| f.path.ends_with(".json")).unwrap().bytes).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_slice(&a.iter().find(|f| f.path.ends_with(".json")).unwrap().bytes).unwrap();
     // skin1 dipole, shared 6-Gaussian fit, normalised: every channel within 1 %.
     for e in json["error_percent"].as_array().unwrap() {
         assert!(e.as_f64().unwrap() < 1.0, "{e}");

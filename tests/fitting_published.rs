@@ -80,7 +80,8 @@ fn jensen_error_table_spans_deon_range() {
 }
 
 /// Thesis Table 4.2, w′ columns (rows by ascending variance; R, G, B).
-const TABLE_4_2_DEON4: [[f64; 3]; 4] = [[1.0, 1.0, 1.0], [0.3251, 0.45, 0.3583], [0.34, 0.1864, 0.0], [0.46, 0.0, 0.0402]];
+const TABLE_4_2_DEON4: [[f64; 3]; 4] =
+    [[1.0, 1.0, 1.0], [0.3251, 0.45, 0.3583], [0.34, 0.1864, 0.0], [0.46, 0.0, 0.0402]];
 const TABLE_4_2_DEON6: [[f64; 3]; 6] = [
     [1.0, 1.0, 1.0],
     [0.3, 0.424, 0.346],

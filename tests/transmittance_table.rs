@@ -20,11 +20,14 @@ fn published_form_starts_at_one_decreases_and_red_reaches_1e4_near_7mm() {
         }
         prev = t;
     }
-    assert_eq!(transmittance(&s, 0.0, TransmittanceForm::Published), [1.0, 1.0, 1.0].map(|v: f64| {
-        // Σ w per channel of d'Eon's preset (sums to 1 up to the printed rounding).
-        let _ = v;
-        v
-    }));
+    assert_eq!(
+        transmittance(&s, 0.0, TransmittanceForm::Published),
+        [1.0, 1.0, 1.0].map(|v: f64| {
+            // Σ w per channel of d'Eon's preset (sums to 1 up to the printed rounding).
+            let _ = v;
+            v
+        })
+    );
     let red7 = transmittance(&s, 7.0, TransmittanceForm::Published)[0];
     assert!(red7 > 0.5e-4 && red7 < 2e-4, "{red7}");
     // The physical form decays slower: exp(−s²/(2v)) ≥ exp(−s²/v).
@@ -70,7 +73,12 @@ fn node_inclusive_texels_and_documented_lookup_formula() {
         let got = sample_linear(&row, u);
         let exact = transmittance(&sum(), s_mm, TransmittanceForm::Published);
         for c in 0..3 {
-            assert!((got[c] - exact[c]).abs() < 2e-3 * exact[0].max(1e-3), "s {s_mm} c {c}: {} vs {}", got[c], exact[c]);
+            assert!(
+                (got[c] - exact[c]).abs() < 2e-3 * exact[0].max(1e-3),
+                "s {s_mm} c {c}: {} vs {}",
+                got[c],
+                exact[c]
+            );
         }
     }
 }

@@ -90,7 +90,10 @@ fn run_error_table(ctx: &Ctx) -> anyhow::Result<()> {
     } else {
         println!("{:<10} {:>9} {:>9} {:>9}   (per-channel 4-Gaussian fit error, %)", "material", "R", "G", "B");
         for r in &rows {
-            println!("{:<10} {:>9.4} {:>9.4} {:>9.4}", r.material, r.error_percent[0], r.error_percent[1], r.error_percent[2]);
+            println!(
+                "{:<10} {:>9.4} {:>9.4} {:>9.4}",
+                r.material, r.error_percent[0], r.error_percent[1], r.error_percent[2]
+            );
         }
     }
     Ok(())
@@ -102,8 +105,7 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
     }
     let count = usize::try_from(a.count)
         .map_err(|_| usage_msg(format!("--count must be in 2..=8 Gaussians, got {}", a.count)))?;
-    let settings =
-        FitSettings { count, shared_variances: !a.per_channel, normalize: a.normalize, starts: a.starts };
+    let settings = FitSettings { count, shared_variances: !a.per_channel, normalize: a.normalize, starts: a.starts };
     settings.validate().map_err(usage)?;
     let stretch = StretchParams { alpha: a.alpha, beta: a.beta, gamma: a.gamma };
     stretch.validate().map_err(usage)?;
@@ -144,8 +146,8 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
         ctx.emit_json(&Value::Object(obj));
     } else {
         let names = ["R", "G", "B"];
-        for c in 0..3 {
-            println!("{} error {:.4} %", names[c], fit.error_percent[c]);
+        for (c, name) in names.iter().enumerate() {
+            println!("{name} error {:.4} %", fit.error_percent[c]);
             for (v, w) in fit.sum.variances_mm2[c].iter().zip(&fit.sum.weights[c]) {
                 println!("  v = {v:>12.6} mm^2   w = {w:.6}");
             }

@@ -122,7 +122,7 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
         result["s_mm"] = json!(s);
         result["T"] = json!(t);
         if !ctx.json {
-            ctx.info(format!("{}", form.formula()));
+            ctx.info(form.formula());
             for (s, t) in s.iter().zip(&t) {
                 println!("s = {s:>8.4} mm   T = {:.6} {:.6} {:.6}", t[0], t[1], t[2]);
             }

@@ -123,7 +123,10 @@ pub fn fit_provenance(source: Value, settings: &FitSettings) -> Value {
 fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: FitParams = parse_params("sss-gaussians-fit", params)?;
     let m = materials::find(&p.material).ok_or_else(|| {
-        InvalidInput::new("material", format!("unknown material '{}' (known: {})", p.material, materials::names().join(", ")))
+        InvalidInput::new(
+            "material",
+            format!("unknown material '{}' (known: {})", p.material, materials::names().join(", ")),
+        )
     })?;
     let profile = m.dipole(FdrForm::Dj05);
     let fit = fit_sum_of_gaussians(&profile, &p.fit).map_err(|e| match e {
@@ -147,7 +150,8 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     } else {
         Box::new(profile)
     };
-    let plot = profile_plot(plotted.as_ref(), Some(&fit.sum), &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count));
+    let plot =
+        profile_plot(plotted.as_ref(), Some(&fit.sum), &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count));
     gaussian_files(&stem, &fit.sum, p.stretch, extra, &plot)
 }
 
@@ -171,10 +175,14 @@ pub fn assets() -> Vec<Asset> {
     vec![
         Asset {
             name: "sss-gaussians",
-            summary: "screen-space SSS parameters of d'Eon's 6- and 4-Gaussian skin presets (JSON, HLSL/GLSL/WGSL, plot)",
+            summary:
+                "screen-space SSS parameters of d'Eon's 6- and 4-Gaussian skin presets (JSON, HLSL/GLSL/WGSL, plot)",
             default_params: || {
-                serde_json::to_value(PresetParams { presets: vec!["deon6".into(), "deon4".into()], stretch: StretchParams::default() })
-                    .expect("params serialise")
+                serde_json::to_value(PresetParams {
+                    presets: vec!["deon6".into(), "deon4".into()],
+                    stretch: StretchParams::default(),
+                })
+                .expect("params serialise")
             },
             bake: bake_presets,
         },

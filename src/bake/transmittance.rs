@@ -13,7 +13,12 @@ pub const VERIFY_TOLERANCE: f64 = 1e-6;
 
 /// Every file of one table: EXR f32/f16, KTX2 RGBA16F, sRGB preview PNG, 16-bit linear PNG and a JSON sidecar with
 /// the provenance (`source`, `form`, convention, lookup formula). Paths `{stem}.*`.
-pub fn table_files(stem: &str, sum: &RgbGaussians, settings: &TableSettings, source: Value) -> Result<Vec<BakedFile>, BakeError> {
+pub fn table_files(
+    stem: &str,
+    sum: &RgbGaussians,
+    settings: &TableSettings,
+    source: Value,
+) -> Result<Vec<BakedFile>, BakeError> {
     let img = table(sum, settings).map_err(|e| match e {
         crate::transmittance::TransmittanceError::Invalid(i) => BakeError::Invalid(i),
     })?;
@@ -76,7 +81,8 @@ pub fn assets() -> Vec<Asset> {
         name: "transmittance",
         summary: "transmittance table T(s) (thesis eq. 5.12) of d'Eon's 6-Gaussian skin, 256x1 over 0..8 mm",
         default_params: || {
-            serde_json::to_value(Params { preset: "deon6".into(), table: TableSettings::default() }).expect("params serialise")
+            serde_json::to_value(Params { preset: "deon6".into(), table: TableSettings::default() })
+                .expect("params serialise")
         },
         bake,
     }]

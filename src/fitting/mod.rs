@@ -69,9 +69,8 @@ impl From<&SumOfGaussians> for RgbGaussians {
 
 impl RadialProfile for RgbGaussians {
     fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3] {
-        [0, 1, 2].map(|c| {
-            self.variances_mm2[c].iter().zip(&self.weights[c]).map(|(v, w)| w * gaussian_mm2(*v, r_mm)).sum()
-        })
+        [0, 1, 2]
+            .map(|c| self.variances_mm2[c].iter().zip(&self.weights[c]).map(|(v, w)| w * gaussian_mm2(*v, r_mm)).sum())
     }
     fn total_reflectance(&self) -> [f64; 3] {
         [0, 1, 2].map(|c| self.weights[c].iter().sum())

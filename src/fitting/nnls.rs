@@ -8,6 +8,9 @@
 //! passive set), which for a convex quadratic is the exact optimum. [`nnls_enumerate`] is an independent exact
 //! solver for small k (every support set, 2ᵏ − 1 unconstrained solves) used as a test oracle.
 
+// Index loops over the k×k system mirror the algorithm's statement.
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::{DMatrix, DVector};
 
 /// Largest k [`nnls`] accepts (stack buffers).
@@ -26,7 +29,7 @@ fn solve_subset(g: &[f64], k: usize, b: &[f64], p: &[usize], z: &mut [f64]) -> O
             }
             if i == j {
                 let d = g[p[i] * k + p[i]];
-                if !(s > 1e-13 * d) {
+                if s.partial_cmp(&(1e-13 * d)) != Some(std::cmp::Ordering::Greater) {
                     return None;
                 }
                 l[i * MAX_K + i] = s.sqrt();

@@ -73,6 +73,7 @@ impl RadialGrid {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
     use crate::diffusion::sum_of_gaussians::gaussian_mm2;

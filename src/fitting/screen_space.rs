@@ -198,10 +198,9 @@ impl ScreenSpaceParams {
             .float_const("SSS_ALPHA", self.stretch.alpha)
             .float_const("SSS_BETA", self.stretch.beta)
             .float_const("SSS_GAMMA", self.stretch.gamma);
-        inc = inc.vec_array("SSS_WEIGHTS", &self.triples(&self.weights)).vec_array(
-            "SSS_BLEND_WEIGHTS",
-            &self.triples(&self.blend_weights),
-        );
+        inc = inc
+            .vec_array("SSS_WEIGHTS", &self.triples(&self.weights))
+            .vec_array("SSS_BLEND_WEIGHTS", &self.triples(&self.blend_weights));
         let arrays: [(&str, &[Vec<f64>; 3]); 5] = [
             ("SSS_VARIANCES", &self.variances_mm2),
             ("SSS_INCREMENTAL_VARIANCES", &self.incremental_variances_mm2),
