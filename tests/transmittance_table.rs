@@ -1,5 +1,8 @@
 //! Transmittance table T(s) (thesis eq. 5.12): values, texel convention, shader lookup, encodings.
 
+// Channel-index loops mirror the per-channel equations.
+#![allow(clippy::needless_range_loop)]
+
 use rtbake::diffusion::sum_of_gaussians::deon6;
 use rtbake::fitting::RgbGaussians;
 use rtbake::io::png::{decode, DecodedPng};
