@@ -59,4 +59,11 @@ fn main() {
     bench("4-Gaussian per-channel fit, cream dipole", runs, None, || fit_sum_of_gaussians(&cream, &per4).unwrap());
     bench("Jensen 2001 error table (33 per-channel fits)", runs, None, || error_table().unwrap());
     let _ = skin1.total_reflectance();
+    // Default bakes of this area (each must stay under 1 s in release).
+    for asset in rtbake::bake::registry() {
+        if ["sss-gaussians", "sss-gaussians-fit", "transmittance"].contains(&asset.name) {
+            let params = (asset.default_params)();
+            bench(&format!("bake {}", asset.name), runs, Some(1.0), || (asset.bake)(&params).unwrap());
+        }
+    }
 }
