@@ -123,7 +123,7 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let mode = if settings.shared_variances { "shared" } else { "per_channel" };
         let file_stem = format!("fit_{stem}_k{count}_{mode}");
         let plotted: Box<dyn RadialProfile> = if settings.normalize {
-            Box::new(rtbake::bake::gaussians::Normalized { inner: profile.as_ref(), totals: fit.profile_totals })
+            Box::new(rtbake::fitting::NormalizedProfile { inner: profile.as_ref(), totals: fit.profile_totals })
         } else {
             profile
         };

@@ -8,7 +8,7 @@ use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
 use crate::error::InvalidInput;
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
-use crate::fitting::{fit_sum_of_gaussians, profile_plot, FitSettings, RgbGaussians};
+use crate::fitting::{fit_sum_of_gaussians, profile_plot, FitSettings, NormalizedProfile, RgbGaussians};
 use crate::io::source::ShaderLang;
 use crate::plot::LinePlot;
 use serde::{Deserialize, Serialize};
@@ -146,29 +146,13 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let stem = format!("sss/gaussians/fit_{}_dipole_k{}_{mode}", m.name, p.fit.count);
     // Plot the profile in the units that were fitted.
     let plotted: Box<dyn RadialProfile> = if p.fit.normalize {
-        Box::new(Normalized { inner: &profile, totals: profile.total_reflectance() })
+        Box::new(NormalizedProfile { inner: &profile, totals: profile.total_reflectance() })
     } else {
         Box::new(profile)
     };
     let plot =
         profile_plot(plotted.as_ref(), Some(&fit.sum), &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count));
     gaussian_files(&stem, &fit.sum, p.stretch, extra, &plot)
-}
-
-/// A profile divided by its per-channel totals.
-pub struct Normalized<'a> {
-    pub inner: &'a dyn RadialProfile,
-    pub totals: [f64; 3],
-}
-
-impl RadialProfile for Normalized<'_> {
-    fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3] {
-        let v = self.inner.reflectance_mm2(r_mm);
-        [0, 1, 2].map(|c| v[c] / self.totals[c])
-    }
-    fn total_reflectance(&self) -> [f64; 3] {
-        [1.0; 3]
-    }
 }
 
 pub fn assets() -> Vec<Asset> {

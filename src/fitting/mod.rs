@@ -77,6 +77,22 @@ impl RadialProfile for RgbGaussians {
     }
 }
 
+/// A profile divided by its per-channel totals (what `FitSettings::normalize` fits; used to plot it).
+pub struct NormalizedProfile<'a> {
+    pub inner: &'a dyn RadialProfile,
+    pub totals: [f64; 3],
+}
+
+impl RadialProfile for NormalizedProfile<'_> {
+    fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3] {
+        let v = self.inner.reflectance_mm2(r_mm);
+        [0, 1, 2].map(|c| v[c] / self.totals[c])
+    }
+    fn total_reflectance(&self) -> [f64; 3] {
+        [1.0; 3]
+    }
+}
+
 /// Plot colours of the R, G, B channels.
 pub const CHANNEL_COLORS: [[u8; 3]; 3] = [[200, 30, 30], [20, 140, 40], [30, 60, 210]];
 
