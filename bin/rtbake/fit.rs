@@ -15,6 +15,8 @@ pub enum FitCommand {
     Separable(fit_separable::FitSeparableArgs),
 }
 
+pub use fit_gaussians::fit_error;
+
 pub fn run(cmd: FitCommand, ctx: &Ctx) -> anyhow::Result<()> {
     match cmd {
         FitCommand::Gaussians(a) => fit_gaussians::run(a, ctx),

@@ -1,10 +1,144 @@
-//! `rtbake transmittance`: not implemented yet.
+//! `rtbake transmittance`: evaluate T(s) (thesis eq. 5.12) at given distances, or bake the table files.
 
-use crate::cli::{usage_msg, Ctx};
+use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
+use rtbake::bake::BakedFile;
+use rtbake::diffusion::materials;
+use rtbake::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
+use rtbake::diffusion::FdrForm;
+use rtbake::fitting::{fit_sum_of_gaussians, FitSettings, RgbGaussians};
+use rtbake::transmittance::{evaluate, TableSettings, TransmittanceForm, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
-pub struct TransmittanceArgs {}
+pub struct TransmittanceArgs {
+    /// Sum-of-Gaussians preset: deon6 | deon4 (default deon6 unless --material is given).
+    #[arg(long, value_name = "NAME", conflicts_with = "material")]
+    pub profile_preset: Option<String>,
+    /// Fit a Jensen 2001 material (dipole, η = 1.3) with --count Gaussians first and use that sum.
+    #[arg(long, value_name = "NAME")]
+    pub material: Option<String>,
+    /// Gaussians for --material (2..=8).
+    #[arg(long, default_value_t = 6, requires = "material")]
+    pub count: usize,
+    /// With --material: divide each channel by its total first (T(0) = 1).
+    #[arg(long, requires = "material")]
+    pub normalize: bool,
+    /// With --material: per-channel variances instead of shared ones.
+    #[arg(long, requires = "material")]
+    pub per_channel: bool,
+    /// Distances s in mm to evaluate, comma-separated (any order, each finite and >= 0).
+    #[arg(long = "s", value_name = "MM,...", allow_hyphen_values = true)]
+    pub s: Option<String>,
+    /// Use exp(-s^2/(2v)) (plane integral of normalised Gaussians) instead of the published exp(-s^2/v).
+    #[arg(long)]
+    pub physical: bool,
+    /// Write the table (EXR f32/f16, KTX2 RGBA16F, sRGB preview PNG, 16-bit linear PNG, JSON) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Table texels along s (2..=16384).
+    #[arg(long, default_value_t = DEFAULT_SAMPLES, allow_hyphen_values = true)]
+    pub samples: u32,
+    /// Table rows (1 = 1-D table; >1 repeats the row for APIs without 1-D textures).
+    #[arg(long, default_value_t = 1)]
+    pub height: u32,
+    /// Table domain end s_max in mm (> 0); texel i holds s = s_max*i/(n-1).
+    #[arg(long = "s-max", default_value_t = DEFAULT_S_MAX_MM, allow_hyphen_values = true)]
+    pub s_max: f64,
+}
 
-pub fn run(_args: TransmittanceArgs, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("rtbake transmittance: not implemented yet"))
+/// Writes a file set under `dir`: every file is staged (temp + fsync) first, then all are renamed, so an error
+/// leaves no partial set of new files.
+pub fn write_file_set(dir: &Path, files: &[BakedFile]) -> anyhow::Result<()> {
+    let mut staged = Vec::new();
+    for f in files {
+        let path = dir.join(&f.path);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| anyhow::anyhow!("{}: {e}", parent.display()))?;
+        }
+        match rtbake::io::atomic::stage(&path, &f.bytes) {
+            Ok(tmp) => staged.push((tmp, path)),
+            Err(e) => {
+                for (tmp, _) in &staged {
+                    let _ = std::fs::remove_file(tmp);
+                }
+                return Err(e.into());
+            }
+        }
+    }
+    for (tmp, path) in &staged {
+        rtbake::io::atomic::commit(tmp, path)?;
+    }
+    Ok(())
+}
+
+fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
+    if let Some(name) = &a.material {
+        let m = materials::find(name).ok_or_else(|| {
+            usage_msg(format!("--material: unknown material '{name}' (known: {})", materials::names().join(", ")))
+        })?;
+        let settings = FitSettings {
+            count: a.count,
+            shared_variances: !a.per_channel,
+            normalize: a.normalize,
+            ..FitSettings::default()
+        };
+        settings.validate().map_err(usage)?;
+        let fit = fit_sum_of_gaussians(&m.dipole(FdrForm::Dj05), &settings).map_err(crate::fit::fit_error)?;
+        let src = json!({"kind": "fit", "material": m.name, "profile": "dipole, eta 1.3, DJ05 Fdr",
+                         "count": a.count, "shared_variances": !a.per_channel, "normalize": a.normalize,
+                         "error_percent": fit.error_percent});
+        return Ok((fit.sum, src, format!("{}_k{}", m.name, a.count)));
+    }
+    let name = a.profile_preset.clone().unwrap_or_else(|| "deon6".into());
+    let sog = preset(&name).ok_or_else(|| {
+        usage_msg(format!("--profile-preset: unknown preset '{name}' (known: {})", PRESET_NAMES.join(", ")))
+    })?;
+    let src = json!({"kind": "preset", "name": name.to_ascii_lowercase()});
+    Ok((RgbGaussians::from(&sog), src, name.to_ascii_lowercase()))
+}
+
+pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    let form = if a.physical { TransmittanceForm::Physical } else { TransmittanceForm::Published };
+    // Validate every input before any work or output.
+    let s_mm = match &a.s {
+        Some(text) => {
+            let v = parse_f64_list("--s", text)?;
+            rtbake::transmittance::check_distances(&v).map_err(usage)?;
+            Some(v)
+        }
+        None => None,
+    };
+    let table = TableSettings { samples: a.samples, height: a.height, s_max_mm: a.s_max, form };
+    table.validate().map_err(usage)?;
+    if s_mm.is_none() && a.out.is_none() {
+        return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));
+    }
+    let (sum, source, stem) = source_sum(&a)?;
+    let form_name = if a.physical { "physical" } else { "published" };
+    let mut result = json!({"form": form_name, "formula": form.formula(), "source": source});
+    if let Some(s) = &s_mm {
+        let t = evaluate(&sum, s, form)?;
+        result["s_mm"] = json!(s);
+        result["T"] = json!(t);
+        if !ctx.json {
+            ctx.info(form.formula());
+            for (s, t) in s.iter().zip(&t) {
+                println!("s = {s:>8.4} mm   T = {:.6} {:.6} {:.6}", t[0], t[1], t[2]);
+            }
+        }
+    }
+    if let Some(dir) = &a.out {
+        let files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
+            .map_err(|e| anyhow::anyhow!(e))?;
+        prepare_out_dir("--out", dir)?;
+        write_file_set(dir, &files)?;
+        result["files"] = json!(files.iter().map(|f| dir.join(&f.path).display().to_string()).collect::<Vec<_>>());
+        result["convention"] = json!(table.convention());
+        ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));
+    }
+    if ctx.json {
+        ctx.emit_json(&result);
+    }
+    Ok(())
 }

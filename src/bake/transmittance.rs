@@ -1,0 +1,89 @@
+//! Transmittance table T(s) (thesis eq. 5.12) in `baked/transmittance/`, from d'Eon's 6-Gaussian skin preset.
+
+use super::{float_texture_files, json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
+use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
+use crate::error::InvalidInput;
+use crate::fitting::RgbGaussians;
+use crate::transmittance::{table, TableSettings, TransmittanceForm};
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// Absolute tolerance `verify` allows on the f32 payloads.
+pub const VERIFY_TOLERANCE: f64 = 1e-6;
+
+/// Every file of one table: EXR f32/f16, KTX2 RGBA16F, sRGB preview PNG, 16-bit linear PNG and a JSON sidecar with
+/// the provenance (`source`, `form`, convention, lookup formula). Paths `{stem}.*`.
+pub fn table_files(
+    stem: &str,
+    sum: &RgbGaussians,
+    settings: &TableSettings,
+    source: Value,
+) -> Result<Vec<BakedFile>, BakeError> {
+    let img = table(sum, settings).map_err(|e| match e {
+        crate::transmittance::TransmittanceError::Invalid(i) => BakeError::Invalid(i),
+    })?;
+    let convention = settings.convention();
+    let mut files = float_texture_files(stem, &img, "lut", &convention, VERIFY_TOLERANCE)?;
+    let mut meta = FileMeta::text("lut", "png", &format!("{convention}; 16-bit linear: value = sample/65535"));
+    meta.width = img.width;
+    meta.height = img.height;
+    meta.channels = img.channels;
+    meta.sample_type = "u16".into();
+    meta.color_space = "linear".into();
+    meta.verify_tolerance = None;
+    files.push(BakedFile { path: format!("{stem}_linear16.png"), bytes: crate::io::png::encode_linear16(&img)?, meta });
+    let form = match settings.form {
+        TransmittanceForm::Published => "published",
+        TransmittanceForm::Physical => "physical",
+    };
+    files.push(json_file(
+        &format!("{stem}.json"),
+        &json!({
+            "source": source,
+            "form": form,
+            "formula": settings.form.formula(),
+            "samples": settings.samples,
+            "height": settings.height,
+            "s_max_mm": settings.s_max_mm,
+            "texel_convention": "node-inclusive: texel i holds s = s_max*i/(n-1)",
+            "shader_lookup": "u = s/s_max*(n-1)/n + 0.5/n, linear filtering, clamp to edge",
+            "variances_mm2": sum.variances_mm2,
+            "weights": sum.weights,
+        }),
+        "json",
+        "provenance of the transmittance table next to it",
+    ));
+    Ok(files)
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Params {
+    preset: String,
+    table: TableSettings,
+}
+
+fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
+    let p: Params = parse_params("transmittance", params)?;
+    let sog = preset(&p.preset).ok_or_else(|| {
+        InvalidInput::new("preset", format!("unknown preset '{}' (known: {})", p.preset, PRESET_NAMES.join(", ")))
+    })?;
+    let form = match p.table.form {
+        TransmittanceForm::Published => "published",
+        TransmittanceForm::Physical => "physical",
+    };
+    let source = json!({"kind": "preset", "name": p.preset, "reference": "d'Eon, Luebke, Enderton, EGSR 2007"});
+    table_files(&format!("transmittance/{}_{form}", p.preset), &RgbGaussians::from(&sog), &p.table, source)
+}
+
+pub fn assets() -> Vec<Asset> {
+    vec![Asset {
+        name: "transmittance",
+        summary: "transmittance table T(s) (thesis eq. 5.12) of d'Eon's 6-Gaussian skin, 256x1 over 0..8 mm",
+        default_params: || {
+            serde_json::to_value(Params { preset: "deon6".into(), table: TableSettings::default() })
+                .expect("params serialise")
+        },
+        bake,
+    }]
+}

@@ -1,0 +1,406 @@
+//! Minimal line plots as SVG text and as raster images (for PNG), without fonts or plotting dependencies.
+//!
+//! Why not `plotters`: its text rendering needs system fonts (or the `ab_glyph` feature plus a bundled font), and
+//! the plots here are a few polylines on a linear or log₁₀ x axis. The SVG is written directly (ticks, numeric tick
+//! labels, axis labels, legend). The raster version draws the same axes, ticks, grid and polylines into an
+//! `Image<u8>` and writes its numeric tick labels with a built-in 3×5 pixel digit font; axis titles and the legend
+//! text appear only in the SVG (the PNG legend is colour swatches in series order). Pure: returns text / pixels.
+
+use crate::image_buf::Image;
+use std::fmt::Write;
+
+/// One polyline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    pub label: String,
+    /// sRGB colour.
+    pub color: [u8; 3],
+    pub dashed: bool,
+    /// (x, y) points in data units; non-finite points (and x ≤ 0 on a log axis) are skipped.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line plot with one x and one y axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinePlot {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    /// log₁₀ x axis.
+    pub log_x: bool,
+    pub series: Vec<Series>,
+}
+
+const MARGIN_L: f64 = 70.0;
+const MARGIN_R: f64 = 20.0;
+const MARGIN_T: f64 = 36.0;
+const MARGIN_B: f64 = 50.0;
+
+/// Axis ranges and ticks in plot coordinates (x already log₁₀ when `log_x`).
+struct Frame {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    x_ticks: Vec<(f64, String)>,
+    y_ticks: Vec<(f64, String)>,
+}
+
+fn nice_step(range: f64, target: usize) -> f64 {
+    let raw = range / target as f64;
+    let mag = 10f64.powf(raw.log10().floor());
+    let f = raw / mag;
+    let m = if f <= 1.0 {
+        1.0
+    } else if f <= 2.0 {
+        2.0
+    } else if f <= 5.0 {
+        5.0
+    } else {
+        10.0
+    };
+    m * mag
+}
+
+fn fmt_tick(v: f64, step: f64) -> String {
+    let decimals = if step >= 1.0 { 0 } else { (-step.log10().floor()) as usize };
+    let s = format!("{v:.decimals$}");
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
+fn fmt_decade(e: i32) -> String {
+    if e >= 0 {
+        format!("{}", 10f64.powi(e))
+    } else {
+        format!("{:.*}", (-e) as usize, 10f64.powi(e))
+    }
+}
+
+impl LinePlot {
+    fn data_points(&self, s: &Series) -> Vec<(f64, f64)> {
+        s.points
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite() && (!self.log_x || *x > 0.0))
+            .map(|&(x, y)| (if self.log_x { x.log10() } else { x }, y))
+            .collect()
+    }
+
+    fn frame(&self) -> Frame {
+        let pts: Vec<(f64, f64)> = self.series.iter().flat_map(|s| self.data_points(s)).collect();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, f64::NEG_INFINITY);
+        for &(x, y) in &pts {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        if !(x0.is_finite() && x1 > x0) {
+            (x0, x1) = (0.0, 1.0);
+        }
+        if !(y1.is_finite() && y1 > y0) {
+            y1 = y0 + 1.0;
+        }
+        let ystep = nice_step(y1 - y0, 5);
+        y1 = (y1 / ystep).ceil() * ystep;
+        y0 = (y0 / ystep).floor() * ystep;
+        let mut y_ticks = Vec::new();
+        let mut t = y0;
+        while t <= y1 + 0.5 * ystep {
+            y_ticks.push((t, fmt_tick(t, ystep)));
+            t += ystep;
+        }
+        let mut x_ticks = Vec::new();
+        if self.log_x {
+            x0 = x0.floor();
+            x1 = x1.ceil();
+            for e in x0 as i32..=x1 as i32 {
+                x_ticks.push((e as f64, fmt_decade(e)));
+            }
+        } else {
+            let xstep = nice_step(x1 - x0, 6);
+            x0 = (x0 / xstep).floor() * xstep;
+            x1 = (x1 / xstep).ceil() * xstep;
+            let mut t = x0;
+            while t <= x1 + 0.5 * xstep {
+                x_ticks.push((t, fmt_tick(t, xstep)));
+                t += xstep;
+            }
+        }
+        Frame { x0, x1, y0, y1, x_ticks, y_ticks }
+    }
+
+    fn mapper(f: &Frame, w: f64, h: f64) -> impl Fn(f64, f64) -> (f64, f64) + '_ {
+        move |x, y| {
+            let px = MARGIN_L + (x - f.x0) / (f.x1 - f.x0) * (w - MARGIN_L - MARGIN_R);
+            let py = h - MARGIN_B - (y - f.y0) / (f.y1 - f.y0) * (h - MARGIN_T - MARGIN_B);
+            (px, py)
+        }
+    }
+
+    /// SVG document of `width × height` user units.
+    pub fn to_svg(&self, width: u32, height: u32) -> String {
+        let (w, h) = (width as f64, height as f64);
+        let f = self.frame();
+        let map = Self::mapper(&f, w, h);
+        let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="11">"#
+        );
+        let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+        let (ax0, ay0) = map(f.x0, f.y0);
+        let (ax1, ay1) = map(f.x1, f.y1);
+        for (x, label) in &f.x_ticks {
+            let (px, _) = map(*x, f.y0);
+            let _ = writeln!(s, r##"<line x1="{px:.2}" y1="{ay1:.2}" x2="{px:.2}" y2="{ay0:.2}" stroke="#e0e0e0"/>"##);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{px:.2}" y1="{ay0:.2}" x2="{px:.2}" y2="{:.2}" stroke="black"/><text x="{px:.2}" y="{:.2}" text-anchor="middle">{}</text>"##,
+                ay0 + 5.0,
+                ay0 + 18.0,
+                esc(label)
+            );
+        }
+        for (y, label) in &f.y_ticks {
+            let (_, py) = map(f.x0, *y);
+            let _ = writeln!(s, r##"<line x1="{ax0:.2}" y1="{py:.2}" x2="{ax1:.2}" y2="{py:.2}" stroke="#e0e0e0"/>"##);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{:.2}" y1="{py:.2}" x2="{ax0:.2}" y2="{py:.2}" stroke="black"/><text x="{:.2}" y="{:.2}" text-anchor="end">{}</text>"##,
+                ax0 - 5.0,
+                ax0 - 8.0,
+                py + 4.0,
+                esc(label)
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<rect x="{ax0:.2}" y="{ay1:.2}" width="{:.2}" height="{:.2}" fill="none" stroke="black"/>"#,
+            ax1 - ax0,
+            ay0 - ay1
+        );
+        for series in &self.series {
+            let pts: Vec<String> = self
+                .data_points(series)
+                .iter()
+                .map(|&(x, y)| {
+                    let (px, py) = map(x, y);
+                    format!("{px:.2},{py:.2}")
+                })
+                .collect();
+            let [r, g, b] = series.color;
+            let dash = if series.dashed { r#" stroke-dasharray="6,4""# } else { "" };
+            let _ = writeln!(
+                s,
+                r##"<polyline fill="none" stroke="#{r:02x}{g:02x}{b:02x}" stroke-width="1.5"{dash} points="{}"/>"##,
+                pts.join(" ")
+            );
+        }
+        for (i, series) in self.series.iter().enumerate() {
+            let [r, g, b] = series.color;
+            let y = MARGIN_T + 12.0 + 14.0 * i as f64;
+            let x = w - MARGIN_R - 150.0;
+            let dash = if series.dashed { r#" stroke-dasharray="6,4""# } else { "" };
+            let _ = writeln!(
+                s,
+                r##"<line x1="{x:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="#{r:02x}{g:02x}{b:02x}" stroke-width="1.5"{dash}/><text x="{:.2}" y="{y:.2}">{}</text>"##,
+                y - 4.0,
+                x + 24.0,
+                y - 4.0,
+                x + 30.0,
+                esc(&series.label)
+            );
+        }
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.2}" y="{:.2}" text-anchor="middle" font-size="13">{}</text>"#,
+            w / 2.0,
+            MARGIN_T - 14.0,
+            esc(&self.title)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.2}" y="{:.2}" text-anchor="middle">{}</text>"#,
+            (ax0 + ax1) / 2.0,
+            h - 10.0,
+            esc(&self.x_label)
+        );
+        let _ = writeln!(
+            s,
+            r#"<text transform="translate(14,{:.2}) rotate(-90)" text-anchor="middle">{}</text>"#,
+            (ay0 + ay1) / 2.0,
+            esc(&self.y_label)
+        );
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// RGB raster of the plot (white background), for PNG encoding.
+    pub fn to_image(&self, width: u32, height: u32) -> Image<u8> {
+        let (w, h) = (width as f64, height as f64);
+        let f = self.frame();
+        let map = Self::mapper(&f, w, h);
+        let mut c = Canvas { img: Image::from_vec(width, height, 3, vec![255; (width * height * 3) as usize]) };
+        let (ax0, ay0) = map(f.x0, f.y0);
+        let (ax1, ay1) = map(f.x1, f.y1);
+        let grid = [224, 224, 224];
+        let black = [0, 0, 0];
+        for (x, label) in &f.x_ticks {
+            let (px, _) = map(*x, f.y0);
+            c.line(px, ay1, px, ay0, grid, false);
+            c.line(px, ay0, px, ay0 + 5.0, black, false);
+            c.text(label, px, ay0 + 9.0, true, black);
+        }
+        for (y, label) in &f.y_ticks {
+            let (_, py) = map(f.x0, *y);
+            c.line(ax0, py, ax1, py, grid, false);
+            c.line(ax0 - 5.0, py, ax0, py, black, false);
+            let tw = text_width(label);
+            c.text(label, ax0 - 8.0 - tw / 2.0, py - 5.0, true, black);
+        }
+        c.line(ax0, ay0, ax1, ay0, black, false);
+        c.line(ax0, ay1, ax1, ay1, black, false);
+        c.line(ax0, ay0, ax0, ay1, black, false);
+        c.line(ax1, ay0, ax1, ay1, black, false);
+        for series in &self.series {
+            let pts: Vec<(f64, f64)> = self.data_points(series).iter().map(|&(x, y)| map(x, y)).collect();
+            for p in pts.windows(2) {
+                c.line(p[0].0, p[0].1, p[1].0, p[1].1, series.color, series.dashed);
+            }
+        }
+        for (i, series) in self.series.iter().enumerate() {
+            let y = MARGIN_T + 8.0 + 10.0 * i as f64;
+            let x = w - MARGIN_R - 40.0;
+            c.line(x, y, x + 24.0, y, series.color, series.dashed);
+        }
+        c.img
+    }
+}
+
+/// 3×5 digit font: each glyph is 5 rows of 3 bits (MSB = left column).
+fn glyph(ch: char) -> Option<[u8; 5]> {
+    Some(match ch {
+        '0' => [7, 5, 5, 5, 7],
+        '1' => [2, 6, 2, 2, 7],
+        '2' => [7, 1, 7, 4, 7],
+        '3' => [7, 1, 7, 1, 7],
+        '4' => [5, 5, 7, 1, 1],
+        '5' => [7, 4, 7, 1, 7],
+        '6' => [7, 4, 7, 5, 7],
+        '7' => [7, 1, 1, 1, 1],
+        '8' => [7, 5, 7, 5, 7],
+        '9' => [7, 5, 7, 1, 7],
+        '.' => [0, 0, 0, 0, 2],
+        '-' => [0, 0, 7, 0, 0],
+        'e' => [0, 7, 7, 4, 7],
+        _ => return None,
+    })
+}
+
+/// Pixel scale of the digit font.
+const FONT_SCALE: f64 = 2.0;
+
+fn text_width(s: &str) -> f64 {
+    s.chars().count() as f64 * 4.0 * FONT_SCALE - FONT_SCALE
+}
+
+struct Canvas {
+    img: Image<u8>,
+}
+
+impl Canvas {
+    fn put(&mut self, x: i64, y: i64, color: [u8; 3]) {
+        if x >= 0 && y >= 0 && (x as u32) < self.img.width && (y as u32) < self.img.height {
+            for (ch, v) in color.iter().enumerate() {
+                self.img.set(x as u32, y as u32, ch as u32, *v);
+            }
+        }
+    }
+
+    /// A 2-pixel-wide line (1 pixel for axis-aligned lines); dashed lines alternate 6 px on, 4 px off.
+    fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool) {
+        let len = ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
+        let steps = (len * 2.0).ceil().max(1.0) as usize;
+        let thick = (x1 - x0).abs() > 0.5 && (y1 - y0).abs() > 0.5 || color != [0, 0, 0] && color != [224, 224, 224];
+        for i in 0..=steps {
+            let t = i as f64 / steps as f64;
+            if dashed && (t * len) % 10.0 >= 6.0 {
+                continue;
+            }
+            let (x, y) = (x0 + t * (x1 - x0), y0 + t * (y1 - y0));
+            let (xi, yi) = (x.round() as i64, y.round() as i64);
+            self.put(xi, yi, color);
+            if thick {
+                self.put(xi + 1, yi, color);
+                self.put(xi, yi + 1, color);
+            }
+        }
+    }
+
+    /// Draws `s` with the digit font; (x, y) is the top-left corner, or the top-centre when `centered`.
+    fn text(&mut self, s: &str, x: f64, y: f64, centered: bool, color: [u8; 3]) {
+        let x = if centered { x - text_width(s) / 2.0 } else { x };
+        for (i, ch) in s.chars().enumerate() {
+            let Some(rows) = glyph(ch) else { continue };
+            let gx = x + i as f64 * 4.0 * FONT_SCALE;
+            for (ry, bits) in rows.iter().enumerate() {
+                for cx in 0..3 {
+                    if bits & (4 >> cx) != 0 {
+                        for sy in 0..FONT_SCALE as i64 {
+                            for sx in 0..FONT_SCALE as i64 {
+                                self.put(
+                                    (gx + cx as f64 * FONT_SCALE).round() as i64 + sx,
+                                    (y + ry as f64 * FONT_SCALE).round() as i64 + sy,
+                                    color,
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> LinePlot {
+        LinePlot {
+            title: "t".into(),
+            x_label: "r (mm)".into(),
+            y_label: "r R(r)".into(),
+            log_x: true,
+            series: vec![Series {
+                label: "a<b".into(),
+                color: [255, 0, 0],
+                dashed: false,
+                points: (1..100).map(|i| (0.01 * i as f64, (i as f64).sqrt())).collect(),
+            }],
+        }
+    }
+
+    #[test]
+    fn svg_has_decade_ticks_labels_and_escaped_legend() {
+        let svg = sample().to_svg(640, 400);
+        assert!(svg.starts_with("<svg"));
+        assert!(svg.trim_end().ends_with("</svg>"));
+        assert!(svg.contains(">0.01</text>") && svg.contains(">0.1</text>") && svg.contains(">1</text>"));
+        assert!(svg.contains("a&lt;b"));
+        assert_eq!(svg.matches("<polyline").count(), 1);
+    }
+
+    #[test]
+    fn raster_draws_series_colour_inside_the_frame() {
+        let img = sample().to_image(320, 200);
+        let red = img.data.chunks(3).filter(|p| p == &[255, 0, 0]).count();
+        assert!(red > 100, "{red}");
+        assert!(img.data.chunks(3).any(|p| p == [0, 0, 0]));
+    }
+}
