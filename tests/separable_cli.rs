@@ -19,7 +19,8 @@ fn dir_is_empty(dir: &Path) -> bool {
 
 #[test]
 fn kernel_json_contract_matches_the_published_17_tap_kernel() {
-    let out = rtbake(&["kernel", "--samples", "17", "--strength", "0.48,0.41,0.28", "--falloff", "1.0,0.37,0.3", "--json"]);
+    let out =
+        rtbake(&["kernel", "--samples", "17", "--strength", "0.48,0.41,0.28", "--falloff", "1.0,0.37,0.3", "--json"]);
     let v = json(&out);
     let obj = v.as_object().unwrap();
     assert_eq!(obj.keys().collect::<Vec<_>>(), vec!["kernel"]);

@@ -130,8 +130,7 @@ fn f32_offsets_carry_the_shipped_asymmetry_and_f64_is_symmetric() {
 fn all_specs() -> Vec<KernelSpec> {
     let mut v = Vec::new();
     for n in [3, 5, 9, 11, 17, 21, 25, 33, 63] {
-        for params in [PUBLISHED, TABLE_6_1, SeparableParams { strength: [1.0, 0.0, 0.5], falloff: [0.0, 2.0, 0.01] }]
-        {
+        for params in [PUBLISHED, TABLE_6_1, SeparableParams { strength: [1.0, 0.0, 0.5], falloff: [0.0, 2.0, 0.01] }] {
             for precision in [Precision::F32, Precision::F64] {
                 v.push(KernelSpec { precision, ..KernelSpec::new(n, params) });
             }

@@ -56,9 +56,8 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let samples = match args.samples {
         None => None,
         Some(n) => {
-            let n = usize::try_from(n).map_err(|_| {
-                usage_msg(format!("--samples must be an odd number of taps in 3..=63, got {n}"))
-            })?;
+            let n = usize::try_from(n)
+                .map_err(|_| usage_msg(format!("--samples must be an odd number of taps in 3..=63, got {n}")))?;
             // Validate the tap count now, before any work.
             KernelSpec::new(n, rtbake::separable::PUBLISHED).validate().map_err(usage)?;
             Some(n)

@@ -111,7 +111,7 @@ impl ObjectiveSpec {
         check_range("--width", self.width, 1e-5, 1.0, "world units")?;
         check_range("--mm-per-world-unit", self.mm_per_world_unit, 1e-3, 1e6, "mm")?;
         let n = self.grid_nodes;
-        if !(5..=401).contains(&n) || n % 2 == 0 {
+        if !(5..=401).contains(&n) || n.is_multiple_of(2) {
             return Err(InvalidInput::new("--grid-nodes", format!("must be an odd number in 5..=401, got {n}")));
         }
         check_range("--grid-extent-mm", self.grid_extent_mm, 0.05, 100.0, "mm")?;
@@ -186,7 +186,11 @@ pub struct TargetKernel {
 
 impl TargetKernel {
     /// The exact 2-D kernel of a radial profile, normalised to unit total and pixel-filtered (module docs).
-    pub fn from_profile(profile: &dyn RadialProfile, spec: &ObjectiveSpec, description: &str) -> Result<Self, FitError> {
+    pub fn from_profile(
+        profile: &dyn RadialProfile,
+        spec: &ObjectiveSpec,
+        description: &str,
+    ) -> Result<Self, FitError> {
         spec.validate()?;
         let nodes = spec.grid_nodes_mm();
         let values = radial_matrix(profile, &nodes, spec.pixel_variance_mm2())?;
@@ -210,7 +214,8 @@ impl TargetKernel {
             }
             v
         });
-        let description = format!("synthetic separable kernel, strength {:?}, falloff {:?}", params.strength, params.falloff);
+        let description =
+            format!("synthetic separable kernel, strength {:?}, falloff {:?}", params.strength, params.falloff);
         Ok(Self { spec: *spec, nodes_mm: nodes, values, description })
     }
 }
@@ -293,10 +298,10 @@ fn filtered_radial(profile: &dyn RadialProfile, rho: f64, sigma2: f64) -> [f64; 
 const GL8_NODES: [f64; 8] = [
     -0.960_289_856_497_536_3,
     -0.796_666_477_413_626_7,
-    -0.525_532_409_916_329_0,
+    -0.525_532_409_916_329,
     -0.183_434_642_495_649_8,
     0.183_434_642_495_649_8,
-    0.525_532_409_916_329_0,
+    0.525_532_409_916_329,
     0.796_666_477_413_626_7,
     0.960_289_856_497_536_3,
 ];
@@ -304,8 +309,8 @@ const GL8_WEIGHTS: [f64; 8] = [
     0.101_228_536_290_376_3,
     0.222_381_034_453_374_5,
     0.313_706_645_877_887_3,
-    0.362_683_783_378_362_0,
-    0.362_683_783_378_362_0,
+    0.362_683_783_378_362,
+    0.362_683_783_378_362,
     0.313_706_645_877_887_3,
     0.222_381_034_453_374_5,
     0.101_228_536_290_376_3,
@@ -434,7 +439,11 @@ impl CostFunction for ChannelProblem<'_> {
 }
 
 /// Runs Nelder–Mead from `start` with simplex edge `step`; returns (best point, best cost, iterations).
-fn nelder_mead(problem: ChannelProblem<'_>, start: Vector2<f64>, step: f64) -> Result<(Vector2<f64>, f64, u64), FitError> {
+fn nelder_mead(
+    problem: ChannelProblem<'_>,
+    start: Vector2<f64>,
+    step: f64,
+) -> Result<(Vector2<f64>, f64, u64), FitError> {
     let f0 = problem.cost(&start).map_err(|e| FitError::Solver(e.to_string()))?;
     let simplex = vec![start, start + Vector2::new(step, 0.0), start + Vector2::new(0.0, step)];
     let solver = NelderMead::new(simplex)
@@ -478,7 +487,6 @@ pub fn fit(target: &TargetKernel) -> Result<FitResult, FitError> {
     spec.validate()?;
     let model = Model::new(&spec);
     let mut params = SeparableParams { strength: [0.0; 3], falloff: [0.0; 3] };
-    let mut per_channel = [0.0; 3];
     let mut iterations = 0;
     for c in 0..3 {
         let problem = || ChannelProblem { model: &model, nodes: &target.nodes_mm, target: &target.values[c] };
@@ -516,7 +524,6 @@ pub fn fit(target: &TargetKernel) -> Result<FitResult, FitError> {
         let (t, f) = to_params(&p);
         params.strength[c] = t;
         params.falloff[c] = f;
-        per_channel[c] = cost;
     }
     // Report the exact objective of the returned numbers.
     let objective_per_channel = objective(target, &params);
@@ -565,7 +572,8 @@ pub fn singular_value_fractions(n: usize, values: &[f64]) -> (f64, f64) {
 /// The report `rtbake fit separable --json` prints: `strength`, `falloff`, `width`, `objective`,
 /// `objective_table_6_1`, plus `objective_definition`, `first_singular_value_energy` and per-channel details.
 pub fn report_json(target: &TargetKernel, result: &FitResult, sep: Option<&Separability>) -> Value {
-    let ratio = if result.objective_table_6_1() > 0.0 { result.objective() / result.objective_table_6_1() } else { 0.0 };
+    let ratio =
+        if result.objective_table_6_1() > 0.0 { result.objective() / result.objective_table_6_1() } else { 0.0 };
     json!({
         "strength": result.params.strength,
         "falloff": result.params.falloff,
@@ -601,7 +609,9 @@ mod tests {
         assert!((bessel_i0e(10.0) / (2_815.716_628_466_254 * (-10.0f64).exp()) - 1.0).abs() < 1e-13);
         assert!((bessel_i0e(30.0) / (7.816_722_978_239_774e11 * (-30.0f64).exp()) - 1.0).abs() < 1e-12);
         // Both sides of the switch between power series and asymptotic expansion (mpmath values).
-        for (z, v) in [(24.9, 0.080_359_332_611_532_2), (25.0, 0.080_196_773_547_436_7), (25.1, 0.080_035_197_254_296_2)] {
+        for (z, v) in
+            [(24.9, 0.080_359_332_611_532_2), (25.0, 0.080_196_773_547_436_7), (25.1, 0.080_035_197_254_296_2)]
+        {
             assert!((bessel_i0e(z) / v - 1.0).abs() < 1e-13, "{z}: {}", bessel_i0e(z));
         }
         assert!((bessel_i0e(100.0) / 0.039_944_379_299_096_7 - 1.0).abs() < 1e-13);

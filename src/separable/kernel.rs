@@ -40,6 +40,7 @@ pub const DEFAULT_EXPONENT: f64 = 2.0;
 pub const SHADER_STEP_DIVISOR: f64 = 3.0;
 
 /// π as the published kernel generator writes it (cancels in the normalisation).
+#[allow(clippy::approx_constant)]
 const PI_AS_PUBLISHED: f64 = 3.14;
 
 /// Offset added to the falloff before dividing (eq. 6.1's `0.001 + f`).
@@ -110,7 +111,7 @@ impl KernelSpec {
     /// Checks every field, naming the CLI flag (JSON field in brackets) and the accepted range.
     pub fn validate(&self) -> Result<(), InvalidInput> {
         let n = self.samples;
-        if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n) || n % 2 == 0 {
+        if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n) || n.is_multiple_of(2) {
             return Err(InvalidInput::new(
                 "--samples",
                 format!("must be an odd number of taps in {MIN_SAMPLES}..={MAX_SAMPLES}, got {n}"),
@@ -153,7 +154,13 @@ pub struct Kernel {
 
 /// Minimal float abstraction so one generator runs in f32 or f64.
 trait Real:
-    Copy + PartialOrd + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
 {
     fn of(v: f64) -> Self;
     fn to_f64(self) -> f64;
@@ -356,7 +363,9 @@ impl Kernel {
                 "{} taps, centre first, then offsets -RANGE..+RANGE; RANGE = {}, EXPONENT = {}.",
                 s.samples, self.range, s.exponent
             ))
-            .comment("rgb = per-channel weight (each channel sums to 1); a = offset in kernel units (mm of the profile).")
+            .comment(
+                "rgb = per-channel weight (each channel sums to 1); a = offset in kernel units (mm of the profile).",
+            )
             .comment("Runtime step (fixed /3 even when RANGE = 2):")
             .comment("  step = sssWidth * (1 / tan(0.5 * FOVy)) / linearDepth * dir * strength(alpha) / 3;")
             .comment("  uv_i = texcoord + SSSS_KERNEL[i].a * step;  one kernel unit = (2/3) * sssWidth world units.");
