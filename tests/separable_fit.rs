@@ -4,7 +4,9 @@
 use rtbake::diffusion::materials;
 use rtbake::diffusion::sum_of_gaussians::{deon6, SumOfGaussians};
 use rtbake::diffusion::{FdrForm, RadialProfile};
-use rtbake::separable::fit::{first_singular_value_energy, fit, objective, ObjectiveSpec, TargetKernel};
+use rtbake::separable::fit::{
+    falloff_at_width, first_singular_value_energy, fit, objective, ObjectiveSpec, TargetKernel,
+};
 use rtbake::separable::{SeparableParams, PUBLISHED, TABLE_6_1};
 
 fn assert_recovers(known: SeparableParams, spec: &ObjectiveSpec) {
@@ -66,6 +68,27 @@ fn fit_to_deon6_is_not_worse_than_table_6_1() {
 }
 
 #[test]
+fn only_width_times_falloff_matters_and_table_6_1_is_scored_at_its_own_width() {
+    let spec = ObjectiveSpec::default();
+    let target = TargetKernel::from_profile(&deon6(), &spec, "deon6").unwrap();
+    let wide = ObjectiveSpec { width: 0.02, ..spec };
+    let target_wide = TargetKernel::from_profile(&deon6(), &wide, "deon6").unwrap();
+    assert_eq!(target.values, target_wide.values, "the target does not depend on the kernel's width");
+    let moved = SeparableParams {
+        strength: TABLE_6_1.strength,
+        falloff: TABLE_6_1.falloff.map(|f| falloff_at_width(f, 0.014, 0.02)),
+    };
+    let a = objective(&target, &TABLE_6_1);
+    let b = objective(&target_wide, &moved);
+    for c in 0..3 {
+        assert!((a[c] - b[c]).abs() <= 1e-9 * a[c], "{a:?} vs {b:?}");
+    }
+    let r = fit(&target_wide).unwrap();
+    assert!(r.objective() <= r.objective_table_6_1());
+    assert_eq!(r.table_6_1_per_channel, a);
+}
+
+#[test]
 fn any_radial_profile_is_a_target() {
     let spec = ObjectiveSpec { grid_nodes: 31, ..ObjectiveSpec::default() };
     let skin1 = materials::find("skin1").unwrap().dipole(FdrForm::default());
@@ -73,8 +96,7 @@ fn any_radial_profile_is_a_target() {
     let target = TargetKernel::from_profile(profile, &spec, "skin1 dipole").unwrap();
     let r = fit(&target).unwrap();
     assert!(r.objective().is_finite() && r.objective() <= r.objective_table_6_1());
-    // A single wide Gaussian needs much less falloff-scaled width in blue than... the same for all channels:
-    // a grey target gives the same parameters in every channel.
+    // A grey target (the same profile in every channel) gives the same parameters in every channel.
     let grey = SumOfGaussians { variances_mm2: vec![0.0064, 0.3], weights: vec![[0.3; 3], [0.7; 3]] };
     let t = TargetKernel::from_profile(&grey, &spec, "grey").unwrap();
     let g = fit(&t).unwrap();

@@ -161,7 +161,8 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let target = TargetKernel::from_profile(&profile, &p.objective, &description).map_err(map)?;
     let result = fit::fit(&target).map_err(map)?;
     let sep = fit::separability(&profile, &p.objective).map_err(map)?;
-    let report = fit::report_json(&target, &result, Some(&sep));
+    // Rounded to 7 significant digits so the file's bytes do not hinge on the last ulp of the platform's libm.
+    let report = round_json(fit::report_json(&target, &result, Some(&sep)), 7);
     let stem = format!("fit_{}", p.profile);
     let mut files = vec![json_file(
         &format!("{DIR}/{stem}.json"),
@@ -174,6 +175,23 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let source = format!("the separable fit to {} (strength/falloff rounded to 1e-6)", p.profile);
     files.extend(kernel_files(DIR, &format!("{stem}_n{}", p.samples), &k, Some(result.width), &source));
     Ok(files)
+}
+
+/// Every non-integer number of `v` rounded to `digits` significant digits.
+fn round_json(v: Value, digits: i32) -> Value {
+    match v {
+        Value::Number(n) if n.is_f64() => {
+            let x = n.as_f64().unwrap_or(0.0);
+            if x == 0.0 || !x.is_finite() {
+                return Value::Number(n);
+            }
+            let rounded: f64 = format!("{:.*e}", (digits - 1) as usize, x).parse().unwrap_or(x);
+            serde_json::Number::from_f64(rounded).map(Value::Number).unwrap_or(Value::Null)
+        }
+        Value::Array(a) => Value::Array(a.into_iter().map(|x| round_json(x, digits)).collect()),
+        Value::Object(o) => Value::Object(o.into_iter().map(|(k, x)| (k, round_json(x, digits))).collect()),
+        other => other,
+    }
 }
 
 /// Fitted parameters rounded to 6 decimals before generating taps (stable bytes across platforms' libm).
@@ -210,6 +228,27 @@ mod tests {
         let f = default_fit_params();
         let back: FitParams = serde_json::from_value(f.clone()).unwrap();
         assert_eq!(serde_json::to_value(&back).unwrap(), f);
+    }
+
+    #[test]
+    fn fit_asset_is_deterministic_and_not_worse_than_table_6_1() {
+        let a = bake_fit(&default_fit_params()).unwrap();
+        let b = bake_fit(&default_fit_params()).unwrap();
+        assert_eq!(a, b);
+        let paths: Vec<&str> = a.iter().map(|f| f.path.as_str()).collect();
+        assert_eq!(
+            paths,
+            [
+                "sss/separable/fit_deon6.json",
+                "sss/separable/fit_deon6_n17.json",
+                "sss/separable/fit_deon6_n17.hlsl",
+                "sss/separable/fit_deon6_n17.glsl",
+                "sss/separable/fit_deon6_n17.wgsl"
+            ]
+        );
+        let v: Value = serde_json::from_slice(&a[0].bytes).unwrap();
+        assert!(v["objective"].as_f64().unwrap() <= v["objective_table_6_1"].as_f64().unwrap());
+        assert_eq!(round_json(serde_json::json!([0.123456789, 3, 2.0]), 3), serde_json::json!([0.123, 3, 2.0]));
     }
 
     #[test]
