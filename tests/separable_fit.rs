@@ -5,7 +5,7 @@ use rtbake::diffusion::materials;
 use rtbake::diffusion::sum_of_gaussians::{deon6, SumOfGaussians};
 use rtbake::diffusion::{FdrForm, RadialProfile};
 use rtbake::separable::fit::{
-    falloff_at_width, first_singular_value_energy, fit, objective, ObjectiveSpec, TargetKernel,
+    falloff_at_width, first_singular_value_energy, fit, objective, ObjectiveSpec, TargetKernel, Weighting,
 };
 use rtbake::separable::{SeparableParams, PUBLISHED, TABLE_6_1};
 
@@ -35,6 +35,9 @@ fn recovers_known_parameters_from_a_synthetic_target() {
     assert_recovers(TABLE_6_1, &spec);
     assert_recovers(PUBLISHED, &spec);
     assert_recovers(SeparableParams { strength: [0.93, 0.55, 0.35], falloff: [0.81, 0.24, 0.6] }, &spec);
+    // Area weighting.
+    let area = ObjectiveSpec { weighting: Weighting::Area, ..spec };
+    assert_recovers(SeparableParams { strength: [0.7, 0.95, 0.4], falloff: [0.5, 0.3, 0.9] }, &area);
     // Another width and a coarser, uniform grid.
     let other = ObjectiveSpec { width: 0.02, grid_nodes: 31, grid_exponent: 1.0, pixel_mm: 0.1, ..spec };
     assert_recovers(SeparableParams { strength: [0.62, 0.81, 0.47], falloff: [1.3, 0.42, 0.17] }, &other);
@@ -86,6 +89,32 @@ fn only_width_times_falloff_matters_and_table_6_1_is_scored_at_its_own_width() {
     let r = fit(&target_wide).unwrap();
     assert!(r.objective() <= r.objective_table_6_1());
     assert_eq!(r.table_6_1_per_channel, a);
+}
+
+#[test]
+fn area_weighting_is_a_quadrature_of_the_integral() {
+    // With area weights the objective approximates eq. 6.2's integral, so it barely depends on the node law.
+    let p = SeparableParams { strength: [0.9, 0.8, 0.7], falloff: [0.9, 0.5, 0.3] };
+    let value = |exponent: f64, nodes: usize| -> f64 {
+        let spec = ObjectiveSpec {
+            weighting: Weighting::Area,
+            grid_exponent: exponent,
+            grid_nodes: nodes,
+            pixel_mm: 0.3,
+            ..ObjectiveSpec::default()
+        };
+        let t = TargetKernel::from_profile(&deon6(), &spec, "deon6").unwrap();
+        objective(&t, &p).iter().sum()
+    };
+    let fine = value(2.0, 201);
+    assert!((value(1.5, 201) / fine - 1.0).abs() < 0.01, "{} vs {fine}", value(1.5, 201));
+    // The plain sum does depend on it (that is its purpose: more samples near 0 weigh more).
+    let plain = |exponent: f64| -> f64 {
+        let spec = ObjectiveSpec { grid_exponent: exponent, ..ObjectiveSpec::default() };
+        let t = TargetKernel::from_profile(&deon6(), &spec, "deon6").unwrap();
+        objective(&t, &p).iter().sum()
+    };
+    assert!((plain(1.0) / plain(2.0) - 1.0).abs() > 0.1);
 }
 
 #[test]

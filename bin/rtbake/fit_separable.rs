@@ -3,7 +3,7 @@
 
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use rtbake::diffusion::{materials, sum_of_gaussians, FdrForm, RadialProfile};
-use rtbake::separable::fit::{self, ObjectiveSpec, TargetKernel};
+use rtbake::separable::fit::{self, ObjectiveSpec, TargetKernel, Weighting};
 use rtbake::separable::kernel::{self, KernelSpec};
 use std::path::PathBuf;
 
@@ -33,12 +33,21 @@ pub struct FitSeparableArgs {
     /// Pixel footprint, mm (the delta term and both kernels are filtered by a Gaussian of variance pixel²/12).
     #[arg(long, default_value_t = ObjectiveSpec::default().pixel_mm, allow_negative_numbers = true)]
     pixel_mm: f64,
+    /// Residual weighting: samples (plain sum, eq. 6.3) or area (cell areas, ≈ eq. 6.2's integral).
+    #[arg(long, value_enum, default_value_t = WeightingArg::Samples)]
+    weighting: WeightingArg,
     /// Also generate the fitted kernel with this many taps (odd, 3..=63).
     #[arg(long, allow_negative_numbers = true)]
     samples: Option<i64>,
     /// Write fit_<target>.json (and the kernel files with --samples) into DIR, atomically.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum WeightingArg {
+    Samples,
+    Area,
 }
 
 pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
@@ -51,6 +60,10 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
         grid_extent_mm: args.grid_extent_mm,
         grid_exponent: args.grid_exponent,
         pixel_mm: args.pixel_mm,
+        weighting: match args.weighting {
+            WeightingArg::Samples => Weighting::Samples,
+            WeightingArg::Area => Weighting::Area,
+        },
     };
     spec.validate().map_err(usage)?;
     let samples = match args.samples {

@@ -28,8 +28,10 @@
 //! - **Sample set A_s.** The tensor grid {(x_i, x_j)} of 1-D nodes x_k = X·sign(τ_k)·|τ_k|^e,
 //!   τ_k = −1 + 2k/(n − 1) (the shader's own offset law; default n = 41, X = 4 mm, e = 2: spacing 0.01 mm at the
 //!   centre, 0.39 mm at the edge).
-//! - **Weighting.** None beyond the sample density (eq. 6.3 is a plain sum): the objective is
+//! - **Weighting.** Default none beyond the sample density (eq. 6.3 is a plain sum): the objective is
 //!   Σ_c Σ_{i,j} (S̃_c(x_i, x_j) − s̃_c(x_i)·s̃_c(x_j))² in mm⁻⁴, where ~ marks pixel-filtered densities.
+//!   [`Weighting::Area`] multiplies each term by the trapezoid cell area a_i·a_j, approximating eq. 6.2's integral
+//!   over [−X, X]² instead (mm⁻²).
 //!
 //! # Solver
 //!
@@ -89,6 +91,30 @@ pub struct ObjectiveSpec {
     pub grid_exponent: f64,
     /// Pixel footprint h, mm; the pixel filter is a Gaussian of variance h²/12.
     pub pixel_mm: f64,
+    /// How samples are weighted (default: plain sum, eq. 6.3).
+    #[serde(default)]
+    pub weighting: Weighting,
+}
+
+/// Weighting of the squared residuals over the sample set.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Weighting {
+    /// Plain sum over the samples (eq. 6.3): the node density (higher near 0) weights the centre.
+    #[default]
+    Samples,
+    /// Each sample weighted by its cell area a_i·a_j (trapezoid rule), approximating eq. 6.2's integral over the
+    /// square [−X, X]² independently of how the nodes are spaced.
+    Area,
+}
+
+impl Weighting {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Samples => "samples",
+            Self::Area => "area",
+        }
+    }
 }
 
 impl Default for ObjectiveSpec {
@@ -101,6 +127,7 @@ impl Default for ObjectiveSpec {
             grid_exponent: 2.0,
             // A 125 mm head filling a 720-pixel viewport (the thesis' α calibration: 20° FOV, 720 px).
             pixel_mm: 125.0 / 720.0,
+            weighting: Weighting::Samples,
         }
     }
 }
@@ -141,6 +168,21 @@ impl ObjectiveSpec {
         v
     }
 
+    /// Per-node weights of the sum: 1 (samples) or the trapezoid cell width (area), mm.
+    pub fn node_weights(&self, nodes: &[f64]) -> Vec<f64> {
+        let n = nodes.len();
+        (0..n)
+            .map(|i| match self.weighting {
+                Weighting::Samples => 1.0,
+                Weighting::Area => {
+                    let left = if i > 0 { nodes[i] - nodes[i - 1] } else { 0.0 };
+                    let right = if i + 1 < n { nodes[i + 1] - nodes[i] } else { 0.0 };
+                    0.5 * (left + right)
+                }
+            })
+            .collect()
+    }
+
     /// The recorded definition of the objective (for reports and provenance).
     pub fn definition(&self, target: &str) -> Value {
         let nodes = self.grid_nodes_mm();
@@ -168,7 +210,12 @@ impl ObjectiveSpec {
                 "min_spacing_mm": nodes[half + 1] - nodes[half],
                 "max_spacing_mm": nodes[nodes.len() - 1] - nodes[nodes.len() - 2],
             },
-            "weighting": "none (plain sum as eq. 6.3); the sample density, higher near 0, weights the centre",
+            "weighting": match self.weighting {
+                Weighting::Samples => "samples: plain sum as eq. 6.3 (every sample weight 1); the node density, \
+                    higher near 0, weights the centre",
+                Weighting::Area => "area: each sample weighted by its trapezoid cell area a_i * a_j (mm^2), \
+                    approximating eq. 6.2's integral over the square; objective in mm^-2",
+            },
         })
     }
 }
@@ -390,16 +437,18 @@ fn gauss_1d(variance: f64, x: f64) -> f64 {
     (-x * x / (2.0 * variance)).exp() / (2.0 * PI * variance).sqrt()
 }
 
-/// Σ_{i,j} (T[i,j] − s_i s_j)² for one channel.
-fn channel_objective(target: &[f64], s: &[f64]) -> f64 {
+/// Σ_{i,j} w_i·w_j·(T[i,j] − s_i s_j)² for one channel.
+fn channel_objective(target: &[f64], s: &[f64], weights: &[f64]) -> f64 {
     let n = s.len();
     let mut acc = 0.0;
     for i in 0..n {
         let row = &target[i * n..(i + 1) * n];
+        let mut acc_row = 0.0;
         for j in 0..n {
             let d = row[j] - s[i] * s[j];
-            acc += d * d;
+            acc_row += weights[j] * d * d;
         }
+        acc += weights[i] * acc_row;
     }
     acc
 }
@@ -413,9 +462,10 @@ pub fn objective(target: &TargetKernel, params: &SeparableParams) -> [f64; 3] {
 /// (made for width 0.014) scores when the fit's fixed width differs.
 pub fn objective_at_width(target: &TargetKernel, params: &SeparableParams, width: f64) -> [f64; 3] {
     let model = Model::new(&ObjectiveSpec { width, ..target.spec });
+    let weights = target.spec.node_weights(&target.nodes_mm);
     [0, 1, 2].map(|c| {
         let s = model.filtered(&target.nodes_mm, params.strength[c], params.falloff[c]);
-        channel_objective(&target.values[c], &s)
+        channel_objective(&target.values[c], &s, &weights)
     })
 }
 
@@ -423,6 +473,7 @@ pub fn objective_at_width(target: &TargetKernel, params: &SeparableParams, width
 struct ChannelProblem<'a> {
     model: &'a Model,
     nodes: &'a [f64],
+    weights: &'a [f64],
     target: &'a [f64],
 }
 
@@ -440,7 +491,7 @@ impl CostFunction for ChannelProblem<'_> {
     type Output = f64;
     fn cost(&self, p: &Self::Param) -> Result<f64, ArgminError> {
         let (t, f) = to_params(p);
-        Ok(channel_objective(self.target, &self.model.filtered(self.nodes, t, f)))
+        Ok(channel_objective(self.target, &self.model.filtered(self.nodes, t, f), self.weights))
     }
 }
 
@@ -498,10 +549,12 @@ pub fn fit(target: &TargetKernel) -> Result<FitResult, FitError> {
     let spec = target.spec;
     spec.validate()?;
     let model = Model::new(&spec);
+    let weights = spec.node_weights(&target.nodes_mm);
     let mut params = SeparableParams { strength: [0.0; 3], falloff: [0.0; 3] };
     let mut iterations = 0;
     for c in 0..3 {
-        let problem = || ChannelProblem { model: &model, nodes: &target.nodes_mm, target: &target.values[c] };
+        let problem =
+            || ChannelProblem { model: &model, nodes: &target.nodes_mm, weights: &weights, target: &target.values[c] };
         let mut starts = vec![
             // Table 6.1 at its own width, moved to the fixed width (same k·(0.001 + f)), so the fit can never be
             // worse than Table 6.1 whenever that falloff is >= 0.
