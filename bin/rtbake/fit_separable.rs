@@ -30,7 +30,8 @@ pub struct FitSeparableArgs {
     /// Node law exponent e: x = extent·sign(τ)|τ|^e (1 = uniform; larger = denser near 0).
     #[arg(long, default_value_t = ObjectiveSpec::default().grid_exponent, allow_negative_numbers = true)]
     grid_exponent: f64,
-    /// Pixel footprint, mm (the delta term and both kernels are filtered by a Gaussian of variance pixel²/12).
+    /// Pixel footprint, mm (default 125/720: a 125 mm head filling 720 px); the delta term and both kernels are
+    /// filtered by a Gaussian of variance pixel²/12.
     #[arg(long, default_value_t = ObjectiveSpec::default().pixel_mm, allow_negative_numbers = true)]
     pixel_mm: f64,
     /// Residual weighting: samples (plain sum, eq. 6.3) or area (cell areas, ≈ eq. 6.2's integral).

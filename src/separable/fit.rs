@@ -13,7 +13,9 @@
 //!   where sssWidth 0.012 gives ≈ 1 mm per kernel unit). So k = (2/3)·width·mm_per_world_unit mm per kernel unit.
 //! - **Model (eq. 6.1).** s_c(x) = t_c·P̂(x / (k·(0.001 + f_c))) + (1 − t_c)·δ(x), where P̂ is the kernel profile
 //!   of [`super::kernel`] (d'Eon's red Gaussians without the narrowest, each exp(−u²/2v)/(2πv), evaluated along a
-//!   line exactly as the shader does) normalised to unit integral over the line, so ∫ s = 1 and ∬ s⊗s = 1.
+//!   line exactly as the shader does, so the 1-D weights are ∝ w/√v) normalised to unit integral over the line,
+//!   so ∫ s = 1 and ∬ s⊗s = 1. The runtime kernel additionally truncates P at ±RANGE kernel units and
+//!   renormalises over its N taps; the fit uses the untruncated model.
 //!   Width and falloff only appear as the product k·(0.001 + f): **width is fixed**, strength and falloff are fitted.
 //! - **Target.** S_c(x, y) = R_c(√(x² + y²)) / R̂_c(0): the target's radial profile R (any
 //!   [`RadialProfile`]) on the plane, normalised to unit total per channel (d'Eon's convention: colour comes from
@@ -41,17 +43,17 @@
 //! to 1). Why Nelder–Mead: two unknowns, a cheap objective (n² products), an optimum that sits on or near a bound,
 //! and no box-constrained quasi-Newton method in argmin; a derivative-free simplex needs no Jacobian of the
 //! reparameterisation, which vanishes exactly at the bounds and would stall gradient methods there. The problem
-//! is not convex, so the simplex starts from Table 6.1's value, the published preset and a grid of 20 points,
-//! and the best result is polished by restarts with a small simplex. Starting from Table 6.1 guarantees the fit
-//! is never worse than Table 6.1 under this objective.
+//! is not convex, so the simplex starts from Table 6.1's value (moved to the fixed width, same k·(0.001 + f)), the
+//! published preset and a grid of 20 points, and the best result is polished by restarts with a small simplex.
+//! Starting from Table 6.1 guarantees the fit is never worse than Table 6.1 under this objective.
 //!
 //! # Separability
 //!
 //! [`separability`] returns σ₁²/Σσᵢ² (energy) and σ₁/Σσᵢ (share) of each channel's pixel-filtered target
 //! kernel matrix K[i, j] = S̃(x_i, x_j) on a uniform grid of pixel footprint h over [−X, X]² (nalgebra SVD). The
 //! thesis' Figure 6.2 reports ~80 % "energy" for skin; for d'Eon's profile at the default pixel the squared
-//! energy is 97.8 / 99.2 / 99.7 % (R, G, B) while the share is 84 / 91 / 95 %, so the thesis' figure most likely
-//! plots the share.
+//! energy is 97.8 / 99.2 / 99.7 % (R, G, B) while the share is 84 / 91 / 95 %: the thesis' figure is closer to
+//! the share; both are reported.
 
 use crate::diffusion::RadialProfile;
 use crate::error::{check_range, InvalidInput};
