@@ -14,4 +14,5 @@ pub mod image_buf;
 pub mod io;
 pub mod manifest;
 pub mod plot;
+pub mod separable;
 pub mod transmittance;

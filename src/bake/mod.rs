@@ -90,11 +90,13 @@ pub fn registry() -> Vec<Asset> {
     v.extend(aa::assets());
     v.extend(gaussians::assets());
     v.extend(transmittance::assets());
+    v.extend(separable::assets());
     v
 }
 
 pub mod aa;
 pub mod gaussians;
+pub mod separable;
 pub mod transmittance;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
