@@ -11,3 +11,5 @@ pub mod error;
 pub mod image_buf;
 pub mod io;
 pub mod manifest;
+pub mod skin_color;
+pub mod spectral;
