@@ -92,8 +92,8 @@ fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Imag
     json!({
         "asset": SKIN_COLOR_LUT,
         "description": "Skin colour lookup table (Jimenez 2012, section 7.6, eq. 7.7, Fig. 7.9): total diffuse \
-            reflectance of the spectral two-layer skin model (Donner et al. 2008) integrated against D65 and the CIE \
-            1931 2-degree observer, as linear sRGB albedo.",
+            reflectance of the spectral two-layer skin model (Donner et al. 2008) integrated against an illuminant and \
+            the CIE 1931 2-degree observer (see model.colorimetry), as linear sRGB albedo.",
         "files": {
             "linear_f32": format!("{LUT_STEM}.exr"),
             "linear_f16": format!("{LUT_STEM}_f16.exr"),
@@ -135,8 +135,12 @@ fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Imag
             "adding": "symmetric: R = R1 + T1^2 R2 / (1 - R1 R2); directional: R = R1 + T1 R2 T1up / (1 - R1up R2)",
             "dermis_bottom": "relative index eta_dermis / eta_below_dermis (default 1 = index-matched: a \
                 semi-infinite dermis has no bottom face)",
-            "colorimetry": "380-780 nm, CIE 1931 2-degree observer, Y(perfect white) = 1, XYZ -> linear sRGB with \
-                [3.2406 -1.5372 -0.4986; -0.9689 1.8758 0.0415; 0.0557 -0.2040 1.0570]",
+            "colorimetry": format!(
+                "illuminant {}, {} nm steps over 380-780 nm, CIE 1931 2-degree observer, Y(perfect white) = 1, XYZ -> \
+                 linear sRGB with [3.2406 -1.5372 -0.4986; -0.9689 1.8758 0.0415; 0.0557 -0.2040 1.0570]",
+                serde_json::to_value(p.illuminant).expect("enum serialises").as_str().unwrap_or("?"),
+                p.spectral_step_nm
+            ),
             "data": "hemoglobin: S. Prahl (OMLC 1999, Gratzer & Kollias), 2 nm, interpolated linearly to 1 nm; CIE \
                 1931 2-degree CMFs and D65: CIE 018:2019 / ISO 11664-2 (1 nm)",
         },

@@ -202,36 +202,47 @@ impl TwoLayerSkinModel {
         self.check_points(&[(0.0, 0.0), (cm_max, 0.0), (0.0, chd_max), (cm_max, chd_max)])
     }
 
-    /// The validity check at the given (Cm, Chd) points (no-op with [`ThinLayer::ClampTransmittance`]).
+    /// The validity check at the given (Cm, Chd) points (no-op with [`ThinLayer::ClampTransmittance`]); the error
+    /// names the wavelength with the longest mean free path and the span of failing wavelengths.
     fn check_points(&self, points: &[(f64, f64)]) -> Result<(), SkinColorError> {
         if self.options.thin_layer == ThinLayer::ClampTransmittance {
             return Ok(());
         }
-        for band in &self.bands {
-            for &(cm, chd) in points {
-                let che = self.physiology.epidermal_hemoglobin(chd);
-                for (layer, field, slab) in [
-                    (
-                        "epidermis",
-                        "epidermis_thickness_mm",
-                        self.epidermis_slab(band, self.epidermis_sigma_a(band, cm, che)),
-                    ),
-                    ("dermis", "dermis_thickness_mm", self.dermis_slab(band, chd)),
-                ] {
+        for (layer, field) in [("epidermis", "epidermis_thickness_mm"), ("dermis", "dermis_thickness_mm")] {
+            // (worst l, its λ, Cm, Chd), first and last failing λ.
+            let mut worst: Option<(f64, f64, f64, f64)> = None;
+            let mut span = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut thickness = 0.0;
+            for band in &self.bands {
+                for &(cm, chd) in points {
+                    let slab = if layer == "epidermis" {
+                        let che = self.physiology.epidermal_hemoglobin(chd);
+                        self.epidermis_slab(band, self.epidermis_sigma_a(band, cm, che))
+                    } else {
+                        self.dermis_slab(band, chd)
+                    };
                     let l = 1.0 / slab.sigma_t_prime();
+                    thickness = slab.thickness_mm;
                     if slab.thickness_mm <= l {
-                        return Err(InvalidInput::new(
-                            field,
-                            format!(
-                                "must exceed the {layer}'s transport mean free path 1/sigma_t' = {l:.5} mm at {} nm \
-                                 (Cm = {cm}, Chd = {chd}) for the multipole diffusion source to lie inside the layer, \
-                                 got {} (thin_layer = clamp-transmittance evaluates it anyway)",
-                                band.spectra.lambda_nm, slab.thickness_mm
-                            ),
-                        )
-                        .into());
+                        let lambda = band.spectra.lambda_nm;
+                        span = (span.0.min(lambda), span.1.max(lambda));
+                        if worst.is_none_or(|w| l > w.0) {
+                            worst = Some((l, lambda, cm, chd));
+                        }
                     }
                 }
+            }
+            if let Some((l, lambda, cm, chd)) = worst {
+                return Err(InvalidInput::new(
+                    field,
+                    format!(
+                        "must exceed the {layer}'s transport mean free path 1/sigma_t' = {l:.5} mm at {lambda} nm \
+                         (Cm = {cm}, Chd = {chd}; too thin from {} to {} nm) for the multipole diffusion source to lie \
+                         inside the layer, got {thickness} (thin_layer = clamp-transmittance evaluates it anyway)",
+                        span.0, span.1
+                    ),
+                )
+                .into());
             }
         }
         Ok(())
