@@ -93,8 +93,8 @@ fn sensitivity_weighted_rgb_is_a_mean_of_the_spectrum() {
     assert!(a[0] < a[1] && a[1] < a[2], "{a:?}");
     assert!(s[0] < s[1] && s[1] < s[2], "{s:?}");
     assert!(rgb.dermis.sigma_a_per_mm[0] < rgb.dermis.sigma_a_per_mm[1], "{:?}", rgb.dermis.sigma_a_per_mm);
-    for c in 0..3 {
-        assert!(close(rgb.dermis.sigma_s_prime_per_mm[c], 0.5 * s[c], 1e-12));
+    for (d, e) in rgb.dermis.sigma_s_prime_per_mm.iter().zip(s) {
+        assert!(close(*d, 0.5 * e, 1e-12));
     }
 
     // With no melanin and no blood the epidermis is pure baseline: its RGB σa is the weighted mean of the baseline

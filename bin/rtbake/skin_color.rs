@@ -25,7 +25,14 @@ pub struct SkinColorArgs {
     /// Bake the lookup table with these parameters into DIR (files under DIR/skin/, written atomically).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Model and table parameters (boxed: keeps the subcommand enum small).
+    #[command(flatten)]
+    pub model: Box<ModelFlags>,
+}
 
+/// Every model/table parameter; each flag is the JSON field of `SkinColorParams` in kebab case.
+#[derive(clap::Args)]
+pub struct ModelFlags {
     /// βm: eumelanin share of the melanin, 0..=1 [default: 0.61].
     #[arg(long, allow_negative_numbers = true)]
     pub melanin_blend: Option<f64>,
@@ -131,7 +138,7 @@ fn parse_resolution(s: &str) -> anyhow::Result<(u64, u64)> {
 }
 
 /// Flags → validated-later library parameters.
-fn params(a: &SkinColorArgs) -> anyhow::Result<SkinColorParams> {
+fn params(a: &ModelFlags) -> anyhow::Result<SkinColorParams> {
     let mut p = SkinColorParams::default();
     macro_rules! set {
         ($($f:ident),*) => { $( if let Some(v) = a.$f { p.$f = v; } )* };
@@ -209,7 +216,7 @@ fn flag_error(e: SkinColorError) -> anyhow::Error {
 }
 
 pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
-    let p = params(&a)?;
+    let p = params(&a.model)?;
     let point = match (a.melanin, a.hemoglobin) {
         (Some(cm), Some(chd)) => Some((cm, chd)),
         (None, None) => None,

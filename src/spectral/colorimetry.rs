@@ -55,7 +55,7 @@ impl SpectralGrid {
     /// `step_nm` must divide the 400 nm range (1, 2, 4, 5, 8, 10, 16, 20, 25, 40, 50 … ≤ 50).
     pub fn new(step_nm: u32) -> Result<Self, InvalidInput> {
         let span = LAST_NM - FIRST_NM;
-        if step_nm == 0 || step_nm > 50 || span % step_nm != 0 {
+        if step_nm == 0 || step_nm > 50 || !span.is_multiple_of(step_nm) {
             return Err(InvalidInput::new(
                 "spectral_step_nm",
                 format!("must divide the {span} nm range 380..=780 nm and be in 1..=50 nm, got {step_nm}"),

@@ -304,11 +304,11 @@ pub fn two_layer_skin_rgb(
     let mut derm = ([0.0; 3], [0.0; 3]);
     for (lambda, w) in reduction.weights()? {
         let k = physiology.coefficients_at(lambda, cm, chd).expect("wavelengths are checked to lie in the table");
-        for c in 0..3 {
-            epi.0[c] += w[c] * k.epidermis.sigma_a_per_mm;
-            epi.1[c] += w[c] * k.epidermis.sigma_s_prime_per_mm;
-            derm.0[c] += w[c] * k.dermis.sigma_a_per_mm;
-            derm.1[c] += w[c] * k.dermis.sigma_s_prime_per_mm;
+        for (c, wc) in w.into_iter().enumerate() {
+            epi.0[c] += wc * k.epidermis.sigma_a_per_mm;
+            epi.1[c] += wc * k.epidermis.sigma_s_prime_per_mm;
+            derm.0[c] += wc * k.dermis.sigma_a_per_mm;
+            derm.1[c] += wc * k.dermis.sigma_s_prime_per_mm;
         }
     }
     Ok(TwoLayerSkinRgb {
