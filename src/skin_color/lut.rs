@@ -96,7 +96,7 @@ impl LutLayout {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LutEvaluation {
-    /// Exact-series totals tabulated per wavelength against ln σa and interpolated (see
+    /// Exact-series totals tabulated per wavelength against √σa and interpolated (see
     /// `two_layer::EpidermisTable`; differs from `direct` by < 1e−7 in linear RGB). Default.
     #[default]
     Tabulated,
