@@ -81,6 +81,7 @@ impl LutLayout {
 
     /// Eq. 7.7: the axis coordinates (u, v) ∈ [0, 1]² of (Cm, Chd) (before the texel-centre mapping).
     pub fn uv(&self, cm: f64, chd: f64) -> (f64, f64) {
+        // eq. 7.7 (normalised by the axis maxima in the default form)
         ((cm / self.index_form.melanin_max()).cbrt(), (chd / self.index_form.hemoglobin_max()).cbrt())
     }
 

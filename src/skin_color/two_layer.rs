@@ -12,6 +12,10 @@
 //!    directional          R = R1↓ + T1↓ R2 T1↑ / (1 − R1↑ R2)   (R1↑, T1↑: the epidermis lit from below);
 //! 4. XYZ under D65 (or E) with the CIE 1931 2° observer, Y(white) = 1, then linear sRGB (`spectral::colorimetry`).
 //!
+//! Point queries ([`TwoLayerSkinModel::evaluate`]) call the series for every wavelength. Whole tables
+//! ([`TwoLayerSkinModel::linear_rgb_grid`]) compute the dermis once per row and take the epidermis totals from an
+//! [`EpidermisTable`] per wavelength (exact-series nodes, cubic interpolation in √σa, agreement to f32 rounding).
+//!
 //! Validity of the thin epidermis: the multipole places its source at depth l = 1/σt′, which must lie inside the
 //! layer (d > l). With the defaults the weakest case is λ = 780 nm, Cm = Chd = 0: σt′ = 4.025 mm⁻¹, l = 0.2484 mm
 //! against d = 0.25 mm, so the published configuration is valid at every wavelength, by a margin of 0.6 %. Thinner
@@ -179,7 +183,9 @@ impl TwoLayerSkinModel {
     fn add_layers(&self, e: [f64; 4], r2: f64) -> f64 {
         let [r1, t1, r1_up, t1_up] = e;
         match self.options.adding {
+            // DJ05 adding as printed (specs/diffusion.md, "symmetric"), at k = 0.
             Adding::Symmetric => r1 + t1 * t1 * r2 / (1.0 - r1 * r2),
+            // Kubelka 1954 directional adding, at k = 0.
             Adding::Directional => r1 + t1 * r2 * t1_up / (1.0 - r1_up * r2),
         }
     }

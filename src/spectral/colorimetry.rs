@@ -116,6 +116,7 @@ impl ColorWeights {
                 *c *= k;
             }
         }
+        // IEC 61966-2-1 XYZ → linear sRGB folded into the weights.
         let linear_srgb = xyz.iter().map(|w| mat3_mul(&SRGB_FROM_XYZ, *w)).collect();
         Self { grid, illuminant, xyz, linear_srgb }
     }
