@@ -5,6 +5,7 @@ Usage: python3 scripts/gen_spectral_data.py [DATA_DIR]   (run from the crate roo
 The test `spectral::data::tests` (tests/skin_spectral_data.rs) re-reads the same files and fails if the embedded copy is stale.
 """
 import os
+import subprocess
 import sys
 
 data_dir = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("RTBAKE_DATA_DIR", "../shared/data")
@@ -89,4 +90,6 @@ o.append("];")
 o.append("")
 with open("src/spectral/data.rs", "w", encoding="utf-8") as f:
     f.write("\n".join(o))
+# Format like the rest of the crate so `cargo fmt --check` and regeneration agree.
+subprocess.run(["rustfmt", "--edition", "2021", "src/spectral/data.rs"], check=True)
 print("wrote src/spectral/data.rs")
