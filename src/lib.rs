@@ -16,3 +16,5 @@ pub mod manifest;
 pub mod plot;
 pub mod separable;
 pub mod transmittance;
+pub mod skin_color;
+pub mod spectral;

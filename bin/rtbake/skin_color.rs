@@ -1,10 +1,307 @@
-//! `rtbake skin-color`: not implemented yet.
+//! `rtbake skin-color`: evaluate the spectral two-layer skin model at one (Cm, Chd) point, and/or bake the
+//! melanin × hemoglobin lookup table into `--out DIR` (thesis §7.6, eq. 7.7). Glue only: flags → `SkinColorParams`
+//! → library.
 
-use crate::cli::{usage_msg, Ctx};
+use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
+use rtbake::diffusion::FdrForm;
+use rtbake::error::InvalidInput;
+use rtbake::skin_color::lut::{IndexForm, LutEvaluation};
+use rtbake::skin_color::two_layer::{Adding, SkinColorError, ThinLayer};
+use rtbake::skin_color::SkinColorParams;
+use rtbake::spectral::colorimetry::Illuminant;
+use std::path::PathBuf;
 
 #[derive(clap::Args)]
-pub struct SkinColorArgs {}
+pub struct SkinColorArgs {
+    /// Melanin volume fraction Cm of the point to evaluate, 0..=0.5 (Table 7.1).
+    #[arg(long, allow_negative_numbers = true, value_name = "CM")]
+    pub melanin: Option<f64>,
+    /// Dermal hemoglobin volume fraction Chd of the point to evaluate, 0..=0.32 (Table 7.1).
+    #[arg(long, allow_negative_numbers = true, value_name = "CHD")]
+    pub hemoglobin: Option<f64>,
+    /// Also output the reflectance spectrum R(λ), 380–780 nm (with --json: "wavelength_nm" and "reflectance").
+    #[arg(long)]
+    pub spectrum: bool,
+    /// Bake the lookup table with these parameters into DIR (files under DIR/skin/, written atomically).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Model and table parameters (boxed: keeps the subcommand enum small).
+    #[command(flatten)]
+    pub model: Box<ModelFlags>,
+}
 
-pub fn run(_args: SkinColorArgs, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("rtbake skin-color: not implemented yet"))
+/// Every model/table parameter; each flag is the JSON field of `SkinColorParams` in kebab case.
+#[derive(clap::Args)]
+pub struct ModelFlags {
+    /// βm: eumelanin share of the melanin, 0..=1 [default: 0.61].
+    #[arg(long, allow_negative_numbers = true)]
+    pub melanin_blend: Option<f64>,
+    /// Che / Chd: epidermal hemoglobin as a fraction of dermal hemoglobin, 0..=1 [default: 0.25].
+    #[arg(long, allow_negative_numbers = true)]
+    pub epidermal_hemoglobin_ratio: Option<f64>,
+    /// γ: blood oxygenation, 0..=1 [default: 0.75].
+    #[arg(long, allow_negative_numbers = true)]
+    pub oxygenation: Option<f64>,
+    /// Hemoglobin concentration of whole blood, g/L, > 0 [default: 150].
+    #[arg(long, allow_negative_numbers = true)]
+    pub hemoglobin_g_per_l: Option<f64>,
+    /// Molar mass of hemoglobin, g/mol, > 0 [default: 64500].
+    #[arg(long, allow_negative_numbers = true)]
+    pub hemoglobin_molar_mass_g_per_mol: Option<f64>,
+    /// Epidermis thickness, mm, > 1/σt′ at every wavelength [default: 0.25].
+    #[arg(long, allow_negative_numbers = true)]
+    pub epidermis_thickness_mm: Option<f64>,
+    /// Dermis thickness, mm, > 0 [default: 20].
+    #[arg(long, allow_negative_numbers = true)]
+    pub dermis_thickness_mm: Option<f64>,
+    /// Refractive index of the epidermis (air above), 0.1..=10 [default: 1.4].
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta_epidermis: Option<f64>,
+    /// Refractive index of the dermis (equal to the epidermis = index-matched interface) [default: 1.4].
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta_dermis: Option<f64>,
+    /// Refractive index below the dermis (equal to the dermis = semi-infinite, matched bottom) [default: 1.4].
+    #[arg(long, allow_negative_numbers = true)]
+    pub eta_below_dermis: Option<f64>,
+    /// Illuminant of the colorimetry [default: d65].
+    #[arg(long, value_enum)]
+    pub illuminant: Option<IlluminantArg>,
+    /// Layer adding at k = 0: symmetric R1 + T1²R2/(1 − R1R2) (published) or directional [default: symmetric].
+    #[arg(long, value_enum)]
+    pub adding: Option<AddingArg>,
+    /// Wavelength step of the 380–780 nm integration, nm; must divide 400 [default: 1].
+    #[arg(long)]
+    pub spectral_step_nm: Option<u32>,
+    /// Fdr polynomial of the boundary conditions [default: dj05].
+    #[arg(long, value_enum)]
+    pub fdr_form: Option<FdrArg>,
+    /// Epidermis thinner than 1/σt′: reject (error) or clamp-transmittance [default: reject].
+    #[arg(long, value_enum)]
+    pub thin_layer: Option<ThinLayerArg>,
+    /// Accept Cm, Chd anywhere in [0, 1] (volume fractions) instead of Table 7.1's ranges.
+    #[arg(long)]
+    pub allow_unphysiological: bool,
+    /// Table index: normalized-cbrt u = ∛(Cm/0.5), v = ∛(Chd/0.32), or literal-cbrt u = ∛Cm, v = ∛Chd
+    /// [default: normalized-cbrt].
+    #[arg(long, value_enum)]
+    pub index_form: Option<IndexFormArg>,
+    /// Table size: N (square) or WxH, each edge 2..=2048 texels [default: 256].
+    #[arg(long, value_name = "N|WxH")]
+    pub resolution: Option<String>,
+    /// Epidermis totals in the table: tabulated exact series (default) or direct per texel.
+    #[arg(long, value_enum)]
+    pub lut_evaluation: Option<LutEvaluationArg>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum IlluminantArg {
+    D65,
+    EqualEnergy,
+}
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum AddingArg {
+    Symmetric,
+    Directional,
+}
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum FdrArg {
+    Dj05,
+    Jensen01,
+}
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ThinLayerArg {
+    Reject,
+    ClampTransmittance,
+}
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum IndexFormArg {
+    NormalizedCbrt,
+    LiteralCbrt,
+}
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum LutEvaluationArg {
+    Tabulated,
+    Direct,
+}
+
+/// Parses `N` or `WxH` (as u64, so absurd sizes are reported rather than overflowing).
+fn parse_resolution(s: &str) -> anyhow::Result<(u64, u64)> {
+    let bad = || usage_msg(format!("--resolution must be N or WxH (e.g. 256 or 256x128), got '{s}'"));
+    let parse = |t: &str| t.trim().parse::<u64>().map_err(|_| bad());
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => Ok((parse(w)?, parse(h)?)),
+        None => {
+            let n = parse(s)?;
+            Ok((n, n))
+        }
+    }
+}
+
+/// Flags → validated-later library parameters.
+fn params(a: &ModelFlags) -> anyhow::Result<SkinColorParams> {
+    let mut p = SkinColorParams::default();
+    macro_rules! set {
+        ($($f:ident),*) => { $( if let Some(v) = a.$f { p.$f = v; } )* };
+    }
+    set!(
+        melanin_blend,
+        epidermal_hemoglobin_ratio,
+        oxygenation,
+        hemoglobin_g_per_l,
+        hemoglobin_molar_mass_g_per_mol,
+        epidermis_thickness_mm,
+        dermis_thickness_mm,
+        eta_epidermis,
+        eta_dermis,
+        eta_below_dermis,
+        spectral_step_nm
+    );
+    if let Some(v) = a.illuminant {
+        p.illuminant = match v {
+            IlluminantArg::D65 => Illuminant::D65,
+            IlluminantArg::EqualEnergy => Illuminant::EqualEnergy,
+        };
+    }
+    if let Some(v) = a.adding {
+        p.adding = match v {
+            AddingArg::Symmetric => Adding::Symmetric,
+            AddingArg::Directional => Adding::Directional,
+        };
+    }
+    if let Some(v) = a.fdr_form {
+        p.fdr_form = match v {
+            FdrArg::Dj05 => FdrForm::Dj05,
+            FdrArg::Jensen01 => FdrForm::Jensen01,
+        };
+    }
+    if let Some(v) = a.thin_layer {
+        p.thin_layer = match v {
+            ThinLayerArg::Reject => ThinLayer::Reject,
+            ThinLayerArg::ClampTransmittance => ThinLayer::ClampTransmittance,
+        };
+    }
+    if let Some(v) = a.index_form {
+        p.index_form = match v {
+            IndexFormArg::NormalizedCbrt => IndexForm::NormalizedCbrt,
+            IndexFormArg::LiteralCbrt => IndexForm::LiteralCbrt,
+        };
+    }
+    if let Some(v) = a.lut_evaluation {
+        p.lut_evaluation = match v {
+            LutEvaluationArg::Tabulated => LutEvaluation::Tabulated,
+            LutEvaluationArg::Direct => LutEvaluation::Direct,
+        };
+    }
+    p.allow_unphysiological = a.allow_unphysiological;
+    if let Some(r) = &a.resolution {
+        let (w, h) = parse_resolution(r)?;
+        let max = rtbake::skin_color::lut::MAX_EDGE as u64;
+        let min = rtbake::skin_color::lut::MIN_EDGE as u64;
+        if !(min..=max).contains(&w) || !(min..=max).contains(&h) {
+            return Err(usage_msg(format!("--resolution must be {min}..={max} texels per edge, got {w}x{h}")));
+        }
+        (p.width, p.height) = (w as u32, h as u32);
+    }
+    Ok(p)
+}
+
+/// Renames a library parameter (JSON field) to the flag the user typed.
+fn flag_error(e: SkinColorError) -> anyhow::Error {
+    let SkinColorError::Invalid(InvalidInput { param, message }) = e;
+    let flag = match param.as_str() {
+        "width" | "height" => "--resolution".to_string(),
+        p => format!("--{}", p.replace('_', "-")),
+    };
+    usage(InvalidInput::new(flag, message))
+}
+
+pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    let p = params(&a.model)?;
+    let point = match (a.melanin, a.hemoglobin) {
+        (Some(cm), Some(chd)) => Some((cm, chd)),
+        (None, None) => None,
+        (Some(_), None) => return Err(usage_msg("--melanin needs --hemoglobin (the point is (Cm, Chd))")),
+        (None, Some(_)) => return Err(usage_msg("--hemoglobin needs --melanin (the point is (Cm, Chd))")),
+    };
+    if point.is_none() && a.out.is_none() {
+        return Err(usage_msg("give a point (--melanin CM --hemoglobin CHD) and/or --out DIR to bake the table"));
+    }
+    if a.spectrum && point.is_none() {
+        return Err(usage_msg("--spectrum needs a point (--melanin CM --hemoglobin CHD)"));
+    }
+    // Everything is validated and computed before anything is written.
+    p.layout().map_err(flag_error)?;
+    let model = p.model().map_err(flag_error)?;
+    let sample = match point {
+        Some((cm, chd)) => Some(model.evaluate(cm, chd, p.allow_unphysiological).map_err(flag_error)?),
+        None => None,
+    };
+    let files = match &a.out {
+        Some(_) => Some(rtbake::bake::skin::skin_color_lut_files(&p).map_err(|e| match e {
+            rtbake::bake::BakeError::Invalid(i) => flag_error(SkinColorError::Invalid(i)),
+            other => anyhow::Error::new(other),
+        })?),
+        None => None,
+    };
+    let mut written = Vec::new();
+    if let (Some(dir), Some(files)) = (&a.out, &files) {
+        prepare_out_dir("--out", dir)?;
+        written = write_all_atomic(dir, files)?;
+        ctx.info(format!("wrote {} files of the skin-colour table to {}", written.len(), dir.display()));
+    }
+    if let Some(s) = &sample {
+        if ctx.json {
+            let mut v = serde_json::json!({ "linear_rgb": s.linear_rgb, "srgb8": s.srgb8 });
+            if a.spectrum {
+                v["wavelength_nm"] = serde_json::json!(model.wavelengths_nm());
+                v["reflectance"] = serde_json::json!(s.reflectance);
+            }
+            if a.out.is_some() {
+                v["written"] = serde_json::json!(written);
+            }
+            ctx.emit_json(&v);
+        } else {
+            let [r, g, b] = s.linear_rgb;
+            let [r8, g8, b8] = s.srgb8;
+            println!("Cm {} Chd {}: linear sRGB {r:.6} {g:.6} {b:.6}  sRGB8 {r8} {g8} {b8}", s.melanin, s.hemoglobin);
+            if a.spectrum {
+                println!("wavelength_nm,reflectance");
+                for (l, r) in model.wavelengths_nm().iter().zip(&s.reflectance) {
+                    println!("{l},{r:.8}");
+                }
+            }
+        }
+    } else if ctx.json {
+        ctx.emit_json(&serde_json::json!({ "written": written }));
+    }
+    Ok(())
+}
+
+/// Stages every file (temp + fsync) before renaming any, so a failure leaves no partial table.
+fn write_all_atomic(dir: &std::path::Path, files: &[rtbake::bake::BakedFile]) -> anyhow::Result<Vec<String>> {
+    use rtbake::io::atomic;
+    let mut staged = Vec::new();
+    for f in files {
+        let path = dir.join(&f.path);
+        let result = path
+            .parent()
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .map_err(|e| anyhow::anyhow!("{}: cannot create directory: {e}", path.display()))
+            .and_then(|()| atomic::stage(&path, &f.bytes).map_err(anyhow::Error::new));
+        match result {
+            Ok(tmp) => staged.push((tmp, path)),
+            Err(e) => {
+                for (tmp, _) in &staged {
+                    let _ = std::fs::remove_file(tmp);
+                }
+                return Err(e);
+            }
+        }
+    }
+    let mut written = Vec::new();
+    for ((tmp, path), f) in staged.iter().zip(files) {
+        atomic::commit(tmp, path)?;
+        written.push(f.path.clone());
+    }
+    Ok(written)
 }

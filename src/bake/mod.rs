@@ -91,6 +91,7 @@ pub fn registry() -> Vec<Asset> {
     v.extend(gaussians::assets());
     v.extend(transmittance::assets());
     v.extend(separable::assets());
+    v.extend(skin::assets());
     v
 }
 
@@ -98,6 +99,7 @@ pub mod aa;
 pub mod gaussians;
 pub mod separable;
 pub mod transmittance;
+pub mod skin;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).

@@ -1,0 +1,80 @@
+//! Benchmark of the skin-colour LUT bake (issue 5): 256×256 at 1 nm, anchor ≤ 0.5 s on 2 cores.
+//!
+//! `cargo run --release --example bench_skin [-- RUNS THREADS]` (defaults 7 runs, 2 threads). Prints the median
+//! wall time and process CPU time (Linux `/proc/self/stat`) of (a) the table itself (`bake_lut`, tabulated epidermis
+//! totals = the default), (b) the whole asset (table + EXR/KTX2/PNG encoders + sidecar + CSVs), and (c) one run of
+//! the direct per-texel evaluation for comparison (and the largest difference between the two tables), with the
+//! ratio against the 0.5 s anchor.
+
+use rtbake::bake::skin::skin_color_lut_files;
+use rtbake::skin_color::lut::{bake_lut, LutEvaluation};
+use rtbake::skin_color::SkinColorParams;
+use std::time::Instant;
+
+const ANCHOR_S: f64 = 0.5;
+
+/// User + system CPU seconds of this process (Linux), or NaN.
+fn cpu_s() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
+    let Some(after) = stat.rsplit_once(')').map(|x| x.1) else { return f64::NAN };
+    let f: Vec<&str> = after.split_whitespace().collect();
+    // Fields 14 and 15 of stat (utime, stime) are at 11 and 12 after the ")"; clock ticks of 1/100 s on Linux.
+    let ticks: f64 = f.get(11).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
+        + f.get(12).and_then(|v| v.parse::<f64>().ok()).unwrap_or(f64::NAN);
+    ticks / 100.0
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn time<F: FnMut()>(runs: usize, mut f: F) -> (f64, f64) {
+    let (mut wall, mut cpu) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let (c0, t0) = (cpu_s(), Instant::now());
+        f();
+        wall.push(t0.elapsed().as_secs_f64());
+        cpu.push(cpu_s() - c0);
+    }
+    (median(wall), median(cpu))
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let runs = args.first().copied().unwrap_or(7).max(5);
+    let threads = args.get(1).copied().unwrap_or(2);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+    let params = SkinColorParams::default();
+    let model = params.model().expect("default params are valid");
+    let layout = params.layout().expect("default layout is valid");
+    println!(
+        "skin-color-lut {}x{} at {} nm, {} threads, median of {runs} runs (machine load avg: {})",
+        layout.width,
+        layout.height,
+        params.spectral_step_nm,
+        threads,
+        std::fs::read_to_string("/proc/loadavg").unwrap_or_default().split_whitespace().next().unwrap_or("?")
+    );
+    pool.install(|| {
+        let (w, c) = time(runs, || {
+            bake_lut(&model, &layout, LutEvaluation::Tabulated).expect("bake");
+        });
+        println!("table (tabulated, default): wall {w:.3} s, cpu {c:.2} s, wall/anchor {:.2}", w / ANCHOR_S);
+        let (w, c) = time(runs, || {
+            skin_color_lut_files(&params).expect("bake");
+        });
+        println!(
+            "whole asset (+ model setup, encoders, CSVs): wall {w:.3} s, cpu {c:.2} s, wall/anchor {:.2}",
+            w / ANCHOR_S
+        );
+        let mut direct = None;
+        let (w, c) = time(1, || {
+            direct = Some(bake_lut(&model, &layout, LutEvaluation::Direct).expect("bake"));
+        });
+        println!("table (direct, 1 run): wall {w:.3} s, cpu {c:.2} s, wall/anchor {:.2}", w / ANCHOR_S);
+        let tab = bake_lut(&model, &layout, LutEvaluation::Tabulated).expect("bake");
+        let max = tab.data.iter().zip(&direct.expect("ran").data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        println!("max |tabulated - direct| over the table: {max:.3e} (linear RGB)");
+    });
+}

@@ -1,0 +1,185 @@
+//! Skin-colour assets in `baked/skin/`: the melanin × hemoglobin lookup table (thesis §7.6, eq. 7.7, Fig. 7.9).
+
+use super::{float_texture_files, json_file, parse_params, text_file, Asset, BakeError, BakedFile};
+use crate::skin_color::lut::{bake_lut, IndexForm, LutLayout};
+use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
+use crate::skin_color::SkinColorParams;
+use serde_json::{json, Value};
+use std::fmt::Write;
+
+/// Asset name of the skin-colour table.
+pub const SKIN_COLOR_LUT: &str = "skin-color-lut";
+/// Stem of the table's texture files (`.exr`, `_f16.exr`, `.ktx2`, `_preview_srgb.png`).
+pub const LUT_STEM: &str = "skin/skin_color_lut";
+pub const SIDECAR_PATH: &str = "skin/skin_color_lut.json";
+pub const SAMPLES_PATH: &str = "skin/skin_color_samples.csv";
+pub const SPECTRA_PATH: &str = "skin/skin_color_spectra.csv";
+
+/// Absolute tolerance `verify` allows on the f32 table (libm differences across platforms are ~1e−15).
+pub const LUT_TOLERANCE: f64 = 1e-6;
+
+/// (Cm, Chd) points of the sample CSV: light to dark along melanin × pale to flushed along hemoglobin.
+pub const SAMPLE_MELANIN: [f64; 7] = [0.0, 0.01, 0.035, 0.07, 0.15, 0.3, 0.5];
+pub const SAMPLE_HEMOGLOBIN: [f64; 6] = [0.0, 0.01, 0.04, 0.1, 0.2, 0.32];
+/// Points whose spectra R(λ) are written (the four corners of Table 7.1 and a medium tone).
+pub const SPECTRUM_POINTS: [(f64, f64); 5] = [(0.0, 0.0), (0.5, 0.0), (0.0, 0.32), (0.5, 0.32), (0.07, 0.04)];
+
+pub fn assets() -> Vec<Asset> {
+    vec![Asset {
+        name: SKIN_COLOR_LUT,
+        summary: "skin colour LUT: melanin x hemoglobin -> linear sRGB albedo (spectral two-layer model, eq. 7.7)",
+        default_params: || serde_json::to_value(SkinColorParams::default()).expect("params serialise"),
+        bake: |v| {
+            let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
+            skin_color_lut_files(&p)
+        },
+    }]
+}
+
+fn invalid(e: SkinColorError) -> BakeError {
+    match e {
+        SkinColorError::Invalid(i) => BakeError::Invalid(i),
+    }
+}
+
+/// The texel convention in words and formulas (manifest `convention`, sidecar).
+pub fn convention(layout: &LutLayout) -> String {
+    let (cm_max, chd_max) = (layout.index_form.melanin_max(), layout.index_form.hemoglobin_max());
+    format!(
+        "linear sRGB (IEC 61966-2-1 primaries, D65-normalised) diffuse albedo, RGB; column i (u, melanin) holds \
+         Cm = {cm_max}*(i/(W-1))^3, row j (v, hemoglobin) holds Chd = {chd_max}*(j/(H-1))^3, top row first, row 0 \
+         (texcoord v = 0) is Chd = 0; sample at texcoord = ((cbrt(Cm/{cm_max})*(W-1)+0.5)/W, \
+         (cbrt(Chd/{chd_max})*(H-1)+0.5)/H) with W = {}, H = {}",
+        layout.width, layout.height
+    )
+}
+
+/// Every file of the skin-colour asset for `p`.
+pub fn skin_color_lut_files(p: &SkinColorParams) -> Result<Vec<BakedFile>, BakeError> {
+    let layout = p.layout().map_err(invalid)?;
+    let model = p.model().map_err(invalid)?;
+    let img = bake_lut(&model, &layout, p.lut_evaluation).map_err(invalid)?;
+    let conv = convention(&layout);
+    let mut files = float_texture_files(LUT_STEM, &img, "lut", &conv, LUT_TOLERANCE)?;
+    files.push(json_file(SIDECAR_PATH, &sidecar(p, &layout, &img), "json", &conv));
+    files.push(text_file(SAMPLES_PATH, samples_csv(&model, &layout).map_err(invalid)?, "csv", "csv", &conv));
+    files.push(text_file(
+        SPECTRA_PATH,
+        spectra_csv(&model).map_err(invalid)?,
+        "csv",
+        "csv",
+        "total diffuse reflectance R(lambda) of the two-layer stack (before colorimetry), one column per (Cm, Chd)",
+    ));
+    Ok(files)
+}
+
+fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Image<f32>) -> Value {
+    let (cm_max, chd_max) = (layout.index_form.melanin_max(), layout.index_form.hemoglobin_max());
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for px in img.data.chunks_exact(3) {
+        for c in 0..3 {
+            lo[c] = lo[c].min(px[c]);
+            hi[c] = hi[c].max(px[c]);
+        }
+    }
+    let form = match layout.index_form {
+        IndexForm::NormalizedCbrt => {
+            "u = cbrt(Cm / 0.5), v = cbrt(Chd / 0.32) (eq. 7.7 normalised to Table 7.1's ranges)"
+        }
+        IndexForm::LiteralCbrt => "u = cbrt(Cm), v = cbrt(Chd) (eq. 7.7 as printed; ranges [0, 1])",
+    };
+    json!({
+        "asset": SKIN_COLOR_LUT,
+        "description": "Skin colour lookup table (Jimenez 2012, section 7.6, eq. 7.7, Fig. 7.9): total diffuse \
+            reflectance of the spectral two-layer skin model (Donner et al. 2008) integrated against an illuminant and \
+            the CIE 1931 2-degree observer (see model.colorimetry), as linear sRGB albedo.",
+        "files": {
+            "linear_f32": format!("{LUT_STEM}.exr"),
+            "linear_f16": format!("{LUT_STEM}_f16.exr"),
+            "linear_f16_ktx2": format!("{LUT_STEM}.ktx2"),
+            "preview_srgb8_not_for_sampling": format!("{LUT_STEM}_preview_srgb.png"),
+            "samples": SAMPLES_PATH,
+            "spectra": SPECTRA_PATH,
+        },
+        "color_space": "linear sRGB (IEC 61966-2-1 primaries); the PNG preview alone is sRGB-encoded",
+        "width": layout.width,
+        "height": layout.height,
+        "channels": ["R", "G", "B"],
+        "index": {
+            "form": form,
+            "u_axis": "columns, left to right: melanin fraction Cm",
+            "v_axis": "rows, top row first: dermal hemoglobin fraction Chd; row 0 (texcoord v = 0) is Chd = 0",
+            "melanin_max": cm_max,
+            "hemoglobin_max": chd_max,
+            "texel_to_concentration": format!(
+                "node-inclusive: t_i = i/(W-1), Cm = {cm_max}*t_i^3; t_j = j/(H-1), Chd = {chd_max}*t_j^3"
+            ),
+            "concentration_to_texcoord": format!(
+                "texcoord.x = (cbrt(Cm/{cm_max})*(W-1)+0.5)/W, texcoord.y = (cbrt(Chd/{chd_max})*(H-1)+0.5)/H \
+                 (texel centres at the nodes; bilinear filtering)"
+            ),
+            "hlsl": format!(
+                "float2 SkinColorUV(float cm, float chd) {{ const float2 n = float2({w}.0, {h}.0); \
+                 float2 t = pow(saturate(float2(cm / {cm_max:?}, chd / {chd_max:?})), 1.0 / 3.0); \
+                 return (t * (n - 1.0) + 0.5) / n; }}",
+                w = layout.width,
+                h = layout.height
+            ),
+            "epidermal_hemoglobin": format!("Che = {} * Chd", p.epidermal_hemoglobin_ratio),
+        },
+        "value_range": { "min": lo, "max": hi },
+        "model": {
+            "layers": "epidermis over dermis; air above; per-layer multipole totals R(0), T(0) with the exact \
+                infinite image series (Donner & Jensen 2005)",
+            "adding": "symmetric: R = R1 + T1^2 R2 / (1 - R1 R2); directional: R = R1 + T1 R2 T1up / (1 - R1up R2)",
+            "dermis_bottom": "relative index eta_dermis / eta_below_dermis (default 1 = index-matched: a \
+                semi-infinite dermis has no bottom face)",
+            "colorimetry": format!(
+                "illuminant {}, {} nm steps over 380-780 nm, CIE 1931 2-degree observer, Y(perfect white) = 1, XYZ -> \
+                 linear sRGB with [3.2406 -1.5372 -0.4986; -0.9689 1.8758 0.0415; 0.0557 -0.2040 1.0570]",
+                serde_json::to_value(p.illuminant).expect("enum serialises").as_str().unwrap_or("?"),
+                p.spectral_step_nm
+            ),
+            "data": "hemoglobin: S. Prahl (OMLC 1999, Gratzer & Kollias), 2 nm, interpolated linearly to 1 nm; CIE \
+                1931 2-degree CMFs and D65: CIE 018:2019 / ISO 11664-2 (1 nm)",
+        },
+        "parameters": serde_json::to_value(p).expect("params serialise"),
+    })
+}
+
+fn samples_csv(model: &TwoLayerSkinModel, layout: &LutLayout) -> Result<String, SkinColorError> {
+    let mut s = String::from(
+        "# skin colour samples evaluated directly by the spectral model (not read from the table); linear = linear \
+         sRGB albedo, srgb8 = IEC 61966-2-1 encoded 8-bit\nmelanin_cm,hemoglobin_chd,texcoord_u,texcoord_v,\
+         linear_r,linear_g,linear_b,srgb8_r,srgb8_g,srgb8_b\n",
+    );
+    for &chd in &SAMPLE_HEMOGLOBIN {
+        for &cm in &SAMPLE_MELANIN {
+            let p = model.evaluate(cm, chd, true)?;
+            let (u, v) = layout.texcoord(cm, chd);
+            let [r, g, b] = p.linear_rgb;
+            let [r8, g8, b8] = p.srgb8;
+            writeln!(s, "{cm},{chd},{u:.6},{v:.6},{r:.8},{g:.8},{b:.8},{r8},{g8},{b8}").expect("string write");
+        }
+    }
+    Ok(s)
+}
+
+fn spectra_csv(model: &TwoLayerSkinModel) -> Result<String, SkinColorError> {
+    let samples: Vec<_> =
+        SPECTRUM_POINTS.iter().map(|&(cm, chd)| model.evaluate(cm, chd, true)).collect::<Result<_, _>>()?;
+    let mut s = String::from("wavelength_nm");
+    for p in &samples {
+        write!(s, ",R_cm{}_chd{}", p.melanin, p.hemoglobin).expect("string write");
+    }
+    s.push('\n');
+    for (i, l) in model.wavelengths_nm().iter().enumerate() {
+        write!(s, "{l}").expect("string write");
+        for p in &samples {
+            write!(s, ",{:.8}", p.reflectance[i]).expect("string write");
+        }
+        s.push('\n');
+    }
+    Ok(s)
+}

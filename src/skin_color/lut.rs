@@ -1,0 +1,133 @@
+//! The melanin × hemoglobin skin-colour lookup table (thesis §7.6, eq. 7.7, Table 7.1, Fig. 7.9).
+//!
+//! Eq. 7.7 indexes the table by the cube roots u = ∛Cm, v = ∛Chd. The default ("normalised") form spans Table
+//! 7.1's ranges: u = ∛(Cm / 0.5), v = ∛(Chd / 0.32); the literal form (`literal-cbrt`) uses u = ∛Cm, v = ∛Chd over
+//! [0, 1]. Texel convention (node-inclusive): column i of a W-wide table holds t = i / (W − 1), Cm = Cm,max · t³;
+//! row j of an H-high table holds Chd = Chd,max · (j / (H − 1))³. Melanin varies along u (columns, left → right),
+//! hemoglobin along v (rows); rows are stored top row first and **row 0 (texcoord v = 0) is Chd = 0**.
+//! A shader sampling with bilinear filtering and normalised texture coordinates uses
+//!
+//!   texcoord.x = (∛(Cm / Cm,max) · (W − 1) + 0.5) / W,   texcoord.y = (∛(Chd / Chd,max) · (H − 1) + 0.5) / H
+//!
+//! so that t = 0 and t = 1 land on the centres of the first and last texels.
+
+use super::two_layer::{SkinColorError, TwoLayerSkinModel};
+use crate::error::{check_range, InvalidInput};
+use crate::image_buf::Image;
+use crate::spectral::skin_layers::{DERMAL_HEMOGLOBIN_FRACTION_MAX, MELANIN_FRACTION_MAX};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Smallest and largest LUT edge (texels). Two texels are needed for t = i/(n − 1); the upper limit keeps a bake
+/// (≈ 401 multipole evaluations per texel) within minutes and is checked before anything is allocated.
+pub const MIN_EDGE: u32 = 2;
+pub const MAX_EDGE: u32 = 2048;
+
+/// How concentrations map to the [0, 1] table axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IndexForm {
+    /// u = ∛(Cm / 0.5), v = ∛(Chd / 0.32): Table 7.1's ranges fill the table (default).
+    #[default]
+    NormalizedCbrt,
+    /// u = ∛Cm, v = ∛Chd as printed in eq. 7.7: the table spans [0, 1] for both fractions.
+    LiteralCbrt,
+}
+
+impl IndexForm {
+    /// Cm at t = 1.
+    pub fn melanin_max(self) -> f64 {
+        match self {
+            Self::NormalizedCbrt => MELANIN_FRACTION_MAX,
+            Self::LiteralCbrt => 1.0,
+        }
+    }
+    /// Chd at t = 1.
+    pub fn hemoglobin_max(self) -> f64 {
+        match self {
+            Self::NormalizedCbrt => DERMAL_HEMOGLOBIN_FRACTION_MAX,
+            Self::LiteralCbrt => 1.0,
+        }
+    }
+}
+
+/// Size and index mapping of the table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LutLayout {
+    pub width: u32,
+    pub height: u32,
+    pub index_form: IndexForm,
+}
+
+impl LutLayout {
+    /// Validates the size (before anything is allocated).
+    pub fn new(width: u32, height: u32, index_form: IndexForm) -> Result<Self, InvalidInput> {
+        check_range("width", width, MIN_EDGE, MAX_EDGE, "texels")?;
+        check_range("height", height, MIN_EDGE, MAX_EDGE, "texels")?;
+        Ok(Self { width, height, index_form })
+    }
+
+    /// Cm of column `i`: Cm,max · (i / (W − 1))³ (inverse of eq. 7.7).
+    pub fn melanin_at_column(&self, i: u32) -> f64 {
+        let t = i as f64 / (self.width - 1) as f64;
+        self.index_form.melanin_max() * t * t * t
+    }
+
+    /// Chd of row `j` (row 0 = top = Chd 0): Chd,max · (j / (H − 1))³.
+    pub fn hemoglobin_at_row(&self, j: u32) -> f64 {
+        let t = j as f64 / (self.height - 1) as f64;
+        self.index_form.hemoglobin_max() * t * t * t
+    }
+
+    /// Eq. 7.7: the axis coordinates (u, v) ∈ [0, 1]² of (Cm, Chd) (before the texel-centre mapping).
+    pub fn uv(&self, cm: f64, chd: f64) -> (f64, f64) {
+        // eq. 7.7 (normalised by the axis maxima in the default form)
+        ((cm / self.index_form.melanin_max()).cbrt(), (chd / self.index_form.hemoglobin_max()).cbrt())
+    }
+
+    /// Normalised texture coordinates of (Cm, Chd) for bilinear sampling (texel centres at the nodes).
+    pub fn texcoord(&self, cm: f64, chd: f64) -> (f64, f64) {
+        let (u, v) = self.uv(cm, chd);
+        let (w, h) = (self.width as f64, self.height as f64);
+        ((u * (w - 1.0) + 0.5) / w, (v * (h - 1.0) + 0.5) / h)
+    }
+}
+
+/// How the table evaluates the epidermis' multipole totals.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LutEvaluation {
+    /// Exact-series totals tabulated per wavelength against √σa and interpolated (see
+    /// `two_layer::EpidermisTable`; differs from `direct` by < 1e−7 in linear RGB). Default.
+    #[default]
+    Tabulated,
+    /// `Slab::totals(Series::Exact)` for every texel and wavelength (about 10–20× slower).
+    Direct,
+}
+
+/// Rows per parallel task (a multiple of nothing in particular: results do not depend on it).
+const ROWS_PER_TASK: usize = 4;
+
+/// Bakes the table: W × H linear sRGB (3 channels, f32), top row first, deterministic for any thread count
+/// (every texel sums its wavelengths in the same order whichever task computes it).
+pub fn bake_lut(
+    model: &TwoLayerSkinModel,
+    layout: &LutLayout,
+    evaluation: LutEvaluation,
+) -> Result<Image<f32>, SkinColorError> {
+    let (cm_max, chd_max) = (layout.index_form.melanin_max(), layout.index_form.hemoglobin_max());
+    model.check_validity(cm_max, chd_max)?;
+    let tables = match evaluation {
+        LutEvaluation::Tabulated => model.epidermis_tables(cm_max, chd_max),
+        LutEvaluation::Direct => vec![None; model.wavelengths_nm().len()],
+    };
+    let melanin: Vec<f64> = (0..layout.width).map(|i| layout.melanin_at_column(i)).collect();
+    let hemoglobin: Vec<f64> = (0..layout.height).map(|j| layout.hemoglobin_at_row(j)).collect();
+    let row_len = 3 * layout.width as usize;
+    let mut img = Image::new(layout.width, layout.height, 3);
+    img.data
+        .par_chunks_mut(row_len * ROWS_PER_TASK)
+        .zip(hemoglobin.par_chunks(ROWS_PER_TASK))
+        .for_each(|(out, chd)| model.linear_rgb_grid(&melanin, chd, &tables, out));
+    Ok(img)
+}

@@ -1,0 +1,331 @@
+//! The physiological two-layer skin: epidermis over dermis, absorption and scattering from chromophore fractions.
+//!
+//! Donner & Jensen, "A Spectral BSSRDF for Shading Human Skin", EGSR 2006 (§3, layer mixing), and Donner et al.,
+//! "A Layered, Heterogeneous Reflectance Model for Acquiring and Rendering Human Skin", SIGGRAPH Asia 2008; the
+//! parameters of the thesis (Jimenez 2012, §7.6, Table 7.1) with the defaults of its skin-colour table (Fig. 7.9).
+//! Exact forms: `specs/skin-color.md`.
+//!
+//! | parameter | symbol | default | Table 7.1 range |
+//! | --- | --- | --- | --- |
+//! | melanin volume fraction (epidermis) | Cm | — | 0 – 0.5 |
+//! | melanin type blend (eumelanin share) | βm | 0.61 | 0 – 1 |
+//! | dermal hemoglobin volume fraction | Chd | — | 0 – 0.32 |
+//! | epidermal hemoglobin fraction | Che = 0.25 · Chd | ratio 0.25 | 0 – 0.1 |
+//! | blood oxygenation | γ | 0.75 | 0 – 1 |
+//! | hemoglobin in whole blood | c | 150 g/L | |
+//! | hemoglobin molar mass | M | 64500 g/mol | |
+//! | epidermis / dermis thickness | | 0.25 mm / 20 mm | |
+//! | refractive index of both layers | η | 1.4 (air above, interface index-matched) | |
+//!
+//! Layer mixing (σ in mm⁻¹, chromophore spectra in [`super::chromophores`]):
+//!
+//!   σa,epi  = Cm [βm σa,em + (1 − βm) σa,pm] + Che [γ σa,oxy + (1 − γ) σa,deoxy] + (1 − Cm − Che) σa,base
+//!   σa,derm = Chd [γ σa,oxy + (1 − γ) σa,deoxy] + (1 − Chd) σa,base
+//!   σs′,epi = 14.74 λ^−0.22 + 2.2e11 λ^−4        σs′,derm = 0.5 σs′,epi
+//!
+//! Below the dermis: the 20 mm dermis is "effectively semi-infinite": at the longest wavelength and with no blood
+//! the diffuse light decays as e^(−σtr z) with σtr ≈ 0.42 mm⁻¹, so e^(−σtr·20 mm) ≈ 2e−4 reaches the bottom face and
+//! the returning fraction is smaller still. A semi-infinite dermis has no bottom interface, so the default bottom
+//! face is index-matched (the tissue below has the dermis' index, `eta_below_dermis = 1.4`, relative index 1): light
+//! that reaches it leaves, none is reflected back. An air gap (`eta_below_dermis = 1.0`) changes the total
+//! reflectance by less than 1e−4 (tested).
+//!
+//! [`two_layer_skin_rgb`] reduces the spectra to per-channel RGB coefficients for the RGB diffusion profiles and
+//! fits (see [`RgbReduction`] for the two reductions offered and why the default is what it is).
+
+use super::chromophores::{ChromophoreSpectra, DEFAULT_HEMOGLOBIN_G_PER_L, DEFAULT_HEMOGLOBIN_MOLAR_MASS_G_PER_MOL};
+use super::colorimetry::{ColorWeights, Illuminant, SpectralGrid};
+use crate::error::{check_positive, check_range, InvalidInput};
+use serde::{Deserialize, Serialize};
+
+/// Upper limit of Cm and Chd in Table 7.1 (the physiological ranges).
+pub const MELANIN_FRACTION_MAX: f64 = 0.5;
+pub const DERMAL_HEMOGLOBIN_FRACTION_MAX: f64 = 0.32;
+/// Upper limit of Che in Table 7.1.
+pub const EPIDERMAL_HEMOGLOBIN_FRACTION_MAX: f64 = 0.1;
+
+/// Every fixed (non-map) parameter of the two-layer skin. JSON field names are the CLI flag names with `_`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SkinPhysiology {
+    /// βm: eumelanin share of the melanin, 0–1 (0.61).
+    pub melanin_blend: f64,
+    /// Che / Chd: epidermal hemoglobin as a fraction of dermal hemoglobin, 0–1 (0.25).
+    pub epidermal_hemoglobin_ratio: f64,
+    /// γ: blood oxygenation, 0–1 (0.75).
+    pub oxygenation: f64,
+    /// Hemoglobin concentration of whole blood, g/L (150).
+    pub hemoglobin_g_per_l: f64,
+    /// Molar mass of hemoglobin, g/mol (64500).
+    pub hemoglobin_molar_mass_g_per_mol: f64,
+    pub epidermis_thickness_mm: f64,
+    pub dermis_thickness_mm: f64,
+    /// Absolute refractive index of the epidermis (1.4); air (1.0) is above it.
+    pub eta_epidermis: f64,
+    /// Absolute refractive index of the dermis (1.4; equal to the epidermis = index-matched interface).
+    pub eta_dermis: f64,
+    /// Absolute refractive index of the medium below the dermis (1.4 = matched, semi-infinite dermis).
+    pub eta_below_dermis: f64,
+}
+
+impl Default for SkinPhysiology {
+    fn default() -> Self {
+        Self {
+            melanin_blend: 0.61,
+            epidermal_hemoglobin_ratio: 0.25,
+            oxygenation: 0.75,
+            hemoglobin_g_per_l: DEFAULT_HEMOGLOBIN_G_PER_L,
+            hemoglobin_molar_mass_g_per_mol: DEFAULT_HEMOGLOBIN_MOLAR_MASS_G_PER_MOL,
+            epidermis_thickness_mm: 0.25,
+            dermis_thickness_mm: 20.0,
+            eta_epidermis: 1.4,
+            eta_dermis: 1.4,
+            eta_below_dermis: 1.4,
+        }
+    }
+}
+
+/// Checks that `eta` is a usable refractive index.
+fn check_eta(param: &str, eta: f64) -> Result<f64, InvalidInput> {
+    check_positive(param, eta, "refractive index")?;
+    check_range(param, eta, 0.1, 10.0, "(refractive index)")
+}
+
+impl SkinPhysiology {
+    /// Validates every field (names in errors are the JSON fields).
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_range("melanin_blend", self.melanin_blend, 0.0, 1.0, "(eumelanin share)")?;
+        check_range("epidermal_hemoglobin_ratio", self.epidermal_hemoglobin_ratio, 0.0, 1.0, "(Che / Chd)")?;
+        check_range("oxygenation", self.oxygenation, 0.0, 1.0, "")?;
+        check_positive("hemoglobin_g_per_l", self.hemoglobin_g_per_l, "g/L")?;
+        check_range("hemoglobin_g_per_l", self.hemoglobin_g_per_l, 0.0, 1000.0, "g/L")?;
+        check_positive("hemoglobin_molar_mass_g_per_mol", self.hemoglobin_molar_mass_g_per_mol, "g/mol")?;
+        check_positive("epidermis_thickness_mm", self.epidermis_thickness_mm, "mm")?;
+        check_range("epidermis_thickness_mm", self.epidermis_thickness_mm, 0.0, 1000.0, "mm")?;
+        check_positive("dermis_thickness_mm", self.dermis_thickness_mm, "mm")?;
+        check_range("dermis_thickness_mm", self.dermis_thickness_mm, 0.0, 1000.0, "mm")?;
+        check_eta("eta_epidermis", self.eta_epidermis)?;
+        check_eta("eta_dermis", self.eta_dermis)?;
+        check_eta("eta_below_dermis", self.eta_below_dermis)?;
+        Ok(())
+    }
+
+    /// Che for a given Chd.
+    pub fn epidermal_hemoglobin(&self, chd: f64) -> f64 {
+        self.epidermal_hemoglobin_ratio * chd
+    }
+
+    /// Chromophore spectra at `lambda_nm` with this physiology's blood constants (250–1000 nm).
+    pub fn spectra_at(&self, lambda_nm: f64) -> Option<ChromophoreSpectra> {
+        ChromophoreSpectra::at(lambda_nm, self.hemoglobin_g_per_l, self.hemoglobin_molar_mass_g_per_mol)
+    }
+
+    /// Both layers' coefficients at one wavelength for melanin fraction `cm` and dermal hemoglobin `chd`.
+    pub fn coefficients_at(&self, lambda_nm: f64, cm: f64, chd: f64) -> Option<TwoLayerCoefficients> {
+        let s = self.spectra_at(lambda_nm)?;
+        let che = self.epidermal_hemoglobin(chd);
+        Some(TwoLayerCoefficients {
+            lambda_nm,
+            epidermis: LayerCoefficients {
+                sigma_a_per_mm: epidermis_sigma_a_per_mm(&s, cm, che, self.melanin_blend, self.oxygenation),
+                sigma_s_prime_per_mm: s.sigma_s_prime_epidermis,
+            },
+            dermis: LayerCoefficients {
+                sigma_a_per_mm: dermis_sigma_a_per_mm(&s, chd, self.oxygenation),
+                sigma_s_prime_per_mm: s.sigma_s_prime_dermis,
+            },
+        })
+    }
+}
+
+/// Checks melanin and dermal-hemoglobin fractions: Table 7.1 ranges (Cm ∈ [0, 0.5], Chd ∈ [0, 0.32], Che ≤ 0.1),
+/// or, with `allow_unphysiological`, any volume fractions in [0, 1] with Cm + Che ≤ 1.
+/// `melanin_param` / `hemoglobin_param` name the inputs in errors.
+pub fn check_concentrations(
+    melanin_param: &str,
+    cm: f64,
+    hemoglobin_param: &str,
+    chd: f64,
+    physiology: &SkinPhysiology,
+    allow_unphysiological: bool,
+) -> Result<(), InvalidInput> {
+    let (cm_max, chd_max) =
+        if allow_unphysiological { (1.0, 1.0) } else { (MELANIN_FRACTION_MAX, DERMAL_HEMOGLOBIN_FRACTION_MAX) };
+    let hint = if allow_unphysiological {
+        "(volume fraction)"
+    } else {
+        "(Table 7.1; allow_unphysiological / --allow-unphysiological lifts it)"
+    };
+    check_range(melanin_param, cm, 0.0, cm_max, hint)?;
+    check_range(hemoglobin_param, chd, 0.0, chd_max, hint)?;
+    let che = physiology.epidermal_hemoglobin(chd);
+    if !allow_unphysiological && che > EPIDERMAL_HEMOGLOBIN_FRACTION_MAX {
+        return Err(InvalidInput::new(
+            hemoglobin_param,
+            format!(
+                "gives an epidermal hemoglobin Che = epidermal_hemoglobin_ratio × Chd = {che} above Table 7.1's 0.1 \
+                 (lower the ratio or allow_unphysiological), got Chd = {chd}"
+            ),
+        ));
+    }
+    if cm + che > 1.0 {
+        return Err(InvalidInput::new(
+            melanin_param,
+            format!("plus the epidermal hemoglobin Che = {che} must not exceed a volume fraction of 1, got Cm = {cm}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Epidermal absorption σa,epi (mm⁻¹):
+/// Cm [βm σa,em + (1 − βm) σa,pm] + Che [γ σa,oxy + (1 − γ) σa,deoxy] + (1 − Cm − Che) σa,base.
+#[inline]
+pub fn epidermis_sigma_a_per_mm(s: &ChromophoreSpectra, cm: f64, che: f64, beta_m: f64, gamma: f64) -> f64 {
+    epidermis_sigma_a_mixed(cm, s.melanin(beta_m), che, s.blood(gamma), s.baseline)
+}
+
+/// The epidermal mixing rule with the melanin and blood mixes already formed (the LUT's inner loop).
+#[inline]
+pub fn epidermis_sigma_a_mixed(cm: f64, melanin: f64, che: f64, blood: f64, baseline: f64) -> f64 {
+    // Donner & Jensen 2006 §3 / Donner et al. 2008 epidermis mixing (specs/skin-color.md)
+    cm * melanin + che * blood + (1.0 - cm - che) * baseline
+}
+
+/// Dermal absorption σa,derm = Chd [γ σa,oxy + (1 − γ) σa,deoxy] + (1 − Chd) σa,base (mm⁻¹).
+#[inline]
+pub fn dermis_sigma_a_per_mm(s: &ChromophoreSpectra, chd: f64, gamma: f64) -> f64 {
+    // Donner & Jensen 2006 §3 / Donner et al. 2008 dermis mixing (specs/skin-color.md)
+    chd * s.blood(gamma) + (1.0 - chd) * s.baseline
+}
+
+/// σa and σs′ of one layer at one wavelength, mm⁻¹.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LayerCoefficients {
+    pub sigma_a_per_mm: f64,
+    pub sigma_s_prime_per_mm: f64,
+}
+
+/// Both layers at one wavelength.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TwoLayerCoefficients {
+    pub lambda_nm: f64,
+    pub epidermis: LayerCoefficients,
+    pub dermis: LayerCoefficients,
+}
+
+/// One layer reduced to R, G, B.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LayerRgb {
+    pub thickness_mm: f64,
+    /// Absolute refractive index of the layer.
+    pub eta: f64,
+    pub sigma_a_per_mm: [f64; 3],
+    pub sigma_s_prime_per_mm: [f64; 3],
+}
+
+/// The physiological two-layer skin reduced to R, G, B (epidermis on top, air above it).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TwoLayerSkinRgb {
+    pub epidermis: LayerRgb,
+    pub dermis: LayerRgb,
+    /// Absolute refractive index below the dermis (equal to the dermis' = matched bottom face).
+    pub eta_below_dermis: f64,
+}
+
+/// How spectra become per-channel coefficients.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum RgbReduction {
+    /// Default. Weighted mean over 380–780 nm (1 nm) with weight w_c(λ) = max(0, s_c(λ)), where
+    /// s_c = `SRGB_FROM_XYZ`·(S x̄, S ȳ, S z̄) is the linear-sRGB channel sensitivity under the illuminant S:
+    /// each channel averages the coefficients over the wavelengths that actually drive that channel of the rendered
+    /// colour. The negative lobes of the sRGB sensitivities are dropped because a mean needs non-negative weights;
+    /// the CIE x̄ itself is not used for R because its 440 nm lobe would leak blue absorption into red.
+    SensitivityWeighted { illuminant: Illuminant },
+    /// Point samples at three wavelengths (R, G, B order), e.g. 700, 546.1, 435.8 nm (the CIE 1931 RGB primaries).
+    Wavelengths { nm: [f64; 3] },
+}
+
+impl Default for RgbReduction {
+    fn default() -> Self {
+        Self::SensitivityWeighted { illuminant: Illuminant::D65 }
+    }
+}
+
+impl RgbReduction {
+    /// The CIE 1931 RGB primaries 700, 546.1, 435.8 nm.
+    pub fn cie_rgb_primaries() -> Self {
+        Self::Wavelengths { nm: [700.0, 546.1, 435.8] }
+    }
+
+    /// Per-channel normalised weights over the wavelengths (λ, [wR, wG, wB]); each column sums to 1.
+    pub fn weights(&self) -> Result<Vec<(f64, [f64; 3])>, InvalidInput> {
+        match self {
+            Self::SensitivityWeighted { illuminant } => {
+                let cw = ColorWeights::new(SpectralGrid::new(1)?, *illuminant);
+                let mut w: Vec<(f64, [f64; 3])> = (0..cw.grid.len())
+                    .map(|i| (cw.grid.wavelength_nm(i), cw.linear_srgb[i].map(|v| v.max(0.0))))
+                    .collect();
+                for c in 0..3 {
+                    let sum: f64 = w.iter().map(|x| x.1[c]).sum();
+                    for x in &mut w {
+                        x.1[c] /= sum;
+                    }
+                }
+                Ok(w)
+            }
+            Self::Wavelengths { nm } => {
+                for (c, &l) in nm.iter().enumerate() {
+                    check_range(&format!("wavelengths_nm[{c}]"), l, 250.0, 1000.0, "nm (Prahl's hemoglobin table)")?;
+                }
+                Ok((0..3)
+                    .map(|c| {
+                        let mut w = [0.0; 3];
+                        w[c] = 1.0;
+                        (nm[c], w)
+                    })
+                    .collect())
+            }
+        }
+    }
+}
+
+/// Per-channel σa, σs′ of both layers for melanin fraction `cm` and dermal hemoglobin `chd` (volume fractions,
+/// checked against Table 7.1 unless `allow_unphysiological`), reduced from the spectra by `reduction`:
+/// σ_c = Σλ w_c(λ) σ(λ) with Σλ w_c(λ) = 1 (a linear mean of the coefficients, not of the appearance).
+pub fn two_layer_skin_rgb(
+    physiology: &SkinPhysiology,
+    cm: f64,
+    chd: f64,
+    allow_unphysiological: bool,
+    reduction: &RgbReduction,
+) -> Result<TwoLayerSkinRgb, InvalidInput> {
+    physiology.validate()?;
+    check_concentrations("melanin_fraction", cm, "hemoglobin_fraction", chd, physiology, allow_unphysiological)?;
+    let mut epi = ([0.0; 3], [0.0; 3]);
+    let mut derm = ([0.0; 3], [0.0; 3]);
+    for (lambda, w) in reduction.weights()? {
+        let k = physiology.coefficients_at(lambda, cm, chd).expect("wavelengths are checked to lie in the table");
+        for (c, wc) in w.into_iter().enumerate() {
+            epi.0[c] += wc * k.epidermis.sigma_a_per_mm;
+            epi.1[c] += wc * k.epidermis.sigma_s_prime_per_mm;
+            derm.0[c] += wc * k.dermis.sigma_a_per_mm;
+            derm.1[c] += wc * k.dermis.sigma_s_prime_per_mm;
+        }
+    }
+    Ok(TwoLayerSkinRgb {
+        epidermis: LayerRgb {
+            thickness_mm: physiology.epidermis_thickness_mm,
+            eta: physiology.eta_epidermis,
+            sigma_a_per_mm: epi.0,
+            sigma_s_prime_per_mm: epi.1,
+        },
+        dermis: LayerRgb {
+            thickness_mm: physiology.dermis_thickness_mm,
+            eta: physiology.eta_dermis,
+            sigma_a_per_mm: derm.0,
+            sigma_s_prime_per_mm: derm.1,
+        },
+        eta_below_dermis: physiology.eta_below_dermis,
+    })
+}
