@@ -15,6 +15,6 @@ pub mod io;
 pub mod manifest;
 pub mod plot;
 pub mod separable;
-pub mod transmittance;
 pub mod skin_color;
 pub mod spectral;
+pub mod transmittance;

@@ -19,7 +19,7 @@ impl Ctx {
 
     /// Prints a JSON value on stdout (one object, pretty, trailing newline).
     pub fn emit_json(&self, v: &serde_json::Value) {
-        println!("{}", serde_json::to_string_pretty(v).expect("JSON values serialise"));
+        print_stdout(&format!("{}\n", serde_json::to_string_pretty(v).expect("JSON values serialise")));
     }
 
     /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
@@ -32,6 +32,19 @@ impl Ctx {
         let pb = indicatif::ProgressBar::new(len);
         pb.set_message(msg.to_string());
         pb
+    }
+}
+
+/// Writes to stdout; a closed pipe (`rtbake … --json | head`) ends the program quietly instead of panicking.
+pub fn print_stdout(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: cannot write to stdout: {e}");
+        std::process::exit(1);
     }
 }
 

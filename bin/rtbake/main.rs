@@ -69,6 +69,12 @@ enum Command {
 }
 
 fn main() {
+    // Behave like other Unix tools when stdout is closed early (`rtbake … | head`): end quietly, no panic.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let argv = match cli::expand_params_file::<Cli>(std::env::args_os().collect()) {
         Ok(a) => a,
         Err(e) => cli::exit_with(&e),

@@ -98,8 +98,8 @@ pub fn registry() -> Vec<Asset> {
 pub mod aa;
 pub mod gaussians;
 pub mod separable;
-pub mod transmittance;
 pub mod skin;
+pub mod transmittance;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
