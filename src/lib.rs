@@ -11,3 +11,4 @@ pub mod error;
 pub mod image_buf;
 pub mod io;
 pub mod manifest;
+pub mod runtime;
