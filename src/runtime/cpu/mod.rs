@@ -55,6 +55,14 @@ impl<'a> Tex8<'a> {
         self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as f32 / 255.0
     }
 
+    /// Nearest fetch of channels 0 and 1 at normalised coordinates (clamp-to-edge).
+    #[inline]
+    pub fn sample2_nearest(&self, u: f32, v: f32) -> [f32; 2] {
+        let x = (u * self.w as f32).floor() as i32;
+        let y = (v * self.h as f32).floor() as i32;
+        [self.load(x, y, 0), if self.ch > 1 { self.load(x, y, 1) } else { 0.0 }]
+    }
+
     /// Bilinear fetch of channels 0 and 1 at normalised coordinates (u, v), clamp-to-edge
     /// (`textureSampleLevel` with a linear, clamped sampler).
     #[inline]
