@@ -31,11 +31,10 @@ fn reference(rel: &str) -> Vec<u8> {
     std::fs::read(dir.join(rel)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(rel).display()))
 }
 
+type Encode<'a> = dyn Fn(&mut wgpu::CommandEncoder, Option<(&GpuTimer, u32)>) + 'a;
+
 /// Times `encode` (3 passes) RUNS times; returns per-pass medians (timestamps) or the wall-time median.
-fn time_passes(
-    g: &rtbake::runtime::device::Gpu,
-    encode: &dyn Fn(&mut wgpu::CommandEncoder, Option<(&GpuTimer, u32)>),
-) -> (Vec<f64>, f64) {
+fn time_passes(g: &rtbake::runtime::device::Gpu, encode: &Encode<'_>) -> (Vec<f64>, f64) {
     let timer = g.timestamps.then(|| GpuTimer::new(&g.device, 3));
     let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); 3];
     let mut wall = Vec::new();
@@ -67,8 +66,8 @@ fn main() {
     let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
     println!("adapter: {}", g.describe());
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
-    let luts = SmaaTextures::new(reference("smaa/AreaTex_RG8_160x560.bin"), reference("smaa/SearchTex_R8_64x16.bin"))
-        .unwrap();
+    let luts =
+        SmaaTextures::new(reference("smaa/AreaTex_RG8_160x560.bin"), reference("smaa/SearchTex_R8_64x16.bin")).unwrap();
     let n = 33;
     let map = MlaaAreaMap::new(n, reference(&format!("mlaa/AreaMap{n}_v1.4_RG8_165x165.bin"))).unwrap();
     println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");

@@ -101,7 +101,15 @@ fn demo_writes_a_png() {
     golden_bake(t.path(), "linear");
     let out = t.path().join("demo.png");
     let o = rtbake(&[
-        "run", "demo", "--output", out.to_str().unwrap(), "--width", "320", "--height", "180", "--baked",
+        "run",
+        "demo",
+        "--output",
+        out.to_str().unwrap(),
+        "--width",
+        "320",
+        "--height",
+        "180",
+        "--baked",
         t.path().to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -122,11 +130,31 @@ fn bad_input_exits_2_and_writes_nothing() {
     // Even max distance.
     let inp = t.path().join("in.png");
     std::fs::write(&inp, rtbake::io::png::encode_u8(&Image::from_vec(4, 4, 4, vec![9u8; 64])).unwrap()).unwrap();
-    let o = rtbake(&["run", "mlaa", "--input", inp.to_str().unwrap(), "--output", outs, "--baked", baked, "--max-distance", "8"]);
+    let o = rtbake(&[
+        "run",
+        "mlaa",
+        "--input",
+        inp.to_str().unwrap(),
+        "--output",
+        outs,
+        "--baked",
+        baked,
+        "--max-distance",
+        "8",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--max-distance"));
     // Output directory missing.
-    let o = rtbake(&["run", "smaa", "--input", inp.to_str().unwrap(), "--output", "/nonexistent/dir/o.png", "--baked", baked]);
+    let o = rtbake(&[
+        "run",
+        "smaa",
+        "--input",
+        inp.to_str().unwrap(),
+        "--output",
+        "/nonexistent/dir/o.png",
+        "--baked",
+        baked,
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(!out.exists());
 }
@@ -139,7 +167,14 @@ fn srgb_declared_lut_is_refused() {
     std::fs::write(&inp, rtbake::io::png::encode_u8(&Image::from_vec(4, 4, 4, vec![9u8; 64])).unwrap()).unwrap();
     let out = t.path().join("out.png");
     let o = rtbake(&[
-        "run", "smaa", "--input", inp.to_str().unwrap(), "--output", out.to_str().unwrap(), "--cpu", "--baked",
+        "run",
+        "smaa",
+        "--input",
+        inp.to_str().unwrap(),
+        "--output",
+        out.to_str().unwrap(),
+        "--cpu",
+        "--baked",
         t.path().to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));

@@ -76,11 +76,8 @@ fn smaa_reduces_error_against_supersampled_truth() {
     let pass = Smaa::new(&g.device, &g.queue, w, h, &golden_smaa()).unwrap();
     let smaa = pass.run(&g.device, &g.queue, &aliased).unwrap();
     // Edge pixels: where the aliased image is visibly wrong.
-    let mask: Vec<bool> = aliased
-        .chunks(4)
-        .zip(truth.chunks(4))
-        .map(|(a, t)| (0..3).any(|k| a[k].abs_diff(t[k]) > 8))
-        .collect();
+    let mask: Vec<bool> =
+        aliased.chunks(4).zip(truth.chunks(4)).map(|(a, t)| (0..3).any(|k| a[k].abs_diff(t[k]) > 8)).collect();
     let edge_px = mask.iter().filter(|m| **m).count();
     let (mae_aliased, psnr_aliased) = errors(&aliased, &truth, &mask);
     let (mae_smaa, psnr_smaa) = errors(&smaa, &truth, &mask);

@@ -86,7 +86,7 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
 }
 
 fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
-    if n < 3 || n % 2 == 0 {
+    if n < 3 || n.is_multiple_of(2) {
         return Err(usage_msg(format!("--max-distance must be odd and >= 3 (e.g. 9, 17, 33, 65, 129), got {n}")));
     }
     let bytes = loader::load_mlaa_area(baked, n).map_err(usage)?;

@@ -42,8 +42,12 @@ pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Resul
     let (w, h) = (img.width, img.height);
     crate::error::check_size("--input", w as u64, h as u64)?;
     let data = match (gpu, aa) {
-        (Some(g), Antialiasing::Smaa(t)) => Smaa::new(&g.device, &g.queue, w, h, t)?.run(&g.device, &g.queue, &img.data)?,
-        (Some(g), Antialiasing::Mlaa(m)) => Mlaa::new(&g.device, &g.queue, w, h, m)?.run(&g.device, &g.queue, &img.data)?,
+        (Some(g), Antialiasing::Smaa(t)) => {
+            Smaa::new(&g.device, &g.queue, w, h, t)?.run(&g.device, &g.queue, &img.data)?
+        }
+        (Some(g), Antialiasing::Mlaa(m)) => {
+            Mlaa::new(&g.device, &g.queue, w, h, m)?.run(&g.device, &g.queue, &img.data)?
+        }
         (None, Antialiasing::Smaa(t)) => cpu::smaa::smaa(&img.data, w, h, t, FilterPrecision::Exact).output,
         (None, Antialiasing::Mlaa(m)) => cpu::mlaa::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output,
     };

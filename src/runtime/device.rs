@@ -33,10 +33,7 @@ pub fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
         wgpu::DeviceType::VirtualGpu => "virtual GPU",
         wgpu::DeviceType::Other => "other",
     };
-    format!(
-        "{} [{:?}, {kind}, driver {} {}]",
-        info.name, info.backend, info.driver, info.driver_info
-    )
+    format!("{} [{:?}, {kind}, driver {} {}]", info.name, info.backend, info.driver, info.driver_info)
 }
 
 /// Options for [`create_headless`].

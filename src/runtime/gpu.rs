@@ -5,7 +5,13 @@ use super::RuntimeError;
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
-pub fn texture(device: &wgpu::Device, label: &str, width: u32, height: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+pub fn texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
     debug_assert!(!format.is_srgb(), "runtime textures are never sRGB");
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
@@ -160,7 +166,11 @@ pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }

@@ -25,7 +25,7 @@ pub struct MlaaAreaMap {
 
 impl MlaaAreaMap {
     pub fn new(n: u32, bytes: Vec<u8>) -> Result<Self, InvalidInput> {
-        if n < 3 || n % 2 == 0 || n > 1025 {
+        if n < 3 || n.is_multiple_of(2) || n > 1025 {
             return Err(InvalidInput::new("--max-distance", format!("must be odd and in 3..=1025, got {n}")));
         }
         let want = (5 * n * 5 * n * 2) as usize;

@@ -15,8 +15,8 @@ pub mod cpu;
 pub mod device;
 pub mod gpu;
 pub mod loader;
-pub mod scene;
 pub mod mlaa;
+pub mod scene;
 pub mod separable_sss;
 pub mod smaa;
 

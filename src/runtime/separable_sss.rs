@@ -135,13 +135,23 @@ impl SeparableSss {
                 device,
                 "sss h",
                 &layout,
-                &[(0, ubo_h.as_entire_binding()), (1, R::TextureView(&cv)), (2, R::TextureView(&dv)), (6, R::Sampler(&lin))],
+                &[
+                    (0, ubo_h.as_entire_binding()),
+                    (1, R::TextureView(&cv)),
+                    (2, R::TextureView(&dv)),
+                    (6, R::Sampler(&lin)),
+                ],
             ),
             gpu::bind_group(
                 device,
                 "sss v",
                 &layout,
-                &[(0, ubo_v.as_entire_binding()), (1, R::TextureView(&tv)), (2, R::TextureView(&dv)), (6, R::Sampler(&lin))],
+                &[
+                    (0, ubo_v.as_entire_binding()),
+                    (1, R::TextureView(&tv)),
+                    (2, R::TextureView(&dv)),
+                    (6, R::Sampler(&lin)),
+                ],
             ),
         ];
         let targets = [tv, view(&output)];

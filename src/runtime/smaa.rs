@@ -97,10 +97,8 @@ impl Smaa {
         let search = gpu::texture(device, "smaa search", SEARCH_TEX_SIZE.0, SEARCH_TEX_SIZE.1, F::R8Unorm);
         gpu::upload(queue, &area, &luts.area);
         gpu::upload(queue, &search, &luts.search);
-        let params = Params {
-            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
-            subsample: [0.0; 4],
-        };
+        let params =
+            Params { rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32], subsample: [0.0; 4] };
         let ubo = gpu::uniform_buffer(device, "smaa params", bytemuck::bytes_of(&params));
         let module = gpu::shader(device, "smaa.wgsl", SHADER);
         let pipe_edges = gpu::fullscreen_pipeline(device, "smaa edges", &module, "fs_edges", F::Rg8Unorm);

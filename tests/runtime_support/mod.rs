@@ -61,6 +61,7 @@ pub fn within(a: &[u8], b: &[u8], tol: u8) -> (f64, u8) {
 /// Fraction of pixels (all `ch` channels) within `tol`.
 pub fn pixels_within(a: &[u8], b: &[u8], ch: usize, tol: u8) -> f64 {
     let n = a.len() / ch;
-    let ok = a.chunks(ch).zip(b.chunks(ch)).filter(|(p, q)| p.iter().zip(*q).all(|(x, y)| x.abs_diff(*y) <= tol)).count();
+    let ok =
+        a.chunks(ch).zip(b.chunks(ch)).filter(|(p, q)| p.iter().zip(*q).all(|(x, y)| x.abs_diff(*y) <= tol)).count();
     ok as f64 / n as f64
 }

@@ -27,9 +27,8 @@ pub fn mlaa(rgba: &[u8], w: u32, h: u32, map: &MlaaAreaMap, prec: FilterPrecisio
 /// Listing 9.1, luminance variant.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
     let w = color.w;
-    let luma = |x: i32, y: i32| {
-        color.load(x, y, 0) * LUMA[0] + color.load(x, y, 1) * LUMA[1] + color.load(x, y, 2) * LUMA[2]
-    };
+    let luma =
+        |x: i32, y: i32| color.load(x, y, 0) * LUMA[0] + color.load(x, y, 1) * LUMA[1] + color.load(x, y, 2) * LUMA[2];
     let mut out = vec![0u8; (w * color.h * 2) as usize];
     out.par_chunks_mut((w * 2) as usize).enumerate().for_each(|(y, row)| {
         let y = y as i32;
@@ -148,7 +147,8 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
         let y = y as i32;
         for x in 0..w as i32 {
-            let a = [weights.load(x, y, 0), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x + 1, y, 3)];
+            let a =
+                [weights.load(x, y, 0), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x + 1, y, 3)];
             let sum = a[0] + a[1] + a[2] + a[3];
             let o = x as usize * 4;
             if sum <= 0.0 {

@@ -44,9 +44,8 @@ pub fn smaa(rgba: &[u8], w: u32, h: u32, luts: &SmaaTextures, prec: FilterPrecis
 /// Pass 1: luma edge detection with local contrast adaptation.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
     let (w, h) = (color.w, color.h);
-    let luma = |x: i32, y: i32| {
-        color.load(x, y, 0) * LUMA[0] + color.load(x, y, 1) * LUMA[1] + color.load(x, y, 2) * LUMA[2]
-    };
+    let luma =
+        |x: i32, y: i32| color.load(x, y, 0) * LUMA[0] + color.load(x, y, 1) * LUMA[1] + color.load(x, y, 2) * LUMA[2];
     let step = |edge: f32, x: f32| if x >= edge { 1.0f32 } else { 0.0 };
     let mut out = vec![0u8; (w * h * 2) as usize];
     out.par_chunks_mut((w * 2) as usize).enumerate().for_each(|(y, row)| {
@@ -307,7 +306,8 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
         let y = y as i32;
         for x in 0..w as i32 {
-            let a = [weights.load(x + 1, y, 3), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x, y, 0)];
+            let a =
+                [weights.load(x + 1, y, 3), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x, y, 0)];
             let o = x as usize * 4;
             if a[0] + a[1] + a[2] + a[3] < 1e-5 {
                 let i = (y as usize * w as usize + x as usize) * 4;
