@@ -13,6 +13,7 @@
 pub mod chain;
 pub mod cpu;
 pub mod device;
+pub mod gaussian_sss;
 pub mod gpu;
 pub mod loader;
 pub mod mlaa;
