@@ -19,6 +19,7 @@ pub mod loader;
 pub mod mlaa;
 pub mod scene;
 pub mod separable_sss;
+pub mod skin_inputs;
 pub mod smaa;
 
 /// Errors of the runtime.

@@ -9,6 +9,7 @@
 pub mod gaussian_sss;
 pub mod mlaa;
 pub mod separable_sss;
+pub mod skin_inputs;
 pub mod smaa;
 
 /// How a bilinear fetch of an 8-bit texture is computed.
