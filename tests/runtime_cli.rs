@@ -182,3 +182,54 @@ fn srgb_declared_lut_is_refused() {
     assert!(err.contains("colour space") && err.contains("AreaTex.bin"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
+    let t = tempfile::tempdir().unwrap();
+    golden_bake(t.path(), "linear");
+    let baked = t.path().to_str().unwrap();
+    let (g, c) = (t.path().join("g.png"), t.path().join("c.png"));
+    for (out, cpu) in [(&g, false), (&c, true)] {
+        let mut args = vec!["run", "demo", "--output", out.to_str().unwrap(), "--width", "192", "--height", "108"];
+        args.extend(["--baked", baked]);
+        if cpu {
+            args.push("--cpu");
+        }
+        let o = rtbake(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let (fg, fc) = (read_rgba(&g), read_rgba(&c));
+    // GPU chain vs CPU chain (f16 SSS differences propagate through sRGB encoding and SMAA): within 2/255 on
+    // 99 % of the samples.
+    let (frac, _) = within(&fg, &fc, 2);
+    assert!(frac >= 0.99, "demo GPU vs CPU: {frac}");
+
+    // run sss on EXR input.
+    let (w, h) = (48u32, 32u32);
+    let color: Vec<f32> =
+        (0..w * h).flat_map(|i| [if (i % w) / 4 % 2 == 0 { 1.0 } else { 0.1 }, 0.5, 0.25, 1.0]).collect();
+    let depth = vec![0.2f32; (w * h) as usize];
+    let cp = t.path().join("c.exr");
+    let dp = t.path().join("d.exr");
+    let enc = |img: &Image<f32>| rtbake::io::exr::encode(img, rtbake::io::exr::ExrPrecision::F32).unwrap();
+    std::fs::write(&cp, enc(&Image::from_vec(w, h, 4, color.clone()))).unwrap();
+    std::fs::write(&dp, enc(&Image::from_vec(w, h, 1, depth))).unwrap();
+    let op = t.path().join("o.exr");
+    let o = rtbake(&[
+        "run", "sss", "--color", cp.to_str().unwrap(), "--depth", dp.to_str().unwrap(), "--output", op.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (out, _) = rtbake::io::exr::decode(&std::fs::read(&op).unwrap(), "o").unwrap();
+    assert_eq!((out.width, out.height, out.channels), (w, h, 4));
+    // Stripes are blurred: red range shrinks.
+    let reds: Vec<f32> = out.data.chunks(4).map(|p| p[0]).collect();
+    let (mn, mx) = reds.iter().fold((f32::MAX, f32::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+    assert!(mx - mn < 0.85, "SSS must blur the stripes: {mn}..{mx}");
+    // Depth of another size is refused with exit 2.
+    std::fs::write(&dp, enc(&Image::from_vec(4, 4, 1, vec![1.0; 16]))).unwrap();
+    let o = rtbake(&[
+        "run", "sss", "--color", cp.to_str().unwrap(), "--depth", dp.to_str().unwrap(), "--output", op.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--depth"));
+}

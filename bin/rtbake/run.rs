@@ -6,7 +6,8 @@ use rtbake::io::{self, atomic::write_atomic};
 use rtbake::runtime::chain::{self, Antialiasing};
 use rtbake::runtime::device::{create_headless, Gpu};
 use rtbake::runtime::mlaa::MlaaAreaMap;
-use rtbake::runtime::{loader, scene};
+use rtbake::runtime::separable_sss::{SeparableSss, SssKernel, SssParams};
+use rtbake::runtime::{demo, loader};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -16,7 +17,10 @@ pub enum RunCommand {
     Smaa(AaArgs),
     /// Antialias a PNG with Jimenez's MLAA (area map of --max-distance from the bake directory).
     Mlaa(MlaaArgs),
-    /// Render a procedural scene (hard-edged shapes) through the available passes and write a PNG.
+    /// Separable SSS (two passes) on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR.
+    Sss(SssArgs),
+    /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
+    /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
     Demo(DemoArgs),
 }
 
@@ -52,6 +56,34 @@ pub struct MlaaArgs {
 }
 
 #[derive(clap::Args)]
+pub struct SssArgs {
+    /// Linear HDR diffuse irradiance, EXR with RGB or RGBA (alpha = per-pixel strength, 0 = not skin; RGB: 1).
+    #[arg(long, value_name = "EXR")]
+    color: PathBuf,
+    /// Linear depth, EXR (first channel used), same size.
+    #[arg(long, value_name = "EXR")]
+    depth: PathBuf,
+    /// Output EXR (RGBA f16).
+    #[arg(long, value_name = "EXR")]
+    output: PathBuf,
+    /// Kernel: JSON array of [r, g, b, offset] taps, centre first (default: the demo's stand-in 17-tap kernel).
+    #[arg(long, value_name = "JSON")]
+    kernel: Option<PathBuf>,
+    /// Kernel width in world units.
+    #[arg(long, default_value_t = 0.012)]
+    sss_width: f32,
+    /// Vertical field of view, degrees.
+    #[arg(long, default_value_t = 20.0)]
+    fovy: f32,
+    /// Disable the follow-surface depth test.
+    #[arg(long)]
+    no_follow_surface: bool,
+    /// Run the CPU reference implementation instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+}
+
+#[derive(clap::Args)]
 pub struct DemoArgs {
     /// Output PNG.
     #[arg(long, value_name = "PNG")]
@@ -81,7 +113,8 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
         }
-        RunCommand::Demo(d) => demo(ctx, d),
+        RunCommand::Sss(a) => sss(ctx, a),
+        RunCommand::Demo(d) => run_demo(ctx, d),
     }
 }
 
@@ -148,7 +181,64 @@ fn report(ctx: &Ctx, pass: &str, output: &Path, img: &Image<u8>, gpu: Option<&Gp
     }
 }
 
-fn demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
+fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
+    let bytes = std::fs::read(path).map_err(|e| usage(anyhow::anyhow!("{flag} {}: {e}", path.display())))?;
+    Ok(io::exr::decode(&bytes, &path.display().to_string()).map_err(usage)?.0)
+}
+
+fn read_kernel(path: &Path) -> anyhow::Result<SssKernel> {
+    let text = std::fs::read_to_string(path).map_err(|e| usage(anyhow::anyhow!("--kernel {}: {e}", path.display())))?;
+    let taps: Vec<[f32; 4]> = serde_json::from_str(&text).map_err(|e| {
+        usage(anyhow::anyhow!("--kernel {}: expected a JSON array of [r, g, b, offset] taps: {e}", path.display()))
+    })?;
+    Ok(SssKernel::new(taps)?)
+}
+
+fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
+    check_output(&a.output)?;
+    let params = SssParams { sss_width: a.sss_width, fovy_deg: a.fovy, follow_surface: !a.no_follow_surface };
+    params.validate()?;
+    let kernel = match &a.kernel {
+        Some(p) => read_kernel(p)?,
+        None => demo::standin_kernel(),
+    };
+    let color = read_exr("--color", &a.color)?;
+    let depth = read_exr("--depth", &a.depth)?;
+    if (color.width, color.height) != (depth.width, depth.height) {
+        return Err(usage_msg(format!(
+            "--depth must match --color's size {}x{}, got {}x{}",
+            color.width, color.height, depth.width, depth.height
+        )));
+    }
+    let rgba = match color.channels {
+        4 => color.data.clone(),
+        3 => color.data.chunks(3).flat_map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+        n => return Err(usage_msg(format!("--color must have 3 or 4 channels (RGB/RGBA), got {n}"))),
+    };
+    let d: Vec<f32> = depth.data.chunks(depth.channels as usize).map(|p| p[0]).collect();
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return Err(usage_msg("--depth must hold finite linear depths > 0"));
+    }
+    let gpu = device(ctx, a.cpu)?;
+    let (w, h) = (color.width, color.height);
+    let t = Instant::now();
+    let out = match &gpu {
+        Some(g) => SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &rgba, &d)?,
+        None => rtbake::runtime::cpu::separable_sss::separable_sss(&rgba, &d, w, h, &kernel, &params),
+    };
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    let img = Image::from_vec(w, h, 4, out);
+    write_atomic(&a.output, &io::exr::encode(&img, io::exr::ExrPrecision::F16)?)?;
+    let adapter = gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU reference".into());
+    ctx.info(format!("sss: {w}x{h} in {ms:.1} ms -> {}", a.output.display()));
+    if ctx.json {
+        ctx.emit_json(&serde_json::json!({"pass": "sss", "output": a.output.display().to_string(), "width": w,
+            "height": h, "adapter": adapter, "wall_ms": ms}));
+    }
+    Ok(())
+}
+
+fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     check_output(&d.output)?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
     let aa = match d.aa.as_str() {
@@ -159,11 +249,7 @@ fn demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     };
     let gpu = device(ctx, d.common.cpu)?;
     let t = Instant::now();
-    let frame = Image::from_vec(d.width, d.height, 4, scene::render_shapes(d.width, d.height, 1));
-    let out = match &aa {
-        Some(aa) => chain::antialias(gpu.as_ref(), &frame, aa)?,
-        None => frame,
-    };
+    let out = demo::render(gpu.as_ref(), d.width, d.height, aa.as_ref())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     write_atomic(&d.output, &io::png::encode_u8(&out)?)?;
     report(ctx, "demo", &d.output, &out, gpu.as_ref(), ms);

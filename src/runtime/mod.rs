@@ -12,6 +12,7 @@
 
 pub mod chain;
 pub mod cpu;
+pub mod demo;
 pub mod device;
 pub mod gaussian_sss;
 pub mod gpu;
