@@ -216,7 +216,14 @@ fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
     std::fs::write(&dp, enc(&Image::from_vec(w, h, 1, depth))).unwrap();
     let op = t.path().join("o.exr");
     let o = rtbake(&[
-        "run", "sss", "--color", cp.to_str().unwrap(), "--depth", dp.to_str().unwrap(), "--output", op.to_str().unwrap(),
+        "run",
+        "sss",
+        "--color",
+        cp.to_str().unwrap(),
+        "--depth",
+        dp.to_str().unwrap(),
+        "--output",
+        op.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (out, _) = rtbake::io::exr::decode(&std::fs::read(&op).unwrap(), "o").unwrap();
@@ -228,7 +235,14 @@ fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
     // Depth of another size is refused with exit 2.
     std::fs::write(&dp, enc(&Image::from_vec(4, 4, 1, vec![1.0; 16]))).unwrap();
     let o = rtbake(&[
-        "run", "sss", "--color", cp.to_str().unwrap(), "--depth", dp.to_str().unwrap(), "--output", op.to_str().unwrap(),
+        "run",
+        "sss",
+        "--color",
+        cp.to_str().unwrap(),
+        "--depth",
+        dp.to_str().unwrap(),
+        "--output",
+        op.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--depth"));

@@ -144,13 +144,8 @@ pub fn render(gpu: Option<&Gpu>, w: u32, h: u32, aa: Option<&Antialiasing>) -> R
     let key = normalise([-0.5, 0.6, 0.62]);
     let back = normalise([0.3, 0.2, -0.93]);
     let (albedo, transmitted) = match gpu {
-        Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, &luts, &rig)?.run(
-            &g.device,
-            &g.queue,
-            &geo.frame,
-            &weights,
-            back,
-        )?,
+        Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, &luts, &rig)?
+            .run(&g.device, &g.queue, &geo.frame, &weights, back)?,
         None => cpu::skin_inputs::skin_inputs(&geo.frame, &luts, &rig, &weights, back),
     };
     // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
@@ -169,7 +164,9 @@ pub fn render(gpu: Option<&Gpu>, w: u32, h: u32, aa: Option<&Antialiasing>) -> R
         diffuse[4 * i + 3] = 1.0;
     }
     let blurred = match gpu {
-        Some(g) => SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?,
+        Some(g) => {
+            SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
+        }
         None => cpu::separable_sss::separable_sss(&diffuse, &geo.depth, w, h, &kernel, &params),
     };
     // Composite over the hard-edged background shapes; add back-lit transmittance; encode sRGB.

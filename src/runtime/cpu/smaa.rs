@@ -43,12 +43,20 @@ pub fn smaa(rgba: &[u8], w: u32, h: u32, luts: &SmaaTextures, prec: FilterPrecis
 
 /// Pass 1: luma edge detection with local contrast adaptation.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
-    let (w, h) = (color.w, color.h);
-    let luma =
-        |x: i32, y: i32| color.load(x, y, 0) * LUMA[0] + color.load(x, y, 1) * LUMA[1] + color.load(x, y, 2) * LUMA[2];
+    let (w, h) = (color.w as usize, color.h as usize);
+    // Luma of every pixel once (same expression as the shader's dot product, evaluated per texel).
+    let mut lum = vec![0.0f32; w * h];
+    lum.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, l) in row.iter_mut().enumerate() {
+            let i = (y * w + x) * 4;
+            let c = &color.data[i..i + 3];
+            *l = (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
+        }
+    });
+    let luma = |x: i32, y: i32| lum[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
     let step = |edge: f32, x: f32| if x >= edge { 1.0f32 } else { 0.0 };
-    let mut out = vec![0u8; (w * h * 2) as usize];
-    out.par_chunks_mut((w * 2) as usize).enumerate().for_each(|(y, row)| {
+    let mut out = vec![0u8; w * h * 2];
+    out.par_chunks_mut(w * 2).enumerate().for_each(|(y, row)| {
         let y = y as i32;
         for x in 0..w as i32 {
             let l = luma(x, y);
@@ -281,7 +289,11 @@ pub fn blending_weights(edges: &Tex8, luts: &SmaaTextures, prec: FilterPrecision
     };
     let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        let erow = &edges.data[y * w as usize * 2..(y + 1) * w as usize * 2];
         for x in 0..w {
+            if erow[x as usize * 2] == 0 && erow[x as usize * 2 + 1] == 0 {
+                continue; // no edge: all weights are zero
+            }
             let wgt = ctx.pixel(x, y as u32);
             for c in 0..4 {
                 row[x as usize * 4 + c] = unorm8(wgt[c]);
