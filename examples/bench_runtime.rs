@@ -111,7 +111,7 @@ fn main() {
         .collect();
     let m = median(times);
     // Per-stage split of the CPU reference (same pool).
-    let stage = |f: &dyn Fn() -> usize| {
+    let stage = |f: &(dyn Fn() -> usize + Sync)| {
         median(
             (0..RUNS)
                 .map(|_| {

@@ -30,8 +30,9 @@ pub enum RuntimeError {
     NoAdapter(String),
     #[error("GPU error: {0}")]
     Gpu(String),
-    #[error(transparent)]
+    #[error("{0}")]
     Lut(#[from] loader::LutError),
-    #[error(transparent)]
+    /// Bad input; kept as the error's source so the command maps it to exit code 2.
+    #[error("{0}")]
     Invalid(#[from] crate::error::InvalidInput),
 }
