@@ -83,8 +83,8 @@ fn neutral_weights_reproduce_neutral_hemoglobin_and_e_follows_eq_5_13() {
     let zero = HemoglobinRig { width: 1, height: 1, targets: vec![vec![[1.0, 0.0]]] };
     let mut p0 = SkinInputs::new(&g.device, &g.queue, 4, 4, &l, &zero).unwrap();
     let (a, _) = p0.run(&g.device, &g.queue, &f0, &[1.0], light).unwrap();
-    for c in 0..3 {
-        assert!((a[c] - half::f16::from_f32(l.albedo[0][c]).to_f32()).abs() < 1e-6);
+    for (got, want) in a[..3].iter().zip(l.albedo[0]) {
+        assert!((got - half::f16::from_f32(want).to_f32()).abs() < 1e-6);
     }
 }
 

@@ -130,7 +130,44 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 }
 
 #[inline]
-pub(crate) fn round_half_away(v: f32) -> f32 {
+pub(crate) fn wgsl_round(v: f32) -> f32 {
     // WGSL `round` rounds half to even; Rust `round` rounds half away from zero. Use the WGSL rule.
     v.round_ties_even()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values measured on lavapipe (Mesa 22.3, llvmpipe): a 255 → 0 step sampled at fractions 0.25, 0.125,
+    /// 0.375, 0.1, 0.7 returned 191, 223, 159, 229, 77 (/255).
+    #[test]
+    fn unorm8_model_reproduces_lavapipe_bilinear() {
+        let data = [255u8, 0];
+        let t = Tex8::new(2, 1, 1, &data);
+        for (f, want) in [(0.25f32, 191u8), (0.125, 223), (0.375, 159), (0.1, 229), (0.7, 77)] {
+            let u = (0.5 + f) / 2.0;
+            let got = t.sample2(u, 0.5, FilterPrecision::Unorm8)[0];
+            assert_eq!((got * 255.0).round() as u8, want, "fraction {f}");
+            let exact = t.sample2(u, 0.5, FilterPrecision::Exact)[0];
+            assert!((exact - (1.0 - f)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn loads_clamp_to_edge_and_nearest_matches_texel() {
+        let data = [10u8, 20, 30, 40];
+        let t = Tex8::new(2, 2, 1, &data);
+        assert_eq!(t.load(-5, -5, 0), 10.0 / 255.0);
+        assert_eq!(t.load(9, 9, 0), 40.0 / 255.0);
+        assert_eq!(t.sample2_nearest(0.74, 0.26,)[0], 20.0 / 255.0);
+    }
+
+    #[test]
+    fn srgb_round_trip() {
+        for i in 0..=255u8 {
+            let v = i as f32 / 255.0;
+            assert_eq!(unorm8(linear_to_srgb(srgb_to_linear(v))), i);
+        }
+    }
 }
