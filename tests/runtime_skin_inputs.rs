@@ -84,7 +84,8 @@ fn neutral_weights_reproduce_neutral_hemoglobin_and_e_follows_eq_5_13() {
     let mut p0 = SkinInputs::new(&g.device, &g.queue, 4, 4, &l, &zero).unwrap();
     let (a, _) = p0.run(&g.device, &g.queue, &f0, &[1.0], light).unwrap();
     for (got, want) in a[..3].iter().zip(l.albedo[0]) {
-        assert!((got - half::f16::from_f32(want).to_f32()).abs() < 1e-6);
+        // The first texel (a neighbour differs by > 0.03), within the filtering error of any backend.
+        assert!((got - half::f16::from_f32(want).to_f32()).abs() < 2e-3, "{got} vs {want}");
     }
 }
 

@@ -166,7 +166,8 @@ impl SkinInputs {
         let maps = data_texture(device, "skin maps", width, height, 1, F::Rgba32Float);
         let normals = data_texture(device, "skin normals", width, height, 1, F::Rgba32Float);
         let k = rig.targets.len() as u32;
-        let rig_tex = data_texture(device, "skin rig", rig.width, rig.height, k, F::Rg16Float);
+        // At least two layers: the GL backend cannot view a one-layer texture as a 2D array.
+        let rig_tex = data_texture(device, "skin rig", rig.width, rig.height, k.max(2), F::Rg16Float);
         for (i, t) in rig.targets.iter().enumerate() {
             queue.write_texture(
                 wgpu::TexelCopyTextureInfo {

@@ -1,7 +1,7 @@
 //! CPU reference of Jimenez's MLAA — the twin of `shaders/mlaa.wgsl` (algorithm and source in
 //! [`crate::runtime::mlaa`]). Same pixel-unit arithmetic, same bilinear/point fetches through [`Tex8`].
 
-use super::{linear_to_srgb, wgsl_round as round, srgb_to_linear, unorm8, FilterPrecision, Tex8};
+use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
 use crate::runtime::mlaa::{MlaaAreaMap, MLAA_THRESHOLD};
 use rayon::prelude::*;
 

@@ -7,7 +7,7 @@
 //! multiply-adds; both can flip an output byte by one. The bilinear precision of the adapter is modelled by
 //! [`FilterPrecision`].
 
-use super::{linear_to_srgb, wgsl_round as round, srgb_to_linear, unorm8, FilterPrecision, Tex8};
+use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
 use crate::runtime::smaa::{SmaaTextures, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
 use rayon::prelude::*;
 
