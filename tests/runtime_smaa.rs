@@ -89,3 +89,25 @@ fn smaa_reduces_error_against_supersampled_truth() {
     assert!(mae_smaa < 0.7 * mae_aliased, "SMAA must clearly reduce the edge error: {mae_smaa} vs {mae_aliased}");
     assert!(psnr_smaa > psnr_aliased + 2.0, "PSNR must improve by > 2 dB: {psnr_smaa} vs {psnr_aliased}");
 }
+
+/// The S2x/T2x and 4x slices of the area texture: GPU and CPU agree, and the output differs from 1x.
+#[test]
+fn smaa_subsample_slices_gpu_matches_cpu() {
+    use rtbake::runtime::smaa::SubsampleIndices;
+    let (w, h) = (192, 160);
+    let g = gpu();
+    let luts = golden_smaa();
+    let img = render_shapes(w, h, 1);
+    let one_x = cpu::smaa::smaa(&img, w, h, &luts, precision(&g)).weights;
+    for s in SubsampleIndices::SMAA_2X.into_iter().chain(SubsampleIndices::SMAA_4X) {
+        let pass = Smaa::with_subsample(&g.device, &g.queue, w, h, &luts, s).unwrap();
+        let out = pass.run(&g.device, &g.queue, &img).unwrap();
+        let weights = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.weights()).unwrap();
+        let c = cpu::smaa::smaa_with_subsample(&img, w, h, &luts, precision(&g), s);
+        let (fo, _) = within(&out, &c.output, 1);
+        let (fw, _) = within(&weights, &c.weights, 1);
+        assert!(fo >= 0.999 && fw >= 0.999, "{s:?}: output {fo}, weights {fw}");
+        assert_ne!(c.weights, one_x, "{s:?} must read other slices than 1x");
+    }
+    assert!(SubsampleIndices([7, 0, 0, 0]).validate().is_err());
+}

@@ -46,6 +46,36 @@ impl SmaaTextures {
     }
 }
 
+/// Area-texture slice indices of one SMAA sample: (vertical orthogonal, horizontal orthogonal, diagonal 1,
+/// diagonal 2), as in the SMAA shader's `subsampleIndices`. Orthogonal slices 0..6, diagonal slices 0..4
+/// (`smaa-mlaa.md`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubsampleIndices(pub [u32; 4]);
+
+impl SubsampleIndices {
+    /// SMAA 1x: slice 0 everywhere.
+    pub const SMAA_1X: Self = Self([0, 0, 0, 0]);
+    /// SMAA S2x / T2x, first and second sample (frame).
+    pub const SMAA_2X: [Self; 2] = [Self([1, 1, 1, 0]), Self([2, 2, 2, 0])];
+    /// SMAA 4x, the four samples.
+    pub const SMAA_4X: [Self; 4] = [Self([5, 3, 1, 3]), Self([4, 6, 2, 3]), Self([3, 5, 1, 4]), Self([6, 4, 2, 4])];
+
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let [v, h, d1, d2] = self.0;
+        if v > 6 || h > 6 || d1 > 4 || d2 > 4 {
+            return Err(InvalidInput::new(
+                "--subsample",
+                format!("orthogonal indices must be in 0..=6 and diagonal ones in 0..=4, got {:?}", self.0),
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn as_f32(&self) -> [f32; 4] {
+        self.0.map(|v| v as f32)
+    }
+}
+
 /// Uniform block of `smaa.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -79,7 +109,7 @@ pub struct Smaa {
 }
 
 impl Smaa {
-    /// Creates every resource for `width × height` frames and uploads the lookup textures.
+    /// Creates every resource for `width × height` frames and uploads the lookup textures (SMAA 1x).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -87,7 +117,20 @@ impl Smaa {
         height: u32,
         luts: &SmaaTextures,
     ) -> Result<Self, RuntimeError> {
+        Self::with_subsample(device, queue, width, height, luts, SubsampleIndices::SMAA_1X)
+    }
+
+    /// As [`Self::new`] with explicit area-texture slices (S2x/T2x/4x samples).
+    pub fn with_subsample(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        width: u32,
+        height: u32,
+        luts: &SmaaTextures,
+        subsample: SubsampleIndices,
+    ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
+        subsample.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "smaa colour", width, height, F::Rgba8Unorm);
         let edges = gpu::texture(device, "smaa edges", width, height, F::Rg8Unorm);
@@ -97,8 +140,10 @@ impl Smaa {
         let search = gpu::texture(device, "smaa search", SEARCH_TEX_SIZE.0, SEARCH_TEX_SIZE.1, F::R8Unorm);
         gpu::upload(queue, &area, &luts.area);
         gpu::upload(queue, &search, &luts.search);
-        let params =
-            Params { rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32], subsample: [0.0; 4] };
+        let params = Params {
+            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+            subsample: subsample.as_f32(),
+        };
         let ubo = gpu::uniform_buffer(device, "smaa params", bytemuck::bytes_of(&params));
         let module = gpu::shader(device, "smaa.wgsl", SHADER);
         let pipe_edges = gpu::fullscreen_pipeline(device, "smaa edges", &module, "fs_edges", F::Rg8Unorm);

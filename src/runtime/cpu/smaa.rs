@@ -8,7 +8,7 @@
 //! [`FilterPrecision`].
 
 use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
-use crate::runtime::smaa::{SmaaTextures, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
+use crate::runtime::smaa::{SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
 use rayon::prelude::*;
 
 const THRESHOLD: f32 = 0.1;
@@ -33,10 +33,22 @@ pub struct SmaaCpuOutput {
 
 /// Runs SMAA 1x on `rgba` (`w·h·4` bytes, sRGB-encoded, top row first).
 pub fn smaa(rgba: &[u8], w: u32, h: u32, luts: &SmaaTextures, prec: FilterPrecision) -> SmaaCpuOutput {
+    smaa_with_subsample(rgba, w, h, luts, prec, SubsampleIndices::SMAA_1X)
+}
+
+/// Runs SMAA with explicit area-texture slices (one sample of S2x/T2x/4x).
+pub fn smaa_with_subsample(
+    rgba: &[u8],
+    w: u32,
+    h: u32,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+) -> SmaaCpuOutput {
     assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
     let color = Tex8::new(w, h, 4, rgba);
     let edges = edge_detection(&color);
-    let weights = blending_weights(&Tex8::new(w, h, 2, &edges), luts, prec);
+    let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, subsample);
     let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
     SmaaCpuOutput { edges, weights, output }
 }
@@ -276,8 +288,18 @@ fn corner_factor(d: [f32; 2]) -> [f32; 2] {
     [(1.0 - CORNER_ROUNDING_NORM) * lr[0] / s, (1.0 - CORNER_ROUNDING_NORM) * lr[1] / s]
 }
 
-/// Pass 2: blending weights (RGBA8) from the edges (RG8).
+/// Pass 2: blending weights (RGBA8) from the edges (RG8), SMAA 1x.
 pub fn blending_weights(edges: &Tex8, luts: &SmaaTextures, prec: FilterPrecision) -> Vec<u8> {
+    blending_weights_with_subsample(edges, luts, prec, SubsampleIndices::SMAA_1X)
+}
+
+/// Pass 2 with explicit area-texture slices.
+pub fn blending_weights_with_subsample(
+    edges: &Tex8,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+) -> Vec<u8> {
     let (w, h) = (edges.w, edges.h);
     let ctx = Ctx {
         edges: *edges,
@@ -285,7 +307,7 @@ pub fn blending_weights(edges: &Tex8, luts: &SmaaTextures, prec: FilterPrecision
         search: Tex8::new(SEARCH_TEX_SIZE.0, SEARCH_TEX_SIZE.1, 1, &luts.search),
         rt: [1.0 / w as f32, 1.0 / h as f32],
         prec,
-        subsample: [0.0; 4],
+        subsample: subsample.as_f32(),
     };
     let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
