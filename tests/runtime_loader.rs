@@ -125,3 +125,30 @@ fn refuses_missing_entry_and_missing_manifest() {
     let e = loader::load_smaa_textures(empty.path()).unwrap_err();
     assert!(matches!(e, LutError::Manifest(_)), "{e}");
 }
+
+#[test]
+fn float_lut_checks_sample_type() {
+    let t = tempfile::tempdir().unwrap();
+    let spec =
+        LutSpec { path: "skin/table.bin".into(), pixel_format: PixelFormat::R16G16B16A16Sfloat, width: 4, height: 2 };
+    let mut f = BakedFile {
+        path: spec.path.clone(),
+        bytes: vec![0u8; 4 * 2 * 8],
+        meta: meta(PixelFormat::R16G16B16A16Sfloat, 4, 2, "linear"),
+    };
+    f.meta.sample_type = "f16".into();
+    let write = |f: &BakedFile| {
+        let mut m = Manifest::new("test".into());
+        m.set_asset("skin", serde_json::json!({}), std::slice::from_ref(f));
+        let p = t.path().join(&f.path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, &f.bytes).unwrap();
+        std::fs::write(t.path().join("manifest.json"), m.to_text()).unwrap();
+    };
+    write(&f);
+    assert_eq!(loader::load_lut(t.path(), &spec).unwrap().len(), 64);
+    f.meta.sample_type = "f32".into();
+    write(&f);
+    let e = loader::load_lut(t.path(), &spec).unwrap_err();
+    assert!(matches!(e, LutError::Mismatch { field: "sample_type", .. }), "{e}");
+}

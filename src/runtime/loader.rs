@@ -103,8 +103,8 @@ pub fn load_lut_with(dir: &Path, manifest: &Manifest, spec: &LutSpec) -> Result<
     if m.channels != spec.pixel_format.channels() {
         return Err(mismatch("channels", spec.pixel_format.channels().to_string(), m.channels.to_string()));
     }
-    let want_sample = if spec.pixel_format.is_unorm8() { "u8" } else { "f16" };
-    if spec.pixel_format.is_unorm8() && m.sample_type != want_sample {
+    let want_sample = sample_type(spec.pixel_format);
+    if m.sample_type != want_sample {
         return Err(mismatch("sample_type", want_sample.into(), m.sample_type.clone()));
     }
     let file = dir.join(&spec.path);
@@ -123,6 +123,15 @@ pub fn load_lut_with(dir: &Path, manifest: &Manifest, spec: &LutSpec) -> Result<
         return Err(LutError::Checksum { path, expected: entry.sha256.clone(), found: sha });
     }
     Ok(bytes)
+}
+
+/// The manifest's `sample_type` for a pixel format.
+fn sample_type(pf: PixelFormat) -> &'static str {
+    match pf {
+        PixelFormat::R8Unorm | PixelFormat::R8G8Unorm | PixelFormat::R8G8B8A8Unorm => "u8",
+        PixelFormat::R16Sfloat | PixelFormat::R16G16Sfloat | PixelFormat::R16G16B16A16Sfloat => "f16",
+        PixelFormat::R32Sfloat | PixelFormat::R32G32B32A32Sfloat => "f32",
+    }
 }
 
 /// SMAA area + search textures from a bake directory.
