@@ -18,3 +18,4 @@ pub mod separable;
 pub mod skin_color;
 pub mod spectral;
 pub mod transmittance;
+pub mod runtime;

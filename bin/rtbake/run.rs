@@ -1,13 +1,257 @@
-//! `rtbake run`: not implemented yet.
+//! `rtbake run`: the GPU runtime (or its CPU reference with --cpu) on image files, and a procedural demo.
 
-use crate::cli::{usage_msg, Ctx};
+use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::image_buf::Image;
+use rtbake::io::{self, atomic::write_atomic};
+use rtbake::runtime::chain::{self, Antialiasing};
+use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::mlaa::MlaaAreaMap;
+use rtbake::runtime::separable_sss::{SeparableSss, SssKernel, SssParams};
+use rtbake::runtime::{demo, loader};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 #[derive(clap::Subcommand)]
 pub enum RunCommand {
-    /// Placeholder.
-    Todo,
+    /// Antialias a PNG with SMAA 1x (area/search textures from the bake directory).
+    Smaa(AaArgs),
+    /// Antialias a PNG with Jimenez's MLAA (area map of --max-distance from the bake directory).
+    Mlaa(MlaaArgs),
+    /// Separable SSS (two passes) on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR.
+    Sss(SssArgs),
+    /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
+    /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
+    Demo(DemoArgs),
 }
 
-pub fn run(_cmd: RunCommand, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("rtbake run: not implemented yet"))
+#[derive(clap::Args)]
+pub struct Common {
+    /// Run the CPU reference implementation instead of the GPU (no adapter needed).
+    #[arg(long)]
+    cpu: bool,
+    /// Bake directory holding manifest.json and the LUTs.
+    #[arg(long, value_name = "DIR", default_value = "baked")]
+    baked: PathBuf,
+}
+
+#[derive(clap::Args)]
+pub struct AaArgs {
+    /// Input PNG (8-bit, gray/gray+alpha/RGB/RGBA, sRGB-encoded).
+    #[arg(long, value_name = "PNG")]
+    input: PathBuf,
+    /// Output PNG (RGBA8).
+    #[arg(long, value_name = "PNG")]
+    output: PathBuf,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(clap::Args)]
+pub struct MlaaArgs {
+    #[command(flatten)]
+    aa: AaArgs,
+    /// Maximum distance N of the area map (the bake holds aa/mlaa/AreaMap{N}_v1.4.bin).
+    #[arg(long, default_value_t = 33)]
+    max_distance: u32,
+}
+
+#[derive(clap::Args)]
+pub struct SssArgs {
+    /// Linear HDR diffuse irradiance, EXR with RGB or RGBA (alpha = per-pixel strength, 0 = not skin; RGB: 1).
+    #[arg(long, value_name = "EXR")]
+    color: PathBuf,
+    /// Linear depth, EXR (first channel used), same size.
+    #[arg(long, value_name = "EXR")]
+    depth: PathBuf,
+    /// Output EXR (RGBA f16).
+    #[arg(long, value_name = "EXR")]
+    output: PathBuf,
+    /// Kernel: JSON array of [r, g, b, offset] taps, centre first (default: the demo's stand-in 17-tap kernel).
+    #[arg(long, value_name = "JSON")]
+    kernel: Option<PathBuf>,
+    /// Kernel width in world units.
+    #[arg(long, default_value_t = 0.012)]
+    sss_width: f32,
+    /// Vertical field of view, degrees.
+    #[arg(long, default_value_t = 20.0)]
+    fovy: f32,
+    /// Disable the follow-surface depth test.
+    #[arg(long)]
+    no_follow_surface: bool,
+    /// Run the CPU reference implementation instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+}
+
+#[derive(clap::Args)]
+pub struct DemoArgs {
+    /// Output PNG.
+    #[arg(long, value_name = "PNG")]
+    output: PathBuf,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Antialiasing of the final frame: smaa, mlaa or none.
+    #[arg(long, default_value = "smaa")]
+    aa: String,
+    #[command(flatten)]
+    common: Common,
+}
+
+pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
+    match cmd {
+        RunCommand::Smaa(a) => {
+            check_output(&a.output)?;
+            let img = read_png(&a.input)?;
+            let aa = Antialiasing::Smaa(loader::load_smaa_textures(&a.common.baked).map_err(usage)?);
+            antialias_file(ctx, &a, img, &aa, "smaa")
+        }
+        RunCommand::Mlaa(m) => {
+            check_output(&m.aa.output)?;
+            let map = load_mlaa(&m.aa.common.baked, m.max_distance)?;
+            let img = read_png(&m.aa.input)?;
+            antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
+        }
+        RunCommand::Sss(a) => sss(ctx, a),
+        RunCommand::Demo(d) => run_demo(ctx, d),
+    }
+}
+
+fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
+    if n < 3 || n.is_multiple_of(2) {
+        return Err(usage_msg(format!("--max-distance must be odd and >= 3 (e.g. 9, 17, 33, 65, 129), got {n}")));
+    }
+    let bytes = loader::load_mlaa_area(baked, n).map_err(usage)?;
+    Ok(MlaaAreaMap::new(n, bytes)?)
+}
+
+/// The output's directory must exist and be writable before any work is done.
+fn check_output(path: &Path) -> anyhow::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(usage_msg(format!("--output {}: directory {} does not exist", path.display(), dir.display())));
+    }
+    Ok(())
+}
+
+fn read_png(path: &Path) -> anyhow::Result<Image<u8>> {
+    let bytes = std::fs::read(path).map_err(|e| usage(anyhow::anyhow!("--input {}: {e}", path.display())))?;
+    let img = match io::png::decode(&bytes, &path.display().to_string()).map_err(usage)? {
+        io::png::DecodedPng::U8(img) => img,
+        io::png::DecodedPng::U16(_) => {
+            return Err(usage_msg(format!("--input {}: 16-bit PNG; expected 8-bit sRGB", path.display())))
+        }
+    };
+    Ok(chain::to_rgba8(&img)?)
+}
+
+fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
+    if cpu {
+        ctx.info("backend: CPU reference");
+        return Ok(None);
+    }
+    let g = create_headless(&Default::default())?;
+    ctx.info(format!("adapter: {}", g.describe()));
+    Ok(Some(g))
+}
+
+fn antialias_file(ctx: &Ctx, a: &AaArgs, img: Image<u8>, aa: &Antialiasing, name: &str) -> anyhow::Result<()> {
+    let gpu = device(ctx, a.common.cpu)?;
+    let t = Instant::now();
+    let out = chain::antialias(gpu.as_ref(), &img, aa)?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    write_atomic(&a.output, &io::png::encode_u8(&out)?)?;
+    report(ctx, name, &a.output, &out, gpu.as_ref(), ms);
+    Ok(())
+}
+
+fn report(ctx: &Ctx, pass: &str, output: &Path, img: &Image<u8>, gpu: Option<&Gpu>, ms: f64) {
+    let adapter = gpu.map(|g| g.describe()).unwrap_or_else(|| "CPU reference".into());
+    ctx.info(format!("{pass}: {}x{} in {ms:.1} ms -> {}", img.width, img.height, output.display()));
+    if ctx.json {
+        ctx.emit_json(&serde_json::json!({
+            "pass": pass,
+            "output": output.display().to_string(),
+            "width": img.width,
+            "height": img.height,
+            "adapter": adapter,
+            "wall_ms": ms,
+        }));
+    }
+}
+
+fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
+    let bytes = std::fs::read(path).map_err(|e| usage(anyhow::anyhow!("{flag} {}: {e}", path.display())))?;
+    Ok(io::exr::decode(&bytes, &path.display().to_string()).map_err(usage)?.0)
+}
+
+fn read_kernel(path: &Path) -> anyhow::Result<SssKernel> {
+    let text = std::fs::read_to_string(path).map_err(|e| usage(anyhow::anyhow!("--kernel {}: {e}", path.display())))?;
+    let taps: Vec<[f32; 4]> = serde_json::from_str(&text).map_err(|e| {
+        usage(anyhow::anyhow!("--kernel {}: expected a JSON array of [r, g, b, offset] taps: {e}", path.display()))
+    })?;
+    Ok(SssKernel::new(taps)?)
+}
+
+fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
+    check_output(&a.output)?;
+    let params = SssParams { sss_width: a.sss_width, fovy_deg: a.fovy, follow_surface: !a.no_follow_surface };
+    params.validate()?;
+    let kernel = match &a.kernel {
+        Some(p) => read_kernel(p)?,
+        None => demo::standin_kernel(),
+    };
+    let color = read_exr("--color", &a.color)?;
+    let depth = read_exr("--depth", &a.depth)?;
+    if (color.width, color.height) != (depth.width, depth.height) {
+        return Err(usage_msg(format!(
+            "--depth must match --color's size {}x{}, got {}x{}",
+            color.width, color.height, depth.width, depth.height
+        )));
+    }
+    let rgba = match color.channels {
+        4 => color.data.clone(),
+        3 => color.data.chunks(3).flat_map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+        n => return Err(usage_msg(format!("--color must have 3 or 4 channels (RGB/RGBA), got {n}"))),
+    };
+    let d: Vec<f32> = depth.data.chunks(depth.channels as usize).map(|p| p[0]).collect();
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return Err(usage_msg("--depth must hold finite linear depths > 0"));
+    }
+    let gpu = device(ctx, a.cpu)?;
+    let (w, h) = (color.width, color.height);
+    let t = Instant::now();
+    let out = match &gpu {
+        Some(g) => SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &rgba, &d)?,
+        None => rtbake::runtime::cpu::separable_sss::separable_sss(&rgba, &d, w, h, &kernel, &params),
+    };
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    let img = Image::from_vec(w, h, 4, out);
+    write_atomic(&a.output, &io::exr::encode(&img, io::exr::ExrPrecision::F16)?)?;
+    let adapter = gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU reference".into());
+    ctx.info(format!("sss: {w}x{h} in {ms:.1} ms -> {}", a.output.display()));
+    if ctx.json {
+        ctx.emit_json(&serde_json::json!({"pass": "sss", "output": a.output.display().to_string(), "width": w,
+            "height": h, "adapter": adapter, "wall_ms": ms}));
+    }
+    Ok(())
+}
+
+fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
+    check_output(&d.output)?;
+    rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
+    let aa = match d.aa.as_str() {
+        "smaa" => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),
+        "mlaa" => Some(Antialiasing::Mlaa(load_mlaa(&d.common.baked, 33)?)),
+        "none" => None,
+        other => return Err(usage_msg(format!("--aa must be smaa, mlaa or none, got {other:?}"))),
+    };
+    let gpu = device(ctx, d.common.cpu)?;
+    let t = Instant::now();
+    let out = demo::render(gpu.as_ref(), d.width, d.height, aa.as_ref())?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    write_atomic(&d.output, &io::png::encode_u8(&out)?)?;
+    report(ctx, "demo", &d.output, &out, gpu.as_ref(), ms);
+    Ok(())
 }

@@ -1,0 +1,181 @@
+//! Per-pass timings of the runtime at 720p and 1080p, and the CPU reference SMAA at 1080p on 2 threads.
+//!
+//!     cargo run --release --example bench_runtime
+//!
+//! GPU passes are timed with timestamp queries when the adapter supports them, else by wall time of
+//! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
+//! rasteriser (lavapipe/llvmpipe) are CPU figures, not GPU figures. Thesis anchors: SMAA 1x 1.02 ms at 1080p
+//! (GTX 470); Jimenez MLAA 0.44 ms at 720p (9800 GTX+). CPU anchor: Reshetov's CPU MLAA, 350 ms; goal ≤ 100 ms.
+//! LUTs: the upstream golden textures from $RTBAKE_REFERENCE_DIR (default ../shared/reference).
+
+use rtbake::diffusion::sum_of_gaussians::deon6;
+use rtbake::runtime::cpu::{self, FilterPrecision, Tex8};
+use rtbake::runtime::demo::standin_kernel;
+use rtbake::runtime::device::{create_headless, DeviceOptions};
+use rtbake::runtime::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use rtbake::runtime::gpu::GpuTimer;
+use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
+use rtbake::runtime::scene::render_shapes;
+use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
+use rtbake::runtime::smaa::{Smaa, SmaaTextures};
+use std::path::PathBuf;
+use std::time::Instant;
+
+const RUNS: usize = 7;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v[v.len() / 2]
+}
+
+fn reference(rel: &str) -> Vec<u8> {
+    let dir = std::env::var_os("RTBAKE_REFERENCE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"));
+    std::fs::read(dir.join(rel)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(rel).display()))
+}
+
+type Encode<'a> = dyn Fn(&mut wgpu::CommandEncoder, Option<(&GpuTimer, u32)>) + 'a;
+
+/// Times `encode` (`slots` passes) RUNS times; returns per-pass medians (timestamps) or the wall-time median.
+fn time_passes(g: &rtbake::runtime::device::Gpu, slots: u32, encode: &Encode<'_>) -> (Vec<f64>, f64) {
+    let timer = g.timestamps.then(|| GpuTimer::new(&g.device, slots));
+    let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); slots as usize];
+    let mut wall = Vec::new();
+    for run in 0..RUNS + 1 {
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        encode(&mut enc, timer.as_ref().map(|t| (t, 0)));
+        if let Some(t) = &timer {
+            t.resolve(&mut enc);
+        }
+        let t0 = Instant::now();
+        g.queue.submit([enc.finish()]);
+        g.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if run == 0 {
+            continue; // warm-up (pipeline compilation on first use)
+        }
+        wall.push(ms);
+        if let Some(t) = &timer {
+            for (k, v) in t.read_ms(&g.device, &g.queue).unwrap().into_iter().enumerate() {
+                per_pass[k].push(v);
+            }
+        }
+    }
+    let pp = if timer.is_some() { per_pass.into_iter().map(median).collect() } else { Vec::new() };
+    (pp, median(wall))
+}
+
+fn main() {
+    let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
+    println!("adapter: {}", g.describe());
+    println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
+    let luts =
+        SmaaTextures::new(reference("smaa/AreaTex_RG8_160x560.bin"), reference("smaa/SearchTex_R8_64x16.bin")).unwrap();
+    let n = 33;
+    let map = MlaaAreaMap::new(n, reference(&format!("mlaa/AreaMap{n}_v1.4_RG8_165x165.bin"))).unwrap();
+    println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
+    for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
+        let img = render_shapes(w, h, 1);
+        let smaa = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
+        smaa.upload(&g.queue, &img).unwrap();
+        let (pp, wall) = time_passes(&g, 3, &|e, t| smaa.encode(e, t));
+        print_line(&format!("SMAA 1x {w}x{h}"), &pp, wall, "thesis 1.02 ms @1080p GTX 470");
+        let mlaa = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
+        mlaa.upload(&g.queue, &img).unwrap();
+        let (pp, wall) = time_passes(&g, 3, &|e, t| mlaa.encode(e, t));
+        print_line(&format!("MLAA N={n} {w}x{h}"), &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
+        // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
+        let (color, depth) = sss_frame(w, h);
+        let sss = SeparableSss::new(&g.device, w, h, &standin_kernel(), &SssParams::default()).unwrap();
+        sss.upload(&g.queue, &color, &depth).unwrap();
+        let (pp, wall) = time_passes(&g, 2, &|e, t| sss.encode(e, t));
+        print_sum(&format!("separable SSS 17 taps {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
+        let blurs = GaussianBlurs::from_sum_of_gaussians(&deon6()).unwrap();
+        let gs = GaussianSss::new(&g.device, w, h, &blurs, &GaussianSssParams::default()).unwrap();
+        gs.upload(&g.queue, &color, &depth).unwrap();
+        let (pp, wall) = time_passes(&g, gs.passes(), &|e, t| gs.encode(e, t));
+        print_sum(&format!("sum-of-Gaussians SSS (deon6) {w}x{h}"), &pp, wall, "thesis 3.07 ms @1080p GTX 580");
+    }
+    // CPU reference SMAA at 1080p on 2 threads.
+    let (w, h) = (1920, 1080);
+    let img = render_shapes(w, h, 1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let times: Vec<f64> = (0..RUNS)
+        .map(|_| {
+            let t = Instant::now();
+            let out = pool.install(|| cpu::smaa::smaa(&img, w, h, &luts, FilterPrecision::Exact));
+            std::hint::black_box(out.output.len());
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    let m = median(times);
+    // Per-stage split of the CPU reference (same pool).
+    let stage = |f: &(dyn Fn() -> usize + Sync)| {
+        median(
+            (0..RUNS)
+                .map(|_| {
+                    let t = Instant::now();
+                    std::hint::black_box(pool.install(f));
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect(),
+        )
+    };
+    let color = Tex8::new(w, h, 4, &img);
+    let edges = cpu::smaa::edge_detection(&color);
+    let weights = cpu::smaa::blending_weights(&Tex8::new(w, h, 2, &edges), &luts, FilterPrecision::Exact);
+    let t_e = stage(&|| cpu::smaa::edge_detection(&color).len());
+    let t_w = stage(&|| cpu::smaa::blending_weights(&Tex8::new(w, h, 2, &edges), &luts, FilterPrecision::Exact).len());
+    let t_b = stage(&|| cpu::smaa::neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights)).len());
+    println!("CPU reference SMAA stages (2 threads): edges {t_e:.1} ms, weights {t_w:.1} ms, blend {t_b:.1} ms");
+    println!(
+        "CPU reference SMAA 1x 1920x1080, 2 threads: {m:.1} ms (goal <= 100 ms: {}; vs Reshetov CPU MLAA 350 ms: {:.2}x)",
+        if m <= 100.0 { "met" } else { "NOT met" },
+        350.0 / m
+    );
+}
+
+fn sss_frame(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
+    let (mut color, mut depth) = (vec![0.0f32; (w * h * 4) as usize], vec![50.0f32; (w * h) as usize]);
+    let r = 0.45 * h as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let (dx, dy) = (x as f32 + 0.5 - w as f32 / 2.0, y as f32 + 0.5 - h as f32 / 2.0);
+            let i = (y * w + x) as usize;
+            if dx * dx + dy * dy < r * r {
+                let z = (r * r - dx * dx - dy * dy).sqrt() / r;
+                let stripe = if (x / 8 + y / 8) % 2 == 0 { 1.0 } else { 0.3 };
+                color[4 * i..4 * i + 4].copy_from_slice(&[0.8 * z * stripe, 0.5 * z * stripe, 0.4 * z * stripe, 1.0]);
+                depth[i] = 2.0 - 0.3 * z;
+            }
+        }
+    }
+    (color, depth)
+}
+
+fn print_sum(name: &str, per_pass: &[f64], wall: f64, anchor: &str) {
+    if per_pass.is_empty() {
+        println!("{name}: wall {wall:.2} ms (submit+wait)  [{anchor}]");
+    } else {
+        let total: f64 = per_pass.iter().sum();
+        let parts: Vec<String> = per_pass.iter().map(|v| format!("{v:.2}")).collect();
+        println!(
+            "{name}: {} passes [{}] ms, total {total:.2} ms (wall {wall:.2} ms)  [{anchor}]",
+            per_pass.len(),
+            parts.join(", ")
+        );
+    }
+}
+
+fn print_line(name: &str, per_pass: &[f64], wall: f64, anchor: &str) {
+    if per_pass.is_empty() {
+        println!("{name}: wall {wall:.2} ms (submit+wait)  [{anchor}]");
+    } else {
+        let total: f64 = per_pass.iter().sum();
+        println!(
+            "{name}: edges {:.2} ms, weights {:.2} ms, blend {:.2} ms, total {total:.2} ms (wall {wall:.2} ms)  [{anchor}]",
+            per_pass[0], per_pass[1], per_pass[2]
+        );
+    }
+}

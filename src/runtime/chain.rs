@@ -1,0 +1,55 @@
+//! Whole-image entry points used by the command and the demo: pick the GPU pass or its CPU reference, run it on
+//! an `Image<u8>`, return an `Image<u8>`. Pure with respect to files (the caller reads and writes them).
+
+use super::cpu::{self, FilterPrecision};
+use super::device::Gpu;
+use super::mlaa::{Mlaa, MlaaAreaMap};
+use super::smaa::{Smaa, SmaaTextures};
+use super::RuntimeError;
+use crate::error::InvalidInput;
+use crate::image_buf::Image;
+
+/// A morphological antialiasing method with its lookup textures.
+pub enum Antialiasing {
+    Smaa(SmaaTextures),
+    Mlaa(MlaaAreaMap),
+}
+
+/// Converts a decoded 8-bit image with 1–4 channels to RGBA8 (grey replicated, missing alpha = 255).
+pub fn to_rgba8(img: &Image<u8>) -> Result<Image<u8>, InvalidInput> {
+    let ch = img.channels as usize;
+    if !(1..=4).contains(&ch) {
+        return Err(InvalidInput::new("--input", format!("must have 1 to 4 channels, got {ch}")));
+    }
+    let mut out = Vec::with_capacity(img.data.len() / ch * 4);
+    for p in img.data.chunks(ch) {
+        let px = match ch {
+            1 => [p[0], p[0], p[0], 255],
+            2 => [p[0], p[0], p[0], p[1]],
+            3 => [p[0], p[1], p[2], 255],
+            _ => [p[0], p[1], p[2], p[3]],
+        };
+        out.extend_from_slice(&px);
+    }
+    Ok(Image::from_vec(img.width, img.height, 4, out))
+}
+
+/// Antialiases an RGBA8 (sRGB-encoded) image on `gpu`, or with the CPU reference when `gpu` is `None`.
+pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Result<Image<u8>, RuntimeError> {
+    if img.channels != 4 {
+        return Err(InvalidInput::new("image", format!("must be RGBA8, got {} channels", img.channels)).into());
+    }
+    let (w, h) = (img.width, img.height);
+    crate::error::check_size("--input", w as u64, h as u64)?;
+    let data = match (gpu, aa) {
+        (Some(g), Antialiasing::Smaa(t)) => {
+            Smaa::new(&g.device, &g.queue, w, h, t)?.run(&g.device, &g.queue, &img.data)?
+        }
+        (Some(g), Antialiasing::Mlaa(m)) => {
+            Mlaa::new(&g.device, &g.queue, w, h, m)?.run(&g.device, &g.queue, &img.data)?
+        }
+        (None, Antialiasing::Smaa(t)) => cpu::smaa::smaa(&img.data, w, h, t, FilterPrecision::Exact).output,
+        (None, Antialiasing::Mlaa(m)) => cpu::mlaa::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output,
+    };
+    Ok(Image::from_vec(w, h, 4, data))
+}

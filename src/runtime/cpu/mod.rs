@@ -1,0 +1,173 @@
+//! CPU reference implementations of the runtime's passes (rayon, no adapter needed).
+//!
+//! Each function mirrors its WGSL shader step for step in f32, so the GPU/CPU comparison tests measure the
+//! hardware, not two different algorithms. Texture fetches go through [`Tex8`], which emulates the fixed-function
+//! sampler: point loads with clamp-to-edge and bilinear fetches with a selectable precision model
+//! ([`FilterPrecision`]): real GPUs filter in (nearly) full float precision, while lavapipe/llvmpipe filter 8-bit
+//! textures with 8-bit weights and return 8-bit results.
+
+pub mod gaussian_sss;
+pub mod mlaa;
+pub mod separable_sss;
+pub mod skin_inputs;
+pub mod smaa;
+
+/// How a bilinear fetch of an 8-bit texture is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FilterPrecision {
+    /// f32 weights and result (what the algorithms assume; desktop GPUs are within ~1e-3 of this).
+    #[default]
+    Exact,
+    /// Weights rounded to 1/256 and every lerp result rounded to 1/255, as measured on lavapipe / llvmpipe
+    /// (Mesa's 8-bit AoS filtering path).
+    Unorm8,
+}
+
+impl FilterPrecision {
+    /// The model that matches an adapter: `Unorm8` for Mesa's software rasterisers, `Exact` otherwise.
+    pub fn for_adapter(name: &str, device_type_is_cpu: bool) -> Self {
+        if device_type_is_cpu || name.to_lowercase().contains("llvmpipe") {
+            Self::Unorm8
+        } else {
+            Self::Exact
+        }
+    }
+}
+
+/// A read-only 8-bit UNORM texture (top row first, `ch` interleaved channels) with sampler emulation.
+#[derive(Clone, Copy)]
+pub struct Tex8<'a> {
+    pub w: u32,
+    pub h: u32,
+    pub ch: u32,
+    pub data: &'a [u8],
+}
+
+impl<'a> Tex8<'a> {
+    pub fn new(w: u32, h: u32, ch: u32, data: &'a [u8]) -> Self {
+        assert_eq!(data.len(), (w * h * ch) as usize, "texture size");
+        Self { w, h, ch, data }
+    }
+
+    /// Texel (x, y) channel c with clamp-to-edge, as a float in [0, 1] (`textureLoad` of a clamped coordinate).
+    #[inline]
+    pub fn load(&self, x: i32, y: i32, c: u32) -> f32 {
+        let x = x.clamp(0, self.w as i32 - 1) as usize;
+        let y = y.clamp(0, self.h as i32 - 1) as usize;
+        self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as f32 / 255.0
+    }
+
+    /// Nearest fetch of channels 0 and 1 at normalised coordinates (clamp-to-edge).
+    #[inline]
+    pub fn sample2_nearest(&self, u: f32, v: f32) -> [f32; 2] {
+        let x = (u * self.w as f32).floor() as i32;
+        let y = (v * self.h as f32).floor() as i32;
+        [self.load(x, y, 0), if self.ch > 1 { self.load(x, y, 1) } else { 0.0 }]
+    }
+
+    /// Bilinear fetch of channels 0 and 1 at normalised coordinates (u, v), clamp-to-edge
+    /// (`textureSampleLevel` with a linear, clamped sampler).
+    #[inline]
+    pub fn sample2(&self, u: f32, v: f32, prec: FilterPrecision) -> [f32; 2] {
+        let x = u * self.w as f32 - 0.5;
+        let y = v * self.h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (mut fx, mut fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i32, y0 as i32);
+        if prec == FilterPrecision::Unorm8 {
+            fx = (fx * 256.0).round() / 256.0;
+            fy = (fy * 256.0).round() / 256.0;
+        }
+        let mut out = [0.0f32; 2];
+        for (c, o) in out.iter_mut().enumerate().take(self.ch.min(2) as usize) {
+            let c = c as u32;
+            let t00 = self.load(x0, y0, c);
+            let t10 = self.load(x0 + 1, y0, c);
+            let t01 = self.load(x0, y0 + 1, c);
+            let t11 = self.load(x0 + 1, y0 + 1, c);
+            *o = match prec {
+                FilterPrecision::Exact => {
+                    let top = t00 + (t10 - t00) * fx;
+                    let bottom = t01 + (t11 - t01) * fx;
+                    top + (bottom - top) * fy
+                }
+                FilterPrecision::Unorm8 => {
+                    let q = |v: f32| (v * 255.0).round() / 255.0;
+                    let top = q(t00 * (1.0 - fx) + t10 * fx);
+                    let bottom = q(t01 * (1.0 - fx) + t11 * fx);
+                    q(top * (1.0 - fy) + bottom * fy)
+                }
+            };
+        }
+        out
+    }
+}
+
+/// Stores a float in an 8-bit UNORM render target (clamp, round to nearest).
+#[inline]
+pub fn unorm8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// sRGB transfer function (IEC 61966-2-1), encoded → linear; same formula as the shaders.
+#[inline]
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear → sRGB-encoded; same formula as the shaders.
+#[inline]
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.0031308 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[inline]
+pub(crate) fn wgsl_round(v: f32) -> f32 {
+    // WGSL `round` rounds half to even; Rust `round` rounds half away from zero. Use the WGSL rule.
+    v.round_ties_even()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values measured on lavapipe (Mesa 22.3, llvmpipe): a 255 → 0 step sampled at fractions 0.25, 0.125,
+    /// 0.375, 0.1, 0.7 returned 191, 223, 159, 229, 77 (/255).
+    #[test]
+    fn unorm8_model_reproduces_lavapipe_bilinear() {
+        let data = [255u8, 0];
+        let t = Tex8::new(2, 1, 1, &data);
+        for (f, want) in [(0.25f32, 191u8), (0.125, 223), (0.375, 159), (0.1, 229), (0.7, 77)] {
+            let u = (0.5 + f) / 2.0;
+            let got = t.sample2(u, 0.5, FilterPrecision::Unorm8)[0];
+            assert_eq!((got * 255.0).round() as u8, want, "fraction {f}");
+            let exact = t.sample2(u, 0.5, FilterPrecision::Exact)[0];
+            assert!((exact - (1.0 - f)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn loads_clamp_to_edge_and_nearest_matches_texel() {
+        let data = [10u8, 20, 30, 40];
+        let t = Tex8::new(2, 2, 1, &data);
+        assert_eq!(t.load(-5, -5, 0), 10.0 / 255.0);
+        assert_eq!(t.load(9, 9, 0), 40.0 / 255.0);
+        assert_eq!(t.sample2_nearest(0.74, 0.26,)[0], 20.0 / 255.0);
+    }
+
+    #[test]
+    fn srgb_round_trip() {
+        for i in 0..=255u8 {
+            let v = i as f32 / 255.0;
+            assert_eq!(unorm8(linear_to_srgb(srgb_to_linear(v))), i);
+        }
+    }
+}

@@ -1,0 +1,369 @@
+//! CPU reference of SMAA 1x — the twin of `shaders/smaa.wgsl` (see that file and [`crate::runtime::smaa`] for
+//! the algorithm and its source, Jimenez et al., Eurographics 2012). Positions are in pixel units, exactly as in the
+//! shader; texture fetches go through [`Tex8`] so the bilinear tricks of SMAA (two edges per search fetch, four
+//! edge bits decoded through the search texture, interpolated area lookups) are reproduced.
+//!
+//! Known differences from a GPU: `pow` (sRGB) and `sqrt` may differ in the last ulp, and the GPU may fuse
+//! multiply-adds; both can flip an output byte by one. The bilinear precision of the adapter is modelled by
+//! [`FilterPrecision`].
+
+use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
+use crate::runtime::smaa::{SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
+use rayon::prelude::*;
+
+const THRESHOLD: f32 = 0.1;
+const LOCAL_CONTRAST_ADAPTATION: f32 = 2.0;
+const MAX_SEARCH_STEPS: f32 = 16.0;
+const MAX_SEARCH_STEPS_DIAG: f32 = 8.0;
+const CORNER_ROUNDING_NORM: f32 = 0.25;
+const AREATEX_MAX_DISTANCE: f32 = 16.0;
+const AREATEX_MAX_DISTANCE_DIAG: f32 = 20.0;
+const AREATEX_SUBTEX_ROWS: f32 = 80.0;
+const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Intermediate and final images of one SMAA run.
+pub struct SmaaCpuOutput {
+    /// RG8 edges (R left, G top).
+    pub edges: Vec<u8>,
+    /// RGBA8 blending weights.
+    pub weights: Vec<u8>,
+    /// RGBA8 output (sRGB-encoded).
+    pub output: Vec<u8>,
+}
+
+/// Runs SMAA 1x on `rgba` (`w·h·4` bytes, sRGB-encoded, top row first).
+pub fn smaa(rgba: &[u8], w: u32, h: u32, luts: &SmaaTextures, prec: FilterPrecision) -> SmaaCpuOutput {
+    smaa_with_subsample(rgba, w, h, luts, prec, SubsampleIndices::SMAA_1X)
+}
+
+/// Runs SMAA with explicit area-texture slices (one sample of S2x/T2x/4x).
+pub fn smaa_with_subsample(
+    rgba: &[u8],
+    w: u32,
+    h: u32,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+) -> SmaaCpuOutput {
+    assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
+    let color = Tex8::new(w, h, 4, rgba);
+    let edges = edge_detection(&color);
+    let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, subsample);
+    let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
+    SmaaCpuOutput { edges, weights, output }
+}
+
+/// Pass 1: luma edge detection with local contrast adaptation.
+pub fn edge_detection(color: &Tex8) -> Vec<u8> {
+    let (w, h) = (color.w as usize, color.h as usize);
+    // Luma of every pixel once (same expression as the shader's dot product, evaluated per texel).
+    let mut lum = vec![0.0f32; w * h];
+    lum.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, l) in row.iter_mut().enumerate() {
+            let i = (y * w + x) * 4;
+            let c = &color.data[i..i + 3];
+            *l = (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
+        }
+    });
+    let luma = |x: i32, y: i32| lum[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
+    let step = |edge: f32, x: f32| if x >= edge { 1.0f32 } else { 0.0 };
+    let mut out = vec![0u8; w * h * 2];
+    out.par_chunks_mut(w * 2).enumerate().for_each(|(y, row)| {
+        let y = y as i32;
+        for x in 0..w as i32 {
+            let l = luma(x, y);
+            let (l_left, l_top) = (luma(x - 1, y), luma(x, y - 1));
+            let delta = [(l - l_left).abs(), (l - l_top).abs()];
+            let mut edges = [step(THRESHOLD, delta[0]), step(THRESHOLD, delta[1])];
+            if edges[0] + edges[1] == 0.0 {
+                continue;
+            }
+            let (l_right, l_bottom) = (luma(x + 1, y), luma(x, y + 1));
+            let mut max_delta = [delta[0].max((l - l_right).abs()), delta[1].max((l - l_bottom).abs())];
+            let (l_leftleft, l_toptop) = (luma(x - 2, y), luma(x, y - 2));
+            max_delta = [max_delta[0].max((l_left - l_leftleft).abs()), max_delta[1].max((l_top - l_toptop).abs())];
+            let final_delta = max_delta[0].max(max_delta[1]);
+            edges[0] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[0]);
+            edges[1] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[1]);
+            row[x as usize * 2] = unorm8(edges[0]);
+            row[x as usize * 2 + 1] = unorm8(edges[1]);
+        }
+    });
+    out
+}
+
+struct Ctx<'a> {
+    edges: Tex8<'a>,
+    area: Tex8<'a>,
+    search: Tex8<'a>,
+    rt: [f32; 2],
+    prec: FilterPrecision,
+    subsample: [f32; 4],
+}
+
+impl Ctx<'_> {
+    #[inline]
+    fn edges_at(&self, px: f32, py: f32) -> [f32; 2] {
+        self.edges.sample2(px * self.rt[0], py * self.rt[1], self.prec)
+    }
+
+    #[inline]
+    fn area_at(&self, tx: f32, ty: f32) -> [f32; 2] {
+        self.area.sample2(tx / AREA_TEX_SIZE.0 as f32, ty / AREA_TEX_SIZE.1 as f32, self.prec)
+    }
+
+    fn search_diag(&self, px: f32, py: f32, dir: [f32; 2], decode: bool) -> ([f32; 2], [f32; 2]) {
+        let mut c = [if decode { px + 0.25 } else { px }, py, -1.0f32, 1.0f32];
+        let mut e = [0.0f32; 2];
+        while c[2] < MAX_SEARCH_STEPS_DIAG - 1.0 && c[3] > 0.9 {
+            c[0] += dir[0];
+            c[1] += dir[1];
+            c[2] += 1.0;
+            e = self.edges_at(c[0], c[1]);
+            if decode {
+                e = decode_diag(e);
+            }
+            c[3] = e[0] * 0.5 + e[1] * 0.5;
+        }
+        ([c[2], c[3]], e)
+    }
+
+    fn area_diag(&self, dist: [f32; 2], e: [f32; 2], offset: f32) -> [f32; 2] {
+        let tx = AREATEX_MAX_DISTANCE_DIAG * e[0] + dist[0] + 0.5 + 80.0;
+        let ty = AREATEX_MAX_DISTANCE_DIAG * e[1] + dist[1] + 0.5 + AREATEX_SUBTEX_ROWS * offset;
+        self.area_at(tx, ty)
+    }
+
+    fn diag_weights(&self, px: f32, py: f32, e: [f32; 2]) -> [f32; 2] {
+        let mut weights = [0.0f32; 2];
+        let mut d = [0.0f32; 4];
+        if e[0] > 0.0 {
+            let (r, end) = self.search_diag(px, py, [-1.0, 1.0], false);
+            d[0] = r[0] + if end[1] > 0.9 { 1.0 } else { 0.0 };
+            d[2] = r[1];
+        }
+        let (r1, _) = self.search_diag(px, py, [1.0, -1.0], false);
+        d[1] = r1[0];
+        d[3] = r1[1];
+        if d[0] + d[1] > 2.0 {
+            let c0 = decode_diag(self.edges_at(px - d[0] + 0.25 - 1.0, py + d[0]));
+            let c1 = decode_diag(self.edges_at(px + d[1] + 1.0, py - d[1] - 0.25));
+            let c = [c0[1], c0[0], c1[1], c1[0]];
+            let mut cc = [2.0 * c[0] + c[1], 2.0 * c[2] + c[3]];
+            if d[2] >= 0.9 {
+                cc[0] = 0.0;
+            }
+            if d[3] >= 0.9 {
+                cc[1] = 0.0;
+            }
+            let a = self.area_diag([d[0], d[1]], cc, self.subsample[2]);
+            weights = [weights[0] + a[0], weights[1] + a[1]];
+        }
+        let (r2, _) = self.search_diag(px, py, [-1.0, -1.0], true);
+        d[0] = r2[0];
+        d[2] = r2[1];
+        if self.edges_at(px + 1.0, py)[0] > 0.0 {
+            let (r3, end) = self.search_diag(px, py, [1.0, 1.0], true);
+            d[1] = r3[0] + if end[1] > 0.9 { 1.0 } else { 0.0 };
+            d[3] = r3[1];
+        } else {
+            d[1] = 0.0;
+            d[3] = 0.0;
+        }
+        if d[0] + d[1] > 2.0 {
+            let (q0x, q0y) = (px - d[0], py - d[0]);
+            let (q1x, q1y) = (px + d[1], py + d[1]);
+            let cx = self.edges_at(q0x - 1.0, q0y)[1];
+            let cy = self.edges_at(q0x, q0y - 1.0)[0];
+            let c1 = self.edges_at(q1x + 1.0, q1y);
+            let (cz, cw) = (c1[1], c1[0]);
+            let mut cc = [2.0 * cx + cy, 2.0 * cz + cw];
+            if d[2] >= 0.9 {
+                cc[0] = 0.0;
+            }
+            if d[3] >= 0.9 {
+                cc[1] = 0.0;
+            }
+            let a = self.area_diag([d[0], d[1]], cc, self.subsample[3]);
+            weights = [weights[0] + a[1], weights[1] + a[0]];
+        }
+        weights
+    }
+
+    fn search_length(&self, e: [f32; 2], offset: f32) -> f32 {
+        let ix = round(32.0 * e[0]) as i32 + if offset > 0.0 { 33 } else { 0 };
+        let iy = 32 - round(32.0 * e[1]) as i32;
+        self.search.load(ix.clamp(0, SEARCH_TEX_SIZE.0 as i32 - 1), iy.clamp(0, SEARCH_TEX_SIZE.1 as i32 - 1), 0)
+    }
+
+    /// Horizontal search; `sign` −1 left, +1 right. Returns the end coordinate.
+    fn search_x(&self, sx: f32, sy: f32, end: f32, sign: f32) -> f32 {
+        let mut t = sx;
+        let mut e = [0.0f32, 1.0];
+        while (if sign < 0.0 { t > end } else { t < end }) && e[1] > 0.8281 && e[0] == 0.0 {
+            e = self.edges_at(t, sy);
+            t += 2.0 * sign;
+        }
+        let offset = -(255.0f32 / 127.0) * self.search_length(e, if sign < 0.0 { 0.0 } else { 0.5 }) + 3.25;
+        t - sign * offset
+    }
+
+    /// Vertical search; `sign` −1 up, +1 down.
+    fn search_y(&self, sx: f32, sy: f32, end: f32, sign: f32) -> f32 {
+        let mut t = sy;
+        let mut e = [1.0f32, 0.0];
+        while (if sign < 0.0 { t > end } else { t < end }) && e[0] > 0.8281 && e[1] == 0.0 {
+            e = self.edges_at(sx, t);
+            t += 2.0 * sign;
+        }
+        let offset = -(255.0f32 / 127.0) * self.search_length([e[1], e[0]], if sign < 0.0 { 0.0 } else { 0.5 }) + 3.25;
+        t - sign * offset
+    }
+
+    fn area_ortho(&self, d: [f32; 2], e1: f32, e2: f32, offset: f32) -> [f32; 2] {
+        let tx = AREATEX_MAX_DISTANCE * round(4.0 * e1) + d[0].sqrt() + 0.5;
+        let ty = AREATEX_MAX_DISTANCE * round(4.0 * e2) + d[1].sqrt() + 0.5 + AREATEX_SUBTEX_ROWS * offset;
+        self.area_at(tx, ty)
+    }
+
+    fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+        let mut weights = [0.0f32; 4];
+        let mut e = [self.edges.load(x as i32, y as i32, 0), self.edges.load(x as i32, y as i32, 1)];
+        let span = 2.0 * MAX_SEARCH_STEPS;
+        if e[1] > 0.0 {
+            let dw = self.diag_weights(px, py, e);
+            weights[0] = dw[0];
+            weights[1] = dw[1];
+            if dw[0] == -dw[1] {
+                let left = self.search_x(px - 0.25, py - 0.125, px - 0.25 - span, -1.0);
+                let y1 = py - 0.25;
+                let e1 = self.edges_at(left, y1)[0];
+                let right = self.search_x(px + 1.25, py - 0.125, px + 1.25 + span, 1.0);
+                let d = [round(left - px).abs(), round(right - px).abs()];
+                let e2 = self.edges_at(right + 1.0, y1)[0];
+                let mut w = self.area_ortho(d, e1, e2, self.subsample[1]);
+                let r = corner_factor(d);
+                let mut f = [1.0f32, 1.0];
+                f[0] -= r[0] * self.edges_at(left, py + 1.0)[0];
+                f[0] -= r[1] * self.edges_at(right + 1.0, py + 1.0)[0];
+                f[1] -= r[0] * self.edges_at(left, py - 2.0)[0];
+                f[1] -= r[1] * self.edges_at(right + 1.0, py - 2.0)[0];
+                w = [w[0] * f[0].clamp(0.0, 1.0), w[1] * f[1].clamp(0.0, 1.0)];
+                weights[0] = w[0];
+                weights[1] = w[1];
+            } else {
+                e[0] = 0.0;
+            }
+        }
+        if e[0] > 0.0 {
+            let up = self.search_y(px - 0.125, py - 0.25, py - 0.25 - span, -1.0);
+            let x1 = px - 0.25;
+            let e1 = self.edges_at(x1, up)[1];
+            let down = self.search_y(px - 0.125, py + 1.25, py + 1.25 + span, 1.0);
+            let d = [round(up - py).abs(), round(down - py).abs()];
+            let e2 = self.edges_at(x1, down + 1.0)[1];
+            let mut w = self.area_ortho(d, e1, e2, self.subsample[0]);
+            let r = corner_factor(d);
+            let mut f = [1.0f32, 1.0];
+            f[0] -= r[0] * self.edges_at(px + 1.0, up)[1];
+            f[0] -= r[1] * self.edges_at(px + 1.0, down + 1.0)[1];
+            f[1] -= r[0] * self.edges_at(px - 2.0, up)[1];
+            f[1] -= r[1] * self.edges_at(px - 2.0, down + 1.0)[1];
+            w = [w[0] * f[0].clamp(0.0, 1.0), w[1] * f[1].clamp(0.0, 1.0)];
+            weights[2] = w[0];
+            weights[3] = w[1];
+        }
+        weights
+    }
+}
+
+fn decode_diag(e: [f32; 2]) -> [f32; 2] {
+    [round(e[0] * (5.0 * e[0] - 5.0 * 0.75).abs()), round(e[1])]
+}
+
+fn corner_factor(d: [f32; 2]) -> [f32; 2] {
+    let lr = [if d[1] >= d[0] { 1.0f32 } else { 0.0 }, if d[0] >= d[1] { 1.0f32 } else { 0.0 }];
+    let s = lr[0] + lr[1];
+    [(1.0 - CORNER_ROUNDING_NORM) * lr[0] / s, (1.0 - CORNER_ROUNDING_NORM) * lr[1] / s]
+}
+
+/// Pass 2: blending weights (RGBA8) from the edges (RG8), SMAA 1x.
+pub fn blending_weights(edges: &Tex8, luts: &SmaaTextures, prec: FilterPrecision) -> Vec<u8> {
+    blending_weights_with_subsample(edges, luts, prec, SubsampleIndices::SMAA_1X)
+}
+
+/// Pass 2 with explicit area-texture slices.
+pub fn blending_weights_with_subsample(
+    edges: &Tex8,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+) -> Vec<u8> {
+    let (w, h) = (edges.w, edges.h);
+    let ctx = Ctx {
+        edges: *edges,
+        area: Tex8::new(AREA_TEX_SIZE.0, AREA_TEX_SIZE.1, 2, &luts.area),
+        search: Tex8::new(SEARCH_TEX_SIZE.0, SEARCH_TEX_SIZE.1, 1, &luts.search),
+        rt: [1.0 / w as f32, 1.0 / h as f32],
+        prec,
+        subsample: subsample.as_f32(),
+    };
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        let erow = &edges.data[y * w as usize * 2..(y + 1) * w as usize * 2];
+        for x in 0..w {
+            if erow[x as usize * 2] == 0 && erow[x as usize * 2 + 1] == 0 {
+                continue; // no edge: all weights are zero
+            }
+            let wgt = ctx.pixel(x, y as u32);
+            for c in 0..4 {
+                row[x as usize * 4 + c] = unorm8(wgt[c]);
+            }
+        }
+    });
+    out
+}
+
+/// Pass 3: neighbourhood blending in linear light; output RGBA8 sRGB-encoded.
+pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
+    let (w, h) = (color.w, color.h);
+    let color_lin = |x: i32, y: i32| {
+        [
+            srgb_to_linear(color.load(x, y, 0)),
+            srgb_to_linear(color.load(x, y, 1)),
+            srgb_to_linear(color.load(x, y, 2)),
+            color.load(x, y, 3),
+        ]
+    };
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        let y = y as i32;
+        for x in 0..w as i32 {
+            let a =
+                [weights.load(x + 1, y, 3), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x, y, 0)];
+            let o = x as usize * 4;
+            if a[0] + a[1] + a[2] + a[3] < 1e-5 {
+                let i = (y as usize * w as usize + x as usize) * 4;
+                row[o..o + 4].copy_from_slice(&color.data[i..i + 4]);
+                continue;
+            }
+            let c = color_lin(x, y);
+            let horizontal = a[0].max(a[2]) > a[1].max(a[3]);
+            let (wt, n0, n1) = if horizontal {
+                ([a[0], a[2]], color_lin(x + 1, y), color_lin(x - 1, y))
+            } else {
+                ([a[1], a[3]], color_lin(x, y + 1), color_lin(x, y - 1))
+            };
+            let s = wt[0] + wt[1];
+            let wn = [wt[0] / s, wt[1] / s];
+            for k in 0..4 {
+                let m0 = c[k] + (n0[k] - c[k]) * wt[0];
+                let m1 = c[k] + (n1[k] - c[k]) * wt[1];
+                let v = wn[0] * m0 + wn[1] * m1;
+                row[o + k] = unorm8(if k < 3 { linear_to_srgb(v) } else { v });
+            }
+        }
+    });
+    out
+}

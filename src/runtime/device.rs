@@ -1,0 +1,97 @@
+//! Headless device creation — the only place the runtime creates a `wgpu::Device`.
+//!
+//! Passes never create devices: they receive `&wgpu::Device` / `&wgpu::Queue` from their caller (as in wgpu's
+//! `hello_compute` example), so tests, benchmarks and engines can hand them any device. This helper is what the
+//! command, the tests and the benchmark use. It honours `WGPU_BACKEND` (e.g. `vulkan`, `gl`) and
+//! `WGPU_ADAPTER_NAME` (case-insensitive substring of the adapter name) and reports the adapter it got, so that
+//! figures measured on a software rasteriser (lavapipe, llvmpipe) are never mistaken for GPU figures.
+
+use super::RuntimeError;
+
+/// A device, its queue and a description of the adapter behind them.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter_info: wgpu::AdapterInfo,
+    /// Whether timestamp queries were enabled on the device (`wgpu::Features::TIMESTAMP_QUERY`).
+    pub timestamps: bool,
+}
+
+impl Gpu {
+    /// One line describing the adapter: name, backend, device type, driver.
+    pub fn describe(&self) -> String {
+        describe_adapter(&self.adapter_info)
+    }
+}
+
+/// One line describing an adapter: name, backend, device type, driver.
+pub fn describe_adapter(info: &wgpu::AdapterInfo) -> String {
+    let kind = match info.device_type {
+        wgpu::DeviceType::Cpu => "CPU (software rasteriser: timings are not GPU figures)",
+        wgpu::DeviceType::DiscreteGpu => "discrete GPU",
+        wgpu::DeviceType::IntegratedGpu => "integrated GPU",
+        wgpu::DeviceType::VirtualGpu => "virtual GPU",
+        wgpu::DeviceType::Other => "other",
+    };
+    format!("{} [{:?}, {kind}, driver {} {}]", info.name, info.backend, info.driver, info.driver_info)
+}
+
+/// Options for [`create_headless`].
+#[derive(Clone, Debug, Default)]
+pub struct DeviceOptions {
+    /// Request `TIMESTAMP_QUERY` when the adapter supports it (benchmarks).
+    pub timestamps: bool,
+}
+
+/// Creates a headless device on the adapter selected by `WGPU_BACKEND` / `WGPU_ADAPTER_NAME` (else the default
+/// adapter of any enabled backend). Fails with [`RuntimeError::NoAdapter`] when none is found.
+pub fn create_headless(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
+    pollster::block_on(create_headless_async(opts))
+}
+
+async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
+    let backends = desc.backends;
+    let instance = wgpu::Instance::new(desc);
+    let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
+        Ok(want) if !want.is_empty() => {
+            let want_lc = want.to_lowercase();
+            let adapters = instance.enumerate_adapters(backends).await;
+            let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+            adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&want_lc)).ok_or_else(|| {
+                RuntimeError::NoAdapter(format!(
+                    "WGPU_ADAPTER_NAME={want:?} matches none of the adapters found ({})",
+                    if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                ))
+            })?
+        }
+        _ => instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| {
+                RuntimeError::NoAdapter(format!(
+                    "{e} (backends {backends:?}; on a machine without a GPU install a software driver, e.g. \
+                     `apt-get install mesa-vulkan-drivers`)"
+                ))
+            })?,
+    };
+    let info = adapter.get_info();
+    let timestamps = opts.timestamps && adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    let required_features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+    let (device, queue) = adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some("rtbake runtime"),
+            required_features,
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        })
+        .await
+        .map_err(|e| RuntimeError::NoAdapter(format!("{}: cannot create a device: {e}", info.name)))?;
+    Ok(Gpu { device, queue, adapter_info: info, timestamps })
+}

@@ -1,0 +1,38 @@
+//! The wgpu runtime: consumes `baked/` the way an engine would and renders headless (spec `runtime.md`).
+//!
+//! Every pass has a CPU reference implementation of the same algorithm in [`cpu`] (rayon, no adapter needed)
+//! whose arithmetic mirrors the WGSL shaders; the tests compare the two on the same inputs.
+//!
+//! Invariants, stated as absences:
+//! - only this module imports `wgpu`; the passes never create a device (they take `&wgpu::Device` /
+//!   `&wgpu::Queue`); [`device::create_headless`] is the one place that does;
+//! - no texture is ever sRGB: data textures are explicit `*Unorm` / float formats, colour images are uploaded as
+//!   `Rgba8Unorm` and the shaders decode/encode sRGB themselves where linear blending is wanted;
+//! - no pass needs `FLOAT32_FILTERABLE` or an f32 render target (lavapipe and llvmpipe run everything).
+
+pub mod chain;
+pub mod cpu;
+pub mod demo;
+pub mod device;
+pub mod gaussian_sss;
+pub mod gpu;
+pub mod loader;
+pub mod mlaa;
+pub mod scene;
+pub mod separable_sss;
+pub mod skin_inputs;
+pub mod smaa;
+
+/// Errors of the runtime.
+#[derive(Debug, thiserror::Error)]
+pub enum RuntimeError {
+    #[error("no usable GPU adapter: {0}")]
+    NoAdapter(String),
+    #[error("GPU error: {0}")]
+    Gpu(String),
+    #[error("{0}")]
+    Lut(#[from] loader::LutError),
+    /// Bad input; kept as the error's source so the command maps it to exit code 2.
+    #[error("{0}")]
+    Invalid(#[from] crate::error::InvalidInput),
+}

@@ -1,0 +1,102 @@
+//! Separable SSS: GPU vs CPU reference, the matte (non-skin pixels pass through), energy conservation.
+
+mod runtime_support;
+
+use rtbake::runtime::cpu::separable_sss::separable_sss;
+use rtbake::runtime::separable_sss::{SeparableSss, SssKernel, SssParams};
+use runtime_support::*;
+
+/// A 17-tap kernel: per-channel Gaussians (sigma 1.0, 0.5, 0.3 kernel units) over offsets in [-3, 3],
+/// normalised per channel, centre first.
+fn kernel() -> SssKernel {
+    let n = 17;
+    let offsets: Vec<f32> = (0..n).map(|i| -3.0 + 6.0 * i as f32 / (n - 1) as f32).collect();
+    let sig = [1.0f32, 0.5, 0.3];
+    let mut taps: Vec<[f32; 4]> = offsets
+        .iter()
+        .map(|&o| {
+            let mut t = [0.0f32, 0.0, 0.0, o];
+            for c in 0..3 {
+                t[c] = (-o * o / (2.0 * sig[c] * sig[c])).exp();
+            }
+            t
+        })
+        .collect();
+    for c in 0..3 {
+        let s: f32 = taps.iter().map(|t| t[c]).sum();
+        taps.iter_mut().for_each(|t| t[c] /= s);
+    }
+    let centre = taps.remove(n / 2);
+    taps.insert(0, centre);
+    SssKernel::new(taps).unwrap()
+}
+
+/// A lit sphere (skin, alpha 1) with stripes of light, on a far background (alpha 0).
+fn scene(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
+    let (mut color, mut depth) = (vec![0.0f32; (w * h * 4) as usize], vec![10.0f32; (w * h) as usize]);
+    let r = 0.4 * w.min(h) as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let (dx, dy) = (x as f32 + 0.5 - w as f32 / 2.0, y as f32 + 0.5 - h as f32 / 2.0);
+            let i = (y * w + x) as usize;
+            let d2 = dx * dx + dy * dy;
+            if d2 < r * r {
+                let z = (r * r - d2).sqrt() / r;
+                let stripe = if ((x / 6) + (y / 9)) % 2 == 0 { 1.0 } else { 0.15 };
+                let lit = (0.3 + 0.7 * z) * stripe;
+                color[4 * i..4 * i + 4].copy_from_slice(&[0.9 * lit, 0.6 * lit, 0.5 * lit, 1.0]);
+                depth[i] = 2.0 - 0.3 * z;
+            } else {
+                color[4 * i..4 * i + 4].copy_from_slice(&[0.2, 0.3, 0.4, 0.0]);
+            }
+        }
+    }
+    (color, depth)
+}
+
+#[test]
+fn sss_gpu_matches_cpu() {
+    let (w, h) = (200, 160);
+    let g = gpu();
+    let (color, depth) = scene(w, h);
+    let (k, p) = (kernel(), SssParams::default());
+    let pass = SeparableSss::new(&g.device, w, h, &k, &p).unwrap();
+    let out = pass.run(&g.device, &g.queue, &color, &depth).unwrap();
+    let cpu = separable_sss(&color, &depth, w, h, &k, &p);
+    // Tolerance in linear space: 2e-3 absolute + 2e-3 relative (f16 storage is ~1e-3 relative).
+    let bad = out.iter().zip(&cpu).filter(|(a, b)| (*a - *b).abs() > 2e-3 + 2e-3 * b.abs()).count();
+    let max = out.iter().zip(&cpu).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    eprintln!("{w}x{h}: {bad} of {} samples outside tolerance, max abs diff {max:.2e}", out.len());
+    assert!(bad as f64 <= 0.001 * out.len() as f64);
+    // The blur did something on skin.
+    let changed = out.iter().zip(&color).filter(|(a, b)| (*a - *b).abs() > 1e-2).count();
+    assert!(changed > 1000, "SSS must blur the stripes ({changed} samples changed)");
+}
+
+#[test]
+fn non_skin_pixels_pass_through_and_energy_is_kept() {
+    let (w, h) = (96, 96);
+    let g = gpu();
+    let (mut color, depth) = scene(w, h);
+    let (k, p) = (kernel(), SssParams { follow_surface: false, ..Default::default() });
+    // Background must come back bit-exact (f16 of the input).
+    let pass = SeparableSss::new(&g.device, w, h, &k, &p).unwrap();
+    let out = pass.run(&g.device, &g.queue, &color, &depth).unwrap();
+    for i in 0..(w * h) as usize {
+        if color[4 * i + 3] == 0.0 {
+            for c in 0..4 {
+                assert_eq!(out[4 * i + c], half::f16::from_f32(color[4 * i + c]).to_f32());
+            }
+        }
+    }
+    // A constant skin image keeps its value (kernel weights sum to 1 per channel).
+    for px in color.chunks_mut(4) {
+        px.copy_from_slice(&[0.5, 0.25, 0.125, 1.0]);
+    }
+    let out = pass.run(&g.device, &g.queue, &color, &vec![2.0; (w * h) as usize]).unwrap();
+    for px in out.chunks(4) {
+        for (c, want) in [0.5f32, 0.25, 0.125].iter().enumerate() {
+            assert!((px[c] - want).abs() < 2e-3 * want, "{px:?}");
+        }
+    }
+}

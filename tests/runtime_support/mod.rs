@@ -1,0 +1,67 @@
+//! Shared helpers of the runtime tests: the device (a missing adapter FAILS the test), golden LUTs, comparisons.
+#![allow(dead_code)]
+
+use rtbake::runtime::cpu::FilterPrecision;
+use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::smaa::SmaaTextures;
+use std::path::PathBuf;
+
+/// The headless device; panics (test failure, not a skip) when there is no adapter.
+pub fn gpu() -> Gpu {
+    match create_headless(&Default::default()) {
+        Ok(g) => {
+            eprintln!("adapter: {}", g.describe());
+            g
+        }
+        Err(e) => panic!("runtime tests need an adapter (install mesa-vulkan-drivers for lavapipe): {e}"),
+    }
+}
+
+/// The bilinear precision model of the test adapter.
+pub fn precision(g: &Gpu) -> FilterPrecision {
+    FilterPrecision::for_adapter(&g.adapter_info.name, g.adapter_info.device_type == wgpu::DeviceType::Cpu)
+}
+
+pub fn reference_dir() -> PathBuf {
+    std::env::var_os("RTBAKE_REFERENCE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"))
+}
+
+fn read(rel: &str) -> Vec<u8> {
+    let p = reference_dir().join(rel);
+    std::fs::read(&p).unwrap_or_else(|e| panic!("golden file {} missing: {e}", p.display()))
+}
+
+/// The upstream SMAA textures (golden bytes).
+pub fn golden_smaa() -> SmaaTextures {
+    SmaaTextures::new(read("smaa/AreaTex_RG8_160x560.bin"), read("smaa/SearchTex_R8_64x16.bin")).unwrap()
+}
+
+/// The upstream MLAA v1.4 area map for maximum distance n.
+pub fn golden_mlaa(n: u32) -> Vec<u8> {
+    read(&format!("mlaa/AreaMap{n}_v1.4_RG8_{}x{}.bin", 5 * n, 5 * n))
+}
+
+/// Fraction of samples that differ by at most `tol`, and the largest difference.
+pub fn within(a: &[u8], b: &[u8], tol: u8) -> (f64, u8) {
+    assert_eq!(a.len(), b.len());
+    let mut ok = 0usize;
+    let mut max = 0u8;
+    for (x, y) in a.iter().zip(b) {
+        let d = x.abs_diff(*y);
+        max = max.max(d);
+        if d <= tol {
+            ok += 1;
+        }
+    }
+    (ok as f64 / a.len() as f64, max)
+}
+
+/// Fraction of pixels (all `ch` channels) within `tol`.
+pub fn pixels_within(a: &[u8], b: &[u8], ch: usize, tol: u8) -> f64 {
+    let n = a.len() / ch;
+    let ok =
+        a.chunks(ch).zip(b.chunks(ch)).filter(|(p, q)| p.iter().zip(*q).all(|(x, y)| x.abs_diff(*y) <= tol)).count();
+    ok as f64 / n as f64
+}
