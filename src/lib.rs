@@ -8,6 +8,7 @@ pub mod aa;
 pub mod bake;
 pub mod diffusion;
 pub mod error;
+pub mod facial;
 pub mod image_buf;
 pub mod io;
 pub mod manifest;

@@ -1,0 +1,382 @@
+//! Exact local mean and standard deviation over a disk (thesis eq. 7.1; Jimenez, Scully, Barbosa, Donner,
+//! Alvarez, Vieira, Matts, Orvalho, Gutierrez, Weyrich, "A practical appearance model for dynamic facial color",
+//! ACM TOG 29(6) / SIGGRAPH Asia 2010):
+//!
+//! ```text
+//! μ(x) = (H * f)(x)        σ(x) = sqrt( (H² * f)(x) − μ(x)² )        f(u) = 1/(πr²) for |u| ≤ r
+//! ```
+//!
+//! The disk is the set of integer texel offsets (dx, dy) with dx² + dy² ≤ r². It is the union of 2r + 1 horizontal
+//! chords of half-width `hw(dy) = floor(sqrt(r² − dy²))`, so with per-row prefix sums each chord costs two look-ups
+//! and a texel costs O(r) (not O(r²)). The inner loop runs over a whole output row per chord, which vectorises.
+//!
+//! Numerics: samples are shifted by the map's global mean `c` before summing (accumulation in f64), so the
+//! variance `E[(H−c)²] − E[H−c]²` does not cancel catastrophically for maps with a large mean; it is clamped at 0
+//! before the square root. Results do not depend on how the rows are split between threads (each texel's sums
+//! are formed in a fixed order), so the bytes are identical for any `RAYON_NUM_THREADS`.
+//!
+//! Borders: [`Border::Clip`] clips the disk at the map border and normalises by the covered texel count (no zero
+//! padding, no wrap); [`Border::Wrap`] treats the map as tileable.
+
+use crate::error::InvalidInput;
+use rayon::prelude::*;
+
+/// How the disk is handled where it leaves the map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Border {
+    /// Clip the disk at the border and normalise by the covered area.
+    Clip,
+    /// Wrap around (tileable maps).
+    Wrap,
+}
+
+impl Border {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Border::Clip => "clip",
+            Border::Wrap => "wrap",
+        }
+    }
+}
+
+/// Local statistics of a single-channel map (row-major, top row first).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalStats {
+    pub width: u32,
+    pub height: u32,
+    /// μ(x) of eq. 7.1.
+    pub mean: Vec<f64>,
+    /// σ(x) of eq. 7.1 (variance clamped at 0 before the square root).
+    pub sigma: Vec<f64>,
+}
+
+/// Largest radius accepted for a `width × height` map: the disk diameter 2r + 1 must fit in the map.
+pub fn max_radius(width: u32, height: u32) -> u32 {
+    (width.min(height).saturating_sub(1)) / 2
+}
+
+/// Checks `radius` against the map size (`param` names the flag in the error).
+pub fn check_radius(param: &str, radius: u32, width: u32, height: u32) -> Result<u32, InvalidInput> {
+    let max = max_radius(width, height);
+    if max == 0 {
+        return Err(InvalidInput::new(
+            param,
+            format!("cannot be used with a {width}x{height} map: the map must be at least 3x3 texels"),
+        ));
+    }
+    if radius == 0 || radius > max {
+        return Err(InvalidInput::new(
+            param,
+            format!(
+                "must be in 1..={max} texels for a {width}x{height} map (the disk diameter 2r+1 must fit), got {radius}"
+            ),
+        ));
+    }
+    Ok(radius)
+}
+
+/// Half-widths of the disk's chords, indexed by `dy + r` for `dy` in `−r..=r`: the largest integer `h` with
+/// `h² + dy² ≤ r²` (exact integer arithmetic).
+pub fn chord_half_widths(radius: u32) -> Vec<u32> {
+    let r = radius as i64;
+    (-r..=r)
+        .map(|dy| {
+            let m = r * r - dy * dy;
+            let mut h = (m as f64).sqrt() as i64;
+            while h * h > m {
+                h -= 1;
+            }
+            while (h + 1) * (h + 1) <= m {
+                h += 1;
+            }
+            h as u32
+        })
+        .collect()
+}
+
+/// Number of texels in the full (unclipped) disk.
+pub fn disk_texel_count(radius: u32) -> u64 {
+    chord_half_widths(radius).iter().map(|&h| 2 * h as u64 + 1).sum()
+}
+
+/// Mean of a map in f64, summed row by row in a fixed order (deterministic).
+pub fn global_mean(data: &[f32]) -> f64 {
+    if data.is_empty() {
+        return 0.0;
+    }
+    let mut s = 0.0f64;
+    for chunk in data.chunks(4096) {
+        s += chunk.iter().map(|&v| v as f64).sum::<f64>();
+    }
+    s / data.len() as f64
+}
+
+/// Rows per parallel task. Any value gives the same bytes; this one balances prefix-sum reuse and parallelism.
+const BAND_ROWS: usize = 64;
+
+/// Exact disk statistics in O(r) per texel. `data` is `width × height` single-channel, top row first.
+/// The radius must pass [`check_radius`].
+pub fn disk_stats(data: &[f32], width: u32, height: u32, radius: u32, border: Border) -> Result<LocalStats, InvalidInput> {
+    check_radius("radius", radius, width, height)?;
+    let (w, h, r) = (width as usize, height as usize, radius as usize);
+    assert_eq!(data.len(), w * h, "map data length");
+    let hws = chord_half_widths(radius);
+    let shift = global_mean(data);
+    let full_count: u64 = hws.iter().map(|&x| 2 * x as u64 + 1).sum();
+    let ext = w + 2 * r + 1; // extended prefix row: index j + r for j in −r..=w+r
+    let mut mean = vec![0.0f64; w * h];
+    let mut sigma = vec![0.0f64; w * h];
+
+    // Extended prefix sums of (H − c) and (H − c)² of one input row.
+    let prefix_row = |y: usize, ps: &mut [f64], pq: &mut [f64]| {
+        let row = &data[y * w..(y + 1) * w];
+        // Plain prefix over 0..=w at index r..=r+w.
+        ps[r] = 0.0;
+        pq[r] = 0.0;
+        let (mut s, mut q) = (0.0f64, 0.0f64);
+        for (x, &v) in row.iter().enumerate() {
+            let d = v as f64 - shift;
+            s += d;
+            q += d * d;
+            ps[r + x + 1] = s;
+            pq[r + x + 1] = q;
+        }
+        match border {
+            Border::Clip => {
+                for j in 0..r {
+                    ps[j] = 0.0;
+                    pq[j] = 0.0;
+                    ps[r + w + 1 + j] = s;
+                    pq[r + w + 1 + j] = q;
+                }
+            }
+            Border::Wrap => {
+                // P(j) = P(j mod w) + floor(j / w)·total, with |j| < w here.
+                for j in 0..r {
+                    // left: index j ↔ position j − r (negative)
+                    let pos = j as i64 - r as i64;
+                    let m = (pos + w as i64) as usize;
+                    ps[j] = ps[r + m] - s;
+                    pq[j] = pq[r + m] - q;
+                }
+                for j in 0..r {
+                    // right: position w + 1 + j
+                    let m = 1 + j;
+                    ps[r + w + 1 + j] = ps[r + m] + s;
+                    pq[r + w + 1 + j] = pq[r + m] + q;
+                }
+            }
+        }
+    };
+
+    mean.par_chunks_mut(BAND_ROWS * w).zip(sigma.par_chunks_mut(BAND_ROWS * w)).enumerate().for_each(
+        |(band, (mean_band, sigma_band))| {
+            let y0 = band * BAND_ROWS;
+            let rows = mean_band.len() / w;
+            // Input rows needed, as positions y0 − r .. y0 + rows + r (wrapped or clipped).
+            let lo = y0 as i64 - r as i64;
+            let hi = (y0 + rows + r) as i64; // exclusive
+            let n_in = (hi - lo) as usize;
+            let mut ps = vec![0.0f64; n_in * ext];
+            let mut pq = vec![0.0f64; n_in * ext];
+            let mut valid = vec![false; n_in];
+            for k in 0..n_in {
+                let pos = lo + k as i64;
+                let y = match border {
+                    Border::Clip if pos < 0 || pos >= h as i64 => continue,
+                    Border::Clip => pos as usize,
+                    Border::Wrap => pos.rem_euclid(h as i64) as usize,
+                };
+                valid[k] = true;
+                prefix_row(y, &mut ps[k * ext..(k + 1) * ext], &mut pq[k * ext..(k + 1) * ext]);
+            }
+            let mut acc_s = vec![0.0f64; w];
+            let mut acc_q = vec![0.0f64; w];
+            let mut count = vec![0u64; w];
+            for oy in 0..rows {
+                acc_s.iter_mut().for_each(|v| *v = 0.0);
+                acc_q.iter_mut().for_each(|v| *v = 0.0);
+                let mut interior_count = 0u64;
+                for (i, &hw) in hws.iter().enumerate() {
+                    let k = oy + i; // input row index in the band buffer (position y0 + oy + i − r)
+                    if !valid[k] {
+                        continue;
+                    }
+                    let hw = hw as usize;
+                    interior_count += 2 * hw as u64 + 1;
+                    let rs = &ps[k * ext..(k + 1) * ext];
+                    let rq = &pq[k * ext..(k + 1) * ext];
+                    let (s_hi, s_lo) = (&rs[r + hw + 1..r + hw + 1 + w], &rs[r - hw..r - hw + w]);
+                    let (q_hi, q_lo) = (&rq[r + hw + 1..r + hw + 1 + w], &rq[r - hw..r - hw + w]);
+                    for ((a, &p1), &p0) in acc_s.iter_mut().zip(s_hi).zip(s_lo) {
+                        *a += p1 - p0;
+                    }
+                    for ((a, &p1), &p0) in acc_q.iter_mut().zip(q_hi).zip(q_lo) {
+                        *a += p1 - p0;
+                    }
+                }
+                // Covered texel counts: constant away from the left/right borders.
+                count.iter_mut().for_each(|c| *c = interior_count);
+                if border == Border::Clip {
+                    let border_cols = (0..r.min(w)).chain(w.saturating_sub(r).max(r)..w);
+                    for x in border_cols {
+                        let mut c = 0u64;
+                        for (i, &hw) in hws.iter().enumerate() {
+                            if !valid[oy + i] {
+                                continue;
+                            }
+                            let hw = hw as i64;
+                            let a = (x as i64 - hw).max(0);
+                            let b = (x as i64 + hw + 1).min(w as i64);
+                            c += (b - a) as u64;
+                        }
+                        count[x] = c;
+                    }
+                } else {
+                    debug_assert_eq!(interior_count, full_count);
+                }
+                let out_m = &mut mean_band[oy * w..(oy + 1) * w];
+                let out_s = &mut sigma_band[oy * w..(oy + 1) * w];
+                for x in 0..w {
+                    let n = count[x] as f64;
+                    let m = acc_s[x] / n;
+                    let var = (acc_q[x] / n - m * m).max(0.0);
+                    out_m[x] = shift + m;
+                    out_s[x] = var.sqrt();
+                }
+            }
+        },
+    );
+    Ok(LocalStats { width, height, mean, sigma })
+}
+
+/// Reference implementation: visits every texel of the disk (O(r²) per texel) and uses the two-pass
+/// variance. For tests and small maps only.
+pub fn disk_stats_brute_force(
+    data: &[f32],
+    width: u32,
+    height: u32,
+    radius: u32,
+    border: Border,
+) -> Result<LocalStats, InvalidInput> {
+    check_radius("radius", radius, width, height)?;
+    let (w, h, r) = (width as i64, height as i64, radius as i64);
+    let mut mean = vec![0.0; (w * h) as usize];
+    let mut sigma = vec![0.0; (w * h) as usize];
+    let mut texels = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            texels.clear();
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    if dx * dx + dy * dy > r * r {
+                        continue;
+                    }
+                    let (sx, sy) = (x + dx, y + dy);
+                    let v = match border {
+                        Border::Clip if sx < 0 || sy < 0 || sx >= w || sy >= h => continue,
+                        Border::Clip => data[(sy * w + sx) as usize],
+                        Border::Wrap => data[(sy.rem_euclid(h) * w + sx.rem_euclid(w)) as usize],
+                    };
+                    texels.push(v as f64);
+                }
+            }
+            let n = texels.len() as f64;
+            let m = texels.iter().sum::<f64>() / n;
+            let var = texels.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n;
+            mean[(y * w + x) as usize] = m;
+            sigma[(y * w + x) as usize] = var.sqrt();
+        }
+    }
+    Ok(LocalStats { width, height, mean, sigma })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise_map(w: u32, h: u32, seed: u32, offset: f32) -> Vec<f32> {
+        let mut s = seed.wrapping_mul(2654435761).wrapping_add(1);
+        (0..w * h)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                offset + (s % 10000) as f32 / 10000.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn chord_half_widths_are_exact() {
+        assert_eq!(chord_half_widths(1), vec![0, 1, 0]);
+        assert_eq!(chord_half_widths(2), vec![0, 1, 2, 1, 0]);
+        // r = 5: 3² + 4² = 5² is on the disk.
+        let hw = chord_half_widths(5);
+        assert_eq!(hw[5 + 3], 4);
+        assert_eq!(hw[5 + 4], 3);
+        assert_eq!(disk_texel_count(1), 5);
+        assert_eq!(disk_texel_count(2), 13);
+    }
+
+    #[test]
+    fn fast_matches_brute_force_clip_and_wrap() {
+        for &(w, h, r) in &[(23u32, 17u32, 3u32), (16, 16, 7), (40, 9, 4), (5, 31, 2), (64, 64, 1)] {
+            let data = noise_map(w, h, w * 31 + h, 0.0);
+            for border in [Border::Clip, Border::Wrap] {
+                let fast = disk_stats(&data, w, h, r, border).unwrap();
+                let slow = disk_stats_brute_force(&data, w, h, r, border).unwrap();
+                for i in 0..(w * h) as usize {
+                    assert!((fast.mean[i] - slow.mean[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} mean at {i}");
+                    assert!((fast.sigma[i] - slow.sigma[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} sigma at {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn large_mean_does_not_cancel() {
+        // Values 1e6 + [0, 1e-3): a naive E[H²] − E[H]² in f64 would lose every digit of the variance.
+        let (w, h, r) = (24u32, 20u32, 4u32);
+        let data: Vec<f32> = noise_map(w, h, 7, 0.0).iter().map(|v| 1.0e4 + v * 0.01).collect();
+        let fast = disk_stats(&data, w, h, r, Border::Clip).unwrap();
+        let slow = disk_stats_brute_force(&data, w, h, r, Border::Clip).unwrap();
+        for i in 0..(w * h) as usize {
+            assert!(slow.sigma[i] > 1e-3);
+            assert!((fast.sigma[i] - slow.sigma[i]).abs() <= 1e-6 * slow.sigma[i], "sigma at {i}");
+            assert!((fast.mean[i] - slow.mean[i]).abs() <= 1e-9 * slow.mean[i]);
+        }
+    }
+
+    #[test]
+    fn flat_map_has_zero_sigma_and_its_mean() {
+        let data = vec![0.125f32; 30 * 20];
+        for border in [Border::Clip, Border::Wrap] {
+            let s = disk_stats(&data, 30, 20, 5, border).unwrap();
+            assert!(s.mean.iter().all(|&m| m == 0.125));
+            assert!(s.sigma.iter().all(|&v| v == 0.0));
+        }
+    }
+
+    #[test]
+    fn radius_is_validated() {
+        let data = vec![0.0f32; 10 * 8];
+        assert!(disk_stats(&data, 10, 8, 0, Border::Clip).is_err());
+        assert!(disk_stats(&data, 10, 8, 4, Border::Clip).is_err());
+        assert!(disk_stats(&data, 10, 8, 3, Border::Clip).is_ok());
+        let e = check_radius("--radius", 9, 10, 8).unwrap_err();
+        assert!(e.to_string().contains("--radius must be in 1..=3"), "{e}");
+    }
+
+    #[test]
+    fn same_bytes_for_any_thread_count() {
+        let (w, h) = (70u32, 150u32);
+        let data = noise_map(w, h, 3, 0.5);
+        let a = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let b = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+        let sa = a.install(|| disk_stats(&data, w, h, 6, Border::Clip).unwrap());
+        let sb = b.install(|| disk_stats(&data, w, h, 6, Border::Clip).unwrap());
+        assert_eq!(sa, sb);
+    }
+}
