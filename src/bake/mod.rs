@@ -88,10 +88,12 @@ pub struct Asset {
 pub fn registry() -> Vec<Asset> {
     let mut v = Vec::new();
     v.extend(aa::assets());
+    v.extend(facial::assets());
     v
 }
 
 pub mod aa;
+pub mod facial;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).

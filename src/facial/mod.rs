@@ -16,3 +16,8 @@
 //! | [`inputs`] | decoding of concentration maps, normal maps and masks with their value mappings |
 
 pub mod disk_stats;
+pub mod hemoglobin_rig;
+pub mod resample;
+pub mod synthetic;
+pub mod inputs;
+pub mod wrinkles;
