@@ -112,8 +112,10 @@ pub fn global_mean(data: &[f32]) -> f64 {
     s / data.len() as f64
 }
 
-/// Rows per parallel task. Any value gives the same bytes; this one balances prefix-sum reuse and parallelism.
-const BAND_ROWS: usize = 64;
+/// Rows per parallel task. Any value gives the same bytes (each texel's sums are formed in the same order).
+const BAND_ROWS: usize = 32;
+/// Output columns per cache tile: the `2r + 1` prefix rows of a tile stay in L2 while its rows are summed.
+const TILE_COLS: usize = 256;
 
 /// Exact disk statistics in O(r) per texel. `data` is `width × height` single-channel, top row first.
 /// The radius must pass [`check_radius`].
@@ -128,43 +130,35 @@ pub fn disk_stats(data: &[f32], width: u32, height: u32, radius: u32, border: Bo
     let mut mean = vec![0.0f64; w * h];
     let mut sigma = vec![0.0f64; w * h];
 
-    // Extended prefix sums of (H − c) and (H − c)² of one input row.
-    let prefix_row = |y: usize, ps: &mut [f64], pq: &mut [f64]| {
+    // Extended prefix sums of (H − c) and (H − c)², interleaved, of one input row.
+    let prefix_row = |y: usize, p: &mut [[f64; 2]]| {
         let row = &data[y * w..(y + 1) * w];
-        // Plain prefix over 0..=w at index r..=r+w.
-        ps[r] = 0.0;
-        pq[r] = 0.0;
+        p[r] = [0.0, 0.0];
         let (mut s, mut q) = (0.0f64, 0.0f64);
         for (x, &v) in row.iter().enumerate() {
             let d = v as f64 - shift;
             s += d;
             q += d * d;
-            ps[r + x + 1] = s;
-            pq[r + x + 1] = q;
+            p[r + x + 1] = [s, q];
         }
         match border {
             Border::Clip => {
                 for j in 0..r {
-                    ps[j] = 0.0;
-                    pq[j] = 0.0;
-                    ps[r + w + 1 + j] = s;
-                    pq[r + w + 1 + j] = q;
+                    p[j] = [0.0, 0.0];
+                    p[r + w + 1 + j] = [s, q];
                 }
             }
             Border::Wrap => {
                 // P(j) = P(j mod w) + floor(j / w)·total, with |j| < w here.
                 for j in 0..r {
-                    // left: index j ↔ position j − r (negative)
-                    let pos = j as i64 - r as i64;
-                    let m = (pos + w as i64) as usize;
-                    ps[j] = ps[r + m] - s;
-                    pq[j] = pq[r + m] - q;
+                    // left: index j ↔ position j − r (negative), equal to P(j − r + w) − total
+                    let m = j + w - r;
+                    p[j] = [p[r + m][0] - s, p[r + m][1] - q];
                 }
                 for j in 0..r {
-                    // right: position w + 1 + j
+                    // right: position w + 1 + j, equal to P(1 + j) + total
                     let m = 1 + j;
-                    ps[r + w + 1 + j] = ps[r + m] + s;
-                    pq[r + w + 1 + j] = pq[r + m] + q;
+                    p[r + w + 1 + j] = [p[r + m][0] + s, p[r + m][1] + q];
                 }
             }
         }
@@ -176,10 +170,8 @@ pub fn disk_stats(data: &[f32], width: u32, height: u32, radius: u32, border: Bo
             let rows = mean_band.len() / w;
             // Input rows needed, as positions y0 − r .. y0 + rows + r (wrapped or clipped).
             let lo = y0 as i64 - r as i64;
-            let hi = (y0 + rows + r) as i64; // exclusive
-            let n_in = (hi - lo) as usize;
-            let mut ps = vec![0.0f64; n_in * ext];
-            let mut pq = vec![0.0f64; n_in * ext];
+            let n_in = rows + 2 * r;
+            let mut pre = vec![[0.0f64; 2]; n_in * ext];
             let mut valid = vec![false; n_in];
             for k in 0..n_in {
                 let pos = lo + k as i64;
@@ -189,61 +181,65 @@ pub fn disk_stats(data: &[f32], width: u32, height: u32, radius: u32, border: Bo
                     Border::Wrap => pos.rem_euclid(h as i64) as usize,
                 };
                 valid[k] = true;
-                prefix_row(y, &mut ps[k * ext..(k + 1) * ext], &mut pq[k * ext..(k + 1) * ext]);
+                prefix_row(y, &mut pre[k * ext..(k + 1) * ext]);
             }
-            let mut acc_s = vec![0.0f64; w];
-            let mut acc_q = vec![0.0f64; w];
-            let mut count = vec![0u64; w];
-            for oy in 0..rows {
-                acc_s.iter_mut().for_each(|v| *v = 0.0);
-                acc_q.iter_mut().for_each(|v| *v = 0.0);
-                let mut interior_count = 0u64;
-                for (i, &hw) in hws.iter().enumerate() {
-                    let k = oy + i; // input row index in the band buffer (position y0 + oy + i − r)
-                    if !valid[k] {
-                        continue;
+            let mut acc = vec![[0.0f64; 2]; TILE_COLS.min(w)];
+            // Covered texel counts per output row: `interior` away from the left/right borders, explicit for
+            // the r columns at each border (w ≥ 2r + 1, so the two border ranges do not overlap).
+            let counts: Vec<(u64, Vec<u64>)> = (0..rows)
+                .map(|oy| {
+                    let valid = &valid;
+                    let hws_valid: Vec<i64> =
+                        hws.iter().enumerate().filter(|&(i, _)| valid[oy + i]).map(|(_, &hw)| hw as i64).collect();
+                    let rows_valid = || hws_valid.iter().copied();
+                    let interior: u64 = rows_valid().map(|hw| 2 * hw as u64 + 1).sum();
+                    if border == Border::Wrap {
+                        debug_assert_eq!(interior, full_count);
+                        return (interior, Vec::new());
                     }
-                    let hw = hw as usize;
-                    interior_count += 2 * hw as u64 + 1;
-                    let rs = &ps[k * ext..(k + 1) * ext];
-                    let rq = &pq[k * ext..(k + 1) * ext];
-                    let (s_hi, s_lo) = (&rs[r + hw + 1..r + hw + 1 + w], &rs[r - hw..r - hw + w]);
-                    let (q_hi, q_lo) = (&rq[r + hw + 1..r + hw + 1 + w], &rq[r - hw..r - hw + w]);
-                    for ((a, &p1), &p0) in acc_s.iter_mut().zip(s_hi).zip(s_lo) {
-                        *a += p1 - p0;
-                    }
-                    for ((a, &p1), &p0) in acc_q.iter_mut().zip(q_hi).zip(q_lo) {
-                        *a += p1 - p0;
-                    }
-                }
-                // Covered texel counts: constant away from the left/right borders.
-                count.iter_mut().for_each(|c| *c = interior_count);
-                if border == Border::Clip {
-                    let border_cols = (0..r.min(w)).chain(w.saturating_sub(r).max(r)..w);
-                    for x in border_cols {
-                        let mut c = 0u64;
-                        for (i, &hw) in hws.iter().enumerate() {
-                            if !valid[oy + i] {
-                                continue;
-                            }
-                            let hw = hw as i64;
-                            let a = (x as i64 - hw).max(0);
-                            let b = (x as i64 + hw + 1).min(w as i64);
-                            c += (b - a) as u64;
+                    let edge = (0..r).chain(w - r..w).map(|x| {
+                        rows_valid().map(|hw| ((x as i64 + hw + 1).min(w as i64) - (x as i64 - hw).max(0)) as u64).sum()
+                    });
+                    (interior, edge.collect())
+                })
+                .collect();
+            // Tile columns so the 2r + 1 prefix rows of a tile stay in cache across consecutive output rows.
+            for x0 in (0..w).step_by(TILE_COLS) {
+                let tw = TILE_COLS.min(w - x0);
+                for oy in 0..rows {
+                    let acc = &mut acc[..tw];
+                    acc.iter_mut().for_each(|a| *a = [0.0, 0.0]);
+                    for (i, &hw) in hws.iter().enumerate() {
+                        let k = oy + i; // input position y0 + oy + i − r
+                        if !valid[k] {
+                            continue;
                         }
-                        count[x] = c;
+                        let hw = hw as usize;
+                        let row = &pre[k * ext..(k + 1) * ext];
+                        let p_hi = &row[x0 + r + hw + 1..x0 + r + hw + 1 + tw];
+                        let p_lo = &row[x0 + r - hw..x0 + r - hw + tw];
+                        for ((a, b), c) in acc.iter_mut().zip(p_hi).zip(p_lo) {
+                            a[0] += b[0] - c[0];
+                            a[1] += b[1] - c[1];
+                        }
                     }
-                } else {
-                    debug_assert_eq!(interior_count, full_count);
-                }
-                let out_m = &mut mean_band[oy * w..(oy + 1) * w];
-                let out_s = &mut sigma_band[oy * w..(oy + 1) * w];
-                for x in 0..w {
-                    let n = count[x] as f64;
-                    let m = acc_s[x] / n;
-                    let var = (acc_q[x] / n - m * m).max(0.0);
-                    out_m[x] = shift + m;
-                    out_s[x] = var.sqrt();
+                    let out_m = &mut mean_band[oy * w + x0..oy * w + x0 + tw];
+                    let out_s = &mut sigma_band[oy * w + x0..oy * w + x0 + tw];
+                    let (interior, edge) = &counts[oy];
+                    for x in 0..tw {
+                        let gx = x0 + x;
+                        let n = if edge.is_empty() || (r..w - r).contains(&gx) {
+                            *interior
+                        } else if gx < r {
+                            edge[gx]
+                        } else {
+                            edge[r + gx - (w - r)]
+                        } as f64;
+                        let m = acc[x][0] / n;
+                        let var = (acc[x][1] / n - m * m).max(0.0);
+                        out_m[x] = shift + m;
+                        out_s[x] = var.sqrt();
+                    }
                 }
             }
         },
