@@ -89,22 +89,30 @@ fn target_weight_reproduces_the_local_statistics_of_the_target() {
     let (rig, _, targets) = fixture_rig(4, 64);
     for (name, map) in &targets {
         let (mu, sg) = local_stat_errors(&rig, name, map, 4);
-        assert!(mu < 0.01, "{name}: mean |Δμ|/μ = {mu}");
-        assert!(sg < 0.10, "{name}: mean |Δσ|/σ = {sg}");
+        eprintln!("{name}: full-res rig: mean |Δμ|/μ = {mu:.5}, mean |Δσ|/σ = {sg:.5}");
+        assert!(mu < 0.005, "{name}: mean |Δμ|/μ = {mu}");
+        assert!(sg < 0.03, "{name}: mean |Δσ|/σ = {sg}");
+        // Baseline: the neutral map's own statistics are much further from the target's.
+        let (mu0, sg0) = local_stat_errors(&rig, "neutral", map, 4);
+        assert!(mu0 > 4.0 * mu && sg0 > 2.0 * sg, "{name}: rig ({mu}, {sg}) vs neutral baseline ({mu0}, {sg0})");
     }
     // Stored at 16² (ratio 4), as a renderer would use it: still close.
     let (rig, _, targets) = fixture_rig(4, 16);
     for (name, map) in &targets {
         let (mu, sg) = local_stat_errors(&rig, name, map, 4);
-        assert!(mu < 0.03, "{name} (16²): mean |Δμ|/μ = {mu}");
-        assert!(sg < 0.25, "{name} (16²): mean |Δσ|/σ = {sg}");
+        eprintln!("{name}: 16² rig: mean |Δμ|/μ = {mu:.5}, mean |Δσ|/σ = {sg:.5}");
+        assert!(mu < 0.01, "{name} (16²): mean |Δμ|/μ = {mu}");
+        assert!(sg < 0.04, "{name} (16²): mean |Δσ|/σ = {sg}");
     }
     // The evaluated map differs from the neutral one: the rig carries the target's perfusion change.
-    let (rig, neutral, _) = fixture_rig(4, 64);
+    // Its mean change (joy: more blood over the cheeks) matches the target's within 5 %.
+    let (rig, neutral, targets) = fixture_rig(4, 64);
     let w = rig_weights(&names(&rig), &[("joy".into(), 1.0)], false).unwrap();
     let joy = evaluate(&rig, &w, 1.0);
-    let diff = joy.iter().zip(&neutral).map(|(a, b)| (a - b).abs() as f64).sum::<f64>() / neutral.len() as f64;
-    assert!(diff > 1e-3, "joy should change the map, mean |Δ| = {diff}");
+    let mean_diff = |a: &[f32]| a.iter().zip(&neutral).map(|(a, b)| (a - b) as f64).sum::<f64>() / neutral.len() as f64;
+    let (d_eval, d_target) = (mean_diff(&joy), mean_diff(&targets[0].1));
+    assert!(d_target > 2e-4, "the joy fixture adds blood: {d_target}");
+    assert!((d_eval - d_target).abs() < 0.05 * d_target, "mean change {d_eval} vs target {d_target}");
 }
 
 #[test]
