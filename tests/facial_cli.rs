@@ -107,9 +107,17 @@ fn hemoglobin_rig_bakes_and_evaluates_back_to_the_neutral_map() {
     // A rig whose files are missing is bad input naming the file.
     std::fs::remove_file(out.join("fear_bias.exr")).unwrap();
     let h3 = dir.path().join("h3.exr");
-    assert_bad(&["maps", "rig-eval", "--rig", s(&rig), "--weights", "neutral=1", "--out", s(&h3)], &["fear_bias.exr"], &h3);
+    assert_bad(
+        &["maps", "rig-eval", "--rig", s(&rig), "--weights", "neutral=1", "--out", s(&h3)],
+        &["fear_bias.exr"],
+        &h3,
+    );
     let missing = dir.path().join("nope.json");
-    assert_bad(&["maps", "rig-eval", "--rig", s(&missing), "--weights", "neutral=1", "--out", s(&h3)], &["--rig", "nope.json"], &h3);
+    assert_bad(
+        &["maps", "rig-eval", "--rig", s(&missing), "--weights", "neutral=1", "--out", s(&h3)],
+        &["--rig", "nope.json"],
+        &h3,
+    );
 }
 
 #[test]
@@ -120,7 +128,8 @@ fn hemoglobin_bad_inputs_exit_2_and_write_nothing() {
     let a = fixture("anger");
     let target = format!("anger={}", s(&a));
     let base = |extra: &[&str]| -> Vec<String> {
-        let mut v: Vec<String> = ["maps", "hemoglobin", "--neutral", s(&n), "--out", s(&out)].iter().map(|x| x.to_string()).collect();
+        let mut v: Vec<String> =
+            ["maps", "hemoglobin", "--neutral", s(&n), "--out", s(&out)].iter().map(|x| x.to_string()).collect();
         v.extend(extra.iter().map(|x| x.to_string()));
         v
     };
@@ -140,7 +149,10 @@ fn hemoglobin_bad_inputs_exit_2_and_write_nothing() {
     // Maps of different sizes.
     let small = dir.path().join("small.png");
     write_png16(&small, 32, 32, 1, 3000);
-    run(&["--target", &format!("fear={}", s(&small)), "--radius", "4"], &["--target fear", "small.png", "32x32", "64x64"]);
+    run(
+        &["--target", &format!("fear={}", s(&small)), "--radius", "4"],
+        &["--target fear", "small.png", "32x32", "64x64"],
+    );
     // Wrong channel count.
     let rgb = dir.path().join("rgb.png");
     write_png16(&rgb, 64, 64, 3, 3000);
@@ -155,12 +167,18 @@ fn hemoglobin_bad_inputs_exit_2_and_write_nothing() {
     let nan = dir.path().join("nan.exr");
     let mut v = vec![0.05f32; 64 * 64];
     v[64 * 3 + 5] = f32::NAN;
-    std::fs::write(&nan, rtbake::io::exr::encode(&Image::from_vec(64, 64, 1, v), rtbake::io::exr::ExrPrecision::F32).unwrap())
-        .unwrap();
+    std::fs::write(
+        &nan,
+        rtbake::io::exr::encode(&Image::from_vec(64, 64, 1, v), rtbake::io::exr::ExrPrecision::F32).unwrap(),
+    )
+    .unwrap();
     run(&["--target", &format!("fear={}", s(&nan)), "--radius", "4"], &["nan.exr", "texel (5, 3)", "NaN"]);
     // Missing and corrupt files.
     let missing = dir.path().join("missing.exr");
-    run(&["--target", &format!("fear={}", s(&missing)), "--radius", "4"], &["--target fear", "missing.exr", "cannot read"]);
+    run(
+        &["--target", &format!("fear={}", s(&missing)), "--radius", "4"],
+        &["--target fear", "missing.exr", "cannot read"],
+    );
     let corrupt = dir.path().join("corrupt.png");
     let mut bytes = std::fs::read(&a).unwrap();
     bytes.truncate(bytes.len() / 2);
@@ -216,18 +234,41 @@ fn wrinkles_and_masks() {
     assert!((rg_gl[1] as i32 - want(-0.2 / 0.932_737_905) as i32).abs() <= 1);
     // Difference encoding needs --base.
     let out_d = dir.path().join("d");
-    assert_bad(&["maps", "wrinkles", "--normal", s(&normal), "--encoding", "difference", "--out", s(&out_d)], &["--base"], &out_d);
-    let o = rtbake(&["maps", "wrinkles", "--normal", s(&normal), "--base", s(&base), "--encoding", "difference", "--out", s(&out_d)]);
+    assert_bad(
+        &["maps", "wrinkles", "--normal", s(&normal), "--encoding", "difference", "--out", s(&out_d)],
+        &["--base"],
+        &out_d,
+    );
+    let o = rtbake(&[
+        "maps",
+        "wrinkles",
+        "--normal",
+        s(&normal),
+        "--base",
+        s(&base),
+        "--encoding",
+        "difference",
+        "--out",
+        s(&out_d),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert_eq!(std::fs::read(out_d.join("wrinkle_difference.bin")).unwrap().len(), 32 * 32 * 4);
     // Bad inputs: wrong channel count, different sizes, cone rejection, missing file.
     let gray = dir.path().join("gray.png");
     write_png16(&gray, 32, 32, 1, 100);
     let out_bad = dir.path().join("bad");
-    assert_bad(&["maps", "wrinkles", "--normal", s(&gray), "--out", s(&out_bad)], &["--normal", "gray.png", "3 (RGB) or 4"], &out_bad);
+    assert_bad(
+        &["maps", "wrinkles", "--normal", s(&gray), "--out", s(&out_bad)],
+        &["--normal", "gray.png", "3 (RGB) or 4"],
+        &out_bad,
+    );
     let big = dir.path().join("big.png");
     write_normal_png(&big, 64, 32, 3, [0.0, 0.0, 1.0]);
-    assert_bad(&["maps", "wrinkles", "--normal", s(&normal), "--base", s(&big), "--out", s(&out_bad)], &["--base", "64x32"], &out_bad);
+    assert_bad(
+        &["maps", "wrinkles", "--normal", s(&normal), "--base", s(&big), "--out", s(&out_bad)],
+        &["--base", "64x32"],
+        &out_bad,
+    );
     let steep = dir.path().join("steep.png");
     write_normal_png(&steep, 8, 8, 3, [0.9, 0.0, 0.436]);
     assert_bad(
@@ -240,22 +281,50 @@ fn wrinkles_and_masks() {
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["wrinkle"]["cone_clamped_texels"], 64);
     let out_m = dir.path().join("m");
-    assert_bad(&["maps", "wrinkles", "--normal", s(&dir.path().join("x.png")), "--out", s(&out_m)], &["--normal", "x.png"], &out_m);
+    assert_bad(
+        &["maps", "wrinkles", "--normal", s(&dir.path().join("x.png")), "--out", s(&out_m)],
+        &["--normal", "x.png"],
+        &out_m,
+    );
 
     // Masks.
     let m1 = dir.path().join("m1.png");
     write_png16(&m1, 32, 32, 1, 65535);
-    let o = rtbake(&["maps", "wrinkle-masks", "--zone", &format!("red={}", s(&m1)), "--zone", &format!("gray={}", s(&m1)), "--size", "8", "--out", s(&out_m)]);
+    let o = rtbake(&[
+        "maps",
+        "wrinkle-masks",
+        "--zone",
+        &format!("red={}", s(&m1)),
+        "--zone",
+        &format!("gray={}", s(&m1)),
+        "--size",
+        "8",
+        "--out",
+        s(&out_m),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let t0 = std::fs::read(out_m.join("wrinkle_masks_0.bin")).unwrap();
     let t1 = std::fs::read(out_m.join("wrinkle_masks_1.bin")).unwrap();
     assert_eq!((t0.len(), &t0[..4], &t1[..4]), (8 * 8 * 4, &[255u8, 0, 0, 0][..], &[0u8, 0, 0, 255][..]));
     let out_m2 = dir.path().join("m2");
-    assert_bad(&["maps", "wrinkle-masks", "--zone", &format!("purple={}", s(&m1)), "--out", s(&out_m2)], &["--zone", "unknown zone 'purple'"], &out_m2);
+    assert_bad(
+        &["maps", "wrinkle-masks", "--zone", &format!("purple={}", s(&m1)), "--out", s(&out_m2)],
+        &["--zone", "unknown zone 'purple'"],
+        &out_m2,
+    );
     let m2 = dir.path().join("m2.png");
     write_png16(&m2, 16, 16, 1, 0);
     assert_bad(
-        &["maps", "wrinkle-masks", "--zone", &format!("red={}", s(&m1)), "--zone", &format!("blue={}", s(&m2)), "--out", s(&out_m2)],
+        &[
+            "maps",
+            "wrinkle-masks",
+            "--zone",
+            &format!("red={}", s(&m1)),
+            "--zone",
+            &format!("blue={}", s(&m2)),
+            "--out",
+            s(&out_m2),
+        ],
         &["--zone blue", "16x16"],
         &out_m2,
     );

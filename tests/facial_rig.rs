@@ -29,7 +29,8 @@ fn committed_fixtures_match_the_generator() {
             std::fs::create_dir_all(fixture_dir()).unwrap();
             std::fs::write(&path, rtbake::io::png::encode_u16(img).unwrap()).unwrap();
         }
-        let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e} (regenerate with RTBAKE_REGENERATE_FIXTURES=1)", path.display()));
+        let bytes = std::fs::read(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (regenerate with RTBAKE_REGENERATE_FIXTURES=1)", path.display()));
         match rtbake::io::png::decode(&bytes, "fixture").unwrap() {
             rtbake::io::png::DecodedPng::U16(f) => assert_eq!(&f, img, "{} is stale", path.display()),
             _ => panic!("{} must be a 16-bit PNG", path.display()),
@@ -39,12 +40,16 @@ fn committed_fixtures_match_the_generator() {
 
 fn load_fixture(name: &str) -> Vec<f32> {
     let p = fixture_dir().join(format!("hemoglobin_{name}.png"));
-    let m = inputs::decode_concentration("--neutral", &p.display().to_string(), &std::fs::read(&p).unwrap(), None).unwrap();
+    let m =
+        inputs::decode_concentration("--neutral", &p.display().to_string(), &std::fs::read(&p).unwrap(), None).unwrap();
     assert_eq!((m.image.width, m.image.height), (FIXTURE_SIZE, FIXTURE_SIZE));
     m.image.data
 }
 
-fn fixture_rig(radius: u32, rig_size: u32) -> (HemoglobinRig, Vec<f32>, Vec<(String, Vec<f32>)>) {
+/// (rig, neutral map, named target maps).
+type FixtureRig = (HemoglobinRig, Vec<f32>, Vec<(String, Vec<f32>)>);
+
+fn fixture_rig(radius: u32, rig_size: u32) -> FixtureRig {
     let neutral = load_fixture("neutral");
     let targets: Vec<(String, Vec<f32>)> = FIXTURE_TARGETS.iter().map(|n| (n.to_string(), load_fixture(n))).collect();
     let refs: Vec<(String, &[f32])> = targets.iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
@@ -127,7 +132,8 @@ fn flat_maps_give_finite_rigs_and_count_floored_texels() {
         assert!(m.scale.iter().chain(&m.bias).all(|v| v.is_finite()), "{}", m.name);
     }
     assert!(rig.h0.iter().all(|v| v.is_finite()));
-    let wts = rig_weights(&names(&rig), &[("t".into(), 0.5), ("f".into(), 0.25), ("neutral".into(), 0.25)], false).unwrap();
+    let wts =
+        rig_weights(&names(&rig), &[("t".into(), 0.5), ("f".into(), 0.25), ("neutral".into(), 0.25)], false).unwrap();
     assert!(evaluate(&rig, &wts, 1.27).iter().all(|v| v.is_finite()));
     // Flat target: scale 0 (σ = 0), bias = the constant.
     let f = rig.maps.iter().find(|m| m.name == "f").unwrap();

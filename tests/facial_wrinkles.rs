@@ -46,10 +46,8 @@ fn pd_of_an_8_bit_normal_map_round_trips() {
     // A normal map stored as 8-bit RGB: PD conversion of the decoded texels reconstructs the decoded normal
     // (normalised) within the PD storage quantisation.
     let ns = normals(4096, 0.95);
-    let data: Vec<f32> = ns
-        .iter()
-        .flat_map(|n| n.map(|c| (2.0 * (((0.5 + 0.5 * c) * 255.0).round() / 255.0) - 1.0) as f32))
-        .collect();
+    let data: Vec<f32> =
+        ns.iter().flat_map(|n| n.map(|c| (2.0 * (((0.5 + 0.5 * c) * 255.0).round() / 255.0) - 1.0) as f32)).collect();
     let img = Image::from_vec(64, 64, 3, data.clone());
     let pd = normals_to_pd("--normal", &img, GreenConvention::DirectX, ConeMode::Reject).unwrap();
     assert_eq!(pd.cone_clamped, 0);
@@ -136,7 +134,7 @@ fn masks_pack_into_two_rgba8_textures_with_area_filtering() {
     assert_eq!(m0.data[(63) * 4], 0); // red, right
     assert!(m0.data.iter().skip(1).step_by(4).all(|&v| v == 0)); // green missing
     assert!(m1.data.iter().skip(3).step_by(4).all(|&v| v == 128)); // gray = round(127.5)
-    // Non-integer ratio 128 -> 48 (8/3): the step stays sharp and the mean is preserved.
+                                                                   // Non-integer ratio 128 -> 48 (8/3): the step stays sharp and the mean is preserved.
     let [m0, _] = pack_zone_masks(&masks, w, h, 48);
     let row: Vec<u8> = (0..48).map(|x| m0.data[x * 4]).collect();
     assert_eq!(row[23], 255);

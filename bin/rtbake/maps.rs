@@ -202,7 +202,8 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         pairs.push((name.to_string(), PathBuf::from(file)));
     }
     let neutral_path = a.neutral.display().to_string();
-    let neutral = inputs::decode_concentration("--neutral", &neutral_path, &read_input("--neutral", &a.neutral)?, range)?;
+    let neutral =
+        inputs::decode_concentration("--neutral", &neutral_path, &read_input("--neutral", &a.neutral)?, range)?;
     let (w, h) = (neutral.image.width, neutral.image.height);
     let mut sources = vec![RigSource {
         name: "neutral".into(),
@@ -218,7 +219,10 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         if (m.image.width, m.image.height) != (w, h) {
             return Err(usage(InvalidInput::new(
                 flag,
-                format!("{p}: map is {}x{}, but the neutral map is {w}x{h}; all maps must have the same size", m.image.width, m.image.height),
+                format!(
+                    "{p}: map is {}x{}, but the neutral map is {w}x{h}; all maps must have the same size",
+                    m.image.width, m.image.height
+                ),
             )));
         }
         sources.push(RigSource {
@@ -234,7 +238,8 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     ctx.info(format!("hemoglobin rig: {w}x{h}, {} targets, r = {} texels", maps.len(), a.radius));
     let refs: Vec<(String, &[f32])> = maps.iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
     let rig = hemoglobin_rig::build_rig(&neutral.image.data, w, h, &refs, &settings)?;
-    let (files, desc) = bf::hemoglobin_rig_files(&rig, "", &sources, "as given by the input value mapping (see maps[].source)")?;
+    let (files, desc) =
+        bf::hemoglobin_rig_files(&rig, "", &sources, "as given by the input value mapping (see maps[].source)")?;
     write_files("--out", &a.out, &files)?;
     let pct = 100.0 * rig.sigma_floored_texels as f64 / (w as f64 * h as f64);
     ctx.info(format!(
@@ -265,8 +270,8 @@ fn file_name(p: &Path) -> String {
 fn load_rig_map(dir: &Path, file: &str, w: u32, h: u32) -> Result<Vec<f32>> {
     let p = dir.join(file);
     let bytes = read_input("--rig", &p)?;
-    let (img, _) = io::exr::decode(&bytes, &p.display().to_string())
-        .map_err(|e| usage(anyhow::anyhow!("--rig: {e}")))?;
+    let (img, _) =
+        io::exr::decode(&bytes, &p.display().to_string()).map_err(|e| usage(anyhow::anyhow!("--rig: {e}")))?;
     if (img.width, img.height, img.channels) != (w, h, 1) {
         return Err(usage_msg(format!(
             "--rig: {} is {}x{}x{}, rig.json says {w}x{h}x1",
@@ -297,7 +302,12 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
     let desc: RigDescription = serde_json::from_str(&text)
         .map_err(|e| usage(anyhow::anyhow!("--rig {}: not a valid rig description: {e}", a.rig.display())))?;
     if desc.schema != bf::RIG_SCHEMA {
-        return Err(usage_msg(format!("--rig {}: schema '{}', expected '{}'", a.rig.display(), desc.schema, bf::RIG_SCHEMA)));
+        return Err(usage_msg(format!(
+            "--rig {}: schema '{}', expected '{}'",
+            a.rig.display(),
+            desc.schema,
+            bf::RIG_SCHEMA
+        )));
     }
     let names: Vec<String> = desc.maps.iter().map(|m| m.name.clone()).collect();
     let weights = hemoglobin_rig::rig_weights(&names, &pairs, a.normalize_weights)?;
@@ -349,7 +359,8 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
 
 fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
-    let green = if a.green == "opengl" { wrinkles::GreenConvention::OpenGl } else { wrinkles::GreenConvention::DirectX };
+    let green =
+        if a.green == "opengl" { wrinkles::GreenConvention::OpenGl } else { wrinkles::GreenConvention::DirectX };
     let cone = if a.cone == "reject" { wrinkles::ConeMode::Reject } else { wrinkles::ConeMode::Clamp };
     let np = a.normal.display().to_string();
     let normal = inputs::decode_normal_map("--normal", &np, &read_input("--normal", &a.normal)?)?;
@@ -463,7 +474,12 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
     let packed = wrinkles::pack_zone_masks(&masks, w, h, a.size);
     let mut files = Vec::new();
     for (i, img) in packed.iter().enumerate() {
-        files.extend(rtbake::bake::unorm8_texture_files(&format!("wrinkle_masks_{i}"), img, "lut", &bf::mask_convention(i))?);
+        files.extend(rtbake::bake::unorm8_texture_files(
+            &format!("wrinkle_masks_{i}"),
+            img,
+            "lut",
+            &bf::mask_convention(i),
+        )?);
     }
     let given: Vec<&str> = wrinkles::ZONES.iter().zip(&masks).filter(|(_, m)| m.is_some()).map(|(z, _)| *z).collect();
     let report = json!({
@@ -476,7 +492,12 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
     });
     files.push(rtbake::bake::json_file("wrinkle_masks.json", &report, "json", "wrinkle mask packing"));
     write_files("--out", &a.out, &files)?;
-    ctx.info(format!("packed {} zone masks into 2 RGBA8 textures {}x{}", given.len(), packed[0].width, packed[0].height));
+    ctx.info(format!(
+        "packed {} zone masks into 2 RGBA8 textures {}x{}",
+        given.len(),
+        packed[0].width,
+        packed[0].height
+    ));
     if ctx.json {
         ctx.emit_json(&report);
     }

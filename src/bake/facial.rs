@@ -79,7 +79,17 @@ pub struct RigMapFiles {
     pub source: RigSource,
 }
 
-fn float_meta(format: &str, st: &str, w: u32, h: u32, ch: u32, pf: Option<PixelFormat>, conv: &str, tol: f64) -> FileMeta {
+#[allow(clippy::too_many_arguments)]
+fn float_meta(
+    format: &str,
+    st: &str,
+    w: u32,
+    h: u32,
+    ch: u32,
+    pf: Option<PixelFormat>,
+    conv: &str,
+    tol: f64,
+) -> FileMeta {
     FileMeta {
         kind: "lut".into(),
         format: format.into(),
@@ -94,7 +104,15 @@ fn float_meta(format: &str, st: &str, w: u32, h: u32, ch: u32, pf: Option<PixelF
     }
 }
 
-fn preview_file(path: String, w: u32, h: u32, values: &[f32], lo: f64, hi: f64, what: &str) -> Result<BakedFile, BakeError> {
+fn preview_file(
+    path: String,
+    w: u32,
+    h: u32,
+    values: &[f32],
+    lo: f64,
+    hi: f64,
+    what: &str,
+) -> Result<BakedFile, BakeError> {
     let data = values.iter().map(|&v| wrinkles::encode_unorm8((v as f64 - lo) / (hi - lo))).collect();
     let bytes = io::png::encode_u8(&Image::from_vec(w, h, 1, data))?;
     let meta = FileMeta {
@@ -242,7 +260,12 @@ pub fn hemoglobin_rig_files(
         previews: "8-bit gray, linear, for viewing only: scale previews map [0, 2]; bias previews share one range (see each file's manifest convention)".into(),
     };
     let value = serde_json::to_value(&desc).map_err(|e| BakeError::Other(e.to_string()))?;
-    files.push(json_file(&format!("{dir}rig.json"), &value, "json", "hemoglobin rig description (schema rtbake-hemoglobin-rig/1)"));
+    files.push(json_file(
+        &format!("{dir}rig.json"),
+        &value,
+        "json",
+        "hemoglobin rig description (schema rtbake-hemoglobin-rig/1)",
+    ));
     Ok((files, desc))
 }
 
@@ -282,7 +305,8 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let dir = format!("{RIG_EXAMPLE_DIR}/");
     let mut files = Vec::new();
     let mut sources = Vec::new();
-    let conc: Vec<(String, Vec<f32>)> = set.iter().map(|(n, img)| (n.clone(), synthetic::u16_to_concentration(img))).collect();
+    let conc: Vec<(String, Vec<f32>)> =
+        set.iter().map(|(n, img)| (n.clone(), synthetic::u16_to_concentration(img))).collect();
     for (name, img) in &set {
         let path = format!("{dir}input/{name}.png");
         files.push(BakedFile {
@@ -308,8 +332,12 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             mapping: "concentration = 0 + (1 - 0) * s / 65535".into(),
         });
     }
-    let settings =
-        RigSettings { radius_texels: p.radius_texels, border: p.border, sigma_floor: p.sigma_floor, rig_size: p.rig_size };
+    let settings = RigSettings {
+        radius_texels: p.radius_texels,
+        border: p.border,
+        sigma_floor: p.sigma_floor,
+        rig_size: p.rig_size,
+    };
     let targets: Vec<(String, &[f32])> = conc[1..].iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
     let rig = hemoglobin_rig::build_rig(&conc[0].1, p.size, p.size, &targets, &settings)?;
     let (rig_files, _) = hemoglobin_rig_files(&rig, &dir, &sources, "dermal hemoglobin volume fraction")?;
@@ -338,13 +366,17 @@ impl Default for WrinkleExampleParams {
 }
 
 /// Manifest convention of a PD map.
-pub const PD_CONVENTION: &str = "partial-derivative normal map (thesis ch. 8): R = nx/nz, G = ny/nz stored as 0.5 + 0.5*pd; \
+pub const PD_CONVENTION: &str =
+    "partial-derivative normal map (thesis ch. 8): R = nx/nz, G = ny/nz stored as 0.5 + 0.5*pd; \
      reconstruct n = normalize(2*rg - 1, 1); DirectX green convention (+y towards increasing v)";
 
 /// Manifest convention of mask textures.
 pub fn mask_convention(index: usize) -> String {
     let zones = &wrinkles::ZONES[index * 4..index * 4 + 4];
-    format!("wrinkle zone masks (thesis Table 8.1): R = {}, G = {}, B = {}, A = {}; values 0..1", zones[0], zones[1], zones[2], zones[3])
+    format!(
+        "wrinkle zone masks (thesis Table 8.1): R = {}, G = {}, B = {}, A = {}; values 0..1",
+        zones[0], zones[1], zones[2], zones[3]
+    )
 }
 
 fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
@@ -377,9 +409,19 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         3,
         normal.data.iter().map(|&s| (2.0 * s as f64 / 255.0 - 1.0) as f32).collect(),
     );
-    let pd = wrinkles::normals_to_pd("wrinkle-maps-example", &decoded, wrinkles::GreenConvention::DirectX, wrinkles::ConeMode::Clamp)?;
+    let pd = wrinkles::normals_to_pd(
+        "wrinkle-maps-example",
+        &decoded,
+        wrinkles::GreenConvention::DirectX,
+        wrinkles::ConeMode::Clamp,
+    )?;
     let (ow, oh, small) = wrinkles::downsample(&pd.pd, p.size, p.size, 2, p.wrinkle_size);
-    files.extend(unorm8_texture_files(&format!("{dir}wrinkle_pd"), &wrinkles::pd_to_rg8(ow, oh, &small), "lut", PD_CONVENTION)?);
+    files.extend(unorm8_texture_files(
+        &format!("{dir}wrinkle_pd"),
+        &wrinkles::pd_to_rg8(ow, oh, &small),
+        "lut",
+        PD_CONVENTION,
+    )?);
     let masks = synthetic::wrinkle_zone_masks(p.size);
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);

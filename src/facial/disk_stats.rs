@@ -119,7 +119,13 @@ const TILE_COLS: usize = 256;
 
 /// Exact disk statistics in O(r) per texel. `data` is `width × height` single-channel, top row first.
 /// The radius must pass [`check_radius`].
-pub fn disk_stats(data: &[f32], width: u32, height: u32, radius: u32, border: Border) -> Result<LocalStats, InvalidInput> {
+pub fn disk_stats(
+    data: &[f32],
+    width: u32,
+    height: u32,
+    radius: u32,
+    border: Border,
+) -> Result<LocalStats, InvalidInput> {
     check_radius("radius", radius, width, height)?;
     let (w, h, r) = (width as usize, height as usize, radius as usize);
     assert_eq!(data.len(), w * h, "map data length");

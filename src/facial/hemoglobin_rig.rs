@@ -160,7 +160,16 @@ pub fn build_rig(
     // eq. 7.4 against the stored neutral bias (see module docs).
     let b0 = resample::upsample_bilinear(&maps[0].bias, rw, rh, width, height);
     let h0: Vec<f32> = neutral.par_iter().zip(&b0).map(|(&hn, &b)| (hn as f64 - b) as f32).collect();
-    Ok(HemoglobinRig { width, height, rig_width: rw, rig_height: rh, settings: settings.clone(), h0, maps, sigma_floored_texels })
+    Ok(HemoglobinRig {
+        width,
+        height,
+        rig_width: rw,
+        rig_height: rh,
+        settings: settings.clone(),
+        h0,
+        maps,
+        sigma_floored_texels,
+    })
 }
 
 /// Turns `name=weight` pairs into one weight per rig map (in rig order; unnamed maps get 0). Weights must be

@@ -106,7 +106,9 @@ pub fn decode_concentration(
         InputFormat::Png => {
             let decoded = io::png::decode(bytes, path).map_err(|e| decode_err(param, path, e))?;
             let (w, h, ch, samples, smax, fmt): (u32, u32, u32, Vec<f64>, f64, &'static str) = match decoded {
-                DecodedPng::U8(i) => (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64).collect(), 255.0, "png8"),
+                DecodedPng::U8(i) => {
+                    (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64).collect(), 255.0, "png8")
+                }
                 DecodedPng::U16(i) => {
                     (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64).collect(), 65535.0, "png16")
                 }
@@ -155,9 +157,7 @@ pub fn decode_normal_map(param: &str, path: &str, bytes: &[u8]) -> Result<Image<
         }
         InputFormat::Png => match io::png::decode(bytes, path).map_err(|e| decode_err(param, path, e))? {
             DecodedPng::U8(i) => (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64 / 255.0).collect()),
-            DecodedPng::U16(i) => {
-                (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64 / 65535.0).collect())
-            }
+            DecodedPng::U16(i) => (i.width, i.height, i.channels, i.data.iter().map(|&s| s as f64 / 65535.0).collect()),
         },
     };
     check_dims(param, path, w, h)?;
@@ -195,7 +195,11 @@ pub fn decode_mask(param: &str, path: &str, bytes: &[u8]) -> Result<Image<f32>, 
     };
     check_dims(param, path, img.width, img.height)?;
     if img.channels != 1 {
-        return Err(bad(param, path, format!("a zone mask must be single-channel (gray), got {} channels", img.channels)));
+        return Err(bad(
+            param,
+            path,
+            format!("a zone mask must be single-channel (gray), got {} channels", img.channels),
+        ));
     }
     if let Some(i) = img.data.iter().position(|v| !(0.0..=1.0).contains(v)) {
         let (x, y) = (i as u32 % img.width, i as u32 / img.width);

@@ -17,7 +17,7 @@
 
 pub mod disk_stats;
 pub mod hemoglobin_rig;
+pub mod inputs;
 pub mod resample;
 pub mod synthetic;
-pub mod inputs;
 pub mod wrinkles;

@@ -46,14 +46,7 @@ fn weighted(values: impl Iterator<Item = f64>, overlaps: &[u64], n: usize) -> f6
 
 /// Area-weighted resampling of an interleaved `width × height × channels` f64 image to `out_w × out_h`.
 /// Sizes must be non-zero (callers validate).
-pub fn resample_area(
-    src: &[f64],
-    width: u32,
-    height: u32,
-    channels: u32,
-    out_w: u32,
-    out_h: u32,
-) -> Vec<f64> {
+pub fn resample_area(src: &[f64], width: u32, height: u32, channels: u32, out_w: u32, out_h: u32) -> Vec<f64> {
     let (w, h, c, ow, oh) = (width as usize, height as usize, channels as usize, out_w as usize, out_h as usize);
     assert_eq!(src.len(), w * h * c, "image data length");
     assert!(ow > 0 && oh > 0 && w > 0 && h > 0);

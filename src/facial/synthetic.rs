@@ -19,7 +19,8 @@ use crate::image_buf::Image;
 
 fn hash(ix: i64, iy: i64, seed: u32) -> u32 {
     // lowbias32 (C. Wellons) over a combination of the lattice point and the seed.
-    let mut x = (ix as u32).wrapping_mul(0x8da6_b343) ^ (iy as u32).wrapping_mul(0xd816_3841) ^ seed.wrapping_mul(0xcb1a_b31f);
+    let mut x =
+        (ix as u32).wrapping_mul(0x8da6_b343) ^ (iy as u32).wrapping_mul(0xd816_3841) ^ seed.wrapping_mul(0xcb1a_b31f);
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
     x ^= x >> 15;
@@ -121,14 +122,62 @@ pub struct Expression {
 
 /// Eight illustrative targets: six basic emotions and two global states (thesis §7.3: exercise, alcohol).
 pub const EXPRESSIONS: [Expression; 8] = [
-    Expression { name: "joy", perfusion_global: 0.0, perfusion: [0.0, 0.35, 0.10, 0.0], contrast_global: 0.0, contrast: [0.0, 0.2, 0.0, 0.0] },
-    Expression { name: "anger", perfusion_global: 0.10, perfusion: [0.30, 0.25, 0.20, 0.10], contrast_global: 0.10, contrast: [0.2, 0.0, 0.0, 0.0] },
-    Expression { name: "fear", perfusion_global: -0.20, perfusion: [-0.10, -0.15, -0.10, 0.0], contrast_global: -0.25, contrast: [0.0; 4] },
-    Expression { name: "disgust", perfusion_global: 0.0, perfusion: [-0.10, 0.0, 0.30, 0.05], contrast_global: 0.0, contrast: [0.0, 0.0, 0.3, 0.0] },
-    Expression { name: "sadness", perfusion_global: -0.05, perfusion: [0.0, -0.05, 0.15, 0.20], contrast_global: -0.10, contrast: [0.0; 4] },
-    Expression { name: "surprise", perfusion_global: 0.0, perfusion: [-0.20, 0.05, 0.0, 0.0], contrast_global: 0.0, contrast: [0.3, 0.0, 0.0, 0.0] },
-    Expression { name: "exercise", perfusion_global: 0.25, perfusion: [0.20, 0.40, 0.20, 0.20], contrast_global: 0.10, contrast: [0.0; 4] },
-    Expression { name: "alcohol", perfusion_global: 0.15, perfusion: [0.0, 0.50, 0.35, 0.0], contrast_global: 0.0, contrast: [0.0, 0.2, 0.0, 0.0] },
+    Expression {
+        name: "joy",
+        perfusion_global: 0.0,
+        perfusion: [0.0, 0.35, 0.10, 0.0],
+        contrast_global: 0.0,
+        contrast: [0.0, 0.2, 0.0, 0.0],
+    },
+    Expression {
+        name: "anger",
+        perfusion_global: 0.10,
+        perfusion: [0.30, 0.25, 0.20, 0.10],
+        contrast_global: 0.10,
+        contrast: [0.2, 0.0, 0.0, 0.0],
+    },
+    Expression {
+        name: "fear",
+        perfusion_global: -0.20,
+        perfusion: [-0.10, -0.15, -0.10, 0.0],
+        contrast_global: -0.25,
+        contrast: [0.0; 4],
+    },
+    Expression {
+        name: "disgust",
+        perfusion_global: 0.0,
+        perfusion: [-0.10, 0.0, 0.30, 0.05],
+        contrast_global: 0.0,
+        contrast: [0.0, 0.0, 0.3, 0.0],
+    },
+    Expression {
+        name: "sadness",
+        perfusion_global: -0.05,
+        perfusion: [0.0, -0.05, 0.15, 0.20],
+        contrast_global: -0.10,
+        contrast: [0.0; 4],
+    },
+    Expression {
+        name: "surprise",
+        perfusion_global: 0.0,
+        perfusion: [-0.20, 0.05, 0.0, 0.0],
+        contrast_global: 0.0,
+        contrast: [0.3, 0.0, 0.0, 0.0],
+    },
+    Expression {
+        name: "exercise",
+        perfusion_global: 0.25,
+        perfusion: [0.20, 0.40, 0.20, 0.20],
+        contrast_global: 0.10,
+        contrast: [0.0; 4],
+    },
+    Expression {
+        name: "alcohol",
+        perfusion_global: 0.15,
+        perfusion: [0.0, 0.50, 0.35, 0.0],
+        contrast_global: 0.0,
+        contrast: [0.0, 0.2, 0.0, 0.0],
+    },
 ];
 
 /// Looks an expression up by name.
@@ -156,9 +205,9 @@ pub fn hemoglobin_at(u: f64, v: f64, seed: u32, expr: Option<&Expression>) -> f6
             let m = region_masks(u, v);
             let mut p = 1.0 + e.perfusion_global;
             let mut c = 1.0 + e.contrast_global;
-            for k in 0..4 {
-                p += e.perfusion[k] * m[k];
-                c += e.contrast[k] * m[k];
+            for ((mk, pk), ck) in m.iter().zip(&e.perfusion).zip(&e.contrast) {
+                p += pk * mk;
+                c += ck * mk;
             }
             base * p + detail * c
         }

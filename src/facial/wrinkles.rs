@@ -120,7 +120,12 @@ fn y_sign(green: GreenConvention) -> f64 {
 }
 
 /// Converts a decoded normal map (3 channels, `n = 2v − 1`) to a PD map in the DirectX convention.
-pub fn normals_to_pd(param: &str, normals: &Image<f32>, green: GreenConvention, cone: ConeMode) -> Result<PdMap, InvalidInput> {
+pub fn normals_to_pd(
+    param: &str,
+    normals: &Image<f32>,
+    green: GreenConvention,
+    cone: ConeMode,
+) -> Result<PdMap, InvalidInput> {
     assert_eq!(normals.channels, 3);
     let s = y_sign(green);
     let mut pd = Vec::with_capacity(normals.data.len() / 3 * 2);
@@ -234,7 +239,10 @@ pub fn zone_weights(expressions: &[(&str, f64)]) -> Result<[f64; 8], InvalidInpu
     for (name, w) in expressions {
         let Some((_, row)) = TABLE_8_1.iter().find(|(n, _)| n == name) else {
             let known: Vec<&str> = TABLE_8_1.iter().map(|(n, _)| *n).collect();
-            return Err(InvalidInput::new("expression", format!("unknown expression '{name}'; known: {}", known.join(", "))));
+            return Err(InvalidInput::new(
+                "expression",
+                format!("unknown expression '{name}'; known: {}", known.join(", ")),
+            ));
         };
         for k in 0..8 {
             z[k] += w * row[k];
