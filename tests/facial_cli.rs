@@ -189,13 +189,18 @@ fn hemoglobin_bad_inputs_exit_2_and_write_nothing() {
     run(&["--target", &format!("fear={}", s(&text)), "--radius", "4"], &["text.png", "not a PNG or OpenEXR"]);
     // Bad sigma floor.
     run(&["--target", &target, "--radius", "4", "--sigma-floor", "0"], &["--sigma-floor"]);
-    // The 8-bit map with a range works.
-    let args = base(&["--target", &format!("fear={}", s(&gray8)), "--radius", "4", "--value-range", "0,0.32"]);
+    // The 8-bit map with a range works, next to an f16 EXR target (comma-separated pairs are accepted).
+    let f16 = dir.path().join("anger_f16.exr");
+    let anger16 = rtbake::facial::inputs::decode_concentration("t", "a", &std::fs::read(&a).unwrap(), None).unwrap();
+    std::fs::write(&f16, rtbake::io::exr::encode(&anger16.image, rtbake::io::exr::ExrPrecision::F16).unwrap()).unwrap();
+    let pair = format!("fear={},anger={}", s(&gray8), s(&f16));
+    let args = base(&["--target", &pair, "--radius", "4", "--value-range", "0,0.32"]);
     let refs: Vec<&str> = args.iter().map(|x| x.as_str()).collect();
     let o = rtbake(&refs);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let desc: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("rig.json")).unwrap()).unwrap();
     assert_eq!(desc["maps"][1]["source"]["mapping"], "concentration = 0 + (0.32 - 0) * s / 255");
+    assert_eq!(desc["maps"][2]["source"]["format"], "exr-f16");
 }
 
 fn write_normal_png(path: &Path, w: u32, h: u32, ch: u32, n: [f64; 3]) {
@@ -327,5 +332,33 @@ fn wrinkles_and_masks() {
         ],
         &["--zone blue", "16x16"],
         &out_m2,
+    );
+}
+
+#[test]
+fn synthetic_command_writes_the_fixtures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("syn");
+    let o = rtbake(&[
+        "maps",
+        "synthetic",
+        "--size",
+        "64",
+        "--seed",
+        "1",
+        "--targets",
+        "joy,anger,fear,disgust",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for n in ["neutral", "joy", "anger", "fear", "disgust"] {
+        assert_eq!(std::fs::read(out.join(format!("{n}.png"))).unwrap(), std::fs::read(fixture(n)).unwrap(), "{n}");
+    }
+    let bad = dir.path().join("bad");
+    assert_bad(
+        &["maps", "synthetic", "--targets", "smile", "--out", s(&bad)],
+        &["--targets", "unknown synthetic expression 'smile'"],
+        &bad,
     );
 }

@@ -36,7 +36,8 @@ pub struct HemoglobinArgs {
     /// Neutral hemoglobin map Hn: single-channel EXR (f16/f32), 16-bit PNG, or 8-bit PNG with --value-range.
     #[arg(long, value_name = "FILE")]
     neutral: PathBuf,
-    /// Target map as NAME=FILE (repeatable), e.g. anger=anger.exr; names use [a-z0-9_-], 'neutral' is reserved.
+    /// Target map as NAME=FILE (repeatable, or comma-separated), e.g. anger=anger.exr; names use [a-z0-9_-],
+    /// 'neutral' is reserved.
     #[arg(long = "target", value_name = "NAME=FILE", required = true)]
     targets: Vec<String>,
     /// Disk radius r of the local statistics (eq. 7.1), in texels of the input maps; 1..=(min(w,h)-1)/2.
@@ -193,7 +194,8 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     let border = parse_border(&a.border);
     // Parse target names first (cheap errors before reading files).
     let mut pairs = Vec::new();
-    for t in &a.targets {
+    // Each --target may also hold comma-separated pairs (as --params FILE expands arrays).
+    for t in a.targets.iter().flat_map(|t| t.split(',')) {
         let (name, file) = split_pair("--target", t)?;
         hemoglobin_rig::check_target_name("--target", name)?;
         if pairs.iter().any(|(n, _): &(String, PathBuf)| n == name) {
@@ -449,7 +451,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
     let mut masks: [Option<Vec<f64>>; 8] = Default::default();
     let mut dims: Option<(u32, u32, String)> = None;
-    for z in &a.zones {
+    for z in a.zones.iter().flat_map(|z| z.split(',')) {
         let (zone, file) = split_pair("--zone", z)?;
         let Some(i) = wrinkles::ZONES.iter().position(|n| *n == zone) else {
             return Err(usage_msg(format!("--zone: unknown zone '{zone}'; zones: {}", wrinkles::ZONES.join(", "))));

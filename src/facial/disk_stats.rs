@@ -324,7 +324,10 @@ mod tests {
 
     #[test]
     fn fast_matches_brute_force_clip_and_wrap() {
-        for &(w, h, r) in &[(23u32, 17u32, 3u32), (16, 16, 7), (40, 9, 4), (5, 31, 2), (64, 64, 1)] {
+        // Includes maps wider than one cache tile (256 columns) and taller than one band (32 rows).
+        for &(w, h, r) in
+            &[(23u32, 17u32, 3u32), (16, 16, 7), (40, 9, 4), (5, 31, 2), (64, 64, 1), (300, 70, 6), (520, 13, 6)]
+        {
             let data = noise_map(w, h, w * 31 + h, 0.0);
             for border in [Border::Clip, Border::Wrap] {
                 let fast = disk_stats(&data, w, h, r, border).unwrap();
