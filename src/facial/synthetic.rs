@@ -8,7 +8,7 @@
 //!   in smooth regional masks (forehead, cheeks, nose, chin) and change the local contrast of the capillary
 //!   detail, loosely following the thesis observations (§7.3.1: more blood over the cheek bones when smiling,
 //!   pallor in fear, flush in anger, different spatial patterns after exercise and alcohol);
-//! - a **wrinkle height field** (forehead lines, crow's feet, nasolabial folds) turned into a tangent-space normal
+//! - a **wrinkle height field** (forehead lines, crow's feet, frown lines, nasolabial folds) turned into a normal
 //!   map, and the 8 zone masks of thesis Table 8.1.
 //!
 //! Only `+ − × ÷`, `floor` and `sqrt` are used (no libm transcendental functions), so the outputs are
@@ -265,7 +265,8 @@ pub fn u16_to_concentration(img: &Image<u16>) -> Vec<f32> {
 // Wrinkles
 
 /// Height (in texel-independent UV units) of the synthetic wrinkle field: horizontal forehead lines, crow's
-/// feet fanning out from the eye corners, and the nasolabial folds. Returns (h, ∂h/∂u, ∂h/∂v).
+/// feet fanning out from the eye corners, frown lines between the brows and the nasolabial folds.
+/// Returns (h, ∂h/∂u, ∂h/∂v).
 fn wrinkle_height(u: f64, v: f64) -> (f64, f64, f64) {
     // Each wrinkle is a groove with profile −a·(1 − t²)² (|t| < 1) across a line, faded along it by a mask.
     let mut h = 0.0;
@@ -316,6 +317,14 @@ fn wrinkle_height(u: f64, v: f64) -> (f64, f64, f64) {
             groove(dist, -slope * sign, 1.0, 0.008, 0.003, fade, fu, 0.0);
         }
     }
+    // Glabella: two short vertical frown lines between the brows.
+    for cu in [0.47, 0.53] {
+        let x = (v - 0.30) / 0.05;
+        if x.abs() < 1.0 {
+            let s = 1.0 - x * x;
+            groove(u - cu, 1.0, 0.0, 0.006, 0.002, s * s, 0.0, 2.0 * s * (-2.0 * x) / 0.05);
+        }
+    }
     // Nasolabial folds: lines from beside the nose to the mouth corners.
     for sign in [-1.0, 1.0] {
         let (u0, v0, u1, v1): (f64, f64, f64, f64) = (0.5 + sign * 0.08, 0.58, 0.5 + sign * 0.15, 0.78);
@@ -358,17 +367,19 @@ pub fn wrinkle_normal_map(size: u32, strength: f64) -> Image<u8> {
 }
 
 /// The 8 zone masks of Table 8.1 (red, green, blue, brown, cyan, magenta, orange, gray) on the synthetic
-/// layout, `size × size`, values in [0, 1]. Zones: forehead left/right, between the brows (upper/lower),
-/// crow's feet left/right, nasolabial folds, chin.
+/// layout, `size × size`, values in [0, 1]. The thesis shows the zones only as colours in Fig. 8.3; this layout
+/// is our reading of the Table 8.1 weights: red/green = outer forehead (left/right), blue/brown = inner forehead
+/// (inner-brow raiser: surprise, fear, sadness), cyan/magenta = between the brows (brow lowerer: anger, disgust),
+/// orange = nose and nasolabial folds, gray = chin (sadness).
 pub fn wrinkle_zone_masks(size: u32) -> Vec<Vec<f64>> {
     let zones: [(f64, f64, f64, f64); 8] = [
-        (0.36, 0.16, 0.16, 0.10), // red: forehead left
-        (0.64, 0.16, 0.16, 0.10), // green: forehead right
-        (0.44, 0.28, 0.07, 0.06), // blue: brow left
-        (0.56, 0.28, 0.07, 0.06), // brown: brow right
-        (0.18, 0.38, 0.08, 0.08), // cyan: crow's feet left
-        (0.82, 0.38, 0.08, 0.08), // magenta: crow's feet right
-        (0.50, 0.68, 0.20, 0.12), // orange: nasolabial folds
+        (0.30, 0.16, 0.14, 0.09), // red: outer forehead left
+        (0.70, 0.16, 0.14, 0.09), // green: outer forehead right
+        (0.42, 0.17, 0.08, 0.09), // blue: inner forehead left
+        (0.58, 0.17, 0.08, 0.09), // brown: inner forehead right
+        (0.46, 0.30, 0.04, 0.06), // cyan: between the brows, left
+        (0.54, 0.30, 0.04, 0.06), // magenta: between the brows, right
+        (0.50, 0.62, 0.20, 0.20), // orange: nose and nasolabial folds
         (0.50, 0.88, 0.12, 0.07), // gray: chin
     ];
     let n = size as f64;
