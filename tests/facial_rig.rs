@@ -209,3 +209,23 @@ fn wrinkle_assets_bake() {
     assert_eq!(v["expressions"]["anger"][0], -0.6);
     assert_eq!(v["weights_float4"]["fear"][1][3], 0.6);
 }
+
+#[test]
+fn evaluation_is_affine_in_the_weights_and_applies_the_global_scale() {
+    // eq. 7.6 is linear in w: H(0.3·anger + 0.7·neutral) = 0.3·H(anger) + 0.7·H(neutral); g multiplies H.
+    let (rig, _, _) = fixture_rig(4, 16);
+    let n = names(&rig);
+    let eval = |pairs: &[(&str, f64)], g: f64| {
+        let p: Vec<(String, f64)> = pairs.iter().map(|(a, b)| (a.to_string(), *b)).collect();
+        evaluate(&rig, &rig_weights(&n, &p, false).unwrap(), g)
+    };
+    let mix = eval(&[("anger", 0.3), ("neutral", 0.7)], 1.0);
+    let a = eval(&[("anger", 1.0)], 1.0);
+    let z = eval(&[("neutral", 1.0)], 1.0);
+    for i in 0..mix.len() {
+        let want = 0.3 * a[i] as f64 + 0.7 * z[i] as f64;
+        assert!((mix[i] as f64 - want).abs() < 1e-6, "texel {i}");
+    }
+    let flushed = eval(&[("anger", 1.0)], 1.27);
+    assert!(flushed.iter().zip(&a).all(|(f, a)| (*f as f64 - 1.27 * *a as f64).abs() < 1e-6));
+}
