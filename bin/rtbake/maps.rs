@@ -239,7 +239,11 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     hemoglobin_rig::check_settings(&settings, w, h)?;
     ctx.info(format!("hemoglobin rig: {w}x{h}, {} targets, r = {} texels", maps.len(), a.radius));
     let refs: Vec<(String, &[f32])> = maps.iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
-    let rig = hemoglobin_rig::build_rig(&neutral.image.data, w, h, &refs, &settings)?;
+    let bar = ctx.progress(1 + refs.len() as u64, "local statistics");
+    let rig = hemoglobin_rig::build_rig_with_progress(&neutral.image.data, w, h, &refs, &settings, &|k| {
+        bar.set_position(k as u64)
+    })?;
+    bar.finish_and_clear();
     let (files, desc) =
         bf::hemoglobin_rig_files(&rig, "", &sources, "as given by the input value mapping (see maps[].source)")?;
     write_files("--out", &a.out, &files)?;

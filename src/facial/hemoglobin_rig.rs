@@ -118,6 +118,18 @@ pub fn build_rig(
     targets: &[(String, &[f32])],
     settings: &RigSettings,
 ) -> Result<HemoglobinRig, InvalidInput> {
+    build_rig_with_progress(neutral, width, height, targets, settings, &|_| {})
+}
+
+/// [`build_rig`] calling `progress(k)` after the k-th of `1 + targets.len()` maps has been analysed.
+pub fn build_rig_with_progress(
+    neutral: &[f32],
+    width: u32,
+    height: u32,
+    targets: &[(String, &[f32])],
+    settings: &RigSettings,
+    progress: &dyn Fn(usize),
+) -> Result<HemoglobinRig, InvalidInput> {
     check_settings(settings, width, height)?;
     let n = width as usize * height as usize;
     if neutral.len() != n {
@@ -147,6 +159,7 @@ pub fn build_rig(
     let bias0 = down(&stats_n.mean);
     drop(stats_n);
     let mut maps = vec![RigMap { name: NEUTRAL.into(), scale: vec![1.0; (rw * rh) as usize], bias: bias0 }];
+    progress(1);
 
     for (name, t) in targets {
         let st = disk_stats::disk_stats(t, width, height, r, settings.border)?;
@@ -155,6 +168,7 @@ pub fn build_rig(
         drop(st);
         let scale = down(&scale_full);
         maps.push(RigMap { name: name.clone(), scale, bias });
+        progress(maps.len());
     }
 
     // eq. 7.4 against the stored neutral bias (see module docs).
