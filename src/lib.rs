@@ -10,6 +10,7 @@ pub mod baked_dir;
 pub mod diffusion;
 pub mod error;
 pub mod fitting;
+pub mod facial;
 pub mod image_buf;
 pub mod io;
 pub mod manifest;

@@ -92,6 +92,7 @@ pub fn registry() -> Vec<Asset> {
     v.extend(transmittance::assets());
     v.extend(separable::assets());
     v.extend(skin::assets());
+    v.extend(facial::assets());
     v
 }
 
@@ -100,6 +101,7 @@ pub mod gaussians;
 pub mod separable;
 pub mod skin;
 pub mod transmittance;
+pub mod facial;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).

@@ -1,0 +1,446 @@
+//! Exact local mean and standard deviation over a disk (thesis eq. 7.1; Jimenez, Scully, Barbosa, Donner,
+//! Alvarez, Vieira, Matts, Orvalho, Gutierrez, Weyrich, "A practical appearance model for dynamic facial color",
+//! ACM TOG 29(6) / SIGGRAPH Asia 2010):
+//!
+//! ```text
+//! μ(x) = (H * f)(x)        σ(x) = sqrt( (H² * f)(x) − μ(x)² )        f(u) = 1/(πr²) for |u| ≤ r
+//! ```
+//!
+//! The disk is the set of integer texel offsets (dx, dy) with dx² + dy² ≤ r². It is the union of 2r + 1 horizontal
+//! chords of half-width `hw(dy) = floor(sqrt(r² − dy²))`, so with per-row prefix sums each chord costs two look-ups
+//! and a texel costs O(r) (not O(r²)). The inner loop runs over a whole output row per chord, which vectorises.
+//!
+//! Numerics: samples are shifted by the map's global mean `c` before summing (accumulation in f64), so the
+//! variance `E[(H−c)²] − E[H−c]²` does not cancel catastrophically for maps with a large mean; it is clamped at 0
+//! before the square root. Results do not depend on how the rows are split between threads (each texel's sums
+//! are formed in a fixed order), so the bytes are identical for any `RAYON_NUM_THREADS`.
+//!
+//! Borders: [`Border::Clip`] clips the disk at the map border and normalises by the covered texel count (no zero
+//! padding, no wrap); [`Border::Wrap`] treats the map as tileable.
+
+use crate::error::InvalidInput;
+use rayon::prelude::*;
+
+/// How the disk is handled where it leaves the map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Border {
+    /// Clip the disk at the border and normalise by the covered area.
+    Clip,
+    /// Wrap around (tileable maps).
+    Wrap,
+}
+
+impl Border {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Border::Clip => "clip",
+            Border::Wrap => "wrap",
+        }
+    }
+}
+
+/// Local statistics of a single-channel map (row-major, top row first).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalStats {
+    pub width: u32,
+    pub height: u32,
+    /// μ(x) of eq. 7.1.
+    pub mean: Vec<f64>,
+    /// σ(x) of eq. 7.1 (variance clamped at 0 before the square root).
+    pub sigma: Vec<f64>,
+}
+
+/// Largest radius accepted for a `width × height` map: the disk diameter 2r + 1 must fit in the map.
+pub fn max_radius(width: u32, height: u32) -> u32 {
+    (width.min(height).saturating_sub(1)) / 2
+}
+
+/// Checks `radius` against the map size (`param` names the flag in the error).
+pub fn check_radius(param: &str, radius: u32, width: u32, height: u32) -> Result<u32, InvalidInput> {
+    let max = max_radius(width, height);
+    if max == 0 {
+        return Err(InvalidInput::new(
+            param,
+            format!("cannot be used with a {width}x{height} map: the map must be at least 3x3 texels"),
+        ));
+    }
+    if radius == 0 || radius > max {
+        return Err(InvalidInput::new(
+            param,
+            format!(
+                "must be in 1..={max} texels for a {width}x{height} map (the disk diameter 2r+1 must fit), got {radius}"
+            ),
+        ));
+    }
+    Ok(radius)
+}
+
+/// Half-widths of the disk's chords, indexed by `dy + r` for `dy` in `−r..=r`: the largest integer `h` with
+/// `h² + dy² ≤ r²` (exact integer arithmetic).
+pub fn chord_half_widths(radius: u32) -> Vec<u32> {
+    let r = radius as i64;
+    (-r..=r)
+        .map(|dy| {
+            let m = r * r - dy * dy;
+            let mut h = (m as f64).sqrt() as i64;
+            while h * h > m {
+                h -= 1;
+            }
+            while (h + 1) * (h + 1) <= m {
+                h += 1;
+            }
+            h as u32
+        })
+        .collect()
+}
+
+/// Number of texels in the full (unclipped) disk.
+pub fn disk_texel_count(radius: u32) -> u64 {
+    chord_half_widths(radius).iter().map(|&h| 2 * h as u64 + 1).sum()
+}
+
+/// Mean of a map in f64, summed row by row in a fixed order (deterministic).
+pub fn global_mean(data: &[f32]) -> f64 {
+    if data.is_empty() {
+        return 0.0;
+    }
+    let mut s = 0.0f64;
+    for chunk in data.chunks(4096) {
+        s += chunk.iter().map(|&v| v as f64).sum::<f64>();
+    }
+    s / data.len() as f64
+}
+
+/// Rows per parallel task. Any value gives the same bytes (each texel's sums are formed in the same order).
+const BAND_ROWS: usize = 32;
+/// Output columns per cache tile: the `2r + 1` prefix rows of a tile stay in L2 while its rows are summed.
+const TILE_COLS: usize = 256;
+
+/// Exact disk statistics in O(r) per texel. `data` is `width × height` single-channel, top row first.
+/// The radius must pass [`check_radius`].
+pub fn disk_stats(
+    data: &[f32],
+    width: u32,
+    height: u32,
+    radius: u32,
+    border: Border,
+) -> Result<LocalStats, InvalidInput> {
+    check_radius("radius", radius, width, height)?;
+    let (w, h, r) = (width as usize, height as usize, radius as usize);
+    assert_eq!(data.len(), w * h, "map data length");
+    let hws = chord_half_widths(radius);
+    let shift = global_mean(data);
+    let full_count: u64 = hws.iter().map(|&x| 2 * x as u64 + 1).sum();
+    let ext = w + 2 * r + 1; // extended prefix row: index j + r for j in −r..=w+r
+    let mut mean = vec![0.0f64; w * h];
+    let mut sigma = vec![0.0f64; w * h];
+
+    // Extended prefix sums of (H − c) and (H − c)², interleaved, of one input row.
+    let prefix_row = |y: usize, p: &mut [[f64; 2]]| {
+        let row = &data[y * w..(y + 1) * w];
+        p[r] = [0.0, 0.0];
+        let (mut s, mut q) = (0.0f64, 0.0f64);
+        for (x, &v) in row.iter().enumerate() {
+            let d = v as f64 - shift;
+            s += d;
+            q += d * d;
+            p[r + x + 1] = [s, q];
+        }
+        match border {
+            Border::Clip => {
+                for j in 0..r {
+                    p[j] = [0.0, 0.0];
+                    p[r + w + 1 + j] = [s, q];
+                }
+            }
+            Border::Wrap => {
+                // P(j) = P(j mod w) + floor(j / w)·total, with |j| < w here.
+                for j in 0..r {
+                    // left: index j ↔ position j − r (negative), equal to P(j − r + w) − total
+                    let m = j + w - r;
+                    p[j] = [p[r + m][0] - s, p[r + m][1] - q];
+                }
+                for j in 0..r {
+                    // right: position w + 1 + j, equal to P(1 + j) + total
+                    let m = 1 + j;
+                    p[r + w + 1 + j] = [p[r + m][0] + s, p[r + m][1] + q];
+                }
+            }
+        }
+    };
+
+    mean.par_chunks_mut(BAND_ROWS * w).zip(sigma.par_chunks_mut(BAND_ROWS * w)).enumerate().for_each(
+        |(band, (mean_band, sigma_band))| {
+            let y0 = band * BAND_ROWS;
+            let rows = mean_band.len() / w;
+            // Input rows needed, as positions y0 − r .. y0 + rows + r (wrapped or clipped).
+            let lo = y0 as i64 - r as i64;
+            let n_in = rows + 2 * r;
+            let mut pre = vec![[0.0f64; 2]; n_in * ext];
+            let mut valid = vec![false; n_in];
+            for k in 0..n_in {
+                let pos = lo + k as i64;
+                let y = match border {
+                    Border::Clip if pos < 0 || pos >= h as i64 => continue,
+                    Border::Clip => pos as usize,
+                    Border::Wrap => pos.rem_euclid(h as i64) as usize,
+                };
+                valid[k] = true;
+                prefix_row(y, &mut pre[k * ext..(k + 1) * ext]);
+            }
+            let mut acc = vec![[0.0f64; 2]; TILE_COLS.min(w)];
+            // Covered texel counts per output row: `interior` away from the left/right borders, explicit for
+            // the r columns at each border (w ≥ 2r + 1, so the two border ranges do not overlap).
+            let counts: Vec<(u64, Vec<u64>)> = (0..rows)
+                .map(|oy| {
+                    let valid = &valid;
+                    let hws_valid: Vec<i64> =
+                        hws.iter().enumerate().filter(|&(i, _)| valid[oy + i]).map(|(_, &hw)| hw as i64).collect();
+                    let rows_valid = || hws_valid.iter().copied();
+                    let interior: u64 = rows_valid().map(|hw| 2 * hw as u64 + 1).sum();
+                    if border == Border::Wrap {
+                        debug_assert_eq!(interior, full_count);
+                        return (interior, Vec::new());
+                    }
+                    let edge = (0..r).chain(w - r..w).map(|x| {
+                        rows_valid().map(|hw| ((x as i64 + hw + 1).min(w as i64) - (x as i64 - hw).max(0)) as u64).sum()
+                    });
+                    (interior, edge.collect())
+                })
+                .collect();
+            // Tile columns so the 2r + 1 prefix rows of a tile stay in cache across consecutive output rows.
+            for x0 in (0..w).step_by(TILE_COLS) {
+                let tw = TILE_COLS.min(w - x0);
+                for oy in 0..rows {
+                    let acc = &mut acc[..tw];
+                    acc.iter_mut().for_each(|a| *a = [0.0, 0.0]);
+                    let chords = Chords { pre: &pre, valid: &valid, hws: &hws, ext, r, oy, x0 };
+                    accumulate(&chords, acc);
+                    let out_m = &mut mean_band[oy * w + x0..oy * w + x0 + tw];
+                    let out_s = &mut sigma_band[oy * w + x0..oy * w + x0 + tw];
+                    let (interior, edge) = &counts[oy];
+                    for x in 0..tw {
+                        let gx = x0 + x;
+                        let n = if edge.is_empty() || (r..w - r).contains(&gx) {
+                            *interior
+                        } else if gx < r {
+                            edge[gx]
+                        } else {
+                            edge[r + gx - (w - r)]
+                        } as f64;
+                        let m = acc[x][0] / n;
+                        let var = (acc[x][1] / n - m * m).max(0.0);
+                        out_m[x] = shift + m;
+                        out_s[x] = var.sqrt();
+                    }
+                }
+            }
+        },
+    );
+    Ok(LocalStats { width, height, mean, sigma })
+}
+
+/// The chords of one output row of a band, read from the band's extended prefix rows.
+struct Chords<'a> {
+    pre: &'a [[f64; 2]],
+    valid: &'a [bool],
+    hws: &'a [u32],
+    ext: usize,
+    r: usize,
+    /// Output row within the band (its chords start at prefix row `oy`).
+    oy: usize,
+    /// First output column of the tile.
+    x0: usize,
+}
+
+/// `acc[x] = Σ_chords P(x + hw + 1) − P(x − hw)` for the tile's columns: the O(r) inner loop.
+#[inline(always)]
+fn accumulate_body(c: &Chords, acc: &mut [[f64; 2]]) {
+    let tw = acc.len();
+    acc.iter_mut().for_each(|a| *a = [0.0, 0.0]);
+    for (i, &hw) in c.hws.iter().enumerate() {
+        let k = c.oy + i; // input position y0 + oy + i − r
+        if !c.valid[k] {
+            continue;
+        }
+        let hw = hw as usize;
+        let row = &c.pre[k * c.ext..(k + 1) * c.ext];
+        let p_hi = &row[c.x0 + c.r + hw + 1..c.x0 + c.r + hw + 1 + tw];
+        let p_lo = &row[c.x0 + c.r - hw..c.x0 + c.r - hw + tw];
+        for ((a, b), l) in acc.iter_mut().zip(p_hi).zip(p_lo) {
+            a[0] += b[0] - l[0];
+            a[1] += b[1] - l[1];
+        }
+    }
+}
+
+/// The same loop compiled for AVX2: identical IEEE operations in the same order (no FMA contraction), so the
+/// results are bit-identical to the baseline build; only the vector width differs.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn accumulate_avx2(c: &Chords, acc: &mut [[f64; 2]]) {
+    accumulate_body(c, acc)
+}
+
+fn accumulate(c: &Chords, acc: &mut [[f64; 2]]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked at run time).
+        return unsafe { accumulate_avx2(c, acc) };
+    }
+    accumulate_body(c, acc)
+}
+
+/// Reference implementation: visits every texel of the disk (O(r²) per texel) and uses the two-pass
+/// variance. For tests and small maps only.
+pub fn disk_stats_brute_force(
+    data: &[f32],
+    width: u32,
+    height: u32,
+    radius: u32,
+    border: Border,
+) -> Result<LocalStats, InvalidInput> {
+    check_radius("radius", radius, width, height)?;
+    let (w, h, r) = (width as i64, height as i64, radius as i64);
+    let mut mean = vec![0.0; (w * h) as usize];
+    let mut sigma = vec![0.0; (w * h) as usize];
+    let mut texels = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            texels.clear();
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    if dx * dx + dy * dy > r * r {
+                        continue;
+                    }
+                    let (sx, sy) = (x + dx, y + dy);
+                    let v = match border {
+                        Border::Clip if sx < 0 || sy < 0 || sx >= w || sy >= h => continue,
+                        Border::Clip => data[(sy * w + sx) as usize],
+                        Border::Wrap => data[(sy.rem_euclid(h) * w + sx.rem_euclid(w)) as usize],
+                    };
+                    texels.push(v as f64);
+                }
+            }
+            let n = texels.len() as f64;
+            let m = texels.iter().sum::<f64>() / n;
+            let var = texels.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n;
+            mean[(y * w + x) as usize] = m;
+            sigma[(y * w + x) as usize] = var.sqrt();
+        }
+    }
+    Ok(LocalStats { width, height, mean, sigma })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise_map(w: u32, h: u32, seed: u32, offset: f32) -> Vec<f32> {
+        let mut s = seed.wrapping_mul(2654435761).wrapping_add(1);
+        (0..w * h)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                offset + (s % 10000) as f32 / 10000.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn chord_half_widths_are_exact() {
+        assert_eq!(chord_half_widths(1), vec![0, 1, 0]);
+        assert_eq!(chord_half_widths(2), vec![0, 1, 2, 1, 0]);
+        // r = 5: 3² + 4² = 5² is on the disk.
+        let hw = chord_half_widths(5);
+        assert_eq!(hw[5 + 3], 4);
+        assert_eq!(hw[5 + 4], 3);
+        assert_eq!(disk_texel_count(1), 5);
+        assert_eq!(disk_texel_count(2), 13);
+    }
+
+    #[test]
+    fn fast_matches_brute_force_clip_and_wrap() {
+        // Includes maps wider than one cache tile (256 columns) and taller than one band (32 rows).
+        for &(w, h, r) in
+            &[(23u32, 17u32, 3u32), (16, 16, 7), (40, 9, 4), (5, 31, 2), (64, 64, 1), (300, 70, 6), (520, 13, 6)]
+        {
+            let data = noise_map(w, h, w * 31 + h, 0.0);
+            for border in [Border::Clip, Border::Wrap] {
+                let fast = disk_stats(&data, w, h, r, border).unwrap();
+                let slow = disk_stats_brute_force(&data, w, h, r, border).unwrap();
+                for i in 0..(w * h) as usize {
+                    assert!((fast.mean[i] - slow.mean[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} mean at {i}");
+                    assert!((fast.sigma[i] - slow.sigma[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} sigma at {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn large_mean_does_not_cancel() {
+        // Values 1e6 + [0, 1e-3): a naive E[H²] − E[H]² in f64 would lose every digit of the variance.
+        let (w, h, r) = (24u32, 20u32, 4u32);
+        let data: Vec<f32> = noise_map(w, h, 7, 0.0).iter().map(|v| 1.0e4 + v * 0.01).collect();
+        let fast = disk_stats(&data, w, h, r, Border::Clip).unwrap();
+        let slow = disk_stats_brute_force(&data, w, h, r, Border::Clip).unwrap();
+        for i in 0..(w * h) as usize {
+            assert!(slow.sigma[i] > 1e-3);
+            assert!((fast.sigma[i] - slow.sigma[i]).abs() <= 1e-6 * slow.sigma[i], "sigma at {i}");
+            assert!((fast.mean[i] - slow.mean[i]).abs() <= 1e-9 * slow.mean[i]);
+        }
+    }
+
+    #[test]
+    fn flat_map_has_zero_sigma_and_its_mean() {
+        let data = vec![0.125f32; 30 * 20];
+        for border in [Border::Clip, Border::Wrap] {
+            let s = disk_stats(&data, 30, 20, 5, border).unwrap();
+            assert!(s.mean.iter().all(|&m| m == 0.125));
+            assert!(s.sigma.iter().all(|&v| v == 0.0));
+        }
+    }
+
+    #[test]
+    fn radius_is_validated() {
+        let data = vec![0.0f32; 10 * 8];
+        assert!(disk_stats(&data, 10, 8, 0, Border::Clip).is_err());
+        assert!(disk_stats(&data, 10, 8, 4, Border::Clip).is_err());
+        assert!(disk_stats(&data, 10, 8, 3, Border::Clip).is_ok());
+        let e = check_radius("--radius", 9, 10, 8).unwrap_err();
+        assert!(e.to_string().contains("--radius must be in 1..=3"), "{e}");
+    }
+
+    #[test]
+    fn simd_dispatch_is_bit_identical_to_the_baseline_loop() {
+        let (r, ext, rows) = (5usize, 40 + 11, 3usize);
+        let n_in = rows + 2 * r;
+        let vals = noise_map(ext as u32, n_in as u32 * 2, 9, -0.5);
+        let pre: Vec<[f64; 2]> = vals.chunks(2).map(|p| [p[0] as f64 * 1e3, p[1] as f64]).collect();
+        let valid: Vec<bool> = (0..n_in).map(|k| k % 4 != 1).collect();
+        let hws = chord_half_widths(r as u32);
+        for oy in 0..rows {
+            let c = Chords { pre: &pre, valid: &valid, hws: &hws, ext, r, oy, x0: 0 };
+            let (mut a, mut b) = (vec![[0.0; 2]; 40], vec![[0.0; 2]; 40]);
+            accumulate(&c, &mut a);
+            accumulate_body(&c, &mut b);
+            assert!(a
+                .iter()
+                .zip(&b)
+                .all(|(x, y)| x[0].to_bits() == y[0].to_bits() && x[1].to_bits() == y[1].to_bits()));
+        }
+    }
+
+    #[test]
+    fn same_bytes_for_any_thread_count() {
+        let (w, h) = (70u32, 150u32);
+        let data = noise_map(w, h, 3, 0.5);
+        let a = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let b = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+        let sa = a.install(|| disk_stats(&data, w, h, 6, Border::Clip).unwrap());
+        let sb = b.install(|| disk_stats(&data, w, h, 6, Border::Clip).unwrap());
+        assert_eq!(sa, sb);
+    }
+}

@@ -1,0 +1,273 @@
+//! Hemoglobin appearance rig: approximate local histogram matching with Gaussian local statistics (thesis §7.4;
+//! Jimenez et al., "A practical appearance model for dynamic facial color", ACM TOG 29(6), SIGGRAPH Asia 2010).
+//!
+//! With disk statistics μ, σ of radius r (eq. 7.1, [`super::disk_stats`]):
+//!
+//! ```text
+//! H0 = Hn − μn                                   (eq. 7.4, mean-free base, full resolution)
+//! bias_0 = μn, scale_0 = 1; bias_i = μi, scale_i = σi / σn     (eq. 7.5)
+//! H = Σ wᵢ·bias_i + H0 · Σ wᵢ·scale_i, Σ wᵢ = 1   (eq. 7.6)
+//! ```
+//!
+//! Storage (thesis §7.6): scale_i and bias_i are low-frequency and are stored at `rig_width × rig_height`
+//! (default 256×256) after area-weighted downsampling ([`super::resample::resample_area`]); a renderer reads them
+//! back with bilinear filtering. So that `w_neutral = 1` reproduces Hn (the spec requires it), H0 is taken against
+//! the **stored** neutral bias as the renderer reconstructs it: `H0 = Hn − bilinear(bias_0 stored as f32)`. The
+//! CPU evaluator [`evaluate`] reads every map the same way (texel centres, clamp to edge), so
+//! `evaluate(w_neutral = 1) = bias_0 + (Hn − bias_0) = Hn` up to the f32 rounding of H0.
+//!
+//! σn can be 0 (flat regions): `scale_i = σi / max(σn, ε)` with a floor ε (`sigma_floor`, concentration units);
+//! the number of full-resolution texels with σn < ε is reported.
+//!
+//! Global states (thesis §7.7): extreme anger / fear scale the whole hemoglobin map (×1.27 / ×0.81); the
+//! evaluator takes that factor as `global_scale`.
+
+use super::disk_stats::{self, Border};
+use super::resample;
+use crate::error::InvalidInput;
+use rayon::prelude::*;
+
+/// Name of the neutral basis map (index 0) in weights and in the rig description.
+pub const NEUTRAL: &str = "neutral";
+
+/// Global hemoglobin scale factors reported in the thesis (§7.7, Fig. 7.1): anger ×1.27, fear ×0.81.
+pub const THESIS_GLOBAL_SCALES: [(&str, f64); 2] = [("anger", 1.27), ("fear", 0.81)];
+
+/// Settings of a rig bake.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigSettings {
+    /// Disk radius r in texels of the full-resolution maps (eq. 7.1).
+    pub radius_texels: u32,
+    pub border: Border,
+    /// Floor ε of σn in `scale_i = σi / max(σn, ε)` (concentration units).
+    pub sigma_floor: f64,
+    /// Requested storage size of scale/bias maps (thesis: 256); clamped per axis to the input size.
+    pub rig_size: u32,
+}
+
+impl Default for RigSettings {
+    fn default() -> Self {
+        Self { radius_texels: 32, border: Border::Clip, sigma_floor: 1e-4, rig_size: 256 }
+    }
+}
+
+/// One basis map of the rig at storage resolution (index 0 is the neutral map with scale = 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigMap {
+    pub name: String,
+    pub scale: Vec<f32>,
+    pub bias: Vec<f32>,
+}
+
+/// A baked rig.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HemoglobinRig {
+    pub width: u32,
+    pub height: u32,
+    pub rig_width: u32,
+    pub rig_height: u32,
+    pub settings: RigSettings,
+    /// Mean-free base H0 at full resolution (eq. 7.4, against the stored neutral bias).
+    pub h0: Vec<f32>,
+    /// `maps[0]` is the neutral map, then the targets in input order.
+    pub maps: Vec<RigMap>,
+    /// Full-resolution texels where σn < ε.
+    pub sigma_floored_texels: u64,
+}
+
+/// Checks a target name: `[a-z0-9_-]`, 1..=64 characters, not `neutral`.
+pub fn check_target_name(param: &str, name: &str) -> Result<(), InvalidInput> {
+    let ok = !name.is_empty()
+        && name.len() <= 64
+        && name.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_' || b == b'-');
+    if !ok {
+        return Err(InvalidInput::new(
+            param,
+            format!("target name must be 1..=64 characters of [a-z0-9_-], got '{name}'"),
+        ));
+    }
+    if name == NEUTRAL {
+        return Err(InvalidInput::new(param, "target name 'neutral' is reserved for the neutral map (--neutral)"));
+    }
+    Ok(())
+}
+
+/// Storage size for a `width × height` input and a requested `rig_size` (clamped per axis).
+pub fn rig_dims(width: u32, height: u32, rig_size: u32) -> (u32, u32) {
+    (rig_size.min(width), rig_size.min(height))
+}
+
+/// Validates the settings against the map size.
+pub fn check_settings(settings: &RigSettings, width: u32, height: u32) -> Result<(), InvalidInput> {
+    disk_stats::check_radius("--radius", settings.radius_texels, width, height)?;
+    if !(settings.sigma_floor.is_finite() && settings.sigma_floor > 0.0) {
+        return Err(InvalidInput::new(
+            "--sigma-floor",
+            format!("must be a finite number > 0 (concentration units), got {}", settings.sigma_floor),
+        ));
+    }
+    crate::error::check_range("--rig-size", settings.rig_size, 1, crate::error::MAX_TEXTURE_EDGE, "texels")?;
+    Ok(())
+}
+
+/// Builds the rig from the neutral map and named targets (single-channel, same size, finite).
+pub fn build_rig(
+    neutral: &[f32],
+    width: u32,
+    height: u32,
+    targets: &[(String, &[f32])],
+    settings: &RigSettings,
+) -> Result<HemoglobinRig, InvalidInput> {
+    build_rig_with_progress(neutral, width, height, targets, settings, &|_| {})
+}
+
+/// [`build_rig`] calling `progress(k)` after the k-th of `1 + targets.len()` maps has been analysed.
+pub fn build_rig_with_progress(
+    neutral: &[f32],
+    width: u32,
+    height: u32,
+    targets: &[(String, &[f32])],
+    settings: &RigSettings,
+    progress: &dyn Fn(usize),
+) -> Result<HemoglobinRig, InvalidInput> {
+    check_settings(settings, width, height)?;
+    let n = width as usize * height as usize;
+    if neutral.len() != n {
+        return Err(InvalidInput::new("--neutral", format!("expected {n} texels, got {}", neutral.len())));
+    }
+    for (i, (name, t)) in targets.iter().enumerate() {
+        check_target_name("--target", name)?;
+        if targets[..i].iter().any(|(o, _)| o == name) {
+            return Err(InvalidInput::new("--target", format!("target '{name}' is given twice")));
+        }
+        if t.len() != n {
+            return Err(InvalidInput::new(format!("--target {name}"), format!("expected {n} texels, got {}", t.len())));
+        }
+    }
+    let (rw, rh) = rig_dims(width, height, settings.rig_size);
+    let r = settings.radius_texels;
+    let eps = settings.sigma_floor;
+
+    let stats_n = disk_stats::disk_stats(neutral, width, height, r, settings.border)?;
+    let sigma_floored_texels = stats_n.sigma.par_iter().filter(|&&s| s < eps).count() as u64;
+    let sigma_n_floored: Vec<f64> = stats_n.sigma.par_iter().map(|&s| s.max(eps)).collect();
+
+    let down = |v: &[f64]| -> Vec<f32> {
+        resample::resample_area(v, width, height, 1, rw, rh).into_iter().map(|x| x as f32).collect()
+    };
+    // eq. 7.5, i = 0
+    let bias0 = down(&stats_n.mean);
+    drop(stats_n);
+    let mut maps = vec![RigMap { name: NEUTRAL.into(), scale: vec![1.0; (rw * rh) as usize], bias: bias0 }];
+    progress(1);
+
+    for (name, t) in targets {
+        let st = disk_stats::disk_stats(t, width, height, r, settings.border)?;
+        let scale_full: Vec<f64> = st.sigma.par_iter().zip(&sigma_n_floored).map(|(&si, &sn)| si / sn).collect(); // eq. 7.5
+        let bias = down(&st.mean); // eq. 7.5: bias_i = μi
+        drop(st);
+        let scale = down(&scale_full);
+        maps.push(RigMap { name: name.clone(), scale, bias });
+        progress(maps.len());
+    }
+
+    // eq. 7.4 against the stored neutral bias (see module docs).
+    let b0 = resample::upsample_bilinear(&maps[0].bias, rw, rh, width, height);
+    let h0: Vec<f32> = neutral.par_iter().zip(&b0).map(|(&hn, &b)| (hn as f64 - b) as f32).collect();
+    Ok(HemoglobinRig {
+        width,
+        height,
+        rig_width: rw,
+        rig_height: rh,
+        settings: settings.clone(),
+        h0,
+        maps,
+        sigma_floored_texels,
+    })
+}
+
+/// Turns `name=weight` pairs into one weight per rig map (in rig order; unnamed maps get 0). Weights must be
+/// finite and sum to 1 within 1e-6, unless `normalize` (then they are divided by their sum, which must not be 0).
+pub fn rig_weights(map_names: &[String], pairs: &[(String, f64)], normalize: bool) -> Result<Vec<f64>, InvalidInput> {
+    let mut w = vec![0.0f64; map_names.len()];
+    let mut seen = vec![false; map_names.len()];
+    for (name, v) in pairs {
+        let Some(i) = map_names.iter().position(|m| m == name) else {
+            return Err(InvalidInput::new(
+                "--weights",
+                format!("unknown target '{name}'; the rig has: {}", map_names.join(", ")),
+            ));
+        };
+        if seen[i] {
+            return Err(InvalidInput::new("--weights", format!("target '{name}' is given twice")));
+        }
+        if !v.is_finite() {
+            return Err(InvalidInput::new("--weights", format!("weight of '{name}' must be finite, got {v}")));
+        }
+        seen[i] = true;
+        w[i] = *v;
+    }
+    let sum: f64 = w.iter().sum();
+    if normalize {
+        if sum.abs() < 1e-12 {
+            return Err(InvalidInput::new("--weights", "cannot normalise weights that sum to 0"));
+        }
+        w.iter_mut().for_each(|x| *x /= sum);
+    } else if (sum - 1.0).abs() > 1e-6 {
+        return Err(InvalidInput::new(
+            "--weights",
+            format!("must sum to 1 (eq. 7.6), got {sum}; pass --normalize-weights to divide by the sum"),
+        ));
+    }
+    Ok(w)
+}
+
+/// Evaluates eq. 7.6 at full resolution: `H = g·(Σ wᵢ·bias_i + H0·Σ wᵢ·scale_i)` with stored maps read
+/// bilinearly. `weights` has one entry per `rig.maps` (see [`rig_weights`]); `global_scale` g is 1 for none.
+pub fn evaluate(rig: &HemoglobinRig, weights: &[f64], global_scale: f64) -> Vec<f32> {
+    assert_eq!(weights.len(), rig.maps.len(), "one weight per rig map");
+    let (w, h, rw, rh) = (rig.width as usize, rig.height as usize, rig.rig_width as usize, rig.rig_height as usize);
+    // Blend the stored maps first (bilinear filtering is linear, so this equals blending the samples).
+    let mut bias = vec![0.0f64; rw * rh];
+    let mut scale = vec![0.0f64; rw * rh];
+    for (m, &wi) in rig.maps.iter().zip(weights) {
+        if wi == 0.0 {
+            continue;
+        }
+        for k in 0..rw * rh {
+            bias[k] += wi * m.bias[k] as f64;
+            scale[k] += wi * m.scale[k] as f64;
+        }
+    }
+    let ax = resample::bilinear_axis(w, rw);
+    let ay = resample::bilinear_axis(h, rh);
+    let lerp = |map: &[f64], cx: (usize, usize, f64), cy: (usize, usize, f64)| {
+        let a = map[cy.0 * rw + cx.0];
+        let b = map[cy.0 * rw + cx.1];
+        let c = map[cy.1 * rw + cx.0];
+        let d = map[cy.1 * rw + cx.1];
+        let top = a + (b - a) * cx.2;
+        let bot = c + (d - c) * cx.2;
+        top + (bot - top) * cy.2
+    };
+    let single = weights.iter().filter(|&&x| x != 0.0).count() == 1;
+    let mut out = vec![0.0f32; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let (b, s) = if single {
+                // One map with weight wi: read the stored f32 maps directly (bit-identical to the H0 reference).
+                let i = weights.iter().position(|&x| x != 0.0).unwrap();
+                let m = &rig.maps[i];
+                (
+                    weights[i] * resample::bilinear_at(&m.bias, rw, ax[x], ay[y]),
+                    weights[i] * resample::bilinear_at(&m.scale, rw, ax[x], ay[y]),
+                )
+            } else {
+                (lerp(&bias, ax[x], ay[y]), lerp(&scale, ax[x], ay[y]))
+            };
+            let v = b + rig.h0[y * w + x] as f64 * s; // eq. 7.6
+            *o = (global_scale * v) as f32;
+        }
+    });
+    out
+}
