@@ -147,6 +147,145 @@ impl Slab {
     }
 }
 
+/// Image pairs summed explicitly by [`Series::Exact`] in real space before the Euler–Maclaurin tail takes over.
+pub const EXACT_EXPLICIT_PAIRS: u32 = 64;
+
+/// One image source, ×4π/α′: f(z) = z (1 + σρ) e^(−σρ)/ρ³ with ρ = sqrt(r² + z²) (odd in z).
+#[inline]
+fn image(z: f64, r2: f64, sigma: f64) -> f64 {
+    let rho = (r2 + z * z).sqrt();
+    z * (1.0 + sigma * rho) * (-sigma * rho).exp() / (rho * rho * rho)
+}
+
+/// e^(−σρ)/ρ = ∫_z^∞ f(z′) dz′ (for z > 0).
+#[inline]
+fn image_tail_integral(z: f64, r2: f64, sigma: f64) -> f64 {
+    let rho = (r2 + z * z).sqrt();
+    (-sigma * rho).exp() / rho
+}
+
+/// ∂f/∂z = e^(−σρ)/ρ³ · [(1 + σρ) − z²(3 + 3σρ + σ²ρ²)/ρ²].
+#[inline]
+fn image_dz(z: f64, r2: f64, sigma: f64) -> f64 {
+    let rho2 = r2 + z * z;
+    let rho = rho2.sqrt();
+    let sr = sigma * rho;
+    (-sr).exp() / (rho2 * rho) * ((1.0 + sr) - z * z * (3.0 + 3.0 * sr + sr * sr) / rho2)
+}
+
+/// Real-space sums. The i-th and (−i)-th image pairs are grouped (f is odd) into
+/// P(j) = Σ_m c_m f(2jL + o_m), j ≥ 1, with four (c_m, o_m); i = 0 is the plain dipole.
+///
+/// [`Series::Exact`] sums j = 1, 2, … until the bound 4(1 + σz)e^(−σz)/z² (z = 2jL − max|o|) on every
+/// remaining term, summed as a geometric series, is below 1e−17 of the magnitude of the sum so far. When σtr·L is
+/// small the terms decay only algebraically (P(j) ~ j^−3 at σa = 0; stopping after N pairs would leave an error
+/// ~N^−2, and the totals of any truncated sum stay at α′ instead of reaching R + T = 1). So after
+/// [`EXACT_EXPLICIT_PAIRS`] pairs the rest Σ_{j>J} P(j) is added by the Euler–Maclaurin midpoint formula
+/// ∫_{J+½}^∞ P(t) dt − P′(J + ½)/24, where ∫ f dz = −e^(−σρ)/ρ is analytic. P varies on the scale ρ/(2L) ≥ J in j,
+/// so the first neglected term, 7·P‴/5760, is ~1e−12 of R(0) for the slabs of the tests (checked against long
+/// truncated sums and against ∫2πr R dr = R̂(0) at σa = 0).
+fn image_series(
+    r_mm: f64,
+    sigma: f64,
+    big_l: f64,
+    dipole: f64,
+    terms: [(f64, f64); 4],
+    series: Series,
+) -> f64 {
+    let r2 = r_mm * r_mm;
+    let pair = |j: f64| -> f64 { terms.iter().map(|&(c, o)| c * image(2.0 * j * big_l + o, r2, sigma)).sum() };
+    let mut sum = dipole;
+    match series {
+        Series::Truncated { pairs } => {
+            for j in 1..=pairs {
+                sum += pair(j as f64);
+            }
+        }
+        Series::Exact => {
+            let o_max = terms.iter().map(|t| t.1.abs()).fold(0.0, f64::max);
+            let ratio = -(-2.0 * big_l * sigma).exp_m1(); // 1 − e^(−2Lσ)
+            let mut scale = dipole.abs();
+            let mut j = 1u32;
+            loop {
+                let p = pair(j as f64);
+                sum += p;
+                scale += p.abs();
+                let z = 2.0 * (j + 1) as f64 * big_l - o_max;
+                let bound = 4.0 * (1.0 + sigma * z) * (-sigma * z).exp() / (z * z);
+                if ratio > 0.0 && bound < 1e-17 * scale * ratio {
+                    break;
+                }
+                if j >= EXACT_EXPLICIT_PAIRS {
+                    // Euler–Maclaurin tail Σ_{j>J} P(j) ≈ ∫_{J+½}^∞ P dt − P′(J+½)/24.
+                    let t0 = j as f64 + 0.5;
+                    let mut tail = 0.0;
+                    for &(c, o) in &terms {
+                        let z0 = 2.0 * t0 * big_l + o;
+                        tail += c
+                            * (image_tail_integral(z0, r2, sigma) / (2.0 * big_l)
+                                - 2.0 * big_l * image_dz(z0, r2, sigma) / 24.0);
+                    }
+                    sum += tail;
+                    break;
+                }
+                j += 1;
+            }
+        }
+    }
+    sum
+}
+
+impl Slab {
+    /// Diffuse reflectance R(r) of the lit (top) face, mm⁻² (DJ05 eq. 12 / `specs/diffusion.md`).
+    pub fn reflectance_mm2(&self, r_mm: f64, series: Series) -> f64 {
+        let (l, zb0, _, big_l) = self.geometry_mm();
+        let sigma = self.sigma_tr();
+        let r2 = r_mm * r_mm;
+        let (a, b) = (l, l + 2.0 * zb0);
+        // i = 0: zr = l, zv = −l − 2zb0 → f(a) − f(−b) = f(a) + f(b).
+        let dipole = image(a, r2, sigma) + image(b, r2, sigma);
+        // j ≥ 1 with −j: f(2jL + a) − f(2jL − b) − f(2jL − a) + f(2jL + b).
+        let terms = [(1.0, a), (1.0, b), (-1.0, -a), (-1.0, -b)];
+        self.albedo_prime() / (4.0 * std::f64::consts::PI) * image_series(r_mm, sigma, big_l, dipole, terms, series)
+    }
+
+    /// Diffuse transmittance T(r) through the bottom face, mm⁻² (DJ05 eq. 13 / `specs/diffusion.md`).
+    pub fn transmittance_mm2(&self, r_mm: f64, series: Series) -> f64 {
+        let (l, zb0, _, big_l) = self.geometry_mm();
+        let sigma = self.sigma_tr();
+        let r2 = r_mm * r_mm;
+        let d = self.thickness_mm;
+        let (ar, av) = (d - l, d + l + 2.0 * zb0);
+        // i = 0: f(d − zr) − f(d − zv) = f(ar) − f(av).
+        let dipole = image(ar, r2, sigma) - image(av, r2, sigma);
+        // j ≥ 1 with −j: f(2jL + ar) − f(2jL + av) − f(2jL − ar) + f(2jL − av).
+        let terms = [(1.0, ar), (-1.0, av), (-1.0, -ar), (1.0, -av)];
+        self.albedo_prime() / (4.0 * std::f64::consts::PI) * image_series(r_mm, sigma, big_l, dipole, terms, series)
+    }
+}
+
+/// Three channels of a slab with the series choice: a [`RadialProfile`](super::RadialProfile) with transmittance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlabRgb {
+    pub channels: [Slab; 3],
+    pub series: Series,
+}
+
+impl super::RadialProfile for SlabRgb {
+    fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.channels[c].reflectance_mm2(r_mm, self.series))
+    }
+    fn total_reflectance(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.channels[c].totals(self.series).0)
+    }
+    fn transmittance_mm2(&self, r_mm: f64) -> Option<[f64; 3]> {
+        Some([0, 1, 2].map(|c| self.channels[c].transmittance_mm2(r_mm, self.series)))
+    }
+    fn total_transmittance(&self) -> Option<[f64; 3]> {
+        Some([0, 1, 2].map(|c| self.channels[c].totals(self.series).1))
+    }
+}
+
 /// Validates a slab and returns it, naming the layer in errors (`layers[i].field`).
 pub fn slab_for_layer(
     index: usize,
