@@ -147,8 +147,10 @@ impl Slab {
     }
 }
 
-/// Image pairs summed explicitly by [`Series::Exact`] in real space before the Euler–Maclaurin tail takes over.
-pub const EXACT_EXPLICIT_PAIRS: u32 = 64;
+/// Most image pairs [`Series::Exact`] sums explicitly while they decay geometrically (σtr·L ≥ 40/4096 ≈ 0.01).
+pub const EXACT_MAX_PAIRS: u32 = 2048;
+/// Pairs summed explicitly before the Euler–Maclaurin tail when the decay is (nearly) algebraic.
+pub const EXACT_EM_PAIRS: u32 = 256;
 
 /// One image source, ×4π/α′: f(z) = z (1 + σρ) e^(−σρ)/ρ³ with ρ = sqrt(r² + z²) (odd in z).
 #[inline]
@@ -177,13 +179,15 @@ fn image_dz(z: f64, r2: f64, sigma: f64) -> f64 {
 /// P(j) = Σ_m c_m f(2jL + o_m), j ≥ 1, with four (c_m, o_m); i = 0 is the plain dipole.
 ///
 /// [`Series::Exact`] sums j = 1, 2, … until the bound 4(1 + σz)e^(−σz)/z² (z = 2jL − max|o|) on every
-/// remaining term, summed as a geometric series, is below 1e−17 of the magnitude of the sum so far. When σtr·L is
-/// small the terms decay only algebraically (P(j) ~ j^−3 at σa = 0; stopping after N pairs would leave an error
-/// ~N^−2, and the totals of any truncated sum stay at α′ instead of reaching R + T = 1). So after
-/// [`EXACT_EXPLICIT_PAIRS`] pairs the rest Σ_{j>J} P(j) is added by the Euler–Maclaurin midpoint formula
-/// ∫_{J+½}^∞ P(t) dt − P′(J + ½)/24, where ∫ f dz = −e^(−σρ)/ρ is analytic. P varies on the scale ρ/(2L) ≥ J in j,
-/// so the first neglected term, 7·P‴/5760, is ~1e−12 of R(0) for the slabs of the tests (checked against long
-/// truncated sums and against ∫2πr R dr = R̂(0) at σa = 0).
+/// remaining term, summed as a geometric series, is below 1e−17 of the magnitude of the sum so far; that takes
+/// about 20/(σtr L) pairs. When σtr L < 40/(2·[`EXACT_MAX_PAIRS`]) — σa → 0 — the terms decay only algebraically
+/// (P(j) ~ j^−3 at σa = 0: stopping after N pairs would leave an error ~N^−2 of the series, and the totals of any
+/// truncated sum stay at α′ instead of reaching R + T = 1). Then [`EXACT_EM_PAIRS`] pairs are summed and the rest
+/// Σ_{j>J} P(j) is added by the Euler–Maclaurin midpoint formula ∫_{J+½}^∞ P(t) dt + P′(J + ½)/24, where
+/// ∫ f dz = −e^(−σρ)/ρ is analytic. P varies in j on the scale min(ρ/(2L), 1/(2Lσ)) ≥ J, so the first neglected
+/// term, −7 P‴/5760, is ~1e−14 of R(0) (tests: long truncated sums at σa = 1e−7 and mpmath at σa = 0 agree
+/// to ~1e−14 of R(0); ∫2πr R dr = R̂(0) at σa = 0). Relative accuracy is lost only where R(r) itself is below
+/// ~1e−14 R(0) (σa = 0, r ≫ L: the image sum cancels to e^(−πr/L)).
 fn image_series(
     r_mm: f64,
     sigma: f64,
@@ -203,27 +207,30 @@ fn image_series(
         }
         Series::Exact => {
             let o_max = terms.iter().map(|t| t.1.abs()).fold(0.0, f64::max);
-            let ratio = -(-2.0 * big_l * sigma).exp_m1(); // 1 − e^(−2Lσ)
+            let two_l_sigma = 2.0 * big_l * sigma;
+            let geometric = two_l_sigma * EXACT_MAX_PAIRS as f64 >= 40.0;
+            let ratio = -(-two_l_sigma).exp_m1(); // 1 − e^(−2Lσ)
             let mut scale = dipole.abs();
             let mut j = 1u32;
             loop {
                 let p = pair(j as f64);
                 sum += p;
                 scale += p.abs();
-                let z = 2.0 * (j + 1) as f64 * big_l - o_max;
-                let bound = 4.0 * (1.0 + sigma * z) * (-sigma * z).exp() / (z * z);
-                if ratio > 0.0 && bound < 1e-17 * scale * ratio {
-                    break;
-                }
-                if j >= EXACT_EXPLICIT_PAIRS {
-                    // Euler–Maclaurin tail Σ_{j>J} P(j) ≈ ∫_{J+½}^∞ P dt − P′(J+½)/24.
+                if geometric {
+                    let z = 2.0 * (j + 1) as f64 * big_l - o_max;
+                    let bound = 4.0 * (1.0 + sigma * z) * (-sigma * z).exp() / (z * z);
+                    if bound < 1e-17 * scale * ratio || j >= EXACT_MAX_PAIRS {
+                        break;
+                    }
+                } else if j >= EXACT_EM_PAIRS {
+                    // Euler–Maclaurin (midpoint) tail Σ_{j>J} P(j) ≈ ∫_{J+½}^∞ P dt + P′(J+½)/24.
                     let t0 = j as f64 + 0.5;
                     let mut tail = 0.0;
                     for &(c, o) in &terms {
                         let z0 = 2.0 * t0 * big_l + o;
                         tail += c
                             * (image_tail_integral(z0, r2, sigma) / (2.0 * big_l)
-                                - 2.0 * big_l * image_dz(z0, r2, sigma) / 24.0);
+                                + 2.0 * big_l * image_dz(z0, r2, sigma) / 24.0);
                     }
                     sum += tail;
                     break;
