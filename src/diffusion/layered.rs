@@ -316,4 +316,8 @@ impl RadialProfile for LayeredProfile {
     fn transmittance_many(&self, radii_mm: &[f64]) -> Option<Vec<[f64; 3]>> {
         Some(radii_mm.par_iter().map(|&r| self.rt_mm2(r).1).collect())
     }
+    fn profile_many(&self, radii_mm: &[f64]) -> (Vec<[f64; 3]>, Option<Vec<[f64; 3]>>) {
+        let rt: Vec<([f64; 3], [f64; 3])> = radii_mm.par_iter().map(|&r| self.rt_mm2(r)).collect();
+        (rt.iter().map(|x| x.0).collect(), Some(rt.iter().map(|x| x.1).collect()))
+    }
 }

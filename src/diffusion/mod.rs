@@ -40,6 +40,10 @@ pub trait RadialProfile: Sync {
     fn transmittance_many(&self, radii_mm: &[f64]) -> Option<Vec<[f64; 3]>> {
         radii_mm.iter().map(|&r| self.transmittance_mm2(r)).collect()
     }
+    /// R and (where defined) T at many radii in one pass.
+    fn profile_many(&self, radii_mm: &[f64]) -> (Vec<[f64; 3]>, Option<Vec<[f64; 3]>>) {
+        (self.reflectance_many(radii_mm), self.transmittance_many(radii_mm))
+    }
 }
 
 /// Which polynomial approximates the average diffuse Fresnel reflectance Fdr(η).

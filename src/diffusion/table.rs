@@ -59,10 +59,11 @@ impl ProfileTable {
     /// Evaluates `profile` at `radii_mm` (checked with [`check_radii`], errors name `radii`).
     pub fn compute(profile: &dyn RadialProfile, radii_mm: &[f64], provenance: Value) -> Result<Self, InvalidInput> {
         check_radii("radii", radii_mm)?;
+        let (reflectance_mm2, transmittance_mm2) = profile.profile_many(radii_mm);
         Ok(Self {
             r_mm: radii_mm.to_vec(),
-            reflectance_mm2: profile.reflectance_many(radii_mm),
-            transmittance_mm2: profile.transmittance_many(radii_mm),
+            reflectance_mm2,
+            transmittance_mm2,
             total_reflectance: profile.total_reflectance(),
             total_transmittance: profile.total_transmittance(),
             provenance,
