@@ -66,8 +66,15 @@ fn single_layer_stack_equals_the_multipole() {
     let stack = LayerStack::new(1.0, 1.3, vec![layer(1.5, 1.4, [0.02, 0.1, 0.4], [1.0, 2.0, 3.0])]).unwrap();
     let p = LayeredProfile::new(&stack, Adding::Symmetric, Series::Exact, FdrForm::Dj05).unwrap();
     for c in 0..3 {
-        let s = Slab::new(stack.layers()[0].sigma_a[c], stack.layers()[0].sigma_s_prime[c], 1.5, 1.4, 1.4 / 1.3, FdrForm::Dj05)
-            .unwrap();
+        let s = Slab::new(
+            stack.layers()[0].sigma_a[c],
+            stack.layers()[0].sigma_s_prime[c],
+            1.5,
+            1.4,
+            1.4 / 1.3,
+            FdrForm::Dj05,
+        )
+        .unwrap();
         let (rt, tt) = s.totals(Series::Exact);
         assert_eq!(p.total_reflectance()[c], rt);
         assert_eq!(p.total_transmittance().unwrap()[c], tt);

@@ -21,7 +21,13 @@ fn dipole_closed_form_total_equals_numerical_integral_for_every_material() {
             let numeric = radial_total(|r| p.reflectance_mm2(r), 1e-7, r_max, 300);
             let closed = p.total_reflectance();
             for c in 0..3 {
-                assert!(rel(numeric[c], closed[c]) < 1e-9, "{} {form:?} ch{c}: {} vs {}", m.name, numeric[c], closed[c]);
+                assert!(
+                    rel(numeric[c], closed[c]) < 1e-9,
+                    "{} {form:?} ch{c}: {} vs {}",
+                    m.name,
+                    numeric[c],
+                    closed[c]
+                );
             }
         }
     }
@@ -68,7 +74,12 @@ fn multipole_totals_equal_numerical_integrals_of_real_space_profiles() {
         let (rt, tt) = s.totals(Series::Exact);
         let (_, _, _, big_l) = s.geometry_mm();
         let r_max = 60.0 * big_l + if s.sigma_tr() > 0.0 { 40.0 / s.sigma_tr() } else { 0.0 };
-        let num = radial_total(|r| [s.reflectance_mm2(r, Series::Exact), s.transmittance_mm2(r, Series::Exact)], 1e-7, r_max, 300);
+        let num = radial_total(
+            |r| [s.reflectance_mm2(r, Series::Exact), s.transmittance_mm2(r, Series::Exact)],
+            1e-7,
+            r_max,
+            300,
+        );
         assert!(rel(num[0], rt) < 1e-9, "{s:?}: ∫R = {} vs R̂(0) = {rt}", num[0]);
         assert!(rel(num[1], tt) < 1e-9, "{s:?}: ∫T = {} vs T̂(0) = {tt}", num[1]);
     }

@@ -104,8 +104,12 @@ impl LayerStack {
 
     /// Parses and validates a layer-stack JSON document.
     pub fn from_json_str(text: &str) -> Result<Self, InvalidInput> {
-        let raw: RawStack = serde_json::from_str(text)
-            .map_err(|e| InvalidInput::new("layers", format!("file is not a valid layer stack (malformed JSON or missing/unknown field): {e}")))?;
+        let raw: RawStack = serde_json::from_str(text).map_err(|e| {
+            InvalidInput::new(
+                "layers",
+                format!("file is not a valid layer stack (malformed JSON or missing/unknown field): {e}"),
+            )
+        })?;
         Self::new(raw.eta_above, raw.eta_below, raw.layers)
     }
 
@@ -129,7 +133,10 @@ impl LayerStack {
         crate::error::check_positive("eta_above", self.eta_above, "refractive index")?;
         crate::error::check_positive("eta_below", self.eta_below, "refractive index")?;
         if self.layers.is_empty() {
-            return Err(InvalidInput::new("layers", "must list at least one layer (top layer first), got an empty list"));
+            return Err(InvalidInput::new(
+                "layers",
+                "must list at least one layer (top layer first), got an empty list",
+            ));
         }
         let n = self.layers.len();
         let mut out = Vec::with_capacity(n);
@@ -144,6 +151,8 @@ impl LayerStack {
                     "mm^-1",
                 )?;
             }
+        }
+        for (j, layer) in self.layers.iter().enumerate() {
             let n_above = if j == 0 { self.eta_above } else { self.layers[j - 1].eta };
             let n_below = if j + 1 == n { self.eta_below } else { self.layers[j + 1].eta };
             let mut slabs = Vec::with_capacity(3);
@@ -231,7 +240,11 @@ impl LayeredProfile {
         let mut sigma_min = f64::INFINITY;
         for ch in &slabs {
             let l1 = 1.0 / ch[0].sigma_t_prime();
-            let rem = if ch.len() > 1 { 2.0 * (ch[0].thickness_mm - l1) + 1.0 / ch[1].sigma_t_prime() } else { f64::INFINITY };
+            let rem = if ch.len() > 1 {
+                2.0 * (ch[0].thickness_mm - l1) + 1.0 / ch[1].sigma_t_prime()
+            } else {
+                f64::INFINITY
+            };
             beta = beta.min(rem).min(total_d - l1);
             for s in ch {
                 let st = s.sigma_tr();

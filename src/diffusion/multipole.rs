@@ -188,14 +188,7 @@ fn image_dz(z: f64, r2: f64, sigma: f64) -> f64 {
 /// term, −7 P‴/5760, is ~1e−14 of R(0) (tests: long truncated sums at σa = 1e−7 and mpmath at σa = 0 agree
 /// to ~1e−14 of R(0); ∫2πr R dr = R̂(0) at σa = 0). Relative accuracy is lost only where R(r) itself is below
 /// ~1e−14 R(0) (σa = 0, r ≫ L: the image sum cancels to e^(−πr/L)).
-fn image_series(
-    r_mm: f64,
-    sigma: f64,
-    big_l: f64,
-    dipole: f64,
-    terms: [(f64, f64); 4],
-    series: Series,
-) -> f64 {
+fn image_series(r_mm: f64, sigma: f64, big_l: f64, dipole: f64, terms: [(f64, f64); 4], series: Series) -> f64 {
     let r2 = r_mm * r_mm;
     let pair = |j: f64| -> f64 { terms.iter().map(|&(c, o)| c * image(2.0 * j * big_l + o, r2, sigma)).sum() };
     let mut sum = dipole;

@@ -79,9 +79,8 @@ impl ProfileSource {
                     }
                 }
             }
-            ProfileSource::Preset(name) => sum_of_gaussians::preset(name)
-                .map(|p| Box::new(p) as Box<dyn RadialProfile + Send>)
-                .ok_or_else(|| {
+            ProfileSource::Preset(name) => {
+                sum_of_gaussians::preset(name).map(|p| Box::new(p) as Box<dyn RadialProfile + Send>).ok_or_else(|| {
                     InvalidInput::new(
                         "profile_preset",
                         format!(
@@ -89,7 +88,8 @@ impl ProfileSource {
                             sum_of_gaussians::PRESET_NAMES.join(", ")
                         ),
                     )
-                }),
+                })
+            }
             ProfileSource::Layers { stack, adding, series, fdr } => {
                 Ok(Box::new(LayeredProfile::new(stack, *adding, *series, *fdr)?))
             }

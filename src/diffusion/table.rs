@@ -29,12 +29,12 @@ pub fn check_radii(param: &str, radii_mm: &[f64]) -> Result<(), InvalidInput> {
     }
     for (i, &r) in radii_mm.iter().enumerate() {
         if !(r.is_finite() && r >= 0.0) {
-            return Err(InvalidInput::new(param, format!("radii must be finite and >= 0 mm, got {r} at position {i}")));
+            return Err(InvalidInput::new(param, format!("must be finite and >= 0 mm, got {r} at position {i}")));
         }
         if i > 0 && r < radii_mm[i - 1] {
             return Err(InvalidInput::new(
                 param,
-                format!("radii must be sorted ascending, got {} before {r} at position {i}", radii_mm[i - 1]),
+                format!("must be sorted ascending, got {} before {r} at position {i}", radii_mm[i - 1]),
             ));
         }
     }
