@@ -178,6 +178,7 @@ fn non_absorbing_slab_profile_matches_high_precision_image_sum() {
     // σa = 0, σs′ = 1.5 mm⁻¹, d = 1 mm, η = 1.4 both faces: R(r) from the full image series summed with mpmath
     // (30 digits, `nsum` with its convergence acceleration).
     let s = slab(0.0, 1.5, 1.0, 1.4, 1.4);
+    #[allow(clippy::excessive_precision)]
     let reference = [
         (0.0, 0.180_423_308_549_500_39),
         (0.5, 0.092_963_009_391_612_49),

@@ -118,6 +118,7 @@ mod tests {
     use super::*;
 
     /// Reference values from mpmath (30 digits), rounded to 20.
+    #[allow(clippy::excessive_precision)]
     const REF: [(f64, f64); 12] = [
         (0.0, 1.0),
         (0.5, 0.938_469_807_240_812_904_23),
