@@ -12,9 +12,10 @@
 //!   R12↑ = R2↑ + T2↑ R1↑ T2↓/(1 − R1↑ R2↓), T12↑ = T2↑ T1↑/(1 − R1↑ R2↓).
 //!
 //! Back to real space, R(r) = (1/2π) ∫₀^∞ R̂(k) J0(kr) k dk. R̂ itself decays only like e^(−l₁k) (the top
-//! layer's source depth), so R(r) = R1↓(r) + G(r): the top layer's reflectance in real space (exact image series,
-//! [`Slab::reflectance_mm2`]) plus the inverse transform G of the smooth remainder R̂stack − R̂1↓
-//! = T1↓ R̂rest T1↑/(1 − …), which decays like e^(−(2(d₁ − l₁) + l₂)k) ([`super::hankel`]).
+//! layer's source depth), so R(r) = R1↓(r) + G(r): the top layer's reflectance in real space (its dipole and first
+//! image pairs, [`Slab::reflectance_mm2`]) plus the inverse transform G of the smooth remainder R̂stack − R̂1↓
+//! = T1↓ R̂rest T1↑/(1 − …), which decays like e^(−(2(d₁ − l₁) + l₂)k), plus the closed-form Hankel transform of
+//! the top layer's remaining images ([`Slab::hankel_tail`], decaying at least as fast) ([`super::hankel`]).
 //! T̂stack has no singular part to split off: every image source lies at least D − l₁ (D = total thickness) from
 //! the exit face, so T̂stack decays like e^(−(D − l₁)k) and is transformed directly.
 //! Measured accuracy (tests): ∫2πr R dr = R̂(0) and ∫2πr T dr = T̂(0) to better than 1e−8 relative; a one-layer
@@ -217,7 +218,9 @@ pub struct LayeredProfile {
     fdr_form: FdrForm,
     /// [channel][layer]
     slabs: [Vec<Slab>; 3],
-    /// Channels 0..3: remainder R̂stack − R̂1↓; 3..6: T̂stack.
+    /// Image pairs of the top layer summed in real space, per channel.
+    top_pairs: [u32; 3],
+    /// Channels 0..3: remainder R̂stack − R̂1↓ (+ the top layer's image tail); 3..6: T̂stack.
     inverse: InverseHankel<6>,
     total_r: [f64; 3],
     total_t: [f64; 3],
@@ -254,13 +257,28 @@ impl LayeredProfile {
             }
         }
         let sigma_min = if sigma_min.is_finite() { sigma_min } else { 0.0 };
+        // With the exact series, the top layer's real-space part is its dipole plus the first `top_pairs[c]` image
+        // pairs; the rest of its series (closed form, `Slab::hankel_tail`) joins the smooth remainder. Its decay
+        // rate 2(J+1)L − b is kept ≥ β so it does not slow the spectrum down (J = 1 in practice).
+        let top_pairs: [u32; 3] = [0, 1, 2].map(|c| match series {
+            Series::Truncated { pairs } => pairs,
+            Series::Exact => {
+                let (l, zb0, _, big_l) = slabs[c][0].geometry_mm();
+                let b = l + 2.0 * zb0;
+                (1..64u32).find(|&j| 2.0 * (j + 1) as f64 * big_l - b >= beta).unwrap_or(64)
+            }
+        });
         let spectrum_slabs = slabs.clone();
         let inverse = InverseHankel::new(
             Box::new(move |k| {
                 let mut v = [0.0; 6];
                 for c in 0..3 {
                     let (_, rem, t) = stack_hankel(&spectrum_slabs[c], k, adding, series);
-                    v[c] = rem;
+                    let tail = match series {
+                        Series::Exact => spectrum_slabs[c][0].hankel_tail(k, top_pairs[c]).0,
+                        Series::Truncated { .. } => 0.0,
+                    };
+                    v[c] = rem + tail;
                     v[3 + c] = t;
                 }
                 v
@@ -268,7 +286,7 @@ impl LayeredProfile {
             beta,
             sigma_min,
         );
-        Ok(Self { stack: stack.clone(), adding, series, fdr_form, slabs, inverse, total_r, total_t })
+        Ok(Self { stack: stack.clone(), adding, series, fdr_form, slabs, top_pairs, inverse, total_r, total_t })
     }
 
     pub fn stack(&self) -> &LayerStack {
@@ -299,7 +317,8 @@ impl LayeredProfile {
     /// (R(r), T(r)) per channel, mm⁻².
     pub fn rt_mm2(&self, r_mm: f64) -> ([f64; 3], [f64; 3]) {
         let g = self.inverse.eval(r_mm);
-        let r = [0, 1, 2].map(|c| self.slabs[c][0].reflectance_mm2(r_mm, self.series) + g[c]);
+        let r = [0, 1, 2]
+            .map(|c| self.slabs[c][0].reflectance_mm2(r_mm, Series::Truncated { pairs: self.top_pairs[c] }) + g[c]);
         let t = [0, 1, 2].map(|c| g[3 + c]);
         (r, t)
     }

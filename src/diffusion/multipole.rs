@@ -99,6 +99,27 @@ impl Slab {
         }
     }
 
+    /// Hankel transforms of the image pairs beyond `pairs` (|i| > pairs) of the infinite series, so that
+    /// `hankel_rt(k, Exact) = hankel_rt(k, Truncated { pairs }) + hankel_tail(k, pairs)`. With q = e^(−2Ls), J = pairs:
+    /// R̂tail = −α′ [sinh(as) + sinh(bs)] q^(J+1)/(1 − q), T̂tail = α′ [sinh(av s) − sinh(ar s)] q^(J+1)/(1 − q)
+    /// (a = l, b = l + 2zb0, ar = d − l, av = d + l + 2zb0), evaluated without overflow.
+    pub fn hankel_tail(&self, k_per_mm: f64, pairs: u32) -> (f64, f64) {
+        let s = (self.sigma_tr().powi(2) + k_per_mm * k_per_mm).sqrt();
+        let (l, zb0, _, big_l) = self.geometry_mm();
+        let d = self.thickness_mm;
+        let (a, b, ar, av) = (l, l + 2.0 * zb0, d - l, d + l + 2.0 * zb0);
+        let h = 0.5 * self.albedo_prime();
+        let one_minus_q = -(-2.0 * big_l * s).exp_m1();
+        if one_minus_q == 0.0 {
+            // s = 0: 2 sinh(xs) q^(J+1)/(1 − q) → x/L.
+            return (-h * (a + b) / big_l, h * (av - ar) / big_l);
+        }
+        let z = 2.0 * (pairs as f64 + 1.0) * big_l;
+        // 2 sinh(xs) q^(J+1) = e^(−(z − x)s) − e^(−(z + x)s), 0 ≤ x < z.
+        let e2 = |x: f64| (-(z - x) * s).exp() - (-(z + x) * s).exp();
+        ((-h * (e2(a) + e2(b))) / one_minus_q, h * (e2(av) - e2(ar)) / one_minus_q)
+    }
+
     /// Total diffuse reflectance and transmittance (R̂(0), T̂(0)).
     pub fn totals(&self, series: Series) -> (f64, f64) {
         self.hankel_rt(0.0, series)
@@ -326,6 +347,23 @@ mod tests {
         let (l, zb0, _, big_l) = slab.geometry_mm();
         assert!((r + t - 1.0).abs() < 1e-12, "R+T = {}", r + t);
         assert!((t - (l + zb0) / big_l).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tail_completes_truncated_sums() {
+        for slab in
+            [skinlike(0.8, 0.02), skinlike(2.0, 0.0), Slab::new(0.3, 2.0, 0.9, 1.3, 0.9, FdrForm::Dj05).unwrap()]
+        {
+            for k in [0.0, 0.3, 2.0, 10.0] {
+                for pairs in [0, 1, 3] {
+                    let (re, te) = slab.hankel_rt(k, Series::Exact);
+                    let (rt, tt) = slab.hankel_rt(k, Series::Truncated { pairs });
+                    let (ra, ta) = slab.hankel_tail(k, pairs);
+                    assert!((rt + ra - re).abs() < 1e-14, "k={k} J={pairs}: R {} vs {re}", rt + ra);
+                    assert!((tt + ta - te).abs() < 1e-14, "k={k} J={pairs}: T {} vs {te}", tt + ta);
+                }
+            }
+        }
     }
 
     #[test]
