@@ -5,33 +5,35 @@
 //! for spectra F that are smooth for k > 0 and decay exponentially, like the layered remainders of
 //! [`super::layered`] (DJ05 evaluated this with a zero-padded 2-D FFT; we integrate in k instead).
 //!
-//! Method: composite 32-point Gauss–Legendre panels in k. Panels are geometrically graded towards k = 0 (halving
-//! down to a quarter of the smallest σtr, where s = sqrt(σtr² + k²) has its branch points ±iσtr) and of equal
-//! width w above, up to k_max. The panel width must resolve the oscillation of J0(kr): a 32-point rule integrates
-//! a polynomial of degree 63, i.e. cos over a phase of 60 rad, to ~1e−14 relative, so radius r uses the first of
-//! the dyadic levels w_ℓ = w₀/2^ℓ with w_ℓ r ≤ 60. w₀ = 8/β for a spectrum decaying like e^(−βk) (at most 16 mm⁻¹).
+//! Method: composite Gauss–Legendre panels in k. Panels are geometrically graded towards k = 0 (halving down to half
+//! the smallest σtr, where s = sqrt(σtr² + k²) has its branch points ±iσtr) and of equal width w above, up to k_max.
+//! The panel width must resolve the oscillation of J0(kr): a 64-point rule is exact for polynomials of degree 127,
+//! which represent cos over a phase of 160 rad to ~2e−15 (the Chebyshev coefficient J_128(80)), and a 32-point rule
+//! over 60 rad to ~1e−14; radius r uses the first of the dyadic levels w_ℓ = w₀/2^ℓ with w_ℓ r ≤ 160 (64 points
+//! on uniform panels and the widest graded one, 32 on the narrower graded panels). w₀ = 16/β for a spectrum
+//! decaying like e^(−βk) (at most 32 mm⁻¹).
 //!
-//! F itself is sampled only once, on 48 Chebyshev nodes of each level-0 panel (F varies by at most e^(−8) across
+//! F itself is sampled only once, on 48 Chebyshev nodes of each level-0 panel (F varies by at most e^(−16) across
 //! one, and a degree-47 interpolant of any e^(−αk) on a graded panel [a, 2a] is accurate to 2^(−48) of its panel
 //! maximum); every level's quadrature nodes lie inside a single level-0 panel (all boundaries are dyadic) and take
 //! F from that interpolant. Each level's nodes and weights × k·F(k)/(2π) are computed once, on first use, and
 //! shared by all radii. The upper limit k_max is where every channel of k·F(k) has fallen below 1e−16 of its peak
-//! (sampled at panel ends; capped at [`K_MAX_CAP_PER_MM`]). The result is deterministic and independent of the
+//! (sampled every w₀/8; capped at [`K_MAX_CAP_PER_MM`]). The result is deterministic and independent of the
 //! thread count.
 //!
 //! Accuracy (tests in `tests/diffusion_layered.rs`): single slabs agree with the analytic real-space multipole to
 //! ~1e−12 of T(0); ∫2πr G dr reproduces F(0) to better than 1e−8 relative.
 
 use super::bessel::j0;
-use super::quadrature::gl32;
+use super::quadrature::{gl32, gl64};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 /// Largest k (mm⁻¹) a spectrum is integrated to; reached only by nearly-singular stacks (decay lengths < 4 µm).
 pub const K_MAX_CAP_PER_MM: f64 = 1.0e4;
-/// Phase k·r (rad) one 32-point panel may span.
-const PHASE_PER_PANEL: f64 = 60.0;
+/// Phase k·r (rad) one 64-point panel may span (a 32-point panel spans at most half of it).
+const PHASE_PER_PANEL: f64 = 160.0;
 const MAX_LEVELS: usize = 40;
 /// Chebyshev nodes per level-0 panel (interpolant of degree 47).
 const CHEB: usize = 48;
@@ -81,22 +83,23 @@ pub struct InverseHankel<const N: usize> {
     levels: Vec<OnceLock<Level<N>>>,
 }
 
-/// Panels of one level: graded [w/2^(m+1), w/2^m] down to `k_grade_min` (at most 40), [0, smallest], then
-/// uniform panels of width w up to `k_max`.
-fn panels(w: f64, k_grade_min: f64, k_max: f64) -> Vec<(f64, f64)> {
-    let mut out: Vec<(f64, f64)> = Vec::new();
+/// Panels (a, b, uses the 64-point rule) of one level: graded [w/2^(m+1), w/2^m] down to `k_grade_min` (at most
+/// 40), [0, smallest], then uniform panels of width w up to `k_max` rounded up to a multiple of w. The uniform panels
+/// and the top graded one use 64 points, the narrower graded ones 32.
+fn panels(w: f64, k_grade_min: f64, k_max: f64) -> Vec<(f64, f64, bool)> {
+    let mut out: Vec<(f64, f64, bool)> = Vec::new();
     let mut hi = w;
-    for _ in 0..40 {
+    for m in 0..40 {
         if hi <= k_grade_min {
             break;
         }
-        out.push((0.5 * hi, hi));
+        out.push((0.5 * hi, hi, m == 0));
         hi *= 0.5;
     }
-    out.push((0.0, hi));
+    out.push((0.0, hi, out.is_empty()));
     out.reverse();
-    let n_uniform = ((k_max - w) / w).round().max(0.0) as usize;
-    out.extend((1..=n_uniform).map(|i| (i as f64 * w, (i + 1) as f64 * w)));
+    let n_uniform = (k_max / w).ceil().max(1.0) as usize - 1;
+    out.extend((1..=n_uniform).map(|i| (i as f64 * w, (i + 1) as f64 * w, true)));
     out
 }
 
@@ -105,13 +108,13 @@ impl<const N: usize> InverseHankel<N> {
     /// 16 mm⁻¹); `sigma_min_per_mm`: the smallest positive σtr entering F (grading towards k = 0; 0 if none).
     pub fn new(f: Box<Spectrum<N>>, decay_length_mm: f64, sigma_min_per_mm: f64) -> Self {
         let beta = if decay_length_mm.is_finite() && decay_length_mm > 0.0 { decay_length_mm } else { 1.0 };
-        let w0 = (8.0 / beta).clamp(1e-3, 16.0);
-        // k_max: scan panel ends until every channel of k·F(k) is below 1e−16 of its peak, twice in a row.
+        let w0 = (16.0 / beta).clamp(1e-3, 32.0);
+        // k_max: scan in steps of w0/8 until every channel of k·F(k) is below 1e−16 of its peak, twice in a row.
         let mut peak = [0.0f64; N];
         let mut quiet = 0;
         let mut m = 1usize;
         let k_max = loop {
-            let k = m as f64 * w0;
+            let k = m as f64 * w0 / 8.0;
             let v = f(k);
             let mut all_small = true;
             for c in 0..N {
@@ -127,11 +130,11 @@ impl<const N: usize> InverseHankel<N> {
             }
             m += 1;
         };
-        let k_grade_min = if sigma_min_per_mm > 0.0 { 0.25 * sigma_min_per_mm } else { f64::INFINITY };
+        let k_grade_min = if sigma_min_per_mm > 0.0 { 0.5 * sigma_min_per_mm } else { f64::INFINITY };
         let master_panels = panels(w0, k_grade_min, k_max);
         let coef: Vec<[[f64; N]; CHEB]> = master_panels
             .par_iter()
-            .map(|&(a, b)| {
+            .map(|&(a, b, _)| {
                 let samples: Vec<[f64; N]> = (0..CHEB)
                     .map(|i| {
                         let t = (PI * (i as f64 + 0.5) / CHEB as f64).cos();
@@ -182,9 +185,9 @@ impl<const N: usize> InverseHankel<N> {
     fn level(&self, l: usize) -> &Level<N> {
         self.levels[l].get_or_init(|| {
             let w = self.w0 / (1u64 << l) as f64;
-            let (x, wt) = gl32();
             let mut level = Level { k: Vec::new(), wf: Vec::new() };
-            for (a, b) in panels(w, self.k_grade_min, self.k_max) {
+            for (a, b, wide) in panels(w, self.k_grade_min, self.k_max) {
+                let (x, wt) = if wide { gl64() } else { gl32() };
                 let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
                 for (xi, wi) in x.iter().zip(wt) {
                     let k = c + h * xi;

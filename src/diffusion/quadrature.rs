@@ -65,6 +65,12 @@ pub fn gl32() -> &'static (Vec<f64>, Vec<f64>) {
     R.get_or_init(|| gauss_legendre(32))
 }
 
+/// The 64-point rule, computed once.
+pub fn gl64() -> &'static (Vec<f64>, Vec<f64>) {
+    static R: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
+    R.get_or_init(|| gauss_legendre(64))
+}
+
 /// ∫_a^b f with composite `rule` on `panels` equal panels.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, panels: usize, rule: &(Vec<f64>, Vec<f64>)) -> f64 {
     let h = (b - a) / panels as f64;
@@ -113,7 +119,7 @@ mod tests {
 
     #[test]
     fn rules_integrate_polynomials_exactly() {
-        for n in [1, 2, 5, 16, 32] {
+        for n in [1, 2, 5, 16, 32, 64] {
             let (x, w) = gauss_legendre(n);
             assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-14, "n={n}");
             // ∫_{-1}^{1} x^(2n-2) = 2/(2n-1)
