@@ -22,7 +22,7 @@
 //! thread count.
 //!
 //! Accuracy (tests in `tests/diffusion_layered.rs`): single slabs agree with the analytic real-space multipole to
-//! ~1e−12 of T(0); ∫2πr G dr reproduces F(0) to better than 1e−8 relative.
+//! ~3e−15 of T(0); ∫2πr G dr reproduces F(0) to ~1e−12 relative.
 
 use super::bessel::j0;
 use super::quadrature::{gl32, gl64};

@@ -18,8 +18,10 @@
 //! the top layer's remaining images ([`Slab::hankel_tail`], decaying at least as fast) ([`super::hankel`]).
 //! T̂stack has no singular part to split off: every image source lies at least D − l₁ (D = total thickness) from
 //! the exit face, so T̂stack decays like e^(−(D − l₁)k) and is transformed directly.
-//! Measured accuracy (tests): ∫2πr R dr = R̂(0) and ∫2πr T dr = T̂(0) to better than 1e−8 relative; a one-layer
-//! stack's T(r) equals the analytic multipole to ~1e−12 of T(0).
+//! Measured accuracy (tests in `tests/diffusion_layered.rs`, asserted with margin): ∫2πr R dr = R̂(0) and
+//! ∫2πr T dr = T̂(0) to ~1e−12 relative (asserted 1e−10); a one-layer stack's R(r) and T(r) equal the analytic
+//! multipole to ~5e−16 of R(0) and ~3e−15 of T(0) (asserted 1e−13) for r in [0.001, 100] mm; the split agrees with a
+//! direct inverse transform of R̂stack to 1e−8.
 
 use super::hankel::InverseHankel;
 use super::multipole::{slab_for_layer, Series, Slab};
