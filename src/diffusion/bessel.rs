@@ -9,7 +9,7 @@
 //!   ω = x − π/4, with at most 9 terms of each series (the truncation error is below 1e−16 for x ≥ 25), and a
 //!   sine/cosine with Cody–Waite reduction and Taylor polynomials (absolute error ~1e−16 for x < 1e7).
 
-use std::f64::consts::{FRAC_1_SQRT_2, PI};
+use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 const SPLIT: f64 = 25.0;
@@ -19,8 +19,8 @@ const ASYM_TERMS: usize = 9;
 
 struct Tables {
     cheb: Vec<[f64; DEGREE]>,
-    /// Coefficients a_k(0) of DLMF 10.17.1: a_k = Π_{j=1..k} (−(2j−1)²) / (k! 8^k).
-    asym: [f64; 2 * ASYM_TERMS],
+    /// (−1)^⌊k/2⌋ a_k, with a_k(0) of DLMF 10.17.1: a_k = Π_{j=1..k} (−(2j−1)²) / (k! 8^k), as they enter P, Q.
+    asym_signed: [f64; 2 * ASYM_TERMS],
 }
 
 /// J0 by Bessel's integral (trapezoid rule, exact to rounding for |x| < ~60). Slow; used to build the tables
@@ -74,7 +74,13 @@ fn tables() -> &'static Tables {
             a *= -(2.0 * kf - 1.0) * (2.0 * kf - 1.0) / (8.0 * kf);
             *ak = a;
         }
-        Tables { cheb, asym }
+        let mut asym_signed = asym;
+        for (k, v) in asym_signed.iter_mut().enumerate() {
+            if (k / 2) % 2 == 1 {
+                *v = -*v;
+            }
+        }
+        Tables { cheb, asym_signed }
     })
 }
 
@@ -106,19 +112,18 @@ pub fn j0(x: f64) -> f64 {
         } else {
             9
         };
-        let y = 1.0 / (x * x);
+        let inv = 1.0 / x;
+        let y = inv * inv;
         let (mut p, mut q) = (0.0, 0.0);
         for k in (0..pairs).rev() {
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            p = p * y + sign * t.asym[2 * k];
-            q = q * y + sign * t.asym[2 * k + 1];
+            // Signs (−1)^k are folded into the table.
+            p = p * y + t.asym_signed[2 * k];
+            q = q * y + t.asym_signed[2 * k + 1];
         }
-        let q = q / x;
+        let q = q * inv;
         let (s, c) = sin_cos(x);
-        // cos(x − π/4) = (cos x + sin x)/√2, sin(x − π/4) = (sin x − cos x)/√2
-        let cw = (c + s) * FRAC_1_SQRT_2;
-        let sw = (s - c) * FRAC_1_SQRT_2;
-        (2.0 / (PI * x)).sqrt() * (p * cw - q * sw)
+        // cos(x − π/4) = (cos x + sin x)/√2, sin(x − π/4) = (sin x − cos x)/√2; sqrt(2/(πx))/√2 = sqrt(1/(πx)).
+        (std::f64::consts::FRAC_1_PI * inv).sqrt() * (p * (c + s) - q * (s - c))
     } else {
         0.0
     }
@@ -134,7 +139,9 @@ fn sin_cos(x: f64) -> (f64, f64) {
     const P1: f64 = 1.570_796_325_802_803;
     const P2: f64 = 9.920_935_791_635_221e-10;
     const P3: f64 = 5.170_182_981_794_105e-19;
-    let n = (x * std::f64::consts::FRAC_2_PI).round();
+    // Nearest quadrant by truncation (x ≥ 0; avoids a libm round call on baseline x86-64).
+    let ni = (x * std::f64::consts::FRAC_2_PI + 0.5) as i64;
+    let n = ni as f64;
     let y = ((x - n * P1) - n * P2) - n * P3;
     let z = y * y;
     // sin y = y Σ (−1)^k z^k/(2k+1)!, cos y = Σ (−1)^k z^k/(2k)!
@@ -156,7 +163,7 @@ fn sin_cos(x: f64) -> (f64, f64) {
                             + z * (1.0 / 479_001_600.0
                                 + z * (-1.0 / 87_178_291_200.0
                                     + z * (1.0 / 20_922_789_888_000.0 + z * (-1.0 / 6_402_373_705_728_000.0)))))))));
-    match (n as i64).rem_euclid(4) {
+    match ni & 3 {
         0 => (sn, cs),
         1 => (cs, -sn),
         2 => (-sn, -cs),
