@@ -57,7 +57,7 @@ pub struct ProfileArgs {
     /// How layers are combined (--layers only).
     #[arg(long, value_enum, default_value = "symmetric")]
     adding: AddingArg,
-    /// Sum image pairs i = -N..N instead of the exact infinite series (multipole and --layers only; N in 0..=100000;
+    /// Sum image pairs i = -N..N instead of the exact infinite series (multipole and --layers only; N in 0..=10000;
     /// DJ05 used 5). Default: exact series.
     #[arg(long, value_name = "N")]
     dipole_pairs: Option<u32>,
@@ -109,8 +109,8 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         FdrArg::Jensen01 => FdrForm::Jensen01,
     };
     if let Some(n) = args.dipole_pairs {
-        if n > 100_000 {
-            return Err(usage_msg(format!("--dipole-pairs must be in 0..=100000, got {n}")));
+        if n > 10_000 {
+            return Err(usage_msg(format!("--dipole-pairs must be in 0..=10000, got {n}")));
         }
     }
     let series = args.dipole_pairs.map(|pairs| Series::Truncated { pairs }).unwrap_or_default();

@@ -2,6 +2,17 @@
 //!
 //! Units everywhere: lengths in mm, coefficients in mm⁻¹, radial profiles R(r), T(r) in mm⁻²
 //! (fraction of incident power per unit area). These modules know nothing about files or the GPU.
+//!
+//! Code map:
+//! - [`dipole`]: semi-infinite medium (Jensen et al. 2001), closed-form total.
+//! - [`multipole`]: slab with different top/bottom boundaries (Donner & Jensen 2005), R(r), T(r) and their Hankel
+//!   transforms with the exact infinite image series (default) or i = −N..N.
+//! - [`layered`]: [`layered::LayerStack`] (JSON, validated) and [`layered::LayeredProfile`] (adding in frequency
+//!   space, symmetric or directional; back to real space by [`hankel`] with [`bessel::j0`]).
+//! - [`materials`], [`sum_of_gaussians`]: the Jensen 2001 materials and d'Eon's Gaussian presets.
+//! - [`source::ProfileSource`]: the one way commands resolve "material / preset / layer stack" into a
+//!   `Box<dyn RadialProfile>` plus provenance; [`table::ProfileTable`]: R, T on a radius grid as CSV / JSON.
+//! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
 pub mod bessel;
 pub mod dipole;
