@@ -193,6 +193,7 @@ fn bad_input_exits_2_naming_the_field() {
     bad(&["profile", "--material", "skin1", "--radii", "0,1,0.5", "--json"], "--radii");
     bad(&["profile", "--material", "skin1", "--radii", "-1,1", "--json"], "--radii");
     bad(&["profile", "--material", "skin1", "--radii", "0,abc", "--json"], "--radii");
+    bad(&["profile", "--material", "skin1", "--radii", "0,1e9", "--json"], "--radii");
     bad(&["profile", "--material", "unobtainium", "--json"], "--material");
     bad(&["profile", "--profile-preset", "deon7", "--json"], "--profile-preset");
     bad(&["profile", "--material", "skin1", "--model", "multipole", "--json"], "--thickness-mm");

@@ -64,13 +64,13 @@ pub struct ProfileArgs {
     /// Polynomial for the average diffuse Fresnel reflectance Fdr(eta).
     #[arg(long, value_enum, default_value = "dj05")]
     fdr: FdrArg,
-    /// Radii in mm, comma-separated, ascending, >= 0. Default: --count radii log-spaced over [--r-min-mm, --r-max-mm].
+    /// Radii in mm, comma-separated, ascending, in 0..=1000. Default: --count radii log-spaced over [--r-min-mm, --r-max-mm].
     #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
     radii: Option<String>,
     /// Smallest radius of the default log grid, mm (> 0).
     #[arg(long, value_name = "MM", default_value_t = table::DEFAULT_R_MIN_MM)]
     r_min_mm: f64,
-    /// Largest radius of the default log grid, mm (> --r-min-mm).
+    /// Largest radius of the default log grid, mm (> --r-min-mm, <= 1000).
     #[arg(long, value_name = "MM", default_value_t = table::DEFAULT_R_MAX_MM)]
     r_max_mm: f64,
     /// Number of radii of the default log grid (2..=1000000).

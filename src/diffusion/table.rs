@@ -13,7 +13,7 @@ pub const DEFAULT_COUNT: usize = 200;
 /// `count` radii log-spaced over [r_min, r_max] mm (inclusive).
 pub fn log_radii(r_min_mm: f64, r_max_mm: f64, count: usize) -> Result<Vec<f64>, InvalidInput> {
     crate::error::check_positive("r_min_mm", r_min_mm, "mm")?;
-    crate::error::check_positive("r_max_mm", r_max_mm, "mm")?;
+    crate::error::check_range("r_max_mm", r_max_mm, f64::MIN_POSITIVE, MAX_RADIUS_MM, "mm")?;
     if r_max_mm <= r_min_mm {
         return Err(InvalidInput::new("r_max_mm", format!("must exceed r_min_mm = {r_min_mm}, got {r_max_mm}")));
     }
@@ -22,14 +22,20 @@ pub fn log_radii(r_min_mm: f64, r_max_mm: f64, count: usize) -> Result<Vec<f64>,
     Ok((0..count).map(|i| (a + (b - a) * i as f64 / (count - 1) as f64).exp()).collect())
 }
 
-/// Radii must be non-empty, finite, ≥ 0 and sorted ascending.
+/// Largest radius a table may ask for, mm (the layered quadrature's node count grows linearly with r).
+pub const MAX_RADIUS_MM: f64 = 1000.0;
+
+/// Radii must be non-empty, finite, in [0, [`MAX_RADIUS_MM`]] and sorted ascending.
 pub fn check_radii(param: &str, radii_mm: &[f64]) -> Result<(), InvalidInput> {
     if radii_mm.is_empty() {
         return Err(InvalidInput::new(param, "must list at least one radius (mm)"));
     }
     for (i, &r) in radii_mm.iter().enumerate() {
-        if !(r.is_finite() && r >= 0.0) {
-            return Err(InvalidInput::new(param, format!("must be finite and >= 0 mm, got {r} at position {i}")));
+        if !(r.is_finite() && (0.0..=MAX_RADIUS_MM).contains(&r)) {
+            return Err(InvalidInput::new(
+                param,
+                format!("must be in 0..={MAX_RADIUS_MM} mm, got {r} at position {i}"),
+            ));
         }
         if i > 0 && r < radii_mm[i - 1] {
             return Err(InvalidInput::new(
