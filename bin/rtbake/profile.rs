@@ -176,12 +176,21 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         ctx.emit_json(&json);
     } else {
         let t = &table.total_reflectance;
-        println!("total R (r, g, b): {:.6} {:.6} {:.6}", t[0], t[1], t[2]);
+        let mut text = format!("total R (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]);
         if let Some(t) = &table.total_transmittance {
-            println!("total T (r, g, b): {:.6} {:.6} {:.6}", t[0], t[1], t[2]);
+            text.push_str(&format!("total T (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]));
         }
-        print!("{}", table.to_csv().lines().filter(|l| !l.starts_with('#')).collect::<Vec<_>>().join("\n"));
-        println!();
+        for line in table.to_csv().lines().filter(|l| !l.starts_with('#')) {
+            text.push_str(line);
+            text.push('\n');
+        }
+        // A closed pipe (`| head`) is not an error.
+        use std::io::Write;
+        if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
+            if e.kind() != std::io::ErrorKind::BrokenPipe {
+                return Err(e.into());
+            }
+        }
     }
     Ok(())
 }

@@ -44,7 +44,82 @@ fn fdr_name(fdr: FdrForm) -> &'static str {
     }
 }
 
+fn parse_fdr(v: &Value) -> Result<FdrForm, InvalidInput> {
+    match v.get("fdr").and_then(Value::as_str).unwrap_or("dj05") {
+        "dj05" => Ok(FdrForm::Dj05),
+        "jensen01" => Ok(FdrForm::Jensen01),
+        other => Err(InvalidInput::new("fdr", format!("must be dj05 or jensen01, got '{other}'"))),
+    }
+}
+
+fn parse_series(v: &Value) -> Result<Series, InvalidInput> {
+    match v.get("series") {
+        None => Ok(Series::Exact),
+        Some(Value::String(s)) if s == "exact" => Ok(Series::Exact),
+        Some(obj) => match obj.get("truncated_pairs").and_then(Value::as_u64) {
+            Some(p) if p <= 10_000 => Ok(Series::Truncated { pairs: p as u32 }),
+            _ => Err(InvalidInput::new(
+                "series",
+                format!("must be \"exact\" or {{\"truncated_pairs\": N}} with N in 0..=10000, got {obj}"),
+            )),
+        },
+    }
+}
+
 impl ProfileSource {
+    /// Rebuilds a source from its [`provenance`](Self::provenance) JSON (so bake parameters round-trip):
+    /// `{"model": "dipole" | "multipole" | "sum-of-gaussians" | "layered", ...}` with the keys `provenance` writes.
+    pub fn from_json(v: &Value) -> Result<Self, InvalidInput> {
+        let model = v
+            .get("model")
+            .and_then(Value::as_str)
+            .ok_or_else(|| InvalidInput::new("model", "must be one of dipole, multipole, sum-of-gaussians, layered"))?;
+        let string = |key: &str| -> Result<String, InvalidInput> {
+            v.get(key)
+                .and_then(Value::as_str)
+                .map(str::to_string)
+                .ok_or_else(|| InvalidInput::new(key, format!("is required (a string) for model {model}")))
+        };
+        match model {
+            "dipole" => Ok(ProfileSource::Material {
+                name: string("material")?,
+                model: MaterialModel::Dipole,
+                fdr: parse_fdr(v)?,
+                series: Series::Exact,
+            }),
+            "multipole" => Ok(ProfileSource::Material {
+                name: string("material")?,
+                model: MaterialModel::Multipole {
+                    thickness_mm: v
+                        .get("thickness_mm")
+                        .and_then(Value::as_f64)
+                        .ok_or_else(|| InvalidInput::new("thickness_mm", "is required (mm) for model multipole"))?,
+                },
+                fdr: parse_fdr(v)?,
+                series: parse_series(v)?,
+            }),
+            "sum-of-gaussians" => Ok(ProfileSource::Preset(string("profile_preset")?)),
+            "layered" => {
+                let layers =
+                    v.get("layers").ok_or_else(|| InvalidInput::new("layers", "is required for model layered"))?;
+                let adding = match v.get("adding").and_then(Value::as_str) {
+                    None => Adding::default(),
+                    Some(a) => Adding::parse("adding", a)?,
+                };
+                Ok(ProfileSource::Layers {
+                    stack: LayerStack::from_json_str(&layers.to_string())?,
+                    adding,
+                    series: parse_series(v)?,
+                    fdr: parse_fdr(v)?,
+                })
+            }
+            other => Err(InvalidInput::new(
+                "model",
+                format!("must be one of dipole, multipole, sum-of-gaussians, layered, got '{other}'"),
+            )),
+        }
+    }
+
     /// Builds the profile. Errors name the parameter: `material`, `thickness_mm`, `profile_preset`, or the
     /// layer-stack field (`layers[1].thickness_mm`, …).
     pub fn build(&self) -> Result<Box<dyn RadialProfile + Send>, InvalidInput> {
@@ -132,5 +207,50 @@ impl ProfileSource {
                 "units": "r in mm, R and T in mm^-2",
             }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diffusion::layered::Layer;
+
+    #[test]
+    fn provenance_round_trips_and_builds() {
+        let stack = LayerStack::new(
+            1.0,
+            1.0,
+            vec![
+                Layer { thickness_mm: 0.25, eta: 1.4, sigma_a: [0.2, 0.5, 1.2], sigma_s_prime: [5.0, 6.0, 7.0] },
+                Layer { thickness_mm: 5.0, eta: 1.4, sigma_a: [0.01, 0.05, 0.1], sigma_s_prime: [1.5, 2.0, 2.5] },
+            ],
+        )
+        .unwrap();
+        let sources = [
+            ProfileSource::Material {
+                name: "skin1".into(),
+                model: MaterialModel::Dipole,
+                fdr: FdrForm::Jensen01,
+                series: Series::Exact,
+            },
+            ProfileSource::Material {
+                name: "marble".into(),
+                model: MaterialModel::Multipole { thickness_mm: 3.0 },
+                fdr: FdrForm::Dj05,
+                series: Series::Truncated { pairs: 5 },
+            },
+            ProfileSource::Preset("deon6".into()),
+            ProfileSource::Layers { stack, adding: Adding::Directional, series: Series::Exact, fdr: FdrForm::Dj05 },
+        ];
+        for src in sources {
+            let back = ProfileSource::from_json(&src.provenance()).unwrap();
+            assert_eq!(back, src);
+            let (a, b) = (src.build().unwrap(), back.build().unwrap());
+            assert_eq!(a.total_reflectance(), b.total_reflectance());
+            assert_eq!(a.reflectance_mm2(0.7), b.reflectance_mm2(0.7));
+        }
+        let e = ProfileSource::from_json(&json!({"model": "dipole", "material": "unobtainium"})).unwrap().build();
+        assert_eq!(e.err().unwrap().param, "material");
+        assert_eq!(ProfileSource::from_json(&json!({"model": "plasma"})).unwrap_err().param, "model");
     }
 }
