@@ -1,10 +1,196 @@
-//! `rtbake profile`: not implemented yet.
+//! `rtbake profile`: evaluate a diffusion profile R(r) (and T(r) for slabs and layer stacks) on a radius grid and
+//! print / write it as JSON or CSV. Parsing and validation only; the maths is `rtbake::diffusion`.
 
-use crate::cli::{usage_msg, Ctx};
+use crate::cli::{parse_f64_list, usage, usage_msg, Ctx};
+use rtbake::diffusion::layered::{Adding, LayerStack};
+use rtbake::diffusion::multipole::Series;
+use rtbake::diffusion::source::{MaterialModel, ProfileSource};
+use rtbake::diffusion::table::{self, ProfileTable};
+use rtbake::diffusion::FdrForm;
+use rtbake::error::InvalidInput;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum ModelArg {
+    /// Semi-infinite medium (Jensen et al. 2001).
+    Dipole,
+    /// Slab of --thickness-mm in air (Donner & Jensen 2005); also prints T(r).
+    Multipole,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum FdrArg {
+    /// Donner & Jensen 2005 polynomial (full digits).
+    Dj05,
+    /// Jensen et al. 2001 polynomial as printed (rounded).
+    Jensen01,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum AddingArg {
+    /// DJ05 as printed (top-lit R, T in both roles).
+    Symmetric,
+    /// Kubelka 1954 (R↓, T↓, R↑, T↑ kept apart).
+    Directional,
+}
 
 #[derive(clap::Args)]
-pub struct ProfileArgs {}
+#[command(group(clap::ArgGroup::new("source").required(true).args(["material", "profile_preset", "layers"])))]
+pub struct ProfileArgs {
+    /// Jensen 2001 measured material (apple, chicken1, chicken2, cream, ketchup, marble, potato, skimmilk, skin1,
+    /// skin2, wholemilk); eta = 1.3.
+    #[arg(long, value_name = "NAME")]
+    material: Option<String>,
+    /// Model for --material.
+    #[arg(long, value_enum, default_value = "dipole")]
+    model: ModelArg,
+    /// Slab thickness for --model multipole, mm (must exceed 1/sigma_t' of every channel).
+    #[arg(long, value_name = "MM")]
+    thickness_mm: Option<f64>,
+    /// Published sum-of-Gaussians profile: deon6 (d'Eon et al. 2007) or deon4 (thesis Table 4.2).
+    #[arg(long, value_name = "NAME")]
+    profile_preset: Option<String>,
+    /// Layer stack JSON, top layer first (mm, mm^-1): {"eta_above": 1.0, "eta_below": 1.0, "layers":
+    /// [{"thickness_mm": .., "eta": .., "sigma_a": [r,g,b], "sigma_s_prime": [r,g,b]}, ...]}.
+    #[arg(long, value_name = "FILE")]
+    layers: Option<PathBuf>,
+    /// How layers are combined (--layers only).
+    #[arg(long, value_enum, default_value = "symmetric")]
+    adding: AddingArg,
+    /// Sum image pairs i = -N..N instead of the exact infinite series (multipole and --layers only; N in 0..=10000;
+    /// DJ05 used 5). Default: exact series.
+    #[arg(long, value_name = "N")]
+    dipole_pairs: Option<u32>,
+    /// Polynomial for the average diffuse Fresnel reflectance Fdr(eta).
+    #[arg(long, value_enum, default_value = "dj05")]
+    fdr: FdrArg,
+    /// Radii in mm, comma-separated, ascending, in 0..=1000. Default: --count radii log-spaced over [--r-min-mm, --r-max-mm].
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    radii: Option<String>,
+    /// Smallest radius of the default log grid, mm (> 0).
+    #[arg(long, value_name = "MM", default_value_t = table::DEFAULT_R_MIN_MM)]
+    r_min_mm: f64,
+    /// Largest radius of the default log grid, mm (> --r-min-mm, <= 1000).
+    #[arg(long, value_name = "MM", default_value_t = table::DEFAULT_R_MAX_MM)]
+    r_max_mm: f64,
+    /// Number of radii of the default log grid (2..=1000000).
+    #[arg(long, value_name = "N", default_value_t = table::DEFAULT_COUNT)]
+    count: usize,
+    /// Also write the table as CSV (r_mm, R per channel, T per channel; totals and options in '#' lines).
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+    /// Also write the table as JSON (same object as --json prints).
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+}
 
-pub fn run(_args: ProfileArgs, _ctx: &Ctx) -> anyhow::Result<()> {
-    Err(usage_msg("rtbake profile: not implemented yet"))
+/// Renames library parameter names to the flags a user typed.
+fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
+    let param = match e.param.as_str() {
+        "material" => "--material".to_string(),
+        "profile_preset" => "--profile-preset".to_string(),
+        "thickness_mm" => "--thickness-mm".to_string(),
+        "radii" => "--radii".to_string(),
+        "r_min_mm" => "--r-min-mm".to_string(),
+        "r_max_mm" => "--r-max-mm".to_string(),
+        "count" => "--count".to_string(),
+        p if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
+            Some(f) => format!("--layers {}: {p}", f.display()),
+            None => p.to_string(),
+        },
+        p => p.to_string(),
+    };
+    usage(InvalidInput::new(param, e.message))
+}
+
+pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    let fdr = match args.fdr {
+        FdrArg::Dj05 => FdrForm::Dj05,
+        FdrArg::Jensen01 => FdrForm::Jensen01,
+    };
+    if let Some(n) = args.dipole_pairs {
+        if n > 10_000 {
+            return Err(usage_msg(format!("--dipole-pairs must be in 0..=10000, got {n}")));
+        }
+    }
+    let series = args.dipole_pairs.map(|pairs| Series::Truncated { pairs }).unwrap_or_default();
+    let layered = args.layers.is_some();
+    let multipole = args.material.is_some() && matches!(args.model, ModelArg::Multipole);
+    if args.dipole_pairs.is_some() && !(layered || multipole) {
+        return Err(usage_msg("--dipole-pairs applies only to --model multipole and --layers"));
+    }
+    if args.thickness_mm.is_some() && !multipole {
+        return Err(usage_msg("--thickness-mm applies only to --material with --model multipole"));
+    }
+
+    let source = if let Some(name) = &args.material {
+        let model = match args.model {
+            ModelArg::Dipole => MaterialModel::Dipole,
+            ModelArg::Multipole => MaterialModel::Multipole {
+                thickness_mm: args
+                    .thickness_mm
+                    .ok_or_else(|| usage_msg("--model multipole needs --thickness-mm (slab thickness in mm)"))?,
+            },
+        };
+        ProfileSource::Material { name: name.clone(), model, fdr, series }
+    } else if let Some(name) = &args.profile_preset {
+        ProfileSource::Preset(name.clone())
+    } else if let Some(path) = &args.layers {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
+        let stack = LayerStack::from_json_str(&text).map_err(|e| flag_error(e, Some(path)))?;
+        let adding = match args.adding {
+            AddingArg::Symmetric => Adding::Symmetric,
+            AddingArg::Directional => Adding::Directional,
+        };
+        ProfileSource::Layers { stack, adding, series, fdr }
+    } else {
+        return Err(usage_msg("one of --material, --profile-preset or --layers is required"));
+    };
+
+    let radii = match &args.radii {
+        Some(list) => {
+            let r = parse_f64_list("--radii", list)?;
+            table::check_radii("radii", &r).map_err(|e| flag_error(e, None))?;
+            r
+        }
+        None => table::log_radii(args.r_min_mm, args.r_max_mm, args.count).map_err(|e| flag_error(e, None))?,
+    };
+
+    let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
+    let table =
+        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| flag_error(e, None))?;
+    let json = table.to_json();
+
+    // Everything computed: now write (atomically) and print.
+    if let Some(path) = &args.csv {
+        rtbake::io::atomic::write_atomic(path, table.to_csv().as_bytes())?;
+        ctx.info(format!("wrote {}", path.display()));
+    }
+    if let Some(path) = &args.out {
+        let text = serde_json::to_string_pretty(&json)? + "\n";
+        rtbake::io::atomic::write_atomic(path, text.as_bytes())?;
+        ctx.info(format!("wrote {}", path.display()));
+    }
+    if ctx.json {
+        ctx.emit_json(&json);
+    } else {
+        let t = &table.total_reflectance;
+        let mut text = format!("total R (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]);
+        if let Some(t) = &table.total_transmittance {
+            text.push_str(&format!("total T (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]));
+        }
+        for line in table.to_csv().lines().filter(|l| !l.starts_with('#')) {
+            text.push_str(line);
+            text.push('\n');
+        }
+        // A closed pipe (`| head`) is not an error.
+        use std::io::Write;
+        if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
+            if e.kind() != std::io::ErrorKind::BrokenPipe {
+                return Err(e.into());
+            }
+        }
+    }
+    Ok(())
 }

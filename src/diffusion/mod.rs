@@ -2,11 +2,28 @@
 //!
 //! Units everywhere: lengths in mm, coefficients in mm⁻¹, radial profiles R(r), T(r) in mm⁻²
 //! (fraction of incident power per unit area). These modules know nothing about files or the GPU.
+//!
+//! Code map:
+//! - [`dipole`]: semi-infinite medium (Jensen et al. 2001), closed-form total.
+//! - [`multipole`]: slab with different top/bottom boundaries (Donner & Jensen 2005), R(r), T(r) and their Hankel
+//!   transforms with the exact infinite image series (default) or i = −N..N.
+//! - [`layered`]: [`layered::LayerStack`] (JSON, validated) and [`layered::LayeredProfile`] (adding in frequency
+//!   space, symmetric or directional; back to real space by [`hankel`] with [`bessel::j0`]).
+//! - [`materials`], [`sum_of_gaussians`]: the Jensen 2001 materials and d'Eon's Gaussian presets.
+//! - [`source::ProfileSource`]: the one way commands resolve "material / preset / layer stack" into a
+//!   `Box<dyn RadialProfile>` plus provenance; [`table::ProfileTable`]: R, T on a radius grid as CSV / JSON.
+//! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
+pub mod bessel;
 pub mod dipole;
+pub mod hankel;
+pub mod layered;
 pub mod materials;
 pub mod multipole;
+pub mod quadrature;
+pub mod source;
 pub mod sum_of_gaussians;
+pub mod table;
 
 /// An RGB radial diffusion profile R(r) in mm⁻² (r in mm), with its total ∫₀^∞ 2πr R(r) dr.
 ///
@@ -17,6 +34,27 @@ pub trait RadialProfile: Sync {
     fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3];
     /// ∫₀^∞ 2πr R(r) dr per channel (dimensionless).
     fn total_reflectance(&self) -> [f64; 3];
+    /// T(r) per channel, mm⁻², for profiles of finite slabs and layer stacks (`None` for semi-infinite media and
+    /// Gaussian presets).
+    fn transmittance_mm2(&self, _r_mm: f64) -> Option<[f64; 3]> {
+        None
+    }
+    /// ∫₀^∞ 2πr T(r) dr per channel, where the profile has a transmittance.
+    fn total_transmittance(&self) -> Option<[f64; 3]> {
+        None
+    }
+    /// R at many radii (implementations may parallelise; results must not depend on the thread count).
+    fn reflectance_many(&self, radii_mm: &[f64]) -> Vec<[f64; 3]> {
+        radii_mm.iter().map(|&r| self.reflectance_mm2(r)).collect()
+    }
+    /// T at many radii, where the profile has a transmittance.
+    fn transmittance_many(&self, radii_mm: &[f64]) -> Option<Vec<[f64; 3]>> {
+        radii_mm.iter().map(|&r| self.transmittance_mm2(r)).collect()
+    }
+    /// R and (where defined) T at many radii in one pass.
+    fn profile_many(&self, radii_mm: &[f64]) -> (Vec<[f64; 3]>, Option<Vec<[f64; 3]>>) {
+        (self.reflectance_many(radii_mm), self.transmittance_many(radii_mm))
+    }
 }
 
 /// Which polynomial approximates the average diffuse Fresnel reflectance Fdr(η).

@@ -1,0 +1,125 @@
+//! Profile tables (`specs/diffusion.md`, "Outputs"): radii on a grid, R(r) (and T(r)) per channel, totals R̂(0),
+//! T̂(0), and the model options, as CSV text or a JSON value. Pure: callers write the bytes.
+
+use super::RadialProfile;
+use crate::error::InvalidInput;
+use serde_json::{json, Value};
+
+/// Default table grid: 200 radii log-spaced over [0.001, 100] mm.
+pub const DEFAULT_R_MIN_MM: f64 = 1e-3;
+pub const DEFAULT_R_MAX_MM: f64 = 100.0;
+pub const DEFAULT_COUNT: usize = 200;
+
+/// `count` radii log-spaced over [r_min, r_max] mm (inclusive).
+pub fn log_radii(r_min_mm: f64, r_max_mm: f64, count: usize) -> Result<Vec<f64>, InvalidInput> {
+    crate::error::check_positive("r_min_mm", r_min_mm, "mm")?;
+    crate::error::check_range("r_max_mm", r_max_mm, f64::MIN_POSITIVE, MAX_RADIUS_MM, "mm")?;
+    if r_max_mm <= r_min_mm {
+        return Err(InvalidInput::new("r_max_mm", format!("must exceed r_min_mm = {r_min_mm}, got {r_max_mm}")));
+    }
+    crate::error::check_range("count", count, 2, 1_000_000, "radii")?;
+    let (a, b) = (r_min_mm.ln(), r_max_mm.ln());
+    Ok((0..count).map(|i| (a + (b - a) * i as f64 / (count - 1) as f64).exp()).collect())
+}
+
+/// Largest radius a table may ask for, mm (the layered quadrature's node count grows linearly with r).
+pub const MAX_RADIUS_MM: f64 = 1000.0;
+
+/// Radii must be non-empty, finite, in [0, [`MAX_RADIUS_MM`]] and sorted ascending.
+pub fn check_radii(param: &str, radii_mm: &[f64]) -> Result<(), InvalidInput> {
+    if radii_mm.is_empty() {
+        return Err(InvalidInput::new(param, "must list at least one radius (mm)"));
+    }
+    for (i, &r) in radii_mm.iter().enumerate() {
+        if !(r.is_finite() && (0.0..=MAX_RADIUS_MM).contains(&r)) {
+            return Err(InvalidInput::new(
+                param,
+                format!("must be in 0..={MAX_RADIUS_MM} mm, got {r} at position {i}"),
+            ));
+        }
+        if i > 0 && r < radii_mm[i - 1] {
+            return Err(InvalidInput::new(
+                param,
+                format!("must be sorted ascending, got {} before {r} at position {i}", radii_mm[i - 1]),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// An evaluated profile.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileTable {
+    pub r_mm: Vec<f64>,
+    /// R(r) per radius, [r, g, b], mm⁻².
+    pub reflectance_mm2: Vec<[f64; 3]>,
+    /// T(r) per radius for slabs and stacks.
+    pub transmittance_mm2: Option<Vec<[f64; 3]>>,
+    pub total_reflectance: [f64; 3],
+    pub total_transmittance: Option<[f64; 3]>,
+    /// Model options (a JSON object) recorded with the table.
+    pub provenance: Value,
+}
+
+impl ProfileTable {
+    /// Evaluates `profile` at `radii_mm` (checked with [`check_radii`], errors name `radii`).
+    pub fn compute(profile: &dyn RadialProfile, radii_mm: &[f64], provenance: Value) -> Result<Self, InvalidInput> {
+        check_radii("radii", radii_mm)?;
+        let (reflectance_mm2, transmittance_mm2) = profile.profile_many(radii_mm);
+        Ok(Self {
+            r_mm: radii_mm.to_vec(),
+            reflectance_mm2,
+            transmittance_mm2,
+            total_reflectance: profile.total_reflectance(),
+            total_transmittance: profile.total_transmittance(),
+            provenance,
+        })
+    }
+
+    /// `{"r_mm": [...], "R": [[r,g,b], ...], "total_R": [r,g,b], ("T", "total_T",) + provenance keys}`.
+    pub fn to_json(&self) -> Value {
+        let mut v = json!({
+            "r_mm": self.r_mm,
+            "R": self.reflectance_mm2,
+            "total_R": self.total_reflectance,
+        });
+        if let Some(t) = &self.transmittance_mm2 {
+            v["T"] = json!(t);
+        }
+        if let Some(t) = &self.total_transmittance {
+            v["total_T"] = json!(t);
+        }
+        if let Value::Object(p) = &self.provenance {
+            for (k, val) in p {
+                if v.get(k).is_none() {
+                    v[k] = val.clone();
+                }
+            }
+        }
+        v
+    }
+
+    /// CSV: `#` comment lines with the provenance and the totals, a header, one row per radius.
+    pub fn to_csv(&self) -> String {
+        let mut s = String::new();
+        s.push_str(&format!("# rtbake profile: {}\n", self.provenance));
+        let t3 = |t: &[f64; 3]| format!("{:e},{:e},{:e}", t[0], t[1], t[2]);
+        s.push_str(&format!("# total_R (r,g,b): {}\n", t3(&self.total_reflectance)));
+        if let Some(t) = &self.total_transmittance {
+            s.push_str(&format!("# total_T (r,g,b): {}\n", t3(t)));
+        }
+        s.push_str("r_mm,R_r,R_g,R_b");
+        if self.transmittance_mm2.is_some() {
+            s.push_str(",T_r,T_g,T_b");
+        }
+        s.push('\n');
+        for (i, r) in self.r_mm.iter().enumerate() {
+            s.push_str(&format!("{r:e},{}", t3(&self.reflectance_mm2[i])));
+            if let Some(t) = &self.transmittance_mm2 {
+                s.push_str(&format!(",{}", t3(&t[i])));
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
