@@ -18,8 +18,9 @@ pub struct FitGaussiansArgs {
     /// Fit a sum-of-Gaussians preset instead: deon6 | deon4.
     #[arg(long, value_name = "NAME")]
     pub profile_preset: Option<String>,
-    // Hook for the lead: `--layers FILE` (a layer-stack JSON → `&dyn RadialProfile`) slots in next to
-    // --material / --profile-preset in `profile_from_args` below.
+    /// Layered targets: --layers FILE or the physiological skin --skin-melanin/--skin-hemoglobin.
+    #[command(flatten)]
+    pub layered: crate::profile_source::LayeredArgs,
     /// Number of Gaussians (2..=8).
     #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
     pub count: i64,
@@ -59,6 +60,14 @@ pub fn fit_error(e: FitError) -> anyhow::Error {
 
 /// The profile to fit, its provenance and a file stem.
 fn profile_from_args(a: &FitGaussiansArgs) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
+    if a.layered.is_set() && (a.material.is_some() || a.profile_preset.is_some()) {
+        return Err(usage_msg(
+            "give one target: --material, --profile-preset, --layers or --skin-melanin/--skin-hemoglobin",
+        ));
+    }
+    if let Some(resolved) = a.layered.resolve()? {
+        return Ok(resolved);
+    }
     if let Some(name) = &a.material {
         let m = materials::find(name).ok_or_else(|| {
             usage_msg(format!("--material: unknown material '{name}' (known: {})", materials::names().join(", ")))
@@ -74,7 +83,9 @@ fn profile_from_args(a: &FitGaussiansArgs) -> anyhow::Result<(Box<dyn RadialProf
         let lower = name.to_ascii_lowercase();
         return Ok((Box::new(RgbGaussians::from(&sog)), json!({"kind": "preset", "name": lower}), lower));
     }
-    Err(usage_msg("one of --material NAME, --profile-preset NAME or --error-table is required"))
+    Err(usage_msg(
+        "one of --material NAME, --profile-preset NAME, --layers FILE, --skin-melanin CM --skin-hemoglobin CHD or --error-table is required",
+    ))
 }
 
 fn run_error_table(ctx: &Ctx) -> anyhow::Result<()> {

@@ -15,6 +15,9 @@ pub struct FitSeparableArgs {
     /// Target: a Jensen et al. 2001 material as a dipole (η = 1.3), e.g. skin1.
     #[arg(long, value_name = "NAME")]
     material: Option<String>,
+    /// Layered targets: --layers FILE or the physiological skin --skin-melanin/--skin-hemoglobin.
+    #[command(flatten)]
+    layered: crate::profile_source::LayeredArgs,
     /// Fixed width (the shader's sssWidth, world units); only width × falloff is identifiable.
     #[arg(long, default_value_t = ObjectiveSpec::default().width, allow_negative_numbers = true)]
     width: f64,
@@ -78,7 +81,17 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     };
 
+    if args.layered.is_set() && (args.material.is_some() || args.profile.is_some()) {
+        return Err(usage_msg("give one target: --profile, --material, --layers or --skin-melanin/--skin-hemoglobin"));
+    }
+    let layered = args.layered.resolve()?;
     let (profile, name, description): (Box<dyn RadialProfile>, String, String) = match (&args.material, &args.profile) {
+        _ if layered.is_some() => {
+            let (profile, provenance, stem) = layered.expect("checked");
+            let kind =
+                if provenance.get("physiological_skin").is_some() { "physiological skin" } else { "layer stack" };
+            (profile, stem.clone(), format!("layered profile ({kind} {stem})"))
+        }
         (Some(m), _) => {
             let mat = materials::find(m).ok_or_else(|| {
                 usage_msg(format!("--material must be one of {}, got {m:?}", materials::names().join(", ")))

@@ -10,6 +10,7 @@ mod fit;
 mod kernel;
 mod maps;
 mod profile;
+mod profile_source;
 mod run;
 mod skin_color;
 mod transmittance;

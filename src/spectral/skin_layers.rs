@@ -329,3 +329,18 @@ pub fn two_layer_skin_rgb(
         eta_below_dermis: physiology.eta_below_dermis,
     })
 }
+
+impl TwoLayerSkinRgb {
+    /// The two layers as a diffusion layer stack (air above, epidermis over dermis), for profiling and fitting
+    /// (`crate::diffusion::layered`). Validity (thickness > 1/σt′ per channel) is checked by the stack.
+    pub fn layer_stack(&self) -> Result<crate::diffusion::layered::LayerStack, InvalidInput> {
+        use crate::diffusion::layered::{Layer, LayerStack};
+        let layer = |l: &LayerRgb| Layer {
+            thickness_mm: l.thickness_mm,
+            eta: l.eta,
+            sigma_a: l.sigma_a_per_mm,
+            sigma_s_prime: l.sigma_s_prime_per_mm,
+        };
+        LayerStack::new(1.0, self.eta_below_dermis, vec![layer(&self.epidermis), layer(&self.dermis)])
+    }
+}
