@@ -86,3 +86,28 @@ fn layered_targets_reject_bad_input() {
         assert!(err.contains(needle), "{args:?}: message should name {needle}: {err}");
     }
 }
+
+#[test]
+fn profile_of_physiological_skin_darkens_with_melanin() {
+    let total = |cm: &str| -> Vec<f64> {
+        let v = json(&rtbake(&[
+            "profile",
+            "--skin-melanin",
+            cm,
+            "--skin-hemoglobin",
+            "0.05",
+            "--radii",
+            "0,0.5,2",
+            "--json",
+        ]));
+        serde_json::from_value(v["total_R"].clone()).unwrap()
+    };
+    let light = total("0.01");
+    let dark = total("0.3");
+    for c in 0..3 {
+        assert!(light[c] > 0.0 && light[c] < 1.0, "{light:?}");
+        assert!(dark[c] < light[c], "melanin must darken every channel: {light:?} -> {dark:?}");
+    }
+    // Red is the least absorbed channel of skin.
+    assert!(light[0] > light[2], "{light:?}");
+}

@@ -35,7 +35,7 @@ pub enum AddingArg {
 }
 
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["material", "profile_preset", "layers"])))]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["material", "profile_preset", "layers", "skin_melanin"])))]
 pub struct ProfileArgs {
     /// Jensen 2001 measured material (apple, chicken1, chicken2, cream, ketchup, marble, potato, skimmilk, skin1,
     /// skin2, wholemilk); eta = 1.3.
@@ -54,7 +54,15 @@ pub struct ProfileArgs {
     /// [{"thickness_mm": .., "eta": .., "sigma_a": [r,g,b], "sigma_s_prime": [r,g,b]}, ...]}.
     #[arg(long, value_name = "FILE")]
     layers: Option<PathBuf>,
-    /// How layers are combined (--layers only).
+    /// Physiological two-layer skin (Donner & Jensen 2006 coefficients, `skin-color.md`; epidermis 0.25 mm over
+    /// dermis 20 mm, eta 1.4) with melanin volume fraction Cm in 0..=0.5 (needs --skin-hemoglobin). Per-channel
+    /// coefficients are D65 x linear-sRGB-sensitivity weighted spectral means.
+    #[arg(long, value_name = "CM", requires = "skin_hemoglobin")]
+    skin_melanin: Option<f64>,
+    /// Dermal hemoglobin volume fraction Chd in 0..=0.32 for --skin-melanin.
+    #[arg(long, value_name = "CHD", requires = "skin_melanin")]
+    skin_hemoglobin: Option<f64>,
+    /// How layers are combined (--layers and --skin-* only).
     #[arg(long, value_enum, default_value = "symmetric")]
     adding: AddingArg,
     /// Sum image pairs i = -N..N instead of the exact infinite series (multipole and --layers only; N in 0..=10000;
@@ -114,7 +122,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     let series = args.dipole_pairs.map(|pairs| Series::Truncated { pairs }).unwrap_or_default();
-    let layered = args.layers.is_some();
+    let layered = args.layers.is_some() || args.skin_melanin.is_some();
     let multipole = args.material.is_some() && matches!(args.model, ModelArg::Multipole);
     if args.dipole_pairs.is_some() && !(layered || multipole) {
         return Err(usage_msg("--dipole-pairs applies only to --model multipole and --layers"));
@@ -139,6 +147,16 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
         let stack = LayerStack::from_json_str(&text).map_err(|e| flag_error(e, Some(path)))?;
+        let adding = match args.adding {
+            AddingArg::Symmetric => Adding::Symmetric,
+            AddingArg::Directional => Adding::Directional,
+        };
+        ProfileSource::Layers { stack, adding, series, fdr }
+    } else if let (Some(cm), Some(chd)) = (args.skin_melanin, args.skin_hemoglobin) {
+        use rtbake::spectral::skin_layers::{two_layer_skin_rgb, RgbReduction, SkinPhysiology};
+        let skin = two_layer_skin_rgb(&SkinPhysiology::default(), cm, chd, false, &RgbReduction::default())
+            .map_err(|e| usage(anyhow::anyhow!("--skin-melanin/--skin-hemoglobin: {e}")))?;
+        let stack = skin.layer_stack().map_err(|e| usage(anyhow::anyhow!("physiological skin: {e}")))?;
         let adding = match args.adding {
             AddingArg::Symmetric => Adding::Symmetric,
             AddingArg::Directional => Adding::Directional,
