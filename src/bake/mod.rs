@@ -97,11 +97,11 @@ pub fn registry() -> Vec<Asset> {
 }
 
 pub mod aa;
+pub mod facial;
 pub mod gaussians;
 pub mod separable;
 pub mod skin;
 pub mod transmittance;
-pub mod facial;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
