@@ -311,6 +311,13 @@ pub struct BakedKernel {
 pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutError> {
     let manifest = Manifest::load(dir)?;
     let v = load_json(dir, &manifest, path)?;
+    separable_kernel_from_json(&v, path)
+}
+
+/// The content checks of [`load_separable_kernel`] on an already-parsed kernel file (`path` names it in errors);
+/// for kernel files outside a bake directory, which have no manifest entry to check against.
+pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<BakedKernel, LutError> {
+    let v = v.clone();
     let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
     if schema != crate::separable::kernel::JSON_SCHEMA {
         return Err(content(
