@@ -239,3 +239,38 @@ fn committed_skin_lut_is_256_square_linear_albedo() {
     let luts = loader::load_skin_luts(&baked(), loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH).unwrap();
     luts.validate().unwrap();
 }
+
+#[test]
+fn committed_hemoglobin_rig_loads_with_neutral_first() {
+    let r = loader::load_hemoglobin_rig(&baked(), loader::HEMOGLOBIN_RIG_PATH).unwrap();
+    assert_eq!(r.names[0], "neutral");
+    assert_eq!(r.rig.targets.len(), r.names.len());
+    assert_eq!((r.rig.width, r.rig.height), (32, 32));
+    assert_eq!((r.h0.width, r.h0.height), (128, 128));
+    // The neutral map has scale 1 (eq. 7.5: sigma_n / sigma_n).
+    assert!(r.rig.targets[0].iter().all(|sb| (sb[0] - 1.0).abs() < 1e-6));
+    let (lo, hi) = r.rig.targets.iter().flatten().fold((f32::MAX, f32::MIN), |(a, b), sb| (a.min(sb[1]), b.max(sb[1])));
+    let h0 = r.h0.data.iter().fold(0.0f32, |a, v| a.max(v.abs()));
+    eprintln!("bias range {lo}..{hi}, |H0| <= {h0}, global {:?}", r.global_scales);
+    assert!(lo >= 0.0 && hi <= 0.32 && h0 < 0.1);
+    // Bilinear H0 at a texel centre is that texel.
+    assert_eq!(r.h0_at(5.5 / 128.0, 7.5 / 128.0), r.h0.data[7 * 128 + 5]);
+}
+
+#[test]
+fn hemoglobin_rig_map_declared_srgb_or_corrupted_is_refused() {
+    let m = Manifest::load(&baked()).unwrap();
+    let paths: Vec<String> =
+        m.files.iter().filter(|e| e.path.starts_with("facial/hemoglobin/example/")).map(|e| e.path.clone()).collect();
+    let bias = "facial/hemoglobin/example/joy_bias.exr";
+    let i = paths.iter().position(|p| p == bias).unwrap();
+    let t = tempfile::tempdir().unwrap();
+    bake_dir(t.path(), files(&paths), |f| f[i].meta.color_space = "srgb".into());
+    let e = loader::load_hemoglobin_rig(t.path(), loader::HEMOGLOBIN_RIG_PATH).unwrap_err();
+    assert!(matches!(e, LutError::ColorSpace { .. }) && e.to_string().contains(bias), "{e}");
+    let t = tempfile::tempdir().unwrap();
+    bake_dir(t.path(), files(&paths), |_| {});
+    corrupt(t.path(), bias, 300);
+    let e = loader::load_hemoglobin_rig(t.path(), loader::HEMOGLOBIN_RIG_PATH).unwrap_err();
+    assert!(matches!(e, LutError::Checksum { .. }), "{e}");
+}

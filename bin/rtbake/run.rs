@@ -297,6 +297,7 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         other => return Err(usage_msg(format!("--aa must be smaa, mlaa or none, got {other:?}"))),
     };
     let assets = DemoAssets::load(&d.common.baked).map_err(usage)?;
+    ctx.info(format!("hemoglobin rig: {}", assets.rig_source));
     let method = match d.sss {
         Method::Separable => SssMethod::Separable,
         Method::Gaussians => SssMethod::Gaussians,

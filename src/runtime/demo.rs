@@ -4,9 +4,10 @@
 //! stage runs on the GPU passes, or on their CPU references when no device is given. No input images.
 //!
 //! Every table comes from the bake directory through the manifest-checked [`super::loader`]: the skin colour
-//! LUT, T(s), the separable kernel and the sum-of-Gaussians fit ([`DemoAssets::load`]). The hemoglobin rig is
-//! the one input still synthetic ([`synthetic_rig`], two targets at 16×16): the baked rig (`facial/…`, JSON +
-//! scale/bias EXRs) plugs in as a [`HemoglobinRig`] in [`DemoAssets::rig`].
+//! LUT, T(s), the separable kernel, the sum-of-Gaussians fit and the example hemoglobin rig with its H0
+//! ([`DemoAssets::load`]). The rig and H0 cover the frame (screen uv ∈ [0, 1]², as the pass samples them); the
+//! weights blend neutral with joy. A bake without the rig falls back to [`synthetic_rig`] (two targets at 16×16)
+//! with a procedural H0, and [`DemoAssets::rig_source`] says so.
 
 use super::chain::{self, Antialiasing};
 use super::cpu;
@@ -37,6 +38,12 @@ pub struct DemoAssets {
     pub blurs: GaussianBlurs,
     pub gaussian_params: GaussianSssParams,
     pub rig: HemoglobinRig,
+    /// One weight per rig target (eq. 7.6), summing to 1.
+    pub rig_weights: Vec<f32>,
+    /// The baked rig with its H0, when the bake has one.
+    pub baked_rig: Option<loader::BakedRig>,
+    /// Where the rig came from, for the command's report.
+    pub rig_source: String,
 }
 
 impl DemoAssets {
@@ -51,7 +58,30 @@ impl DemoAssets {
         let k = loader::load_separable_kernel(dir, kernel_path)?;
         let g = loader::load_gaussians(dir, loader::GAUSSIANS_PATH)?;
         let sss = SssParams { sss_width: k.sss_width.unwrap_or(SssParams::default().sss_width), ..Default::default() };
-        Ok(Self { luts, kernel: k.kernel, sss, blurs: g.blurs, gaussian_params: g.params, rig: synthetic_rig() })
+        let listed = crate::manifest::Manifest::load(dir)?.entry(loader::HEMOGLOBIN_RIG_PATH).is_some();
+        let (rig, rig_weights, baked_rig, rig_source) = if listed {
+            let b = loader::load_hemoglobin_rig(dir, loader::HEMOGLOBIN_RIG_PATH)?;
+            // 60 % neutral, 40 % joy (or the second target) — a mild flush.
+            let mut wts = vec![0.0f32; b.rig.targets.len()];
+            let joy = b.names.iter().position(|n| n == "joy").unwrap_or(wts.len() - 1);
+            wts[0] = 0.6;
+            wts[joy] += 0.4;
+            (b.rig.clone(), wts, Some(b), format!("baked {}", loader::HEMOGLOBIN_RIG_PATH))
+        } else {
+            let src = format!("synthetic (no {} in the bake)", loader::HEMOGLOBIN_RIG_PATH);
+            (synthetic_rig(), vec![0.4, 0.6], None, src)
+        };
+        Ok(Self {
+            luts,
+            kernel: k.kernel,
+            sss,
+            blurs: g.blurs,
+            gaussian_params: g.params,
+            rig,
+            rig_weights,
+            baked_rig,
+            rig_source,
+        })
     }
 }
 
@@ -78,7 +108,7 @@ struct Geometry {
 /// Spheres as (centre x, centre y in units of the frame height, radius, depth of the centre).
 const SPHERES: [(f32, f32, f32, f32); 3] = [(0.5, 0.5, 0.32, 4.0), (0.16, 0.72, 0.12, 5.0), (0.84, 0.3, 0.1, 3.5)];
 
-fn geometry(w: u32, h: u32) -> Geometry {
+fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
     let n = (w * h) as usize;
     let mut g = Geometry {
         frame: SkinFrame {
@@ -109,8 +139,11 @@ fn geometry(w: u32, h: u32) -> Geometry {
                     g.frame.normals[i] = [dx / r, -dy / r, z];
                     // Fair, dark and medium skin (the LUT darkens quickly: Cm = 0.035 is already tanned).
                     g.frame.melanin[i] = [0.008, 0.12, 0.035][k];
-                    // Pore-scale variation of the mean-free neutral hemoglobin.
-                    g.frame.h0[i] = 0.006 * ((x as f32 * 0.9).sin() * (y as f32 * 0.7).cos());
+                    // Mean-free neutral hemoglobin: the baked H0 at the screen uv, else a pore-scale pattern.
+                    g.frame.h0[i] = match rig {
+                        Some(r) => r.h0_at((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / hf),
+                        None => 0.006 * ((x as f32 * 0.9).sin() * (y as f32 * 0.7).cos()),
+                    };
                     // Thin at the rim (ears, nose in a head), thick in the middle.
                     g.frame.thickness_mm[i] = 0.3 + 6.0 * z;
                 }
@@ -130,15 +163,15 @@ pub fn render(
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
     crate::error::check_size("--width/--height", w as u64, h as u64)?;
-    let geo = geometry(w, h);
+    let geo = geometry(w, h, assets.baked_rig.as_ref());
     let (luts, rig, kernel, params) = (&assets.luts, &assets.rig, &assets.kernel, &assets.sss);
-    let weights = [0.4f32, 0.6];
+    let weights = &assets.rig_weights;
     let key = normalise([-0.5, 0.6, 0.62]);
     let back = normalise([0.3, 0.2, -0.93]);
     let (albedo, transmitted) = match gpu {
         Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?
-            .run(&g.device, &g.queue, &geo.frame, &weights, back)?,
-        None => cpu::skin_inputs::skin_inputs(&geo.frame, luts, rig, &weights, back),
+            .run(&g.device, &g.queue, &geo.frame, weights, back)?,
+        None => cpu::skin_inputs::skin_inputs(&geo.frame, luts, rig, weights, back),
     };
     // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let n = (w * h) as usize;

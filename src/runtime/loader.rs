@@ -26,6 +26,9 @@ pub const TRANSMITTANCE_PATH: &str = "transmittance/deon6_published.exr";
 /// Skin colour LUT in `baked/` (EXR f32, RGB, melanin × hemoglobin); sidecar: same stem, `.json`.
 pub const SKIN_LUT_PATH: &str = "skin/skin_color_lut.exr";
 
+/// Example hemoglobin rig in `baked/` (schema `rtbake-hemoglobin-rig/1`; scale/bias EXRs and H0 beside it).
+pub const HEMOGLOBIN_RIG_PATH: &str = "facial/hemoglobin/example/rig.json";
+
 /// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
 pub fn sidecar_path(exr_path: &str) -> String {
     match exr_path.strip_suffix(".exr") {
@@ -493,4 +496,86 @@ pub fn load_skin_luts(
         transmittance: t.values,
         s_max_mm: t.s_max_mm,
     })
+}
+
+/// A baked hemoglobin rig (eq. 7.6): the per-target (scale, bias) maps the pass takes and the full-resolution H0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedRig {
+    /// Targets in the file's order (`maps[0]` = neutral).
+    pub rig: crate::runtime::skin_inputs::HemoglobinRig,
+    /// Target names, same order.
+    pub names: Vec<String>,
+    /// Mean-free neutral hemoglobin H0 (eq. 7.4), `full_size`, top row first.
+    pub h0: crate::image_buf::Image<f32>,
+    /// Global state factors g of eq. 7.6 by target name (e.g. anger 1.27).
+    pub global_scales: Vec<(String, f64)>,
+}
+
+impl BakedRig {
+    /// H0 sampled bilinearly (clamp to edge) at texture coordinates (u, v) ∈ [0, 1]², texel centres at
+    /// (i + 0.5)/size, as the rig's `sampling` field states.
+    pub fn h0_at(&self, u: f32, v: f32) -> f32 {
+        let (w, h) = (self.h0.width as i64, self.h0.height as i64);
+        let (x, y) = (u * w as f32 - 0.5, v * h as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |i: i64, j: i64| self.h0.data[(j.clamp(0, h - 1) * w + i.clamp(0, w - 1)) as usize];
+        let (i, j) = (x0 as i64, y0 as i64);
+        let top = at(i, j) + (at(i + 1, j) - at(i, j)) * fx;
+        let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * fx;
+        top + (bottom - top) * fy
+    }
+}
+
+/// Loads a hemoglobin rig (`rtbake-hemoglobin-rig/1`) and every map it names (paths relative to the rig file's
+/// folder), each through the manifest checks: single-channel f32 EXRs, scale/bias at `rig_size`, H0 at
+/// `full_size`. Refuses more targets than the pass holds ([`crate::runtime::skin_inputs::MAX_RIG_TARGETS`]), a
+/// first map that is not the neutral one, and values outside the dermal-hemoglobin range the skin LUT indexes.
+pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError> {
+    use crate::runtime::skin_inputs::{HemoglobinRig, MAX_RIG_TARGETS};
+    let manifest = Manifest::load(dir)?;
+    let v = load_json(dir, &manifest, path)?;
+    let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
+    if schema != "rtbake-hemoglobin-rig/1" {
+        return Err(content(path, format!("schema {schema:?}, the runtime reads \"rtbake-hemoglobin-rig/1\"")));
+    }
+    let folder = path.rsplit_once('/').map(|(d, _)| format!("{d}/")).unwrap_or_default();
+    let [rw, rh]: [u32; 2] = field_as(&v, path, "rig_size")?;
+    let [fw, fh]: [u32; 2] = field_as(&v, path, "full_size")?;
+    let maps: Vec<serde_json::Value> = field_as(&v, path, "maps")?;
+    if maps.is_empty() || maps.len() > MAX_RIG_TARGETS {
+        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", maps.len())));
+    }
+    let map1 = |file: &str, (w, h): (u32, u32)| -> Result<Vec<f32>, LutError> {
+        let p = format!("{folder}{file}");
+        let img = load_exr_f32(dir, &manifest, &p, 1, (1, 1))?;
+        if (img.width, img.height) != (w, h) {
+            return Err(content(&p, format!("{}x{}, the rig says {w}x{h}", img.width, img.height)));
+        }
+        Ok(img.data)
+    };
+    let (mut targets, mut names) = (Vec::new(), Vec::new());
+    for (i, m) in maps.iter().enumerate() {
+        let name: String = field_as(m, path, "name")?;
+        if i == 0 && name != "neutral" {
+            return Err(content(path, format!("maps[0] is {name:?}; eq. 7.6 needs the neutral map first")));
+        }
+        let scale = map1(&field_as::<String>(m, path, "scale_exr")?, (rw, rh))?;
+        let bias = map1(&field_as::<String>(m, path, "bias_exr")?, (rw, rh))?;
+        if let Some(b) = bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
+            return Err(content(
+                path,
+                format!("{name}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)"),
+            ));
+        }
+        targets.push(scale.into_iter().zip(bias).map(|(s, b)| [s, b]).collect());
+        names.push(name);
+    }
+    let h0_file: String = field_as(&v, path, "h0.exr")?;
+    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&h0_file, (fw, fh))?);
+    let global: serde_json::Map<String, serde_json::Value> = field_as(&v, path, "global_scales")?;
+    let global_scales = global.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
+    let rig = HemoglobinRig { width: rw, height: rh, targets };
+    rig.validate().map_err(|e| content(path, e.to_string()))?;
+    Ok(BakedRig { rig, names, h0, global_scales })
 }
