@@ -211,7 +211,7 @@ fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
 fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::BakedKernel> {
     let listed = rtbake::manifest::Manifest::load(baked).ok().is_some_and(|m| m.entry(kernel).is_some());
     if listed {
-        return Ok(loader::load_separable_kernel(baked, kernel).map_err(usage)?);
+        return loader::load_separable_kernel(baked, kernel).map_err(usage);
     }
     let path = Path::new(kernel);
     if !path.is_file() {
@@ -224,7 +224,7 @@ fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::
     let text = std::fs::read_to_string(path).map_err(|e| usage(anyhow::anyhow!("--kernel {kernel}: {e}")))?;
     let v: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| usage(anyhow::anyhow!("--kernel {kernel}: not valid JSON: {e}")))?;
-    Ok(loader::separable_kernel_from_json(&v, kernel).map_err(usage)?)
+    loader::separable_kernel_from_json(&v, kernel).map_err(usage)
 }
 
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {

@@ -384,12 +384,9 @@ pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError
     let fit = crate::diffusion::sum_of_gaussians::SumOfGaussians { variances_mm2, weights };
     let blurs = GaussianBlurs::from_sum_of_gaussians(&fit).map_err(|e| content(path, e.to_string()))?;
     for i in 0..n {
-        for c in 0..3 {
-            if (blurs.blend[i][c] as f64 - blend[i][c]).abs() > 1e-6 {
-                return Err(content(
-                    path,
-                    format!("blend_weights[{i}][{c}] = {} but eq. 4.8 gives {}", blend[i][c], blurs.blend[i][c]),
-                ));
+        for (c, (&got, &recorded)) in blurs.blend[i].iter().zip(&blend[i]).enumerate() {
+            if (got as f64 - recorded).abs() > 1e-6 {
+                return Err(content(path, format!("blend_weights[{i}][{c}] = {recorded} but eq. 4.8 gives {got}")));
             }
         }
         let inc = (blurs.incremental_sigma_mm[i] as f64).powi(2);
