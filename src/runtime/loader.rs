@@ -6,6 +6,14 @@
 //! quietly disable SMAA — bevy #21425); file size = width·height·bytes per texel; sha256 as recorded. Any
 //! mismatch is a [`LutError`] naming the file, the property, what was expected and what was found.
 //!
+//! The float and JSON tables get the same manifest checks and then content checks, each in a typed loader:
+//! [`load_separable_kernel`] (schema, tap count = `samples`, centre first, channels sum to 1, step divisor 3),
+//! [`load_gaussians`] (shared variances, recorded w′ᵢ and incremental variances = eq. 4.8 / vᵢ − vᵢ₋₁),
+//! [`load_transmittance`] and [`load_skin_lut`] (EXR f32, decoded size/channels/precision = declared, sidecar
+//! JSON consistent: node-inclusive T(s) with T(0) = 1; LUT index ranges 0.5 / 0.32), [`load_hemoglobin_rig`]
+//! (every scale/bias map and H0 of the rig JSON). JSON files may declare colour space `n/a`; texel data must be
+//! `linear`; non-raw files must also have the manifest's `size_bytes`.
+//!
 //! The paths of the baked files are the constants below — the one place to change when the bake layout moves.
 
 use crate::io::PixelFormat;
