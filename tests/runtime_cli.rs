@@ -366,3 +366,31 @@ fn sss_reads_baked_kernels_and_gaussians() {
         assert!(!op.exists());
     }
 }
+
+/// `--rig-weights` blends the baked rig's targets; unknown names or weights not summing to 1 exit 2.
+#[test]
+fn demo_rig_weights_from_json() {
+    let t = tempfile::tempdir().unwrap();
+    let weights = t.path().join("w.json");
+    let demo = |out: &Path, w: Option<&str>| {
+        let mut args = vec!["run", "demo", "--output", out.to_str().unwrap(), "--width", "128", "--height", "72"];
+        args.push("--cpu");
+        if let Some(w) = w {
+            std::fs::write(&weights, w).unwrap();
+            args.extend(["--rig-weights", weights.to_str().unwrap()]);
+        }
+        Command::new(env!("CARGO_BIN_EXE_rtbake")).current_dir(env!("CARGO_MANIFEST_DIR")).args(&args).output().unwrap()
+    };
+    let (a, b) = (t.path().join("neutral.png"), t.path().join("anger.png"));
+    assert!(demo(&a, Some(r#"{"neutral": 1.0}"#)).status.success());
+    assert!(demo(&b, Some(r#"{"neutral": 0.2, "anger": 0.8}"#)).status.success());
+    assert_ne!(read_rgba(&a), read_rgba(&b), "the rig weights must change the skin colour");
+    for (w, needle) in [(r#"{"smile": 1.0}"#, "unknown target"), (r#"{"neutral": 0.5}"#, "sum to 1")] {
+        let out = t.path().join("bad.png");
+        let o = demo(&out, Some(w));
+        assert_eq!(o.status.code(), Some(2), "{w}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("--rig-weights") && err.contains(needle), "{w}: {err}");
+        assert!(!out.exists());
+    }
+}

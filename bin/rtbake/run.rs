@@ -115,6 +115,10 @@ pub struct DemoArgs {
     /// SSS pass of the demo: separable (baked kernel) or gaussians (baked sum-of-Gaussians fit).
     #[arg(long, value_enum, default_value = "separable")]
     sss: Method,
+    /// Hemoglobin rig weights (eq. 7.6): JSON file {"target name": weight, ...} summing to 1 (default: neutral 0.6,
+    /// joy 0.4 with the baked example rig).
+    #[arg(long, value_name = "JSON")]
+    rig_weights: Option<PathBuf>,
     #[command(flatten)]
     common: Common,
 }
@@ -296,7 +300,14 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         "none" => None,
         other => return Err(usage_msg(format!("--aa must be smaa, mlaa or none, got {other:?}"))),
     };
-    let assets = DemoAssets::load(&d.common.baked).map_err(usage)?;
+    let mut assets = DemoAssets::load(&d.common.baked).map_err(usage)?;
+    if let Some(p) = &d.rig_weights {
+        let text =
+            std::fs::read_to_string(p).map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: {e}", p.display())))?;
+        let v: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: not valid JSON: {e}", p.display())))?;
+        assets.set_rig_weights(&v)?;
+    }
     ctx.info(format!("hemoglobin rig: {}", assets.rig_source));
     let method = match d.sss {
         Method::Separable => SssMethod::Separable,

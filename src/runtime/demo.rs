@@ -17,6 +17,7 @@ use super::loader::{self, LutError};
 use super::separable_sss::{SeparableSss, SssKernel, SssParams};
 use super::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
 use super::RuntimeError;
+use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use std::path::Path;
 
@@ -40,6 +41,8 @@ pub struct DemoAssets {
     pub rig: HemoglobinRig,
     /// One weight per rig target (eq. 7.6), summing to 1.
     pub rig_weights: Vec<f32>,
+    /// Target names, same order as the weights.
+    pub rig_names: Vec<String>,
     /// The baked rig with its H0, when the bake has one.
     pub baked_rig: Option<loader::BakedRig>,
     /// Where the rig came from, for the command's report.
@@ -59,17 +62,18 @@ impl DemoAssets {
         let g = loader::load_gaussians(dir, loader::GAUSSIANS_PATH)?;
         let sss = SssParams { sss_width: k.sss_width.unwrap_or(SssParams::default().sss_width), ..Default::default() };
         let listed = crate::manifest::Manifest::load(dir)?.entry(loader::HEMOGLOBIN_RIG_PATH).is_some();
-        let (rig, rig_weights, baked_rig, rig_source) = if listed {
+        let (rig, rig_weights, rig_names, baked_rig, rig_source) = if listed {
             let b = loader::load_hemoglobin_rig(dir, loader::HEMOGLOBIN_RIG_PATH)?;
             // 60 % neutral, 40 % joy (or the second target) — a mild flush.
             let mut wts = vec![0.0f32; b.rig.targets.len()];
             let joy = b.names.iter().position(|n| n == "joy").unwrap_or(wts.len() - 1);
             wts[0] = 0.6;
             wts[joy] += 0.4;
-            (b.rig.clone(), wts, Some(b), format!("baked {}", loader::HEMOGLOBIN_RIG_PATH))
+            let names = b.names.clone();
+            (b.rig.clone(), wts, names, Some(b), format!("baked {}", loader::HEMOGLOBIN_RIG_PATH))
         } else {
             let src = format!("synthetic (no {} in the bake)", loader::HEMOGLOBIN_RIG_PATH);
-            (synthetic_rig(), vec![0.4, 0.6], None, src)
+            (synthetic_rig(), vec![0.4, 0.6], vec!["neutral".into(), "blush".into()], None, src)
         };
         Ok(Self {
             luts,
@@ -79,9 +83,38 @@ impl DemoAssets {
             gaussian_params: g.params,
             rig,
             rig_weights,
+            rig_names,
             baked_rig,
             rig_source,
         })
+    }
+}
+
+impl DemoAssets {
+    /// Sets the rig weights from a JSON object `{"target name": weight, …}` (`--rig-weights`): every name must
+    /// be a target of the rig, weights finite, and their sum 1 ± 1e-3 (eq. 7.6 blends the targets); targets not
+    /// named get 0.
+    pub fn set_rig_weights(&mut self, json: &serde_json::Value) -> Result<(), InvalidInput> {
+        let param = "--rig-weights";
+        let obj = json.as_object().ok_or_else(|| {
+            InvalidInput::new(param, "must be a JSON object {\"target name\": weight, ...}".to_string())
+        })?;
+        let mut w = vec![0.0f32; self.rig_names.len()];
+        for (name, v) in obj {
+            let i = self.rig_names.iter().position(|n| n == name).ok_or_else(|| {
+                InvalidInput::new(param, format!("unknown target {name:?}; the rig has {:?}", self.rig_names))
+            })?;
+            let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                InvalidInput::new(param, format!("weight of {name:?} must be a finite number, got {v}"))
+            })?;
+            w[i] = x as f32;
+        }
+        let sum: f32 = w.iter().sum();
+        if (sum - 1.0).abs() > 1e-3 {
+            return Err(InvalidInput::new(param, format!("weights must sum to 1 (eq. 7.6), got {sum}")));
+        }
+        self.rig_weights = w;
+        Ok(())
     }
 }
 
