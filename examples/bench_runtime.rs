@@ -6,18 +6,18 @@
 //! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
 //! rasteriser (lavapipe/llvmpipe) are CPU figures, not GPU figures. Thesis anchors: SMAA 1x 1.02 ms at 1080p
 //! (GTX 470); Jimenez MLAA 0.44 ms at 720p (9800 GTX+). CPU anchor: Reshetov's CPU MLAA, 350 ms; goal ≤ 100 ms.
-//! LUTs: the upstream golden textures from $RTBAKE_REFERENCE_DIR (default ../shared/reference).
+//! Tables: the committed bake (`baked/` beside the crate, or $RTBAKE_BAKED_DIR) through the manifest-checked
+//! loader: SMAA area/search, MLAA AreaMap33 v1.4, the published 17-tap separable kernel, d'Eon's 6 Gaussians.
 
-use rtbake::diffusion::sum_of_gaussians::deon6;
 use rtbake::runtime::cpu::{self, FilterPrecision, Tex8};
-use rtbake::runtime::demo::standin_kernel;
 use rtbake::runtime::device::{create_headless, DeviceOptions};
-use rtbake::runtime::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use rtbake::runtime::gaussian_sss::GaussianSss;
 use rtbake::runtime::gpu::GpuTimer;
+use rtbake::runtime::loader;
 use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
 use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
-use rtbake::runtime::smaa::{Smaa, SmaaTextures};
+use rtbake::runtime::smaa::Smaa;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -28,11 +28,10 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn reference(rel: &str) -> Vec<u8> {
-    let dir = std::env::var_os("RTBAKE_REFERENCE_DIR")
+fn baked_dir() -> PathBuf {
+    std::env::var_os("RTBAKE_BAKED_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"));
-    std::fs::read(dir.join(rel)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(rel).display()))
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"))
 }
 
 type Encode<'a> = dyn Fn(&mut wgpu::CommandEncoder, Option<(&GpuTimer, u32)>) + 'a;
@@ -70,10 +69,12 @@ fn main() {
     let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
     println!("adapter: {}", g.describe());
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
-    let luts =
-        SmaaTextures::new(reference("smaa/AreaTex_RG8_160x560.bin"), reference("smaa/SearchTex_R8_64x16.bin")).unwrap();
+    let dir = baked_dir();
+    let luts = loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"));
     let n = 33;
-    let map = MlaaAreaMap::new(n, reference(&format!("mlaa/AreaMap{n}_v1.4_RG8_165x165.bin"))).unwrap();
+    let map = MlaaAreaMap::new(n, loader::load_mlaa_area(&dir, n).unwrap_or_else(|e| panic!("{e}"))).unwrap();
+    let kernel = loader::load_separable_kernel(&dir, loader::SEPARABLE_KERNEL_PATH).unwrap_or_else(|e| panic!("{e}"));
+    let fit = loader::load_gaussians(&dir, loader::GAUSSIANS_PATH).unwrap_or_else(|e| panic!("{e}"));
     println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
     for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
         let img = render_shapes(w, h, 1);
@@ -87,12 +88,11 @@ fn main() {
         print_line(&format!("MLAA N={n} {w}x{h}"), &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
         // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
         let (color, depth) = sss_frame(w, h);
-        let sss = SeparableSss::new(&g.device, w, h, &standin_kernel(), &SssParams::default()).unwrap();
+        let sss = SeparableSss::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
         sss.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, 2, &|e, t| sss.encode(e, t));
         print_sum(&format!("separable SSS 17 taps {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
-        let blurs = GaussianBlurs::from_sum_of_gaussians(&deon6()).unwrap();
-        let gs = GaussianSss::new(&g.device, w, h, &blurs, &GaussianSssParams::default()).unwrap();
+        let gs = GaussianSss::new(&g.device, w, h, &fit.blurs, &fit.params).unwrap();
         gs.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, gs.passes(), &|e, t| gs.encode(e, t));
         print_sum(&format!("sum-of-Gaussians SSS (deon6) {w}x{h}"), &pp, wall, "thesis 3.07 ms @1080p GTX 580");

@@ -2,50 +2,60 @@
 
 mod runtime_support;
 
-use rtbake::bake::{BakedFile, FileMeta};
+use rtbake::bake::BakedFile;
 use rtbake::image_buf::Image;
-use rtbake::io::PixelFormat;
 use rtbake::manifest::Manifest;
 use rtbake::runtime::loader;
 use runtime_support::*;
 use std::path::Path;
 use std::process::Command;
 
-fn lut(path: &str, bytes: Vec<u8>, pf: PixelFormat, w: u32, h: u32, color_space: &str) -> BakedFile {
-    BakedFile {
-        path: path.into(),
-        bytes,
-        meta: FileMeta {
-            kind: "lut".into(),
-            format: "raw".into(),
-            pixel_format: Some(pf),
-            width: w,
-            height: h,
-            channels: pf.channels(),
-            sample_type: "u8".into(),
-            color_space: color_space.into(),
-            convention: "test".into(),
-            verify_tolerance: None,
-        },
-    }
+/// Committed files of `baked/` with their committed manifest metadata.
+fn committed(paths: &[&str]) -> Vec<BakedFile> {
+    let m = Manifest::load(&baked_dir()).unwrap();
+    paths
+        .iter()
+        .map(|p| BakedFile {
+            path: p.to_string(),
+            bytes: std::fs::read(baked_dir().join(p)).unwrap(),
+            meta: m.entry(p).unwrap_or_else(|| panic!("{p} not in baked/manifest.json")).meta.clone(),
+        })
+        .collect()
 }
 
-/// A bake directory holding the golden SMAA textures and the N = 9 MLAA map, with a manifest.
-fn golden_bake(dir: &Path, area_color_space: &str) {
-    let s = golden_smaa();
-    let files = vec![
-        lut(loader::SMAA_AREA_PATH, s.area, PixelFormat::R8G8Unorm, 160, 560, area_color_space),
-        lut(loader::SMAA_SEARCH_PATH, s.search, PixelFormat::R8Unorm, 64, 16, "linear"),
-        lut(&loader::mlaa_area_path(9), golden_mlaa(9), PixelFormat::R8G8Unorm, 45, 45, "linear"),
-    ];
+fn write_bake(dir: &Path, files: &[BakedFile]) {
     let mut m = Manifest::new("test".into());
-    m.set_asset("aa", serde_json::json!({}), &files);
-    for f in &files {
+    m.set_asset("test", serde_json::json!({}), files);
+    for f in files {
         let p = dir.join(&f.path);
         std::fs::create_dir_all(p.parent().unwrap()).unwrap();
         std::fs::write(p, &f.bytes).unwrap();
     }
     std::fs::write(dir.join("manifest.json"), m.to_text()).unwrap();
+}
+
+/// Every table the demo and the passes read, copied from the committed bake.
+fn demo_tables() -> Vec<String> {
+    vec![
+        loader::SMAA_AREA_PATH.into(),
+        loader::SMAA_SEARCH_PATH.into(),
+        loader::mlaa_area_path(9),
+        loader::mlaa_area_path(33),
+        loader::SEPARABLE_KERNEL_PATH.into(),
+        loader::GAUSSIANS_PATH.into(),
+        loader::TRANSMITTANCE_PATH.into(),
+        loader::sidecar_path(loader::TRANSMITTANCE_PATH),
+        loader::SKIN_LUT_PATH.into(),
+        loader::sidecar_path(loader::SKIN_LUT_PATH),
+    ]
+}
+
+/// A bake directory holding copies of the committed tables, the SMAA area texture declared `area_color_space`.
+fn copied_bake(dir: &Path, area_color_space: &str) {
+    let paths = demo_tables();
+    let mut files = committed(&paths.iter().map(String::as_str).collect::<Vec<_>>());
+    files[0].meta.color_space = area_color_space.into();
+    write_bake(dir, &files);
 }
 
 fn rtbake(args: &[&str]) -> std::process::Output {
@@ -65,7 +75,7 @@ fn read_rgba(p: &Path) -> Vec<u8> {
 #[test]
 fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
     let t = tempfile::tempdir().unwrap();
-    golden_bake(t.path(), "linear");
+    copied_bake(t.path(), "linear");
     let (w, h) = (160, 120);
     let input = Image::from_vec(w, h, 4, rtbake::runtime::scene::render_shapes(w, h, 1));
     let inp = t.path().join("in.png");
@@ -80,7 +90,7 @@ fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
         }
         for (out, cpu) in [(&gpu_out, false), (&cpu_out, true)] {
             let mut args = vec!["run", pass, "--input", inp.to_str().unwrap(), "--output", out.to_str().unwrap()];
-            args.extend(["--baked", baked]);
+            args.extend(["--baked-dir", baked]);
             args.extend(&extra);
             if cpu {
                 args.push("--cpu");
@@ -98,7 +108,7 @@ fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
 #[test]
 fn demo_writes_a_png() {
     let t = tempfile::tempdir().unwrap();
-    golden_bake(t.path(), "linear");
+    copied_bake(t.path(), "linear");
     let out = t.path().join("demo.png");
     let o = rtbake(&[
         "run",
@@ -109,7 +119,7 @@ fn demo_writes_a_png() {
         "320",
         "--height",
         "180",
-        "--baked",
+        "--baked-dir",
         t.path().to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -119,12 +129,12 @@ fn demo_writes_a_png() {
 #[test]
 fn bad_input_exits_2_and_writes_nothing() {
     let t = tempfile::tempdir().unwrap();
-    golden_bake(t.path(), "linear");
+    copied_bake(t.path(), "linear");
     let baked = t.path().to_str().unwrap();
     let out = t.path().join("out.png");
     let outs = out.to_str().unwrap();
     // Missing input file.
-    let o = rtbake(&["run", "smaa", "--input", "/nonexistent.png", "--output", outs, "--baked", baked]);
+    let o = rtbake(&["run", "smaa", "--input", "/nonexistent.png", "--output", outs, "--baked-dir", baked]);
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--input"));
     // Even max distance.
@@ -137,7 +147,7 @@ fn bad_input_exits_2_and_writes_nothing() {
         inp.to_str().unwrap(),
         "--output",
         outs,
-        "--baked",
+        "--baked-dir",
         baked,
         "--max-distance",
         "8",
@@ -152,7 +162,7 @@ fn bad_input_exits_2_and_writes_nothing() {
         inp.to_str().unwrap(),
         "--output",
         "/nonexistent/dir/o.png",
-        "--baked",
+        "--baked-dir",
         baked,
     ]);
     assert_eq!(o.status.code(), Some(2));
@@ -162,7 +172,7 @@ fn bad_input_exits_2_and_writes_nothing() {
 #[test]
 fn srgb_declared_lut_is_refused() {
     let t = tempfile::tempdir().unwrap();
-    golden_bake(t.path(), "srgb");
+    copied_bake(t.path(), "srgb");
     let inp = t.path().join("in.png");
     std::fs::write(&inp, rtbake::io::png::encode_u8(&Image::from_vec(4, 4, 4, vec![9u8; 64])).unwrap()).unwrap();
     let out = t.path().join("out.png");
@@ -186,12 +196,12 @@ fn srgb_declared_lut_is_refused() {
 #[test]
 fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
     let t = tempfile::tempdir().unwrap();
-    golden_bake(t.path(), "linear");
+    copied_bake(t.path(), "linear");
     let baked = t.path().to_str().unwrap();
     let (g, c) = (t.path().join("g.png"), t.path().join("c.png"));
     for (out, cpu) in [(&g, false), (&c, true)] {
         let mut args = vec!["run", "demo", "--output", out.to_str().unwrap(), "--width", "192", "--height", "108"];
-        args.extend(["--baked", baked]);
+        args.extend(["--baked-dir", baked]);
         if cpu {
             args.push("--cpu");
         }
@@ -246,4 +256,141 @@ fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--depth"));
+}
+
+/// From a clean checkout: `rtbake run demo --output demo.png` in the crate root reads the committed `baked/`.
+#[test]
+fn demo_runs_from_the_crate_root_with_the_committed_bake() {
+    let t = tempfile::tempdir().unwrap();
+    for (name, extra) in [("sep.png", vec![]), ("gauss.png", vec!["--sss", "gaussians", "--aa", "mlaa"])] {
+        let out = t.path().join(name);
+        let mut args = vec!["run", "demo", "--output", out.to_str().unwrap(), "--width", "256", "--height", "144"];
+        args.extend(extra);
+        let o = Command::new(env!("CARGO_BIN_EXE_rtbake"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));
+        let img = read_rgba(&out);
+        assert_eq!(img.len(), 256 * 144 * 4);
+        // The centre of the head sphere is lit skin: red > green > blue, not the background.
+        let c = &img[(72 * 256 + 128) * 4..][..3];
+        assert!(c[0] > c[1] && c[1] > c[2] && c[0] > 120, "{name}: centre pixel {c:?}");
+    }
+}
+
+#[test]
+fn demo_refuses_a_bake_without_the_skin_lut() {
+    let t = tempfile::tempdir().unwrap();
+    let paths: Vec<String> = demo_tables().into_iter().filter(|p| !p.starts_with("skin/")).collect();
+    write_bake(t.path(), &committed(&paths.iter().map(String::as_str).collect::<Vec<_>>()));
+    let out = t.path().join("demo.png");
+    let o = rtbake(&[
+        "run",
+        "demo",
+        "--output",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--cpu",
+        "--baked-dir",
+        t.path().to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("skin/skin_color_lut.exr") && err.contains("not listed"), "{err}");
+    assert!(!out.exists());
+}
+
+/// `run sss`: baked kernel by default, another kernel of the bake, a kernel file elsewhere, the Gaussian fit;
+/// a kernel declared sRGB or a missing kernel is refused with exit 2.
+#[test]
+fn sss_reads_baked_kernels_and_gaussians() {
+    let t = tempfile::tempdir().unwrap();
+    let mut files =
+        committed(&[loader::SEPARABLE_KERNEL_PATH, "sss/separable/published_n11.json", loader::GAUSSIANS_PATH]);
+    let mut srgb = files[1].clone();
+    srgb.path = "sss/separable/srgb.json".into();
+    srgb.meta.color_space = "srgb".into();
+    files.push(srgb);
+    let bake = t.path().join("bake");
+    write_bake(&bake, &files);
+    let (w, h) = (48u32, 32u32);
+    let color: Vec<f32> =
+        (0..w * h).flat_map(|i| [if (i % w) / 4 % 2 == 0 { 1.0 } else { 0.1 }, 0.5, 0.25, 1.0]).collect();
+    let enc = |img: &Image<f32>| rtbake::io::exr::encode(img, rtbake::io::exr::ExrPrecision::F32).unwrap();
+    let (cp, dp) = (t.path().join("c.exr"), t.path().join("d.exr"));
+    std::fs::write(&cp, enc(&Image::from_vec(w, h, 4, color))).unwrap();
+    std::fs::write(&dp, enc(&Image::from_vec(w, h, 1, vec![0.2f32; (w * h) as usize]))).unwrap();
+    let outside = t.path().join("kernel.json");
+    std::fs::copy(bake.join("sss/separable/published_n11.json"), &outside).unwrap();
+    let op = t.path().join("o.exr");
+    let run = |extra: &[&str]| {
+        let _ = std::fs::remove_file(&op);
+        let mut args = vec!["run", "sss", "--color", cp.to_str().unwrap(), "--depth", dp.to_str().unwrap()];
+        args.extend(["--output", op.to_str().unwrap(), "--cpu", "--baked-dir", bake.to_str().unwrap()]);
+        args.extend(extra);
+        rtbake(&args)
+    };
+    let red_range = || {
+        let (out, _) = rtbake::io::exr::decode(&std::fs::read(&op).unwrap(), "o").unwrap();
+        let reds: Vec<f32> = out.data.chunks(4).map(|p| p[0]).collect();
+        reds.iter().fold(f32::MIN, |a, v| a.max(*v)) - reds.iter().fold(f32::MAX, |a, v| a.min(*v))
+    };
+    let mut ranges = Vec::new();
+    for extra in [
+        vec![],
+        vec!["--kernel", "sss/separable/published_n11.json"],
+        vec!["--kernel", outside.to_str().unwrap()],
+        vec!["--method", "gaussians"],
+    ] {
+        let o = run(&extra);
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let r = red_range();
+        assert!(r < 0.85, "{extra:?}: SSS must blur the stripes (red range {r})");
+        ranges.push(r);
+    }
+    // The same kernel from the bake and from a file outside it gives the same image.
+    assert_eq!(ranges[1], ranges[2]);
+    for (extra, needle) in [
+        (vec!["--kernel", "sss/separable/srgb.json"], "colour space"),
+        (vec!["--kernel", "sss/separable/none.json"], "--kernel sss/separable/none.json"),
+    ] {
+        let o = run(&extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{extra:?}: {err}");
+        assert!(!op.exists());
+    }
+}
+
+/// `--rig-weights` blends the baked rig's targets; unknown names or weights not summing to 1 exit 2.
+#[test]
+fn demo_rig_weights_from_json() {
+    let t = tempfile::tempdir().unwrap();
+    let weights = t.path().join("w.json");
+    let demo = |out: &Path, w: Option<&str>| {
+        let mut args = vec!["run", "demo", "--output", out.to_str().unwrap(), "--width", "128", "--height", "72"];
+        args.push("--cpu");
+        if let Some(w) = w {
+            std::fs::write(&weights, w).unwrap();
+            args.extend(["--rig-weights", weights.to_str().unwrap()]);
+        }
+        Command::new(env!("CARGO_BIN_EXE_rtbake")).current_dir(env!("CARGO_MANIFEST_DIR")).args(&args).output().unwrap()
+    };
+    let (a, b) = (t.path().join("neutral.png"), t.path().join("anger.png"));
+    assert!(demo(&a, Some(r#"{"neutral": 1.0}"#)).status.success());
+    assert!(demo(&b, Some(r#"{"neutral": 0.2, "anger": 0.8}"#)).status.success());
+    assert_ne!(read_rgba(&a), read_rgba(&b), "the rig weights must change the skin colour");
+    for (w, needle) in [(r#"{"smile": 1.0}"#, "unknown target"), (r#"{"neutral": 0.5}"#, "sum to 1")] {
+        let out = t.path().join("bad.png");
+        let o = demo(&out, Some(w));
+        assert_eq!(o.status.code(), Some(2), "{w}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("--rig-weights") && err.contains(needle), "{w}: {err}");
+        assert!(!out.exists());
+    }
 }

@@ -1,4 +1,4 @@
-//! Jimenez MLAA: GPU vs CPU reference on the same inputs (golden v1.4 area maps), and a quality check.
+//! Jimenez MLAA: GPU vs CPU reference on the same inputs (rtbake's baked v1.4 area maps), and a quality check.
 
 mod runtime_support;
 
@@ -9,7 +9,7 @@ use runtime_support::*;
 
 fn gpu_vs_cpu(w: u32, h: u32, n: u32) {
     let g = gpu();
-    let map = MlaaAreaMap::new(n, golden_mlaa(n)).unwrap();
+    let map = MlaaAreaMap::new(n, baked_mlaa(n)).unwrap();
     let img = render_shapes(w, h, 1);
     let pass = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
     let out = pass.run(&g.device, &g.queue, &img).unwrap();
@@ -39,7 +39,7 @@ fn mlaa_gpu_matches_cpu_n33_odd_size() {
 fn mlaa_reduces_edge_error() {
     let (w, h) = (256, 256);
     let g = gpu();
-    let map = MlaaAreaMap::new(17, golden_mlaa(17)).unwrap();
+    let map = MlaaAreaMap::new(17, baked_mlaa(17)).unwrap();
     let aliased = render_shapes(w, h, 1);
     let truth = render_shapes(w, h, 4);
     let out = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap().run(&g.device, &g.queue, &aliased).unwrap();

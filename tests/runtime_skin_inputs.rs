@@ -46,13 +46,30 @@ fn frame(w: u32, h: u32) -> SkinFrame {
 
 #[test]
 fn skin_inputs_gpu_matches_cpu() {
+    gpu_matches_cpu(&luts(), &rig(), &[0.4, 0.6]);
+}
+
+/// The committed skin colour LUT (256×256), T(s) and example hemoglobin rig, through the loader.
+#[test]
+fn skin_inputs_gpu_matches_cpu_with_the_baked_tables() {
+    use rtbake::runtime::loader;
+    let dir = baked_dir();
+    let l = loader::load_skin_luts(&dir, loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH).unwrap();
+    let r = loader::load_hemoglobin_rig(&dir, loader::HEMOGLOBIN_RIG_PATH).unwrap();
+    let mut weights = vec![0.0f32; r.rig.targets.len()];
+    weights[0] = 0.5;
+    weights[1] = 0.5;
+    gpu_matches_cpu(&l, &r.rig, &weights);
+}
+
+fn gpu_matches_cpu(l: &SkinLuts, r: &HemoglobinRig, weights: &[f32]) {
     let (w, h) = (128, 96);
     let g = gpu();
-    let (l, r, f) = (luts(), rig(), frame(w, h));
-    let (weights, light) = ([0.4f32, 0.6], [0.0f32, 0.6, -0.8]);
-    let mut pass = SkinInputs::new(&g.device, &g.queue, w, h, &l, &r).unwrap();
-    let (ga, gt) = pass.run(&g.device, &g.queue, &f, &weights, light).unwrap();
-    let (ca, ct) = skin_inputs(&f, &l, &r, &weights, light);
+    let f = frame(w, h);
+    let light = [0.0f32, 0.6, -0.8];
+    let mut pass = SkinInputs::new(&g.device, &g.queue, w, h, l, r).unwrap();
+    let (ga, gt) = pass.run(&g.device, &g.queue, &f, weights, light).unwrap();
+    let (ca, ct) = skin_inputs(&f, l, r, weights, light);
     for (name, gv, cv) in [("albedo", &ga, &ca), ("transmitted", &gt, &ct)] {
         let bad = gv.iter().zip(cv).filter(|(a, b)| (*a - *b).abs() > 2e-3 + 2e-3 * b.abs()).count();
         let max = gv.iter().zip(cv).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);

@@ -1,5 +1,5 @@
 //! SMAA 1x: GPU vs CPU reference on the same inputs, and antialiasing quality against a 16× supersampled
-//! ground truth.
+//! ground truth. Textures: rtbake's own bake (`baked/`, through the manifest-checked loader).
 
 mod runtime_support;
 
@@ -10,7 +10,7 @@ use runtime_support::*;
 
 fn gpu_vs_cpu(w: u32, h: u32) {
     let g = gpu();
-    let luts = golden_smaa();
+    let luts = baked_smaa();
     let img = render_shapes(w, h, 1);
     let pass = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
     let out = pass.run(&g.device, &g.queue, &img).unwrap();
@@ -73,7 +73,7 @@ fn smaa_reduces_error_against_supersampled_truth() {
     let g = gpu();
     let aliased = render_shapes(w, h, 1);
     let truth = render_shapes(w, h, 4); // 16 samples per pixel
-    let pass = Smaa::new(&g.device, &g.queue, w, h, &golden_smaa()).unwrap();
+    let pass = Smaa::new(&g.device, &g.queue, w, h, &baked_smaa()).unwrap();
     let smaa = pass.run(&g.device, &g.queue, &aliased).unwrap();
     // Edge pixels: where the aliased image is visibly wrong.
     let mask: Vec<bool> =
@@ -96,7 +96,7 @@ fn smaa_subsample_slices_gpu_matches_cpu() {
     use rtbake::runtime::smaa::SubsampleIndices;
     let (w, h) = (192, 160);
     let g = gpu();
-    let luts = golden_smaa();
+    let luts = baked_smaa();
     let img = render_shapes(w, h, 1);
     let one_x = cpu::smaa::smaa(&img, w, h, &luts, precision(&g)).weights;
     for s in SubsampleIndices::SMAA_2X.into_iter().chain(SubsampleIndices::SMAA_4X) {

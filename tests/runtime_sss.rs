@@ -54,12 +54,29 @@ fn scene(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
     (color, depth)
 }
 
+/// The published 17-tap kernel from the committed bake, through the manifest-checked loader.
+fn baked_kernel() -> SssKernel {
+    let dir = baked_dir();
+    rtbake::runtime::loader::load_separable_kernel(&dir, rtbake::runtime::loader::SEPARABLE_KERNEL_PATH)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .kernel
+}
+
 #[test]
 fn sss_gpu_matches_cpu() {
+    gpu_matches_cpu(&kernel());
+}
+
+#[test]
+fn sss_gpu_matches_cpu_with_the_baked_kernel() {
+    gpu_matches_cpu(&baked_kernel());
+}
+
+fn gpu_matches_cpu(k: &SssKernel) {
     let (w, h) = (200, 160);
     let g = gpu();
     let (color, depth) = scene(w, h);
-    let (k, p) = (kernel(), SssParams::default());
+    let (k, p) = (k.clone(), SssParams::default());
     let pass = SeparableSss::new(&g.device, w, h, &k, &p).unwrap();
     let out = pass.run(&g.device, &g.queue, &color, &depth).unwrap();
     let cpu = separable_sss(&color, &depth, w, h, &k, &p);
@@ -75,10 +92,16 @@ fn sss_gpu_matches_cpu() {
 
 #[test]
 fn non_skin_pixels_pass_through_and_energy_is_kept() {
+    for k in [kernel(), baked_kernel()] {
+        pass_through_and_energy(k);
+    }
+}
+
+fn pass_through_and_energy(k: SssKernel) {
     let (w, h) = (96, 96);
     let g = gpu();
     let (mut color, depth) = scene(w, h);
-    let (k, p) = (kernel(), SssParams { follow_surface: false, ..Default::default() });
+    let p = SssParams { follow_surface: false, ..Default::default() };
     // Background must come back bit-exact (f16 of the input).
     let pass = SeparableSss::new(&g.device, w, h, &k, &p).unwrap();
     let out = pass.run(&g.device, &g.queue, &color, &depth).unwrap();

@@ -4,10 +4,12 @@ use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::image_buf::Image;
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::runtime::chain::{self, Antialiasing};
+use rtbake::runtime::demo::{self, DemoAssets, SssMethod};
 use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::gaussian_sss::{GaussianSss, GaussianSssParams};
+use rtbake::runtime::loader;
 use rtbake::runtime::mlaa::MlaaAreaMap;
-use rtbake::runtime::separable_sss::{SeparableSss, SssKernel, SssParams};
-use rtbake::runtime::{demo, loader};
+use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -17,7 +19,8 @@ pub enum RunCommand {
     Smaa(AaArgs),
     /// Antialias a PNG with Jimenez's MLAA (area map of --max-distance from the bake directory).
     Mlaa(MlaaArgs),
-    /// Separable SSS (two passes) on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR.
+    /// Subsurface scattering on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR: separable SSS
+    /// with a baked kernel (default), or the screen-space sum of Gaussians with the baked fit.
     Sss(SssArgs),
     /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
     /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
@@ -29,8 +32,8 @@ pub struct Common {
     /// Run the CPU reference implementation instead of the GPU (no adapter needed).
     #[arg(long)]
     cpu: bool,
-    /// Bake directory holding manifest.json and the LUTs.
-    #[arg(long, value_name = "DIR", default_value = "baked")]
+    /// Bake directory holding manifest.json and the LUTs (every table is checked against the manifest).
+    #[arg(long = "baked-dir", alias = "baked", value_name = "DIR", default_value = "baked")]
     baked: PathBuf,
 }
 
@@ -66,21 +69,35 @@ pub struct SssArgs {
     /// Output EXR (RGBA f16).
     #[arg(long, value_name = "EXR")]
     output: PathBuf,
-    /// Kernel: JSON array of [r, g, b, offset] taps, centre first (default: the demo's stand-in 17-tap kernel).
-    #[arg(long, value_name = "JSON")]
-    kernel: Option<PathBuf>,
-    /// Kernel width in world units.
-    #[arg(long, default_value_t = 0.012)]
-    sss_width: f32,
+    /// Separable kernel (schema rtbake-separable-kernel/1): a path listed in the manifest of --baked-dir
+    /// (checked against it), or a kernel file elsewhere (content checks only).
+    #[arg(long, value_name = "JSON", default_value = loader::SEPARABLE_KERNEL_PATH)]
+    kernel: String,
+    /// SSS method: separable (--kernel) or gaussians (--gaussians).
+    #[arg(long, value_enum, default_value = "separable")]
+    method: Method,
+    /// Sum-of-Gaussians fit for --method gaussians, a path listed in the manifest of --baked-dir.
+    #[arg(long, value_name = "JSON", default_value = loader::GAUSSIANS_PATH)]
+    gaussians: String,
+    /// Kernel width in world units (default: the kernel file's sss_width, else 0.012).
+    #[arg(long)]
+    sss_width: Option<f32>,
     /// Vertical field of view, degrees.
     #[arg(long, default_value_t = 20.0)]
     fovy: f32,
     /// Disable the follow-surface depth test.
     #[arg(long)]
     no_follow_surface: bool,
-    /// Run the CPU reference implementation instead of the GPU.
-    #[arg(long)]
-    cpu: bool,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum Method {
+    /// Separable SSS (thesis ch. 6), two passes.
+    Separable,
+    /// Screen-space sum of Gaussians (thesis ch. 4), α scaled from its 720-pixel viewport to the image height.
+    Gaussians,
 }
 
 #[derive(clap::Args)]
@@ -95,6 +112,13 @@ pub struct DemoArgs {
     /// Antialiasing of the final frame: smaa, mlaa or none.
     #[arg(long, default_value = "smaa")]
     aa: String,
+    /// SSS pass of the demo: separable (baked kernel) or gaussians (baked sum-of-Gaussians fit).
+    #[arg(long, value_enum, default_value = "separable")]
+    sss: Method,
+    /// Hemoglobin rig weights (eq. 7.6): JSON file {"target name": weight, ...} summing to 1 (default: neutral 0.6,
+    /// joy 0.4 with the baked example rig).
+    #[arg(long, value_name = "JSON")]
+    rig_weights: Option<PathBuf>,
     #[command(flatten)]
     common: Common,
 }
@@ -186,22 +210,41 @@ fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
     Ok(io::exr::decode(&bytes, &path.display().to_string()).map_err(usage)?.0)
 }
 
-fn read_kernel(path: &Path) -> anyhow::Result<SssKernel> {
-    let text = std::fs::read_to_string(path).map_err(|e| usage(anyhow::anyhow!("--kernel {}: {e}", path.display())))?;
-    let taps: Vec<[f32; 4]> = serde_json::from_str(&text).map_err(|e| {
-        usage(anyhow::anyhow!("--kernel {}: expected a JSON array of [r, g, b, offset] taps: {e}", path.display()))
-    })?;
-    Ok(SssKernel::new(taps)?)
+/// The kernel named by --kernel: through the manifest of the bake directory when it lists the path, else a
+/// kernel file elsewhere (content checks only).
+fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::BakedKernel> {
+    let listed = rtbake::manifest::Manifest::load(baked).ok().is_some_and(|m| m.entry(kernel).is_some());
+    if listed {
+        return loader::load_separable_kernel(baked, kernel).map_err(usage);
+    }
+    let path = Path::new(kernel);
+    if !path.is_file() {
+        return Err(usage_msg(format!(
+            "--kernel {kernel}: neither listed in {}/manifest.json nor an existing file",
+            baked.display()
+        )));
+    }
+    ctx.info(format!("kernel {kernel}: not in a bake directory, content checks only (no manifest, no sha256)"));
+    let text = std::fs::read_to_string(path).map_err(|e| usage(anyhow::anyhow!("--kernel {kernel}: {e}")))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| usage(anyhow::anyhow!("--kernel {kernel}: not valid JSON: {e}")))?;
+    loader::separable_kernel_from_json(&v, kernel).map_err(usage)
 }
 
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     check_output(&a.output)?;
-    let params = SssParams { sss_width: a.sss_width, fovy_deg: a.fovy, follow_surface: !a.no_follow_surface };
-    params.validate()?;
-    let kernel = match &a.kernel {
-        Some(p) => read_kernel(p)?,
-        None => demo::standin_kernel(),
+    let baked = &a.common.baked;
+    let (kernel, gaussians) = match a.method {
+        Method::Separable => (Some(read_kernel(ctx, baked, &a.kernel)?), None),
+        Method::Gaussians => (None, Some(loader::load_gaussians(baked, &a.gaussians).map_err(usage)?)),
     };
+    let default_width = kernel.as_ref().and_then(|k| k.sss_width).unwrap_or(SssParams::default().sss_width);
+    let params = SssParams {
+        sss_width: a.sss_width.unwrap_or(default_width),
+        fovy_deg: a.fovy,
+        follow_surface: !a.no_follow_surface,
+    };
+    params.validate()?;
     let color = read_exr("--color", &a.color)?;
     let depth = read_exr("--depth", &a.depth)?;
     if (color.width, color.height) != (depth.width, depth.height) {
@@ -219,12 +262,22 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
         return Err(usage_msg("--depth must hold finite linear depths > 0"));
     }
-    let gpu = device(ctx, a.cpu)?;
+    let gpu = device(ctx, a.common.cpu)?;
     let (w, h) = (color.width, color.height);
     let t = Instant::now();
-    let out = match &gpu {
-        Some(g) => SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &rgba, &d)?,
-        None => rtbake::runtime::cpu::separable_sss::separable_sss(&rgba, &d, w, h, &kernel, &params),
+    let out = match (&gpu, &kernel, &gaussians) {
+        (Some(g), Some(k), _) => {
+            SeparableSss::new(&g.device, w, h, &k.kernel, &params)?.run(&g.device, &g.queue, &rgba, &d)?
+        }
+        (None, Some(k), _) => rtbake::runtime::cpu::separable_sss::separable_sss(&rgba, &d, w, h, &k.kernel, &params),
+        (_, None, Some(f)) => {
+            let gp = GaussianSssParams { alpha: f.params.alpha * h as f32 / 720.0, ..f.params };
+            match &gpu {
+                Some(g) => GaussianSss::new(&g.device, w, h, &f.blurs, &gp)?.run(&g.device, &g.queue, &rgba, &d)?,
+                None => rtbake::runtime::cpu::gaussian_sss::gaussian_sss(&rgba, &d, w, h, &f.blurs, &gp),
+            }
+        }
+        (_, None, None) => unreachable!("one SSS method is selected"),
     };
     let ms = t.elapsed().as_secs_f64() * 1e3;
     let img = Image::from_vec(w, h, 4, out);
@@ -247,9 +300,22 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         "none" => None,
         other => return Err(usage_msg(format!("--aa must be smaa, mlaa or none, got {other:?}"))),
     };
+    let mut assets = DemoAssets::load(&d.common.baked).map_err(usage)?;
+    if let Some(p) = &d.rig_weights {
+        let text =
+            std::fs::read_to_string(p).map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: {e}", p.display())))?;
+        let v: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: not valid JSON: {e}", p.display())))?;
+        assets.set_rig_weights(&v)?;
+    }
+    ctx.info(format!("hemoglobin rig: {}", assets.rig_source));
+    let method = match d.sss {
+        Method::Separable => SssMethod::Separable,
+        Method::Gaussians => SssMethod::Gaussians,
+    };
     let gpu = device(ctx, d.common.cpu)?;
     let t = Instant::now();
-    let out = demo::render(gpu.as_ref(), d.width, d.height, aa.as_ref())?;
+    let out = demo::render(gpu.as_ref(), d.width, d.height, &assets, method, aa.as_ref())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     write_atomic(&d.output, &io::png::encode_u8(&out)?)?;
     report(ctx, "demo", &d.output, &out, gpu.as_ref(), ms);

@@ -1,78 +1,125 @@
 //! The procedural demo frame: skin-shaded spheres (a "head" and two smaller ones) in front of hard-edged shapes,
 //! through the whole chain — skin inputs (rig → hemoglobin → albedo LUT, T(s)·E) → diffuse lighting →
-//! separable SSS → + transmittance → sRGB encode → SMAA / MLAA. Every stage runs on the GPU passes, or on their
-//! CPU references when no device is given. No input files.
+//! separable SSS (or the screen-space sum of Gaussians) → + transmittance → sRGB encode → SMAA / MLAA. Every
+//! stage runs on the GPU passes, or on their CPU references when no device is given. No input images.
 //!
-//! Stand-ins until the baked assets are wired: the albedo LUT is a smooth analytic melanin/hemoglobin tint
-//! ([`standin_skin_luts`]), T(s) is eq. 5.12 evaluated on d'Eon's 6-Gaussian fit, and the kernel is
-//! [`standin_kernel`] (per-channel Gaussians). Each can be replaced by the baked table without touching the chain.
+//! Every table comes from the bake directory through the manifest-checked [`super::loader`]: the skin colour
+//! LUT, T(s), the separable kernel, the sum-of-Gaussians fit and the example hemoglobin rig with its H0
+//! ([`DemoAssets::load`]). The rig and H0 cover the frame (screen uv ∈ [0, 1]², as the pass samples them); the
+//! weights blend neutral with joy. A bake without the rig falls back to [`synthetic_rig`] (two targets at 16×16)
+//! with a procedural H0, and [`DemoAssets::rig_source`] says so.
 
 use super::chain::{self, Antialiasing};
 use super::cpu;
 use super::device::Gpu;
+use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use super::loader::{self, LutError};
 use super::separable_sss::{SeparableSss, SssKernel, SssParams};
 use super::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
 use super::RuntimeError;
-use crate::diffusion::sum_of_gaussians::deon6;
+use crate::error::InvalidInput;
 use crate::image_buf::Image;
+use std::path::Path;
 
-/// Stand-in skin LUTs: albedo tinted by melanin (absorbs blue most) and hemoglobin (absorbs green/blue), and
-/// T(s) = Σ wᵢ exp(−s²/vᵢ) (thesis eq. 5.12, published form) from d'Eon's 6 Gaussians on s ∈ [0, 8] mm.
-pub fn standin_skin_luts() -> SkinLuts {
-    let (w, h) = (32u32, 32u32);
-    let mut albedo = Vec::with_capacity((w * h) as usize);
-    for j in 0..h {
-        for i in 0..w {
-            let cm = 0.5 * (i as f32 / (w - 1) as f32).powi(3);
-            let chd = 0.32 * (j as f32 / (h - 1) as f32).powi(3);
-            let m = [(-2.0 * cm).exp(), (-3.5 * cm).exp(), (-5.5 * cm).exp()];
-            let hb = [(-0.6 * chd).exp(), (-4.0 * chd).exp(), (-3.0 * chd).exp()];
-            albedo.push([0.85 * m[0] * hb[0], 0.70 * m[1] * hb[1], 0.62 * m[2] * hb[2]]);
+/// Which subsurface-scattering pass the demo runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SssMethod {
+    /// Separable SSS (thesis ch. 6) with the baked kernel.
+    Separable,
+    /// Screen-space sum of Gaussians (thesis ch. 4) with the baked fit.
+    Gaussians,
+}
+
+/// The tables the demo renders with.
+#[derive(Clone, Debug)]
+pub struct DemoAssets {
+    pub luts: SkinLuts,
+    pub kernel: SssKernel,
+    pub sss: SssParams,
+    pub blurs: GaussianBlurs,
+    pub gaussian_params: GaussianSssParams,
+    pub rig: HemoglobinRig,
+    /// One weight per rig target (eq. 7.6), summing to 1.
+    pub rig_weights: Vec<f32>,
+    /// Target names, same order as the weights.
+    pub rig_names: Vec<String>,
+    /// The baked rig with its H0, when the bake has one.
+    pub baked_rig: Option<loader::BakedRig>,
+    /// Where the rig came from, for the command's report.
+    pub rig_source: String,
+}
+
+impl DemoAssets {
+    /// Loads the default baked tables from `dir` (paths in [`loader`]); kernel width from the kernel file.
+    pub fn load(dir: &Path) -> Result<Self, LutError> {
+        Self::load_with_kernel(dir, loader::SEPARABLE_KERNEL_PATH)
+    }
+
+    /// As [`DemoAssets::load`] with another kernel file of the bake directory.
+    pub fn load_with_kernel(dir: &Path, kernel_path: &str) -> Result<Self, LutError> {
+        let luts = loader::load_skin_luts(dir, loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH)?;
+        let k = loader::load_separable_kernel(dir, kernel_path)?;
+        let g = loader::load_gaussians(dir, loader::GAUSSIANS_PATH)?;
+        let sss = SssParams { sss_width: k.sss_width.unwrap_or(SssParams::default().sss_width), ..Default::default() };
+        let listed = crate::manifest::Manifest::load(dir)?.entry(loader::HEMOGLOBIN_RIG_PATH).is_some();
+        let (rig, rig_weights, rig_names, baked_rig, rig_source) = if listed {
+            let b = loader::load_hemoglobin_rig(dir, loader::HEMOGLOBIN_RIG_PATH)?;
+            // 60 % neutral, 40 % joy (or the second target) — a mild flush.
+            let mut wts = vec![0.0f32; b.rig.targets.len()];
+            let joy = b.names.iter().position(|n| n == "joy").unwrap_or(wts.len() - 1);
+            wts[0] = 0.6;
+            wts[joy] += 0.4;
+            let names = b.names.clone();
+            (b.rig.clone(), wts, names, Some(b), format!("baked {}", loader::HEMOGLOBIN_RIG_PATH))
+        } else {
+            let src = format!("synthetic (no {} in the bake)", loader::HEMOGLOBIN_RIG_PATH);
+            (synthetic_rig(), vec![0.4, 0.6], vec!["neutral".into(), "blush".into()], None, src)
+        };
+        Ok(Self {
+            luts,
+            kernel: k.kernel,
+            sss,
+            blurs: g.blurs,
+            gaussian_params: g.params,
+            rig,
+            rig_weights,
+            rig_names,
+            baked_rig,
+            rig_source,
+        })
+    }
+}
+
+impl DemoAssets {
+    /// Sets the rig weights from a JSON object `{"target name": weight, …}` (`--rig-weights`): every name must
+    /// be a target of the rig, weights finite, and their sum 1 ± 1e-3 (eq. 7.6 blends the targets); targets not
+    /// named get 0.
+    pub fn set_rig_weights(&mut self, json: &serde_json::Value) -> Result<(), InvalidInput> {
+        let param = "--rig-weights";
+        let obj = json.as_object().ok_or_else(|| {
+            InvalidInput::new(param, "must be a JSON object {\"target name\": weight, ...}".to_string())
+        })?;
+        let mut w = vec![0.0f32; self.rig_names.len()];
+        for (name, v) in obj {
+            let i = self.rig_names.iter().position(|n| n == name).ok_or_else(|| {
+                InvalidInput::new(param, format!("unknown target {name:?}; the rig has {:?}", self.rig_names))
+            })?;
+            let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                InvalidInput::new(param, format!("weight of {name:?} must be a finite number, got {v}"))
+            })?;
+            w[i] = x as f32;
         }
+        let sum: f32 = w.iter().sum();
+        if (sum - 1.0).abs() > 1e-3 {
+            return Err(InvalidInput::new(param, format!("weights must sum to 1 (eq. 7.6), got {sum}")));
+        }
+        self.rig_weights = w;
+        Ok(())
     }
-    let fit = deon6();
-    let n = 64;
-    let transmittance = (0..n)
-        .map(|i| {
-            let s = 8.0 * i as f64 / (n - 1) as f64;
-            let mut t = [0.0f32; 3];
-            for (v, wt) in fit.variances_mm2.iter().zip(&fit.weights) {
-                for c in 0..3 {
-                    t[c] += (wt[c] * (-s * s / v).exp()) as f32; // eq. 5.12
-                }
-            }
-            t
-        })
-        .collect();
-    SkinLuts { albedo_size: (w, h), albedo, transmittance, s_max_mm: 8.0 }
 }
 
-/// Stand-in 17-tap separable kernel: per-channel Gaussians (σ = 1.0, 0.45, 0.3 kernel units) on offsets in
-/// [−3, 3], normalised per channel, centre first.
-pub fn standin_kernel() -> SssKernel {
-    let n = 17;
-    let sig = [1.0f32, 0.45, 0.3];
-    let mut taps: Vec<[f32; 4]> = (0..n)
-        .map(|i| {
-            let o = -3.0 + 6.0 * i as f32 / (n - 1) as f32;
-            let mut t = [0.0, 0.0, 0.0, o];
-            for c in 0..3 {
-                t[c] = (-o * o / (2.0 * sig[c] * sig[c])).exp();
-            }
-            t
-        })
-        .collect();
-    for c in 0..3 {
-        let s: f32 = taps.iter().map(|t| t[c]).sum();
-        taps.iter_mut().for_each(|t| t[c] /= s);
-    }
-    let centre = taps.remove(n / 2);
-    taps.insert(0, centre);
-    SssKernel { taps }
-}
-
-/// A two-target rig (neutral, blush) at 16×16.
-fn standin_rig() -> HemoglobinRig {
+/// A synthetic two-target rig (neutral, blush) at 16×16: (scale, bias) per texel, eq. 7.6.
+pub fn synthetic_rig() -> HemoglobinRig {
     let s = 16u32;
     let neutral = vec![[1.0f32, 0.06]; (s * s) as usize];
     let blush = (0..s * s)
@@ -94,7 +141,7 @@ struct Geometry {
 /// Spheres as (centre x, centre y in units of the frame height, radius, depth of the centre).
 const SPHERES: [(f32, f32, f32, f32); 3] = [(0.5, 0.5, 0.32, 4.0), (0.16, 0.72, 0.12, 5.0), (0.84, 0.3, 0.1, 3.5)];
 
-fn geometry(w: u32, h: u32) -> Geometry {
+fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
     let n = (w * h) as usize;
     let mut g = Geometry {
         frame: SkinFrame {
@@ -123,9 +170,13 @@ fn geometry(w: u32, h: u32) -> Geometry {
                     g.depth[i] = depth;
                     g.skin[i] = true;
                     g.frame.normals[i] = [dx / r, -dy / r, z];
-                    g.frame.melanin[i] = [0.04, 0.25, 0.12][k];
-                    // Pore-scale variation of the mean-free neutral hemoglobin.
-                    g.frame.h0[i] = 0.015 * ((x as f32 * 0.9).sin() * (y as f32 * 0.7).cos());
+                    // Fair, dark and medium skin (the LUT darkens quickly: Cm = 0.035 is already tanned).
+                    g.frame.melanin[i] = [0.008, 0.12, 0.035][k];
+                    // Mean-free neutral hemoglobin: the baked H0 at the screen uv, else a pore-scale pattern.
+                    g.frame.h0[i] = match rig {
+                        Some(r) => r.h0_at((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / hf),
+                        None => 0.006 * ((x as f32 * 0.9).sin() * (y as f32 * 0.7).cos()),
+                    };
                     // Thin at the rim (ears, nose in a head), thick in the middle.
                     g.frame.thickness_mm[i] = 0.3 + 6.0 * z;
                 }
@@ -135,18 +186,25 @@ fn geometry(w: u32, h: u32) -> Geometry {
     g
 }
 
-/// Renders the demo frame (RGBA8, sRGB-encoded). `aa` None leaves it aliased.
-pub fn render(gpu: Option<&Gpu>, w: u32, h: u32, aa: Option<&Antialiasing>) -> Result<Image<u8>, RuntimeError> {
+/// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased.
+pub fn render(
+    gpu: Option<&Gpu>,
+    w: u32,
+    h: u32,
+    assets: &DemoAssets,
+    method: SssMethod,
+    aa: Option<&Antialiasing>,
+) -> Result<Image<u8>, RuntimeError> {
     crate::error::check_size("--width/--height", w as u64, h as u64)?;
-    let geo = geometry(w, h);
-    let (luts, rig, kernel, params) = (standin_skin_luts(), standin_rig(), standin_kernel(), SssParams::default());
-    let weights = [0.4f32, 0.6];
+    let geo = geometry(w, h, assets.baked_rig.as_ref());
+    let (luts, rig, kernel, params) = (&assets.luts, &assets.rig, &assets.kernel, &assets.sss);
+    let weights = &assets.rig_weights;
     let key = normalise([-0.5, 0.6, 0.62]);
     let back = normalise([0.3, 0.2, -0.93]);
     let (albedo, transmitted) = match gpu {
-        Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, &luts, &rig)?
-            .run(&g.device, &g.queue, &geo.frame, &weights, back)?,
-        None => cpu::skin_inputs::skin_inputs(&geo.frame, &luts, &rig, &weights, back),
+        Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?
+            .run(&g.device, &g.queue, &geo.frame, weights, back)?,
+        None => cpu::skin_inputs::skin_inputs(&geo.frame, luts, rig, weights, back),
     };
     // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let n = (w * h) as usize;
@@ -157,17 +215,23 @@ pub fn render(gpu: Option<&Gpu>, w: u32, h: u32, aa: Option<&Antialiasing>) -> R
         }
         let nn = geo.frame.normals[i];
         let lambert = (nn[0] * key[0] + nn[1] * key[1] + nn[2] * key[2]).max(0.0);
-        let e = 2.2 * lambert + 0.08;
+        let e = 1.6 * lambert + 0.1;
         for c in 0..3 {
             diffuse[4 * i + c] = albedo[4 * i + c] * e;
         }
         diffuse[4 * i + 3] = 1.0;
     }
-    let blurred = match gpu {
-        Some(g) => {
-            SeparableSss::new(&g.device, w, h, &kernel, &params)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
+    // α of eq. 4.1 is stated for a 720-pixel viewport: scale it to this one.
+    let gp = GaussianSssParams { alpha: assets.gaussian_params.alpha * h as f32 / 720.0, ..assets.gaussian_params };
+    let blurred = match (gpu, method) {
+        (Some(g), SssMethod::Separable) => {
+            SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
         }
-        None => cpu::separable_sss::separable_sss(&diffuse, &geo.depth, w, h, &kernel, &params),
+        (None, SssMethod::Separable) => cpu::separable_sss::separable_sss(&diffuse, &geo.depth, w, h, kernel, params),
+        (Some(g), SssMethod::Gaussians) => {
+            GaussianSss::new(&g.device, w, h, &assets.blurs, &gp)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
+        }
+        (None, SssMethod::Gaussians) => cpu::gaussian_sss::gaussian_sss(&diffuse, &geo.depth, w, h, &assets.blurs, &gp),
     };
     // Composite over the hard-edged background shapes; add back-lit transmittance; encode sRGB.
     let mut rgba = super::scene::render_shapes(w, h, 1);
@@ -175,10 +239,13 @@ pub fn render(gpu: Option<&Gpu>, w: u32, h: u32, aa: Option<&Antialiasing>) -> R
         if !geo.skin[i] {
             continue;
         }
+        let v: [f32; 3] =
+            std::array::from_fn(|c| blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c]);
+        // Tone map the luminance (1 − e^−L) and keep the channel ratios, so skin keeps its hue in highlights.
+        let l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+        let scale = if l > 0.0 { (1.0 - (-l).exp()) / l } else { 0.0 };
         for c in 0..3 {
-            let v = blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c];
-            let tonemapped = v / (1.0 + v);
-            rgba[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb(tonemapped));
+            rgba[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb((v[c] * scale).min(1.0)));
         }
         rgba[4 * i + 3] = 255;
     }

@@ -6,16 +6,44 @@
 //! quietly disable SMAA — bevy #21425); file size = width·height·bytes per texel; sha256 as recorded. Any
 //! mismatch is a [`LutError`] naming the file, the property, what was expected and what was found.
 //!
+//! The float and JSON tables get the same manifest checks and then content checks, each in a typed loader:
+//! [`load_separable_kernel`] (schema, tap count = `samples`, centre first, channels sum to 1, step divisor 3),
+//! [`load_gaussians`] (shared variances, recorded w′ᵢ and incremental variances = eq. 4.8 / vᵢ − vᵢ₋₁),
+//! [`load_transmittance`] and [`load_skin_lut`] (EXR f32, decoded size/channels/precision = declared, sidecar
+//! JSON consistent: node-inclusive T(s) with T(0) = 1; LUT index ranges 0.5 / 0.32), [`load_hemoglobin_rig`]
+//! (every scale/bias map and H0 of the rig JSON). JSON files may declare colour space `n/a`; texel data must be
+//! `linear`; non-raw files must also have the manifest's `size_bytes`.
+//!
 //! The paths of the baked files are the constants below — the one place to change when the bake layout moves.
 
 use crate::io::PixelFormat;
-use crate::manifest::{sha256_hex, Manifest, ManifestError};
+use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError};
 use std::path::Path;
 
 /// SMAA area texture in `baked/` (RG8 160×560).
 pub const SMAA_AREA_PATH: &str = "aa/smaa/AreaTex.bin";
 /// SMAA search texture in `baked/` (R8 64×16).
 pub const SMAA_SEARCH_PATH: &str = "aa/smaa/SearchTex.bin";
+
+/// Default separable-SSS kernel in `baked/` (schema `rtbake-separable-kernel/1`, 17 taps, published parameters).
+pub const SEPARABLE_KERNEL_PATH: &str = "sss/separable/published_n17.json";
+/// Default sum-of-Gaussians fit for the screen-space SSS in `baked/` (d'Eon's 6 Gaussians).
+pub const GAUSSIANS_PATH: &str = "sss/gaussians/deon6.json";
+/// Default transmittance table T(s) in `baked/` (EXR f32, RGB, node-inclusive); sidecar: same stem, `.json`.
+pub const TRANSMITTANCE_PATH: &str = "transmittance/deon6_published.exr";
+/// Skin colour LUT in `baked/` (EXR f32, RGB, melanin × hemoglobin); sidecar: same stem, `.json`.
+pub const SKIN_LUT_PATH: &str = "skin/skin_color_lut.exr";
+
+/// Example hemoglobin rig in `baked/` (schema `rtbake-hemoglobin-rig/1`; scale/bias EXRs and H0 beside it).
+pub const HEMOGLOBIN_RIG_PATH: &str = "facial/hemoglobin/example/rig.json";
+
+/// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
+pub fn sidecar_path(exr_path: &str) -> String {
+    match exr_path.strip_suffix(".exr") {
+        Some(stem) => format!("{stem}.json"),
+        None => format!("{exr_path}.json"),
+    }
+}
 
 /// Jimenez MLAA v1.4 area map for maximum distance `n` in `baked/` (RG8 5n×5n).
 pub fn mlaa_area_path(n: u32) -> String {
@@ -63,6 +91,9 @@ pub enum LutError {
     Size { path: String, expected: usize, found: usize, what: String },
     #[error("{path}: sha256 {found} does not match the manifest's {expected} (corrupted or modified file)")]
     Checksum { path: String, expected: String, found: String },
+    /// The file passed the manifest checks but its content is not what the runtime can use.
+    #[error("{path}: {message}")]
+    Content { path: String, message: String },
 }
 
 /// Reads `dir/manifest.json` and loads one LUT after checking it against `spec`.
@@ -73,56 +104,103 @@ pub fn load_lut(dir: &Path, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
 
 /// Loads one LUT described by an already-parsed manifest.
 pub fn load_lut_with(dir: &Path, manifest: &Manifest, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
-    let path = spec.path.clone();
+    let expect = Expect {
+        format: "raw",
+        pixel_format: Some(spec.pixel_format),
+        size: Some((spec.width, spec.height)),
+        channels: Some(spec.pixel_format.channels()),
+        sample_type: sample_type(spec.pixel_format),
+        data: DataKind::Texture,
+    };
+    Ok(read_checked(dir, manifest, &spec.path, &expect)?.0)
+}
+
+/// Whether a file is texel data (colour space must be `linear`) or a text/JSON table (`linear` or `n/a`).
+#[derive(Clone, Copy, PartialEq)]
+enum DataKind {
+    Texture,
+    Table,
+}
+
+/// What the runtime expects of one manifest entry (`None`: not checked here).
+struct Expect<'a> {
+    format: &'a str,
+    pixel_format: Option<PixelFormat>,
+    size: Option<(u32, u32)>,
+    channels: Option<u32>,
+    sample_type: &'a str,
+    data: DataKind,
+}
+
+/// Checks `path`'s manifest entry against `expect`, reads the file, checks its length against the manifest's
+/// `size_bytes` and its sha256. Returns the bytes and the entry.
+fn read_checked<'m>(
+    dir: &Path,
+    manifest: &'m Manifest,
+    path: &str,
+    expect: &Expect,
+) -> Result<(Vec<u8>, &'m Entry), LutError> {
     let entry = manifest
-        .entry(&spec.path)
-        .ok_or_else(|| LutError::NotInManifest { dir: dir.display().to_string(), path: path.clone() })?;
+        .entry(path)
+        .ok_or_else(|| LutError::NotInManifest { dir: dir.display().to_string(), path: path.to_string() })?;
     let m = &entry.meta;
     let mismatch = |field: &'static str, expected: String, found: String| LutError::Mismatch {
-        path: path.clone(),
+        path: path.to_string(),
         field,
         expected,
         found,
     };
-    if m.color_space != "linear" {
-        return Err(LutError::ColorSpace { path: path.clone(), found: m.color_space.clone() });
+    let colour_ok = m.color_space == "linear" || (expect.data == DataKind::Table && m.color_space == "n/a");
+    if !colour_ok {
+        return Err(LutError::ColorSpace { path: path.to_string(), found: m.color_space.clone() });
     }
-    if m.format != "raw" {
-        return Err(mismatch("format", "\"raw\"".into(), format!("{:?}", m.format)));
+    if m.format != expect.format {
+        return Err(mismatch("format", format!("{:?}", expect.format), format!("{:?}", m.format)));
     }
-    if m.pixel_format != Some(spec.pixel_format) {
-        return Err(mismatch("pixel_format", format!("{:?}", spec.pixel_format), format!("{:?}", m.pixel_format)));
+    if let Some(pf) = expect.pixel_format {
+        if m.pixel_format != Some(pf) {
+            return Err(mismatch("pixel_format", format!("{pf:?}"), format!("{:?}", m.pixel_format)));
+        }
     }
-    if (m.width, m.height) != (spec.width, spec.height) {
-        return Err(mismatch(
-            "width x height",
-            format!("{}x{}", spec.width, spec.height),
-            format!("{}x{}", m.width, m.height),
-        ));
+    if let Some((w, h)) = expect.size {
+        if (m.width, m.height) != (w, h) {
+            return Err(mismatch("width x height", format!("{w}x{h}"), format!("{}x{}", m.width, m.height)));
+        }
     }
-    if m.channels != spec.pixel_format.channels() {
-        return Err(mismatch("channels", spec.pixel_format.channels().to_string(), m.channels.to_string()));
+    if let Some(c) = expect.channels {
+        if m.channels != c {
+            return Err(mismatch("channels", c.to_string(), m.channels.to_string()));
+        }
     }
-    let want_sample = sample_type(spec.pixel_format);
-    if m.sample_type != want_sample {
-        return Err(mismatch("sample_type", want_sample.into(), m.sample_type.clone()));
+    if m.sample_type != expect.sample_type {
+        return Err(mismatch("sample_type", expect.sample_type.into(), m.sample_type.clone()));
     }
-    let file = dir.join(&spec.path);
+    let file = dir.join(path);
     let bytes = std::fs::read(&file).map_err(|e| LutError::Read { path: file.display().to_string(), source: e })?;
-    let expected = (spec.width * spec.height * spec.pixel_format.bytes_per_texel()) as usize;
-    if bytes.len() != expected {
+    // Raw texels: the length follows from the size and format; other containers: the manifest's size_bytes.
+    if let (true, Some(pf), Some((w, h))) = (expect.format == "raw", expect.pixel_format, expect.size) {
+        let expected = (w * h * pf.bytes_per_texel()) as usize;
+        if bytes.len() != expected {
+            return Err(LutError::Size {
+                path: path.to_string(),
+                expected,
+                found: bytes.len(),
+                what: format!("{w}x{h} {pf:?}"),
+            });
+        }
+    } else if bytes.len() as u64 != entry.size_bytes {
         return Err(LutError::Size {
-            path,
-            expected,
+            path: path.to_string(),
+            expected: entry.size_bytes as usize,
             found: bytes.len(),
-            what: format!("{}x{} {:?}", spec.width, spec.height, spec.pixel_format),
+            what: "size_bytes in the manifest".into(),
         });
     }
     let sha = sha256_hex(&bytes);
     if sha != entry.sha256 {
-        return Err(LutError::Checksum { path, expected: entry.sha256.clone(), found: sha });
+        return Err(LutError::Checksum { path: path.to_string(), expected: entry.sha256.clone(), found: sha });
     }
-    Ok(bytes)
+    Ok((bytes, entry))
 }
 
 /// The manifest's `sample_type` for a pixel format.
@@ -145,4 +223,364 @@ pub fn load_smaa_textures(dir: &Path) -> Result<crate::runtime::smaa::SmaaTextur
 /// MLAA v1.4 area map of maximum distance `n` from a bake directory.
 pub fn load_mlaa_area(dir: &Path, n: u32) -> Result<Vec<u8>, LutError> {
     load_lut(dir, &LutSpec::mlaa_area(n))
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Typed loaders for the float and JSON tables (same manifest checks as the AA LUTs, then content checks).
+
+fn content(path: &str, message: impl Into<String>) -> LutError {
+    LutError::Content { path: path.to_string(), message: message.into() }
+}
+
+/// Reads a JSON table listed in the manifest (`format` json, `sample_type` text, colour space linear or n/a).
+fn load_json(dir: &Path, manifest: &Manifest, path: &str) -> Result<serde_json::Value, LutError> {
+    let expect = Expect {
+        format: "json",
+        pixel_format: None,
+        size: None,
+        channels: None,
+        sample_type: "text",
+        data: DataKind::Table,
+    };
+    let (bytes, _) = read_checked(dir, manifest, path, &expect)?;
+    serde_json::from_slice(&bytes).map_err(|e| content(path, format!("not valid JSON: {e}")))
+}
+
+/// Reads a float EXR listed in the manifest (`format` exr, `sample_type` f32, linear, `channels` channels) and
+/// checks that the decoded image has the declared size, channel count and precision.
+fn load_exr_f32(
+    dir: &Path,
+    manifest: &Manifest,
+    path: &str,
+    channels: u32,
+    min_size: (u32, u32),
+) -> Result<crate::image_buf::Image<f32>, LutError> {
+    let expect = Expect {
+        format: "exr",
+        pixel_format: None,
+        size: None,
+        channels: Some(channels),
+        sample_type: "f32",
+        data: DataKind::Texture,
+    };
+    let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
+    let (w, h) = (entry.meta.width, entry.meta.height);
+    if w < min_size.0 || h < min_size.1 {
+        return Err(LutError::Mismatch {
+            path: path.to_string(),
+            field: "width x height",
+            expected: format!("at least {}x{}", min_size.0, min_size.1),
+            found: format!("{w}x{h}"),
+        });
+    }
+    let (img, precision) = crate::io::exr::decode(&bytes, path).map_err(|e| content(path, e.to_string()))?;
+    if (img.width, img.height, img.channels) != (w, h, channels) {
+        return Err(content(
+            path,
+            format!(
+                "decodes to {}x{} with {} channels, the manifest declares {w}x{h} with {channels}",
+                img.width, img.height, img.channels
+            ),
+        ));
+    }
+    if precision != crate::io::exr::ExrPrecision::F32 {
+        return Err(content(path, "decodes to half floats, the manifest declares sample_type f32"));
+    }
+    if img.data.iter().any(|v| !v.is_finite()) {
+        return Err(content(path, "holds non-finite values"));
+    }
+    Ok(img)
+}
+
+fn field<'a>(v: &'a serde_json::Value, path: &str, key: &str) -> Result<&'a serde_json::Value, LutError> {
+    key.split('.').try_fold(v, |v, k| v.get(k).ok_or_else(|| content(path, format!("missing field \"{key}\""))))
+}
+
+fn field_f64(v: &serde_json::Value, path: &str, key: &str) -> Result<f64, LutError> {
+    field(v, path, key)?.as_f64().ok_or_else(|| content(path, format!("field \"{key}\" must be a number")))
+}
+
+fn field_as<T: serde::de::DeserializeOwned>(v: &serde_json::Value, path: &str, key: &str) -> Result<T, LutError> {
+    serde_json::from_value(field(v, path, key)?.clone())
+        .map_err(|e| content(path, format!("field \"{key}\" has the wrong shape: {e}")))
+}
+
+/// A baked separable-SSS kernel (schema `rtbake-separable-kernel/1`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedKernel {
+    /// Taps `[r, g, b, offset]`, centre first, as the pass takes them.
+    pub kernel: crate::runtime::separable_sss::SssKernel,
+    /// Largest |offset| in kernel units.
+    pub range: f64,
+    /// The world-space width the kernel was made for, if the file records it.
+    pub sss_width: Option<f32>,
+}
+
+/// Loads a separable-SSS kernel JSON (`rtbake-separable-kernel/1`) after the manifest checks; refuses a kernel
+/// whose tap count differs from `samples`, whose first tap is not the centre, whose channels do not each sum to 1
+/// (±1e-4), or whose `step_divisor` is not the 3 the shader hard-codes.
+pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutError> {
+    let manifest = Manifest::load(dir)?;
+    let v = load_json(dir, &manifest, path)?;
+    separable_kernel_from_json(&v, path)
+}
+
+/// The content checks of [`load_separable_kernel`] on an already-parsed kernel file (`path` names it in errors);
+/// for kernel files outside a bake directory, which have no manifest entry to check against.
+pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<BakedKernel, LutError> {
+    let v = v.clone();
+    let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
+    if schema != crate::separable::kernel::JSON_SCHEMA {
+        return Err(content(
+            path,
+            format!("schema {schema:?}, the runtime reads {:?}", crate::separable::kernel::JSON_SCHEMA),
+        ));
+    }
+    let taps: Vec<[f32; 4]> = field_as(&v, path, "kernel")?;
+    let samples: usize = field_as(&v, path, "samples")?;
+    if taps.len() != samples {
+        return Err(content(path, format!("\"samples\" = {samples} but \"kernel\" has {} taps", taps.len())));
+    }
+    if taps.first().is_some_and(|t| t[3] != 0.0) {
+        return Err(content(path, "kernel[0] must be the centre tap (offset 0)"));
+    }
+    for c in 0..3 {
+        let sum: f64 = taps.iter().map(|t| t[c] as f64).sum();
+        if (sum - 1.0).abs() > 1e-4 {
+            return Err(content(path, format!("channel {} weights sum to {sum}, must be 1", ["r", "g", "b"][c])));
+        }
+    }
+    let step = field_f64(&v, path, "step_divisor")?;
+    if step != 3.0 {
+        return Err(content(path, format!("step_divisor {step}; the separable SSS shader divides the step by 3")));
+    }
+    let range = field_f64(&v, path, "range")?;
+    let sss_width = v.get("sss_width").and_then(|w| w.as_f64()).map(|w| w as f32);
+    let kernel = crate::runtime::separable_sss::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))?;
+    Ok(BakedKernel { kernel, range, sss_width })
+}
+
+/// A baked sum-of-Gaussians fit with the screen-space parameters derived from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedGaussians {
+    pub fit: crate::diffusion::sum_of_gaussians::SumOfGaussians,
+    /// Incremental blurs and blend weights w′ᵢ (eq. 4.8), checked against the values recorded in the file.
+    pub blurs: crate::runtime::gaussian_sss::GaussianBlurs,
+    /// α, β, γ as recorded (lod factor: the exact rule of eq. 4.6).
+    pub params: crate::runtime::gaussian_sss::GaussianSssParams,
+}
+
+/// Loads a sum-of-Gaussians JSON (`sss/gaussians/*.json`) after the manifest checks. The pass blurs all three
+/// channels with one σ per Gaussian, so `shared_variances` must be true. The recorded `blend_weights` and
+/// `incremental_variances` must agree with eq. 4.8 and vᵢ − vᵢ₋₁ recomputed from `weights` and `variances`
+/// (1e-6): a file edited in one place only is refused.
+pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError> {
+    use crate::runtime::gaussian_sss::{GaussianBlurs, GaussianSssParams};
+    let manifest = Manifest::load(dir)?;
+    let v = load_json(dir, &manifest, path)?;
+    if field(&v, path, "shared_variances")?.as_bool() != Some(true) {
+        return Err(content(path, "per-channel variances; the screen-space pass needs shared_variances = true"));
+    }
+    let variances_mm2: Vec<f64> = field_as(&v, path, "variances")?;
+    let weights: Vec<[f64; 3]> = field_as(&v, path, "weights")?;
+    let blend: Vec<[f64; 3]> = field_as(&v, path, "blend_weights")?;
+    let incremental: Vec<f64> = field_as(&v, path, "incremental_variances")?;
+    let n = variances_mm2.len();
+    if weights.len() != n || blend.len() != n || incremental.len() != n {
+        return Err(content(path, format!("{n} variances but weights/blend_weights/incremental_variances differ")));
+    }
+    let fit = crate::diffusion::sum_of_gaussians::SumOfGaussians { variances_mm2, weights };
+    let blurs = GaussianBlurs::from_sum_of_gaussians(&fit).map_err(|e| content(path, e.to_string()))?;
+    for i in 0..n {
+        for (c, (&got, &recorded)) in blurs.blend[i].iter().zip(&blend[i]).enumerate() {
+            if (got as f64 - recorded).abs() > 1e-6 {
+                return Err(content(path, format!("blend_weights[{i}][{c}] = {recorded} but eq. 4.8 gives {got}")));
+            }
+        }
+        let inc = (blurs.incremental_sigma_mm[i] as f64).powi(2);
+        if (inc - incremental[i]).abs() > 1e-6 * incremental[i].max(1.0) {
+            return Err(content(
+                path,
+                format!("incremental_variances[{i}] = {} but v_i - v_(i-1) = {inc}", incremental[i]),
+            ));
+        }
+    }
+    let params = GaussianSssParams {
+        alpha: field_f64(&v, path, "lod_thresholds.alpha")? as f32,
+        beta: field_f64(&v, path, "lod_thresholds.beta")? as f32,
+        gamma: field_f64(&v, path, "lod_thresholds.gamma")? as f32,
+        ..GaussianSssParams::default()
+    };
+    params.validate().map_err(|e| content(path, e.to_string()))?;
+    Ok(BakedGaussians { fit, blurs, params })
+}
+
+/// A baked transmittance table T(s), node-inclusive: texel i holds s = s_max·i/(n−1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransmittanceTable {
+    pub values: Vec<[f32; 3]>,
+    pub s_max_mm: f32,
+}
+
+/// Loads T(s) (EXR f32 RGB, `width` samples, identical rows) and its sidecar JSON (`s_max_mm`, `samples`,
+/// node-inclusive texel convention), both through the manifest checks. Refuses a table whose rows differ, whose
+/// sidecar disagrees with the EXR's width, whose convention is not node-inclusive, or whose T(0) is not ≈ 1
+/// per channel (±1e-3; eq. 5.12 at s = 0 is Σ wᵢ).
+pub fn load_transmittance(dir: &Path, path: &str) -> Result<TransmittanceTable, LutError> {
+    let manifest = Manifest::load(dir)?;
+    let img = load_exr_f32(dir, &manifest, path, 3, (2, 1))?;
+    let side_path = sidecar_path(path);
+    let side = load_json(dir, &manifest, &side_path)?;
+    let samples: u32 = field_as(&side, &side_path, "samples")?;
+    if samples != img.width {
+        return Err(content(&side_path, format!("samples = {samples}, the table {path} is {} wide", img.width)));
+    }
+    let conv = field(&side, &side_path, "texel_convention")?.as_str().unwrap_or_default();
+    if !conv.starts_with("node-inclusive") {
+        return Err(content(&side_path, format!("texel_convention {conv:?}; the pass samples node-inclusive tables")));
+    }
+    let s_max_mm = field_f64(&side, &side_path, "s_max_mm")?;
+    if !(s_max_mm.is_finite() && s_max_mm > 0.0) {
+        return Err(content(&side_path, format!("s_max_mm must be > 0, got {s_max_mm}")));
+    }
+    let row = (3 * img.width) as usize;
+    if img.data.chunks(row).any(|r| r != &img.data[..row]) {
+        return Err(content(path, "rows differ; T(s) is one row (repeated rows must be identical)"));
+    }
+    let values: Vec<[f32; 3]> = img.data[..row].chunks(3).map(|p| [p[0], p[1], p[2]]).collect();
+    if values[0].iter().any(|t| (t - 1.0).abs() > 1e-3) {
+        return Err(content(path, format!("T(0) = {:?}; a normalised profile gives 1 per channel", values[0])));
+    }
+    Ok(TransmittanceTable { values, s_max_mm: s_max_mm as f32 })
+}
+
+/// The skin colour LUT: linear RGB albedo, columns = melanin, rows = hemoglobin (top row Chd = 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlbedoLut {
+    pub width: u32,
+    pub height: u32,
+    pub albedo: Vec<[f32; 3]>,
+}
+
+/// Loads the skin colour LUT (EXR f32 RGB, ≥ 2×2) and its sidecar JSON through the manifest checks. The pass
+/// indexes it with u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), node-inclusive ([`crate::runtime::skin_inputs::CM_MAX`],
+/// [`crate::runtime::skin_inputs::CHD_MAX`]); a sidecar with other ranges or another size is refused.
+pub fn load_skin_lut(dir: &Path, path: &str) -> Result<AlbedoLut, LutError> {
+    use crate::runtime::skin_inputs::{CHD_MAX, CM_MAX};
+    let manifest = Manifest::load(dir)?;
+    let img = load_exr_f32(dir, &manifest, path, 3, (2, 2))?;
+    let side_path = sidecar_path(path);
+    let side = load_json(dir, &manifest, &side_path)?;
+    let (w, h): (u32, u32) = (field_as(&side, &side_path, "width")?, field_as(&side, &side_path, "height")?);
+    if (w, h) != (img.width, img.height) {
+        return Err(content(&side_path, format!("says {w}x{h}, the LUT {path} is {}x{}", img.width, img.height)));
+    }
+    let cm = field_f64(&side, &side_path, "index.melanin_max")?;
+    let chd = field_f64(&side, &side_path, "index.hemoglobin_max")?;
+    if cm as f32 != CM_MAX || chd as f32 != CHD_MAX {
+        return Err(content(
+            &side_path,
+            format!("index ranges Cm <= {cm}, Chd <= {chd}; the pass indexes Cm <= {CM_MAX}, Chd <= {CHD_MAX}"),
+        ));
+    }
+    let albedo = img.data.chunks(3).map(|p| [p[0], p[1], p[2]]).collect();
+    Ok(AlbedoLut { width: img.width, height: img.height, albedo })
+}
+
+/// The skin LUTs of the pass from a bake directory: the albedo LUT at `skin_lut` and T(s) at `transmittance`.
+pub fn load_skin_luts(
+    dir: &Path,
+    skin_lut: &str,
+    transmittance: &str,
+) -> Result<crate::runtime::skin_inputs::SkinLuts, LutError> {
+    let lut = load_skin_lut(dir, skin_lut)?;
+    let t = load_transmittance(dir, transmittance)?;
+    Ok(crate::runtime::skin_inputs::SkinLuts {
+        albedo_size: (lut.width, lut.height),
+        albedo: lut.albedo,
+        transmittance: t.values,
+        s_max_mm: t.s_max_mm,
+    })
+}
+
+/// A baked hemoglobin rig (eq. 7.6): the per-target (scale, bias) maps the pass takes and the full-resolution H0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedRig {
+    /// Targets in the file's order (`maps[0]` = neutral).
+    pub rig: crate::runtime::skin_inputs::HemoglobinRig,
+    /// Target names, same order.
+    pub names: Vec<String>,
+    /// Mean-free neutral hemoglobin H0 (eq. 7.4), `full_size`, top row first.
+    pub h0: crate::image_buf::Image<f32>,
+    /// Global state factors g of eq. 7.6 by target name (e.g. anger 1.27).
+    pub global_scales: Vec<(String, f64)>,
+}
+
+impl BakedRig {
+    /// H0 sampled bilinearly (clamp to edge) at texture coordinates (u, v) ∈ [0, 1]², texel centres at
+    /// (i + 0.5)/size, as the rig's `sampling` field states.
+    pub fn h0_at(&self, u: f32, v: f32) -> f32 {
+        let (w, h) = (self.h0.width as i64, self.h0.height as i64);
+        let (x, y) = (u * w as f32 - 0.5, v * h as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |i: i64, j: i64| self.h0.data[(j.clamp(0, h - 1) * w + i.clamp(0, w - 1)) as usize];
+        let (i, j) = (x0 as i64, y0 as i64);
+        let top = at(i, j) + (at(i + 1, j) - at(i, j)) * fx;
+        let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * fx;
+        top + (bottom - top) * fy
+    }
+}
+
+/// Loads a hemoglobin rig (`rtbake-hemoglobin-rig/1`) and every map it names (paths relative to the rig file's
+/// folder), each through the manifest checks: single-channel f32 EXRs, scale/bias at `rig_size`, H0 at
+/// `full_size`. Refuses more targets than the pass holds ([`crate::runtime::skin_inputs::MAX_RIG_TARGETS`]), a
+/// first map that is not the neutral one, and values outside the dermal-hemoglobin range the skin LUT indexes.
+pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError> {
+    use crate::runtime::skin_inputs::{HemoglobinRig, MAX_RIG_TARGETS};
+    let manifest = Manifest::load(dir)?;
+    let v = load_json(dir, &manifest, path)?;
+    let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
+    if schema != "rtbake-hemoglobin-rig/1" {
+        return Err(content(path, format!("schema {schema:?}, the runtime reads \"rtbake-hemoglobin-rig/1\"")));
+    }
+    let folder = path.rsplit_once('/').map(|(d, _)| format!("{d}/")).unwrap_or_default();
+    let [rw, rh]: [u32; 2] = field_as(&v, path, "rig_size")?;
+    let [fw, fh]: [u32; 2] = field_as(&v, path, "full_size")?;
+    let maps: Vec<serde_json::Value> = field_as(&v, path, "maps")?;
+    if maps.is_empty() || maps.len() > MAX_RIG_TARGETS {
+        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", maps.len())));
+    }
+    let map1 = |file: &str, (w, h): (u32, u32)| -> Result<Vec<f32>, LutError> {
+        let p = format!("{folder}{file}");
+        let img = load_exr_f32(dir, &manifest, &p, 1, (1, 1))?;
+        if (img.width, img.height) != (w, h) {
+            return Err(content(&p, format!("{}x{}, the rig says {w}x{h}", img.width, img.height)));
+        }
+        Ok(img.data)
+    };
+    let (mut targets, mut names) = (Vec::new(), Vec::new());
+    for (i, m) in maps.iter().enumerate() {
+        let name: String = field_as(m, path, "name")?;
+        if i == 0 && name != "neutral" {
+            return Err(content(path, format!("maps[0] is {name:?}; eq. 7.6 needs the neutral map first")));
+        }
+        let scale = map1(&field_as::<String>(m, path, "scale_exr")?, (rw, rh))?;
+        let bias = map1(&field_as::<String>(m, path, "bias_exr")?, (rw, rh))?;
+        if let Some(b) = bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
+            return Err(content(
+                path,
+                format!("{name}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)"),
+            ));
+        }
+        targets.push(scale.into_iter().zip(bias).map(|(s, b)| [s, b]).collect());
+        names.push(name);
+    }
+    let h0_file: String = field_as(&v, path, "h0.exr")?;
+    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&h0_file, (fw, fh))?);
+    let global: serde_json::Map<String, serde_json::Value> = field_as(&v, path, "global_scales")?;
+    let global_scales = global.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
+    let rig = HemoglobinRig { width: rw, height: rh, targets };
+    rig.validate().map_err(|e| content(path, e.to_string()))?;
+    Ok(BakedRig { rig, names, h0, global_scales })
 }

@@ -22,6 +22,39 @@ pub fn precision(g: &Gpu) -> FilterPrecision {
     FilterPrecision::for_adapter(&g.adapter_info.name, g.adapter_info.device_type == wgpu::DeviceType::Cpu)
 }
 
+/// The committed bake directory (`baked/` beside the crate).
+pub fn baked_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked")
+}
+
+/// rtbake's SMAA textures from the committed bake, through the manifest-checked loader.
+pub fn baked_smaa() -> SmaaTextures {
+    rtbake::runtime::loader::load_smaa_textures(&baked_dir()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// rtbake's MLAA v1.4 area map for maximum distance n from the committed bake, through the loader.
+pub fn baked_mlaa(n: u32) -> Vec<u8> {
+    rtbake::runtime::loader::load_mlaa_area(&baked_dir(), n).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The reference folder if it holds the golden files; otherwise says so plainly and returns None, or fails the
+/// test when `RTBAKE_REQUIRE_REFERENCE=1`.
+pub fn reference_dir_checked() -> Option<PathBuf> {
+    let dir = reference_dir();
+    if dir.join("smaa/SHA256SUMS").is_file() && dir.join("mlaa/SHA256SUMS").is_file() {
+        return Some(dir);
+    }
+    let msg = format!(
+        "reference folder {} not found (set RTBAKE_REFERENCE_DIR): comparison with the upstream golden textures NOT run",
+        dir.display()
+    );
+    if std::env::var("RTBAKE_REQUIRE_REFERENCE").as_deref() == Ok("1") {
+        panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
+    }
+    eprintln!("{msg}");
+    None
+}
+
 pub fn reference_dir() -> PathBuf {
     std::env::var_os("RTBAKE_REFERENCE_DIR")
         .map(PathBuf::from)
