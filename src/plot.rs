@@ -308,8 +308,11 @@ impl LinePlot {
         c.line(ax1, ay0, ax1, ay1, black, false);
         for series in &self.series {
             let pts: Vec<(f64, f64)> = self.visible_points(series, &f).iter().map(|&(x, y)| map(x, y)).collect();
+            // The dash pattern runs along the whole polyline (segments are often shorter than one dash).
+            let mut phase = 0.0;
             for p in pts.windows(2) {
-                c.line(p[0].0, p[0].1, p[1].0, p[1].1, series.color, series.dashed);
+                c.dashed_line(p[0].0, p[0].1, p[1].0, p[1].1, series.color, series.dashed, phase);
+                phase += ((p[1].0 - p[0].0).powi(2) + (p[1].1 - p[0].1).powi(2)).sqrt();
             }
         }
         for (i, series) in self.series.iter().enumerate() {
@@ -394,12 +397,18 @@ impl Canvas {
 
     /// A 2-pixel-wide line (1 pixel for axis-aligned lines); dashed lines alternate 6 px on, 4 px off.
     fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool) {
+        self.dashed_line(x0, y0, x1, y1, color, dashed, 0.0);
+    }
+
+    /// [`Canvas::line`] whose dash pattern starts `phase` pixels into the pattern.
+    #[allow(clippy::too_many_arguments)]
+    fn dashed_line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool, phase: f64) {
         let len = ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
         let steps = (len * 2.0).ceil().max(1.0) as usize;
         let thick = (x1 - x0).abs() > 0.5 && (y1 - y0).abs() > 0.5 || color != [0, 0, 0] && color != [224, 224, 224];
         for i in 0..=steps {
             let t = i as f64 / steps as f64;
-            if dashed && (t * len) % 10.0 >= 6.0 {
+            if dashed && (phase + t * len) % 10.0 >= 6.0 {
                 continue;
             }
             let (x, y) = (x0 + t * (x1 - x0), y0 + t * (y1 - y0));
@@ -502,6 +511,19 @@ mod tests {
         let img = panels_to_image(&[a.clone(), b], 300, 200);
         assert_eq!((img.width, img.height), (300, 400));
         assert_eq!(img.data[..img.data.len() / 2], a.to_image(300, 200).data[..]);
+    }
+
+    #[test]
+    fn dashes_run_across_short_segments() {
+        // 400 points: every segment is ~1 px, far shorter than a dash.
+        let mut p = sample();
+        p.series[0].points = (0..400).map(|i| (1.0 + i as f64, 1.0)).collect();
+        p.log_x = false;
+        let count = |p: &LinePlot| p.to_image(640, 200).data.chunks(3).filter(|px| px == &[255, 0, 0]).count();
+        let solid = count(&p);
+        p.series[0].dashed = true;
+        let dashed = count(&p);
+        assert!((dashed as f64) < 0.75 * solid as f64 && dashed as f64 > 0.45 * solid as f64, "{dashed} vs {solid}");
     }
 
     #[test]

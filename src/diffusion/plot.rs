@@ -53,7 +53,7 @@ impl PlotFormat {
 const CHANNEL_NAMES: [&str; 3] = ["R", "G", "B"];
 
 fn lighter(c: [u8; 3]) -> [u8; 3] {
-    c.map(|v| ((v as u16 + 2 * 255) / 3) as u8)
+    c.map(|v| ((v as u16 + 255) / 2) as u8)
 }
 
 fn darker(c: [u8; 3]) -> [u8; 3] {
