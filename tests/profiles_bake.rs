@@ -58,6 +58,8 @@ fn writes_tables_and_plots_for_every_default_profile() {
         assert!(json["model"].is_string(), "{stem}");
         assert_eq!(json["r_mm"].as_array().unwrap().len(), 200);
         let csv = text(&files, &format!("profiles/{stem}.csv"));
+        let svg = text(&files, &format!("profiles/{stem}.svg"));
+        assert!(svg.contains("<desc>rtbake profile: {") && svg.matches("<polyline").count() >= 6, "{stem}");
         assert!(csv.lines().next().is_some_and(|l| l.starts_with("# rtbake profile: {") && l.contains("\"model\":")));
     }
     let pngs: Vec<&str> = files.iter().filter(|f| f.path.ends_with(".png")).map(|f| f.path.as_str()).collect();

@@ -78,6 +78,12 @@ fn overlay_fit_adds_one_dashed_series_per_channel() {
     assert_eq!(lines.len(), 12);
     assert_eq!(lines.iter().filter(|l| l.contains("stroke-dasharray")).count(), 6);
     assert!(svg.contains(">3-Gaussian fit B</text>"));
+    // The SVG records the model options and the fit.
+    let desc = svg.split("<desc>rtbake profile: ").nth(1).unwrap().split("</desc>").next().unwrap();
+    let v: serde_json::Value = serde_json::from_str(desc).unwrap();
+    assert_eq!((v["material"].as_str(), v["model"].as_str()), (Some("marble"), Some("dipole")));
+    assert_eq!(v["overlay_fit"]["count"], 3);
+    assert_eq!(v["overlay_fit"]["variances_mm2"].as_array().unwrap().len(), 3);
 }
 
 /// Exit 2, the flag named on stderr, nothing in `dir`.

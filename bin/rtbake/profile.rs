@@ -215,7 +215,15 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 None => None,
             };
             let panels = profile_panels(&table, fit.as_ref().map(|f| &f.sum), &plot_title(&source));
-            Some(render(&panels, format)?)
+            let mut provenance = table.provenance.clone();
+            if let (Some(f), Some(s)) = (&fit, &fit_settings) {
+                provenance["overlay_fit"] = serde_json::json!({
+                    "count": s.count, "shared_variances": s.shared_variances, "normalize": s.normalize,
+                    "starts": s.starts, "variances_mm2": f.sum.variances_mm2[0], "weights": f.sum.weights,
+                    "error_percent": f.error_percent,
+                });
+            }
+            Some(render(&panels, format, &provenance)?)
         }
         None => None,
     };

@@ -132,7 +132,7 @@ columns r_mm, R_r, R_g, R_b in mm^-2 (then T_r, T_g, T_b for layer stacks); radi
 const JSON_CONVENTION: &str = "r_mm: radii (mm, log-spaced); R: [r, g, b] per radius, mm^-2; total_R = R^(0) = \
 int 2 pi r R dr; T, total_T for layer stacks; remaining keys: model options (provenance)";
 const PLOT_CONVENTION: &str = "two panels over a log10 r axis (mm): r R(r) (1/mm, linear y) above, R(r) (mm^-2, log10 \
-y, 10 decades) below; solid R per channel, dashed lighter T";
+y, 10 decades) below; solid R per channel, dashed lighter T; SVG <desc>: model options (JSON)";
 
 /// A stem component: lower-case letters, digits, `_`, `-`, `.`, not starting with `.`.
 fn check_name(param: &str, name: &str) -> Result<(), InvalidInput> {
@@ -260,7 +260,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         files.push(text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION));
         files.push(json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION));
         let panels = profile_panels(&t, None, title);
-        let svg = render(&panels, PlotFormat::Svg)?;
+        let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
         files.push(BakedFile {
             path: format!("{path}.svg"),
             bytes: svg,
@@ -273,7 +273,11 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             meta.channels = 3;
             meta.sample_type = "u8".into();
             meta.color_space = "srgb".into();
-            files.push(BakedFile { path: format!("{path}.png"), bytes: render(&panels, PlotFormat::Png)?, meta });
+            files.push(BakedFile {
+                path: format!("{path}.png"),
+                bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
+                meta,
+            });
         }
         let r = t.total_reflectance;
         let tt = t.total_transmittance.map(|v| format!("{:e},{:e},{:e}", v[0], v[1], v[2])).unwrap_or(",,".into());

@@ -15,6 +15,7 @@ use super::RadialProfile;
 use crate::error::InvalidInput;
 use crate::fitting::{RgbGaussians, CHANNEL_COLORS};
 use crate::plot::{panels_to_image, panels_to_svg, LinePlot, Series};
+use serde_json::Value;
 use std::path::Path;
 
 /// Width of a profile plot, pixels / SVG user units.
@@ -119,9 +120,16 @@ pub fn profile_panels(table: &ProfileTable, fit: Option<&RgbGaussians>, title: &
 }
 
 /// The panels rendered as a file in `format`: SVG text, or an RGB PNG ([`PLOT_WIDTH`] × 2·[`PANEL_HEIGHT`]).
-pub fn render(panels: &[LinePlot], format: PlotFormat) -> Result<Vec<u8>, crate::io::IoError> {
+/// The SVG records `provenance` (the model options, as JSON) in its `<desc>` element; a PNG carries pixels only.
+pub fn render(panels: &[LinePlot], format: PlotFormat, provenance: &Value) -> Result<Vec<u8>, crate::io::IoError> {
     match format {
-        PlotFormat::Svg => Ok(panels_to_svg(panels, PLOT_WIDTH, PANEL_HEIGHT).into_bytes()),
+        PlotFormat::Svg => {
+            let svg = panels_to_svg(panels, PLOT_WIDTH, PANEL_HEIGHT);
+            let desc = provenance.to_string().replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+            // After the opening `<svg …>` line.
+            let (head, body) = svg.split_once('\n').unwrap_or((&svg, ""));
+            Ok(format!("{head}\n<desc>rtbake profile: {desc}</desc>\n{body}").into_bytes())
+        }
         PlotFormat::Png => crate::io::png::encode_u8(&panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT)),
     }
 }
@@ -155,7 +163,12 @@ mod tests {
             assert_eq!(v, r * table.reflectance_mm2[7][c]);
             assert_eq!(bottom.series[c].points[7].1, table.reflectance_mm2[7][c]);
         }
-        let svg = String::from_utf8(render(&[top, bottom], PlotFormat::Svg).unwrap()).unwrap();
+        let prov = serde_json::json!({"material": "skin1", "note": "a<b"});
+        let svg = String::from_utf8(render(&[top, bottom], PlotFormat::Svg, &prov).unwrap()).unwrap();
         assert_eq!(svg.matches("<polyline").count(), 6);
+        assert!(
+            svg.starts_with("<svg")
+                && svg.contains(r#"<desc>rtbake profile: {"material":"skin1","note":"a&lt;b"}</desc>"#)
+        );
     }
 }
