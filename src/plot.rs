@@ -4,7 +4,9 @@
 //! the plots here are a few polylines on a linear or log₁₀ x axis. The SVG is written directly (ticks, numeric tick
 //! labels, axis labels, legend). The raster version draws the same axes, ticks, grid and polylines into an
 //! `Image<u8>` and writes its numeric tick labels with a built-in 3×5 pixel digit font; axis titles and the legend
-//! text appear only in the SVG (the PNG legend is colour swatches in series order). Pure: returns text / pixels.
+//! text appear only in the SVG (the PNG legend is colour swatches in series order). The y axis may be log₁₀ too
+//! (decade ticks; at most [`LOG_Y_DECADES`] decades below the largest value are shown). Several plots can be stacked
+//! vertically into one document ([`panels_to_svg`], [`panels_to_image`]). Pure: returns text / pixels.
 
 use crate::image_buf::Image;
 use std::fmt::Write;
@@ -28,6 +30,9 @@ pub struct LinePlot {
     pub y_label: String,
     /// log₁₀ x axis.
     pub log_x: bool,
+    /// log₁₀ y axis (points with y ≤ 0 are skipped, as are points more than [`LOG_Y_DECADES`] decades below the
+    /// largest value).
+    pub log_y: bool,
     pub series: Vec<Series>,
 }
 
@@ -35,6 +40,9 @@ const MARGIN_L: f64 = 70.0;
 const MARGIN_R: f64 = 20.0;
 const MARGIN_T: f64 = 36.0;
 const MARGIN_B: f64 = 50.0;
+
+/// Decades a log₁₀ y axis spans at most, counted down from the decade above the largest value.
+pub const LOG_Y_DECADES: f64 = 10.0;
 
 /// Axis ranges and ticks in plot coordinates (x already log₁₀ when `log_x`).
 struct Frame {
@@ -80,18 +88,34 @@ fn fmt_decade(e: i32) -> String {
     }
 }
 
+/// Decade label for a log y axis: plain decimals for 1e-3..1e3, else `1e-5`.
+fn fmt_log_tick(e: i32) -> String {
+    if (-3..=3).contains(&e) {
+        fmt_decade(e)
+    } else {
+        format!("1e{e}")
+    }
+}
+
 impl LinePlot {
     fn data_points(&self, s: &Series) -> Vec<(f64, f64)> {
         s.points
             .iter()
-            .filter(|(x, y)| x.is_finite() && y.is_finite() && (!self.log_x || *x > 0.0))
-            .map(|&(x, y)| (if self.log_x { x.log10() } else { x }, y))
+            .filter(|(x, y)| x.is_finite() && y.is_finite() && (!self.log_x || *x > 0.0) && (!self.log_y || *y > 0.0))
+            .map(|&(x, y)| (if self.log_x { x.log10() } else { x }, if self.log_y { y.log10() } else { y }))
             .collect()
+    }
+
+    /// Plot-space points of `s` that lie inside the frame's y range (only a log y axis cuts any off).
+    fn visible_points(&self, s: &Series, f: &Frame) -> Vec<(f64, f64)> {
+        self.data_points(s).into_iter().filter(|&(_, y)| y >= f.y0).collect()
     }
 
     fn frame(&self) -> Frame {
         let pts: Vec<(f64, f64)> = self.series.iter().flat_map(|s| self.data_points(s)).collect();
-        let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, f64::NEG_INFINITY);
+        // A linear y axis always includes 0; a log one starts at the smallest value.
+        let y_start = if self.log_y { f64::INFINITY } else { 0.0f64 };
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, y_start, f64::NEG_INFINITY);
         for &(x, y) in &pts {
             x0 = x0.min(x);
             x1 = x1.max(x);
@@ -101,17 +125,33 @@ impl LinePlot {
         if !(x0.is_finite() && x1 > x0) {
             (x0, x1) = (0.0, 1.0);
         }
+        if !y0.is_finite() {
+            y0 = 0.0;
+        }
         if !(y1.is_finite() && y1 > y0) {
             y1 = y0 + 1.0;
         }
-        let ystep = nice_step(y1 - y0, 5);
-        y1 = (y1 / ystep).ceil() * ystep;
-        y0 = (y0 / ystep).floor() * ystep;
+        // Round-off below a zero baseline (e.g. −1e−18 from a numerical transform) does not add a negative tick row.
+        if !self.log_y && y0 < 0.0 && -y0 < 1e-6 * y1.abs() {
+            y0 = 0.0;
+        }
         let mut y_ticks = Vec::new();
-        let mut t = y0;
-        while t <= y1 + 0.5 * ystep {
-            y_ticks.push((t, fmt_tick(t, ystep)));
-            t += ystep;
+        if self.log_y {
+            y1 = y1.ceil();
+            y0 = y0.floor().max(y1 - LOG_Y_DECADES);
+            let every = if y1 - y0 > 6.0 { 2 } else { 1 };
+            for e in (y0 as i32..=y1 as i32).filter(|e| (y1 as i32 - e) % every == 0) {
+                y_ticks.push((e as f64, fmt_log_tick(e)));
+            }
+        } else {
+            let ystep = nice_step(y1 - y0, 5);
+            y1 = (y1 / ystep).ceil() * ystep;
+            y0 = (y0 / ystep).floor() * ystep;
+            let mut t = y0;
+            while t <= y1 + 0.5 * ystep {
+                y_ticks.push((t, fmt_tick(t, ystep)));
+                t += ystep;
+            }
         }
         let mut x_ticks = Vec::new();
         if self.log_x {
@@ -143,16 +183,16 @@ impl LinePlot {
 
     /// SVG document of `width × height` user units.
     pub fn to_svg(&self, width: u32, height: u32) -> String {
+        panels_to_svg(std::slice::from_ref(self), width, height)
+    }
+
+    /// The plot's SVG elements (no `<svg>` wrapper) in a `width × height` box at the origin.
+    fn svg_elements(&self, width: u32, height: u32) -> String {
         let (w, h) = (width as f64, height as f64);
         let f = self.frame();
         let map = Self::mapper(&f, w, h);
         let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
         let mut s = String::new();
-        let _ = writeln!(
-            s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="11">"#
-        );
-        let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
         let (ax0, ay0) = map(f.x0, f.y0);
         let (ax1, ay1) = map(f.x1, f.y1);
         for (x, label) in &f.x_ticks {
@@ -186,7 +226,7 @@ impl LinePlot {
         );
         for series in &self.series {
             let pts: Vec<String> = self
-                .data_points(series)
+                .visible_points(series, &f)
                 .iter()
                 .map(|&(x, y)| {
                     let (px, py) = map(x, y);
@@ -236,7 +276,6 @@ impl LinePlot {
             (ay0 + ay1) / 2.0,
             esc(&self.y_label)
         );
-        s.push_str("</svg>\n");
         s
     }
 
@@ -268,9 +307,12 @@ impl LinePlot {
         c.line(ax0, ay0, ax0, ay1, black, false);
         c.line(ax1, ay0, ax1, ay1, black, false);
         for series in &self.series {
-            let pts: Vec<(f64, f64)> = self.data_points(series).iter().map(|&(x, y)| map(x, y)).collect();
+            let pts: Vec<(f64, f64)> = self.visible_points(series, &f).iter().map(|&(x, y)| map(x, y)).collect();
+            // The dash pattern runs along the whole polyline (segments are often shorter than one dash).
+            let mut phase = 0.0;
             for p in pts.windows(2) {
-                c.line(p[0].0, p[0].1, p[1].0, p[1].1, series.color, series.dashed);
+                c.dashed_line(p[0].0, p[0].1, p[1].0, p[1].1, series.color, series.dashed, phase);
+                phase += ((p[1].0 - p[0].0).powi(2) + (p[1].1 - p[0].1).powi(2)).sqrt();
             }
         }
         for (i, series) in self.series.iter().enumerate() {
@@ -280,6 +322,37 @@ impl LinePlot {
         }
         c.img
     }
+}
+
+/// One SVG document with `panels` stacked top to bottom, each `width × panel_height` user units.
+pub fn panels_to_svg(panels: &[LinePlot], width: u32, panel_height: u32) -> String {
+    let height = panel_height * panels.len().max(1) as u32;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="sans-serif" font-size="11">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    for (i, p) in panels.iter().enumerate() {
+        if i == 0 {
+            s.push_str(&p.svg_elements(width, panel_height));
+        } else {
+            let _ = writeln!(s, r#"<g transform="translate(0,{})">"#, i as u32 * panel_height);
+            s.push_str(&p.svg_elements(width, panel_height));
+            s.push_str("</g>\n");
+        }
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// One RGB raster with `panels` stacked top to bottom, each `width × panel_height` pixels.
+pub fn panels_to_image(panels: &[LinePlot], width: u32, panel_height: u32) -> Image<u8> {
+    let mut data = Vec::with_capacity((width * panel_height * 3) as usize * panels.len());
+    for p in panels {
+        data.extend_from_slice(&p.to_image(width, panel_height).data);
+    }
+    Image::from_vec(width, panel_height * panels.len() as u32, 3, data)
 }
 
 /// 3×5 digit font: each glyph is 5 rows of 3 bits (MSB = left column).
@@ -324,12 +397,18 @@ impl Canvas {
 
     /// A 2-pixel-wide line (1 pixel for axis-aligned lines); dashed lines alternate 6 px on, 4 px off.
     fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool) {
+        self.dashed_line(x0, y0, x1, y1, color, dashed, 0.0);
+    }
+
+    /// [`Canvas::line`] whose dash pattern starts `phase` pixels into the pattern.
+    #[allow(clippy::too_many_arguments)]
+    fn dashed_line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool, phase: f64) {
         let len = ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
         let steps = (len * 2.0).ceil().max(1.0) as usize;
         let thick = (x1 - x0).abs() > 0.5 && (y1 - y0).abs() > 0.5 || color != [0, 0, 0] && color != [224, 224, 224];
         for i in 0..=steps {
             let t = i as f64 / steps as f64;
-            if dashed && (t * len) % 10.0 >= 6.0 {
+            if dashed && (phase + t * len) % 10.0 >= 6.0 {
                 continue;
             }
             let (x, y) = (x0 + t * (x1 - x0), y0 + t * (y1 - y0));
@@ -377,6 +456,7 @@ mod tests {
             x_label: "r (mm)".into(),
             y_label: "r R(r)".into(),
             log_x: true,
+            log_y: false,
             series: vec![Series {
                 label: "a<b".into(),
                 color: [255, 0, 0],
@@ -394,6 +474,56 @@ mod tests {
         assert!(svg.contains(">0.01</text>") && svg.contains(">0.1</text>") && svg.contains(">1</text>"));
         assert!(svg.contains("a&lt;b"));
         assert_eq!(svg.matches("<polyline").count(), 1);
+    }
+
+    #[test]
+    fn log_y_axis_has_decade_ticks_and_cuts_the_deep_tail() {
+        let mut p = sample();
+        p.log_y = true;
+        // y from 1 down to 1e-20 and one non-positive value: the axis spans 10 decades below the top decade.
+        p.series[0].points = (0..=20).map(|i| (10f64.powi(i - 10), 10f64.powi(-i))).collect();
+        p.series[0].points.push((1e20, 0.0));
+        let f = p.frame();
+        assert_eq!((f.y0, f.y1), (-LOG_Y_DECADES, 0.0));
+        assert!(f.y_ticks.iter().any(|(_, l)| l == "1") && f.y_ticks.iter().any(|(_, l)| l == "1e-10"));
+        let visible = p.visible_points(&p.series[0], &f);
+        assert_eq!(visible.len(), 11);
+        assert!(visible.iter().all(|&(_, y)| (-LOG_Y_DECADES..=0.0).contains(&y)));
+        let svg = p.to_svg(640, 400);
+        assert!(svg.contains(">1e-10</text>"));
+    }
+
+    #[test]
+    fn linear_axis_ignores_round_off_below_zero() {
+        let mut p = sample();
+        p.series[0].points.push((2.0, -1e-18));
+        assert_eq!(p.frame().y0, 0.0);
+        p.series[0].points.push((3.0, -1.0));
+        assert!(p.frame().y0 <= -1.0);
+    }
+
+    #[test]
+    fn panels_stack_vertically() {
+        let (a, b) = (sample(), sample());
+        let svg = panels_to_svg(&[a.clone(), b.clone()], 300, 200);
+        assert!(svg.contains(r#"height="400""#) && svg.contains(r#"<g transform="translate(0,200)">"#));
+        assert_eq!(svg.matches("<polyline").count(), 2);
+        let img = panels_to_image(&[a.clone(), b], 300, 200);
+        assert_eq!((img.width, img.height), (300, 400));
+        assert_eq!(img.data[..img.data.len() / 2], a.to_image(300, 200).data[..]);
+    }
+
+    #[test]
+    fn dashes_run_across_short_segments() {
+        // 400 points: every segment is ~1 px, far shorter than a dash.
+        let mut p = sample();
+        p.series[0].points = (0..400).map(|i| (1.0 + i as f64, 1.0)).collect();
+        p.log_x = false;
+        let count = |p: &LinePlot| p.to_image(640, 200).data.chunks(3).filter(|px| px == &[255, 0, 0]).count();
+        let solid = count(&p);
+        p.series[0].dashed = true;
+        let dashed = count(&p);
+        assert!((dashed as f64) < 0.75 * solid as f64 && dashed as f64 > 0.45 * solid as f64, "{dashed} vs {solid}");
     }
 
     #[test]

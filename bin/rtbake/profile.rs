@@ -1,14 +1,17 @@
 //! `rtbake profile`: evaluate a diffusion profile R(r) (and T(r) for slabs and layer stacks) on a radius grid and
-//! print / write it as JSON or CSV. Parsing and validation only; the maths is `rtbake::diffusion`.
+//! print / write it as JSON or CSV, and plot it (`--plot`, PNG or SVG, optionally with a fitted sum of Gaussians).
+//! Parsing and validation only; the maths is `rtbake::diffusion` and `rtbake::fitting`.
 
 use crate::cli::{parse_f64_list, usage, usage_msg, Ctx};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
+use rtbake::diffusion::plot::{profile_panels, render, PlotFormat};
 use rtbake::diffusion::source::{MaterialModel, ProfileSource};
 use rtbake::diffusion::table::{self, ProfileTable};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
-use std::path::PathBuf;
+use rtbake::fitting::{fit_sum_of_gaussians, FitSettings};
+use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum ModelArg {
@@ -90,6 +93,16 @@ pub struct ProfileArgs {
     /// Also write the table as JSON (same object as --json prints).
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Also write a plot, PNG or SVG by the extension (.png / .svg): two stacked panels over a log r axis (mm),
+    /// r R(r) on a linear y axis above and R(r) on a log y axis below, at the tabulated radii; solid R per channel,
+    /// dashed lighter T where present, dashed darker --overlay-fit. The PNG has numeric tick labels only (the
+    /// SVG carries titles and the legend).
+    #[arg(long, value_name = "FILE")]
+    plot: Option<PathBuf>,
+    /// Overlay a K-Gaussian fit with shared variances (R, G, B share the variances; fitted in profile units, not
+    /// normalised; 8 deterministic starts) on --plot. K in 2..=8.
+    #[arg(long, value_name = "K", requires = "plot")]
+    overlay_fit: Option<usize>,
 }
 
 /// Renames library parameter names to the flags a user typed.
@@ -102,6 +115,7 @@ fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
         "r_min_mm" => "--r-min-mm".to_string(),
         "r_max_mm" => "--r-max-mm".to_string(),
         "count" => "--count".to_string(),
+        "--count" => "--overlay-fit".to_string(),
         p if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
@@ -175,10 +189,44 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => table::log_radii(args.r_min_mm, args.r_max_mm, args.count).map_err(|e| flag_error(e, None))?,
     };
 
+    for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
+        if let Some(p) = path {
+            check_output_file(flag, p)?;
+        }
+    }
+    let plot_format = match &args.plot {
+        Some(path) => Some(PlotFormat::from_path("--plot", path).map_err(usage)?),
+        None => None,
+    };
+    let fit_settings =
+        args.overlay_fit.map(|count| FitSettings { count, shared_variances: true, normalize: false, starts: 8 });
+    if let Some(s) = &fit_settings {
+        s.validate().map_err(|e| flag_error(e, None))?;
+    }
+
     let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
     let table =
         ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| flag_error(e, None))?;
     let json = table.to_json();
+    let plot_bytes = match plot_format {
+        Some(format) => {
+            let fit = match &fit_settings {
+                Some(s) => Some(fit_sum_of_gaussians(profile.as_ref(), s).map_err(crate::fit::fit_error)?),
+                None => None,
+            };
+            let panels = profile_panels(&table, fit.as_ref().map(|f| &f.sum), &plot_title(&source));
+            let mut provenance = table.provenance.clone();
+            if let (Some(f), Some(s)) = (&fit, &fit_settings) {
+                provenance["overlay_fit"] = serde_json::json!({
+                    "count": s.count, "shared_variances": s.shared_variances, "normalize": s.normalize,
+                    "starts": s.starts, "variances_mm2": f.sum.variances_mm2[0], "weights": f.sum.weights,
+                    "error_percent": f.error_percent,
+                });
+            }
+            Some(render(&panels, format, &provenance)?)
+        }
+        None => None,
+    };
 
     // Everything computed: now write (atomically) and print.
     if let Some(path) = &args.csv {
@@ -188,6 +236,10 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if let Some(path) = &args.out {
         let text = serde_json::to_string_pretty(&json)? + "\n";
         rtbake::io::atomic::write_atomic(path, text.as_bytes())?;
+        ctx.info(format!("wrote {}", path.display()));
+    }
+    if let (Some(path), Some(bytes)) = (&args.plot, &plot_bytes) {
+        rtbake::io::atomic::write_atomic(path, bytes)?;
         ctx.info(format!("wrote {}", path.display()));
     }
     if ctx.json {
@@ -211,4 +263,34 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Before any work: `path` must not be a directory, and its directory must exist and accept a new file (probed).
+fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
+    if path.is_dir() {
+        return Err(usage_msg(format!("{flag} {}: is a directory, expected a file path", path.display())));
+    }
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(usage_msg(format!("{flag} {}: directory {} does not exist", path.display(), dir.display())));
+    }
+    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", path.display())))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Plot title naming the profile.
+fn plot_title(source: &ProfileSource) -> String {
+    match source {
+        ProfileSource::Material { name, model: MaterialModel::Dipole, .. } => format!("{name} (dipole)"),
+        ProfileSource::Material { name, model: MaterialModel::Multipole { thickness_mm }, .. } => {
+            format!("{name} (multipole, {thickness_mm} mm slab)")
+        }
+        ProfileSource::Preset(name) => format!("{name} (sum of Gaussians)"),
+        ProfileSource::Layers { stack, adding, .. } => {
+            format!("{}-layer stack ({} adding)", stack.layers().len(), adding.name())
+        }
+    }
 }

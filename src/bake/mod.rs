@@ -93,12 +93,14 @@ pub fn registry() -> Vec<Asset> {
     v.extend(separable::assets());
     v.extend(skin::assets());
     v.extend(facial::assets());
+    v.extend(profiles::assets());
     v
 }
 
 pub mod aa;
 pub mod facial;
 pub mod gaussians;
+pub mod profiles;
 pub mod separable;
 pub mod skin;
 pub mod transmittance;

@@ -127,5 +127,12 @@ pub fn profile_plot(profile: &dyn RadialProfile, fit: Option<&RgbGaussians>, tit
             });
         }
     }
-    LinePlot { title: title.into(), x_label: "r (mm)".into(), y_label: "r R(r) (1/mm)".into(), log_x: true, series }
+    LinePlot {
+        title: title.into(),
+        x_label: "r (mm)".into(),
+        y_label: "r R(r) (1/mm)".into(),
+        log_x: true,
+        log_y: false,
+        series,
+    }
 }

@@ -1,0 +1,333 @@
+//! Diffusion-profile tables and plots in `baked/profiles/` (`specs/diffusion.md`, "Outputs"): R(r) (and T(r) for
+//! layer stacks) per channel on a log radius grid, with the totals R̂(0), T̂(0) and the model options, as CSV and
+//! JSON ([`ProfileTable`]), plus a two-panel plot ([`crate::diffusion::plot`]: r·R(r) over log r, R(r) log–log) as
+//! SVG for every profile and as PNG for the few listed in `png_plots`.
+//!
+//! Default profiles:
+//! - `profiles/dipole/<material>`: the 11 measured materials of Jensen, Marschner, Levoy, Hanrahan, "A Practical
+//!   Model for Subsurface Light Transport", SIGGRAPH 2001, as semi-infinite dipoles (η = 1.3, DJ05 Fdr);
+//! - `profiles/presets/deon6`, `deon4`: d'Eon, Luebke, Enderton, "Efficient Rendering of Human Skin", EGSR 2007
+//!   (6 Gaussians) and thesis Table 4.2 (4 Gaussians);
+//! - `profiles/skin/two_layer_cm<Cm>_chd<Chd>`: the physiological two-layer skin (Donner & Jensen 2006 coefficients,
+//!   `specs/skin-color.md`; epidermis 0.25 mm over dermis 20 mm, η = 1.4; D65 × linear-sRGB-sensitivity weighted
+//!   per-channel coefficients) at (Cm, Chd) = (0.02, 0.05), (0.1, 0.1), (0.3, 0.05), symmetric adding (DJ05);
+//! - `profiles/layered/skin3_example`: an illustrative three-layer stack, **not a measured material** (DJ05's
+//!   three-layer skin coefficients are not public): a thin, translucent skin fold (ear rim, nostril) with air on both
+//!   sides — epidermis 0.25 mm, blood-rich upper dermis 0.5 mm, lower dermis 1.5 mm, η = 1.4 throughout. The
+//!   coefficients are the physiological model's, rounded to 3 digits: epidermis at (Cm, Chd) = (0.1, 0.05), upper
+//!   dermis at Chd = 0.3, lower dermis at Chd = 0.05. Being thin, it has a visible T(r).
+//!
+//! `profiles/totals.csv` lists every profile's R̂(0) and T̂(0). All tables use the default grid of
+//! `rtbake profile` (200 radii log-spaced over [0.001, 100] mm), so `rtbake profile --material skin1 --json` prints
+//! the same numbers as `profiles/dipole/skin1.json`.
+
+use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
+use crate::diffusion::layered::{Adding, LayerStack};
+use crate::diffusion::multipole::Series;
+use crate::diffusion::plot::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
+use crate::diffusion::source::{MaterialModel, ProfileSource};
+use crate::diffusion::table::{self, ProfileTable};
+use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
+use crate::error::InvalidInput;
+use crate::spectral::skin_layers::{two_layer_skin_rgb, RgbReduction, SkinPhysiology};
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+use std::collections::BTreeSet;
+
+/// The radius grid (log-spaced, inclusive).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Grid {
+    r_min_mm: f64,
+    r_max_mm: f64,
+    count: usize,
+}
+
+/// One point of the physiological two-layer skin.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkinPoint {
+    /// Cm, 0..=0.5.
+    melanin_fraction: f64,
+    /// Chd, 0..=0.32.
+    hemoglobin_fraction: f64,
+}
+
+/// A named layer stack (`stack` in the `--layers` JSON schema).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NamedStack {
+    name: String,
+    /// What the stack is, recorded with its outputs.
+    description: String,
+    adding: Adding,
+    stack: Value,
+}
+
+/// Parameters of `diffusion-profiles`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProfilesParams {
+    grid: Grid,
+    /// Fdr polynomial for the dipoles and stacks.
+    fdr: FdrForm,
+    /// Jensen 2001 materials, as dipoles.
+    materials: Vec<String>,
+    /// Sum-of-Gaussians presets.
+    presets: Vec<String>,
+    /// Physiological two-layer skin points (default physiology and RGB reduction).
+    skin: Vec<SkinPoint>,
+    /// How the skin layers are combined.
+    skin_adding: Adding,
+    /// User layer stacks.
+    stacks: Vec<NamedStack>,
+    /// Profiles (stems below `profiles/`, e.g. `dipole/skin1`) that also get a PNG plot.
+    png_plots: Vec<String>,
+}
+
+fn default_params() -> ProfilesParams {
+    let layer = |thickness_mm: f64, sigma_a: [f64; 3], sigma_s_prime: [f64; 3]| json!({"thickness_mm": thickness_mm, "eta": 1.4, "sigma_a": sigma_a, "sigma_s_prime": sigma_s_prime});
+    ProfilesParams {
+        grid: Grid {
+            r_min_mm: table::DEFAULT_R_MIN_MM,
+            r_max_mm: table::DEFAULT_R_MAX_MM,
+            count: table::DEFAULT_COUNT,
+        },
+        fdr: FdrForm::Dj05,
+        materials: materials::names().iter().map(|s| s.to_string()).collect(),
+        presets: sum_of_gaussians::PRESET_NAMES.iter().map(|s| s.to_string()).collect(),
+        skin: [(0.02, 0.05), (0.1, 0.1), (0.3, 0.05)]
+            .map(|(cm, chd)| SkinPoint { melanin_fraction: cm, hemoglobin_fraction: chd })
+            .to_vec(),
+        skin_adding: Adding::Symmetric,
+        stacks: vec![NamedStack {
+            name: "skin3_example".into(),
+            description: "illustrative thin skin fold in air (not a measured material): epidermis 0.25 mm, blood-rich \
+                          upper dermis 0.5 mm, lower dermis 1.5 mm; physiological-model coefficients rounded to 3 \
+                          digits (epidermis at Cm 0.1, Chd 0.05; upper dermis Chd 0.3; lower dermis Chd 0.05)"
+                .into(),
+            adding: Adding::Symmetric,
+            stack: json!({
+                "eta_above": 1.0,
+                "eta_below": 1.0,
+                "layers": [
+                    layer(0.25, [3.41, 4.81, 9.59], [5.46, 6.37, 9.15]),
+                    layer(0.5, [3.87, 5.89, 20.5], [2.73, 3.18, 4.58]),
+                    layer(1.5, [0.678, 1.03, 3.52], [2.73, 3.18, 4.58]),
+                ],
+            }),
+        }],
+        png_plots: vec![
+            "dipole/skin1".into(),
+            "presets/deon6".into(),
+            "skin/two_layer_cm0.1_chd0.1".into(),
+            "layered/skin3_example".into(),
+        ],
+    }
+}
+
+const CSV_CONVENTION: &str =
+    "'#' lines: provenance (JSON) and totals R^(0) = int 2 pi r R dr (and T^(0)) per channel; \
+columns r_mm, R_r, R_g, R_b in mm^-2 (then T_r, T_g, T_b for layer stacks); radii log-spaced";
+const JSON_CONVENTION: &str = "r_mm: radii (mm, log-spaced); R: [r, g, b] per radius, mm^-2; total_R = R^(0) = \
+int 2 pi r R dr; T, total_T for layer stacks; remaining keys: model options (provenance)";
+const PLOT_CONVENTION: &str = "two panels over a log10 r axis (mm): r R(r) (1/mm, linear y) above, R(r) (mm^-2, log10 \
+y, 10 decades) below; solid R per channel, dashed lighter T; SVG <desc>: model options (JSON)";
+
+/// A stem component: lower-case letters, digits, `_`, `-`, `.`, not starting with `.`.
+fn check_name(param: &str, name: &str) -> Result<(), InvalidInput> {
+    let ok = !name.is_empty()
+        && !name.starts_with('.')
+        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || matches!(c, '_' | '-' | '.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(InvalidInput::new(param, format!("must be a file name of [a-z0-9_.-] not starting with '.', got '{name}'")))
+    }
+}
+
+/// The profiles to bake: (stem below `profiles/`, title, source, extra provenance keys).
+fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Value)>, InvalidInput> {
+    let mut out = Vec::new();
+    for name in &p.materials {
+        let m = materials::find(name).ok_or_else(|| {
+            InvalidInput::new(
+                "materials",
+                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
+            )
+        })?;
+        let src = ProfileSource::Material {
+            name: m.name.into(),
+            model: MaterialModel::Dipole,
+            fdr: p.fdr,
+            series: Series::Exact,
+        };
+        out.push((
+            format!("dipole/{}", m.name),
+            format!("{} (dipole, Jensen 2001)", m.name),
+            src,
+            json!({"reference": "Jensen, Marschner, Levoy, Hanrahan, SIGGRAPH 2001"}),
+        ));
+    }
+    for name in &p.presets {
+        let lower = name.to_ascii_lowercase();
+        if sum_of_gaussians::preset(&lower).is_none() {
+            return Err(InvalidInput::new(
+                "presets",
+                format!(
+                    "'{name}' is not a known preset; expected one of {}",
+                    sum_of_gaussians::PRESET_NAMES.join(", ")
+                ),
+            ));
+        }
+        out.push((
+            format!("presets/{lower}"),
+            format!("{lower} (sum of Gaussians)"),
+            ProfileSource::Preset(lower),
+            json!({"reference": "d'Eon, Luebke, Enderton, EGSR 2007; thesis Table 4.2"}),
+        ));
+    }
+    let physiology = SkinPhysiology::default();
+    let reduction = RgbReduction::default();
+    for (i, s) in p.skin.iter().enumerate() {
+        let skin = two_layer_skin_rgb(&physiology, s.melanin_fraction, s.hemoglobin_fraction, false, &reduction)
+            .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
+        let stack = skin.layer_stack().map_err(|e| InvalidInput::new(format!("skin[{i}]"), e.to_string()))?;
+        let (cm, chd) = (s.melanin_fraction, s.hemoglobin_fraction);
+        out.push((
+            format!("skin/two_layer_cm{cm}_chd{chd}"),
+            format!("two-layer skin, Cm {cm}, Chd {chd}"),
+            ProfileSource::Layers { stack, adding: p.skin_adding, series: Series::Exact, fdr: p.fdr },
+            json!({"skin": {
+                "melanin_fraction": cm,
+                "hemoglobin_fraction": chd,
+                "physiology": physiology,
+                "rgb_reduction": reduction,
+                "reference": "Donner & Jensen 2006 coefficients (specs/skin-color.md); layers by DJ05 adding",
+            }}),
+        ));
+    }
+    for (i, s) in p.stacks.iter().enumerate() {
+        check_name(&format!("stacks[{i}].name"), &s.name)?;
+        let stack = LayerStack::from_json_str(&s.stack.to_string())
+            .map_err(|e| InvalidInput::new(format!("stacks[{i}].stack: {}", e.param), e.message))?;
+        out.push((
+            format!("layered/{}", s.name),
+            format!("{} ({}-layer stack)", s.name, stack.layers().len()),
+            ProfileSource::Layers { stack, adding: s.adding, series: Series::Exact, fdr: p.fdr },
+            json!({"name": s.name, "description": s.description}),
+        ));
+    }
+    Ok(out)
+}
+
+fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
+    let p: ProfilesParams = parse_params("diffusion-profiles", params)?;
+    let radii = table::log_radii(p.grid.r_min_mm, p.grid.r_max_mm, p.grid.count)
+        .map_err(|e| InvalidInput::new(format!("grid.{}", e.param), e.message))?;
+    let list = sources(&p)?;
+    let stems: BTreeSet<&str> = list.iter().map(|s| s.0.as_str()).collect();
+    if stems.len() != list.len() {
+        return Err(InvalidInput::new("materials/presets/skin/stacks", "list the same profile twice").into());
+    }
+    for (i, png) in p.png_plots.iter().enumerate() {
+        if !stems.contains(png.as_str()) {
+            return Err(InvalidInput::new(
+                format!("png_plots[{i}]"),
+                format!(
+                    "'{png}' is not one of the baked profiles ({})",
+                    stems.iter().copied().collect::<Vec<_>>().join(", ")
+                ),
+            )
+            .into());
+        }
+    }
+    let mut files = Vec::new();
+    let mut totals = String::from(
+        "# rtbake diffusion-profiles: totals R^(0) = int 2 pi r R(r) dr and T^(0) (empty where the model has no T)\n\
+         profile,total_R_r,total_R_g,total_R_b,total_T_r,total_T_g,total_T_b\n",
+    );
+    for (stem, title, source, extra) in &list {
+        let profile = source.build()?;
+        let mut provenance = source.provenance();
+        if let (Value::Object(dst), Value::Object(src)) = (&mut provenance, extra) {
+            for (k, v) in src {
+                dst.insert(k.clone(), v.clone());
+            }
+        }
+        let t = ProfileTable::compute(profile.as_ref(), &radii, provenance)?;
+        let path = format!("profiles/{stem}");
+        files.push(text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION));
+        files.push(json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION));
+        let panels = profile_panels(&t, None, title);
+        let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
+        files.push(BakedFile {
+            path: format!("{path}.svg"),
+            bytes: svg,
+            meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+        });
+        if p.png_plots.iter().any(|s| s == stem) {
+            let mut meta = FileMeta::text("plot", "png", PLOT_CONVENTION);
+            meta.width = PLOT_WIDTH;
+            meta.height = 2 * PANEL_HEIGHT;
+            meta.channels = 3;
+            meta.sample_type = "u8".into();
+            meta.color_space = "srgb".into();
+            files.push(BakedFile {
+                path: format!("{path}.png"),
+                bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
+                meta,
+            });
+        }
+        let r = t.total_reflectance;
+        let tt = t.total_transmittance.map(|v| format!("{:e},{:e},{:e}", v[0], v[1], v[2])).unwrap_or(",,".into());
+        totals.push_str(&format!("{stem},{:e},{:e},{:e},{tt}\n", r[0], r[1], r[2]));
+    }
+    files.push(text_file(
+        "profiles/totals.csv",
+        totals,
+        "csv",
+        "csv",
+        "one row per baked profile (stem below profiles/): total_R = R^(0), total_T = T^(0) per channel",
+    ));
+    Ok(files)
+}
+
+pub fn assets() -> Vec<Asset> {
+    vec![Asset {
+        name: "diffusion-profiles",
+        summary: "R(r) (and T(r)) tables (CSV, JSON) and plots of the Jensen 2001 dipoles, d'Eon's presets, the \
+                  physiological two-layer skin and an example 3-layer stack",
+        default_params: || serde_json::to_value(default_params()).expect("params serialise"),
+        bake,
+    }]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_params_round_trip_and_name_every_profile() {
+        let v = (assets()[0].default_params)();
+        let p: ProfilesParams = serde_json::from_value(v.clone()).unwrap();
+        assert_eq!(serde_json::to_value(&p).unwrap(), v);
+        let list = sources(&p).unwrap();
+        assert_eq!(list.len(), 11 + 2 + 3 + 1);
+        let three = list.iter().find(|s| s.0 == "layered/skin3_example").unwrap();
+        assert!(matches!(&three.2, ProfileSource::Layers { stack, .. } if stack.layers().len() == 3));
+    }
+
+    #[test]
+    fn bad_params_name_the_field() {
+        let mut v = (assets()[0].default_params)();
+        v["png_plots"] = json!(["dipole/unobtainium"]);
+        assert!(bake(&v).unwrap_err().to_string().contains("png_plots[0]"));
+        let mut v = (assets()[0].default_params)();
+        v["stacks"][0]["name"] = json!("../x");
+        assert!(bake(&v).unwrap_err().to_string().contains("stacks[0].name"));
+        let mut v = (assets()[0].default_params)();
+        v["skin"][0]["melanin_fraction"] = json!(0.9);
+        assert!(bake(&v).unwrap_err().to_string().contains("skin[0]"));
+    }
+}
