@@ -121,16 +121,7 @@ impl GaussianSss {
         let rt1 = gpu::texture(device, "gsss rt1", width, height, F::Rgba16Float);
         let rt2 = gpu::texture(device, "gsss rt2", width, height, F::Rgba16Float);
         let rtf = gpu::texture(device, "gsss rtf", width, height, F::Rgba16Float);
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("gsss depth"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: F::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let depth = gpu::data_texture(device, "gsss depth", width, height, F::R32Float);
         let module = gpu::shader(device, "gaussian_sss.wgsl", SHADER);
         let pipe_h = gpu::fullscreen_pipeline(device, "gsss horizontal", &module, "fs_horizontal", F::Rgba16Float);
         let blend = wgpu::BlendState {

@@ -28,6 +28,28 @@ pub fn texture(
     })
 }
 
+/// A sampled, upload-only 2D texture (no render attachment): for inputs such as the `R32Float` linear depth,
+/// which not every backend can render to.
+pub fn data_texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    debug_assert!(!format.is_srgb(), "runtime textures are never sRGB");
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
 /// Bytes per texel of the formats the runtime uses.
 pub fn bytes_per_texel(format: wgpu::TextureFormat) -> u32 {
     format.block_copy_size(None).expect("uncompressed colour format")

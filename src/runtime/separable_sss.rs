@@ -98,16 +98,7 @@ impl SeparableSss {
         let color = gpu::texture(device, "sss colour", width, height, F::Rgba16Float);
         let tmp = gpu::texture(device, "sss horizontal", width, height, F::Rgba16Float);
         let output = gpu::texture(device, "sss output", width, height, F::Rgba16Float);
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("sss depth"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: F::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let depth = gpu::data_texture(device, "sss depth", width, height, F::R32Float);
         let module = gpu::shader(device, "separable_sss.wgsl", SHADER);
         let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", F::Rgba16Float);
         let lin = gpu::linear_clamp_sampler(device);
