@@ -3,7 +3,7 @@
 //! Written deterministically: stable key order, no timestamps, entries sorted by path. Re-baking an unchanged
 //! tree changes no byte of any file; only `git_revision` follows the source tree it was baked from.
 
-use crate::bake::{BakedFile, FileMeta};
+use crate::io::PixelFormat;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use sha2::{Digest, Sha256};
@@ -11,6 +11,56 @@ use std::path::Path;
 
 pub const MANIFEST_NAME: &str = "manifest.json";
 pub const SCHEMA: &str = "rtbake-manifest/1";
+
+/// Metadata recorded in the manifest for one file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileMeta {
+    /// What the file is: `lut`, `preview`, `c-header`, `rust-source`, `shader-include`, `json`, `csv`, `plot`.
+    pub kind: String,
+    /// Container: `raw`, `dds`, `ktx2`, `png`, `exr`, `c`, `rust`, `hlsl`, `glsl`, `wgsl`, `json`, `csv`, `svg`.
+    pub format: String,
+    /// GPU texel format of the payload where it has one.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pixel_format: Option<PixelFormat>,
+    pub width: u32,
+    pub height: u32,
+    pub channels: u32,
+    /// `u8`, `u16`, `f16`, `f32`, or `text`.
+    pub sample_type: String,
+    /// `linear` for every data texture; `srgb` only for labelled viewing previews; `n/a` for text.
+    pub color_space: String,
+    /// Texel / index convention (how a shader maps coordinates to parameters), in words and formulas.
+    pub convention: String,
+    /// Absolute tolerance used by `verify` for float payloads (None: must be byte-identical).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub verify_tolerance: Option<f64>,
+}
+
+impl FileMeta {
+    /// Metadata of a text file (sources, JSON, CSV).
+    pub fn text(kind: &str, format: &str, convention: &str) -> Self {
+        Self {
+            kind: kind.into(),
+            format: format.into(),
+            pixel_format: None,
+            width: 0,
+            height: 0,
+            channels: 0,
+            sample_type: "text".into(),
+            color_space: "n/a".into(),
+            convention: convention.into(),
+            verify_tolerance: None,
+        }
+    }
+}
+
+/// One output file: path relative to the bake directory, its bytes and its metadata.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakedFile {
+    pub path: String,
+    pub bytes: Vec<u8>,
+    pub meta: FileMeta,
+}
 
 /// One file of the bake.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,10 +1,8 @@
 //! Skin shading inputs: GPU vs CPU reference, rig evaluation (eq. 7.6), E of eq. 5.13, node-inclusive lookups.
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::runtime::cpu::skin_inputs::skin_inputs;
 use rtbake::runtime::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
-use runtime_support::*;
 
 fn luts() -> SkinLuts {
     let (w, h) = (16u32, 12u32);

@@ -1,4 +1,5 @@
-//! Shared helpers of the runtime tests: the device (a missing adapter FAILS the test), golden LUTs, comparisons.
+//! Shared helpers of the integration tests: the CLI runner, the one rule for external inputs, the device (a missing
+//! adapter FAILS the test), golden LUTs, comparisons.
 #![allow(dead_code)]
 
 use rtbake::runtime::cpu::FilterPrecision;
@@ -37,28 +38,74 @@ pub fn baked_mlaa(n: u32) -> Vec<u8> {
     rtbake::runtime::loader::load_mlaa_area(&baked_dir(), n).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The reference folder if it holds the golden files; otherwise says so plainly and returns None, or fails the
-/// test when `RTBAKE_REQUIRE_REFERENCE=1`.
-pub fn reference_dir_checked() -> Option<PathBuf> {
+/// Runs the `rtbake` binary built for these tests.
+pub fn rtbake(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("run rtbake")
+}
+
+/// The golden reference folder: `$RTBAKE_REFERENCE_DIR`, default `../shared/reference` beside the crate.
+pub fn reference_dir() -> PathBuf {
+    std::env::var_os("RTBAKE_REFERENCE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| crate_dir().join("../shared/reference"))
+}
+
+/// The crate root.
+pub fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Whether CI asked for every external input (`RTBAKE_REQUIRE_REFERENCE=1`).
+pub fn external_inputs_required() -> bool {
+    std::env::var("RTBAKE_REQUIRE_REFERENCE").as_deref() == Ok("1")
+}
+
+/// The one rule for a missing external input: fail under `RTBAKE_REQUIRE_REFERENCE=1`, otherwise say plainly what
+/// was not checked. The message goes straight to the process' stderr (not through the test harness' capture), so
+/// a plain `cargo test` shows it.
+pub fn skip_missing(what: &str, path: &std::path::Path, env_var: &str) {
+    let msg = format!("SKIPPED: {what} — {} not found (set {env_var}; see README \"Tests\")", path.display());
+    if external_inputs_required() {
+        panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
+    }
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{msg}");
+}
+
+/// The reference folder if it holds the golden files; otherwise reports the skip of `what` under the rule above.
+pub fn reference_dir_for(what: &str) -> Option<PathBuf> {
     let dir = reference_dir();
     if dir.join("smaa/SHA256SUMS").is_file() && dir.join("mlaa/SHA256SUMS").is_file() {
         return Some(dir);
     }
-    let msg = format!(
-        "reference folder {} not found (set RTBAKE_REFERENCE_DIR): comparison with the upstream golden textures NOT run",
-        dir.display()
-    );
-    if std::env::var("RTBAKE_REQUIRE_REFERENCE").as_deref() == Ok("1") {
-        panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
-    }
-    eprintln!("{msg}");
+    skip_missing(what, &dir, "RTBAKE_REFERENCE_DIR");
     None
 }
 
-pub fn reference_dir() -> PathBuf {
-    std::env::var_os("RTBAKE_REFERENCE_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"))
+/// The reference folder for the runtime's golden-texture comparisons.
+pub fn reference_dir_checked() -> Option<PathBuf> {
+    reference_dir_for("comparison with the upstream golden SMAA/MLAA textures")
+}
+
+/// One file of the reference folder (e.g. `consumers/separable-sss/SeparableSSS.h`), or the skip of `what`.
+pub fn reference_file(rel: &str, what: &str) -> Option<PathBuf> {
+    let path = reference_dir().join(rel);
+    if path.is_file() {
+        return Some(path);
+    }
+    skip_missing(what, &path, "RTBAKE_REFERENCE_DIR");
+    None
+}
+
+/// The physical data tables (`$RTBAKE_DATA_DIR`, default `../shared/data`), or the skip of `what`.
+pub fn data_dir_for(what: &str) -> Option<PathBuf> {
+    let dir =
+        std::env::var_os("RTBAKE_DATA_DIR").map(PathBuf::from).unwrap_or_else(|| crate_dir().join("../shared/data"));
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    skip_missing(what, &dir, "RTBAKE_DATA_DIR");
+    None
 }
 
 fn read(rel: &str) -> Vec<u8> {

@@ -2,10 +2,8 @@
 //! when appended to a tiny compute entry point that reads each constant (arrays with a run-time index), and by
 //! the device (`create_shader_module` + pipeline under a validation error scope on the test adapter).
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::manifest::{sha256_hex, Manifest};
-use runtime_support::*;
 use wgpu::naga;
 
 /// The baked WGSL includes: (manifest path, source), checksums verified.

@@ -1,11 +1,9 @@
 //! `fit gaussians` and `fit separable` on layered targets: a user layer stack (`--layers`) and the physiological
 //! two-layer skin (`--skin-melanin`, `--skin-hemoglobin`).
 
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("run rtbake")
-}
+use crate::support::rtbake;
 
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -1,11 +1,9 @@
 //! Screen-space sum-of-Gaussians SSS: GPU vs CPU reference, eq. 4.8 blend weights, depth LOD skip, energy.
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::diffusion::sum_of_gaussians::{deon4, deon6};
 use rtbake::runtime::cpu::gaussian_sss::gaussian_sss;
 use rtbake::runtime::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
-use runtime_support::*;
 
 /// Two striped discs (skin, alpha 1): one near (depth ≈ 2), one far (depth ≈ 20, where the narrow Gaussians
 /// are skipped by eq. 4.6), on a background (alpha 0).

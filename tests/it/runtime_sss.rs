@@ -1,10 +1,8 @@
 //! Separable SSS: GPU vs CPU reference, the matte (non-skin pixels pass through), energy conservation.
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::runtime::cpu::separable_sss::separable_sss;
 use rtbake::runtime::separable_sss::{SeparableSss, SssKernel, SssParams};
-use runtime_support::*;
 
 /// A 17-tap kernel: per-channel Gaussians (sigma 1.0, 0.5, 0.3 kernel units) over offsets in [-3, 3],
 /// normalised per channel, centre first.

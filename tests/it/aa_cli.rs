@@ -2,11 +2,8 @@
 //! files with the expected bytes.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("rtbake runs")
-}
+use crate::support::rtbake;
 
 fn entries(dir: &Path) -> Vec<String> {
     match std::fs::read_dir(dir) {
@@ -136,12 +133,9 @@ fn no_u_smoothing_flag_gives_the_v2_8_texture() {
     let smoothed_off = std::fs::read(a.join("AreaTex.bin")).unwrap();
     assert_eq!(smoothed_off, std::fs::read(b.join("AreaTex_v2.8.bin")).unwrap());
     // And that is the published v2.8 payload when the reference folder is present.
-    let reference = std::env::var_os("RTBAKE_REFERENCE_DIR")
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"))
-        .join("smaa/AreaTex_v2.8_RG8_160x560.bin");
-    match std::fs::read(&reference) {
-        Ok(want) => assert!(smoothed_off == want, "differs from {}", reference.display()),
-        Err(_) => eprintln!("{} not found; published-bytes comparison skipped", reference.display()),
+    if let Some(reference) =
+        crate::support::reference_file("smaa/AreaTex_v2.8_RG8_160x560.bin", "v2.8 area texture vs the published bytes")
+    {
+        assert!(smoothed_off == std::fs::read(&reference).unwrap(), "differs from {}", reference.display());
     }
 }

@@ -4,11 +4,9 @@ use rtbake::diffusion::materials;
 use rtbake::diffusion::multipole::{Series, Slab};
 use rtbake::diffusion::{FdrForm, RadialProfile};
 use serde_json::Value;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("rtbake runs")
-}
+use crate::support::rtbake;
 
 fn json_of(out: &Output) -> Value {
     assert!(out.status.success(), "stderr: {}", String::from_utf8_lossy(&out.stderr));

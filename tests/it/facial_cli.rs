@@ -3,15 +3,13 @@
 
 use rtbake::image_buf::Image;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/facial/hemoglobin_{name}.png"))
 }
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("run rtbake")
-}
+use crate::support::rtbake;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

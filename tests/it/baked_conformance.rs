@@ -9,18 +9,8 @@ fn crate_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Golden reference folder, or `None` (with a plain message) when it is absent and not required.
 fn reference_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("RTBAKE_REFERENCE_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| crate_dir().join("../shared/reference"));
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    let required = std::env::var("RTBAKE_REQUIRE_REFERENCE").is_ok_and(|v| v == "1");
-    assert!(!required, "golden reference folder {} is missing and RTBAKE_REQUIRE_REFERENCE=1", dir.display());
-    eprintln!("NOTE: golden reference folder {} is missing; golden comparison NOT performed", dir.display());
-    None
+    crate::support::reference_dir_for("baked/ vs the upstream golden textures")
 }
 
 #[test]

@@ -1,12 +1,10 @@
 //! `rtbake run …`: end-to-end on files, and refusal of bad input (exit 2, nothing written).
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::bake::BakedFile;
 use rtbake::image_buf::Image;
 use rtbake::manifest::Manifest;
 use rtbake::runtime::loader;
-use runtime_support::*;
 use std::path::Path;
 use std::process::Command;
 
@@ -58,9 +56,7 @@ fn copied_bake(dir: &Path, area_color_space: &str) {
     write_bake(dir, &files);
 }
 
-fn rtbake(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().unwrap()
-}
+use crate::support::rtbake;
 
 fn read_rgba(p: &Path) -> Vec<u8> {
     match rtbake::io::png::decode(&std::fs::read(p).unwrap(), "out").unwrap() {

@@ -1,11 +1,9 @@
 //! Jimenez MLAA: GPU vs CPU reference on the same inputs (rtbake's baked v1.4 area maps), and a quality check.
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::runtime::cpu;
 use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
 use rtbake::runtime::scene::render_shapes;
-use runtime_support::*;
 
 fn gpu_vs_cpu(w: u32, h: u32, n: u32) {
     let g = gpu();

@@ -1,12 +1,10 @@
 //! SMAA 1x: GPU vs CPU reference on the same inputs, and antialiasing quality against a 16× supersampled
 //! ground truth. Textures: rtbake's own bake (`baked/`, through the manifest-checked loader).
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::runtime::cpu;
 use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::smaa::Smaa;
-use runtime_support::*;
 
 fn gpu_vs_cpu(w: u32, h: u32) {
     let g = gpu();

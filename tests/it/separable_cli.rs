@@ -2,11 +2,9 @@
 //! (clear error naming the flag, exit 2, nothing written).
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("rtbake runs")
-}
+use crate::support::rtbake;
 
 fn json(out: &Output) -> serde_json::Value {
     assert!(out.status.success(), "stderr: {}", String::from_utf8_lossy(&out.stderr));

@@ -12,21 +12,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 
 fn reference_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("RTBAKE_REFERENCE_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"));
-    if dir.join("smaa/SHA256SUMS").is_file() && dir.join("mlaa/SHA256SUMS").is_file() {
-        return Some(dir);
-    }
-    let msg = format!(
-        "reference folder {} not found (set RTBAKE_REFERENCE_DIR); golden SMAA/MLAA comparison skipped",
-        dir.display()
-    );
-    if std::env::var("RTBAKE_REQUIRE_REFERENCE").as_deref() == Ok("1") {
-        panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
-    }
-    eprintln!("{msg}");
-    None
+    crate::support::reference_dir_for("golden SMAA/MLAA byte comparison")
 }
 
 fn sums(dir: &std::path::Path) -> HashMap<String, String> {

@@ -6,14 +6,12 @@
 //! blending weights, where the textures enter). A missing reference folder is reported on stderr and the
 //! comparison is not run; with `RTBAKE_REQUIRE_REFERENCE=1` it fails.
 
-mod runtime_support;
-
+use crate::support::*;
 use rtbake::runtime::cpu;
 use rtbake::runtime::gpu::read_texture;
 use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
 use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::smaa::Smaa;
-use runtime_support::*;
 
 #[test]
 fn smaa_with_baked_textures_equals_smaa_with_golden_textures() {

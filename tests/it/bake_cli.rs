@@ -6,9 +6,7 @@ use std::process::{Command, Output};
 /// A small, fast asset used to exercise the machinery.
 const SMALL: &str = "smaa-search";
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("run rtbake")
-}
+use crate::support::rtbake;
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

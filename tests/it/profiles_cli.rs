@@ -3,11 +3,8 @@
 use rtbake::fitting::CHANNEL_COLORS;
 use rtbake::io::png::{decode, DecodedPng};
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn rtbake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtbake")).args(args).output().expect("rtbake runs")
-}
+use crate::support::rtbake;
 
 fn ok(args: &[&str]) {
     let out = rtbake(args);

@@ -1,0 +1,45 @@
+//! rtbake's integration tests, one binary (one link after a library change) with a module per area.
+//!
+//! External inputs follow one rule (`support::external`): the golden SMAA/MLAA textures and consumer files
+//! (`../shared/reference` or `$RTBAKE_REFERENCE_DIR`) and the physical data tables (`../shared/data` or
+//! `$RTBAKE_DATA_DIR`) are optional on a plain clone — a test that needs a missing one says so on stderr (even
+//! without `--nocapture`) and checks only what needs nothing external — and `RTBAKE_REQUIRE_REFERENCE=1` (CI) turns
+//! every such skip into a failure.
+
+mod support;
+
+mod aa_cli;
+mod aa_golden;
+mod bake_cli;
+mod baked_conformance;
+mod diffusion_cli;
+mod diffusion_layered;
+mod diffusion_physics;
+mod facial_cli;
+mod facial_rig;
+mod facial_wrinkles;
+mod fit_layered_cli;
+mod fitting_bake;
+mod fitting_cli;
+mod fitting_determinism;
+mod fitting_published;
+mod profiles_bake;
+mod profiles_cli;
+mod runtime_cli;
+mod runtime_gaussian_sss;
+mod runtime_golden_textures;
+mod runtime_loader;
+mod runtime_loader_tables;
+mod runtime_mlaa;
+mod runtime_shader_includes;
+mod runtime_skin_inputs;
+mod runtime_smaa;
+mod runtime_sss;
+mod separable_cli;
+mod separable_fit;
+mod separable_kernel;
+mod skin_cli;
+mod skin_color;
+mod skin_layers;
+mod skin_spectral_data;
+mod transmittance_table;
