@@ -1,6 +1,7 @@
 //! `rtbake run`: the GPU runtime (or its CPU reference with --cpu) on image files, and a procedural demo.
 
 use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::baked_layout::path;
 use rtbake::image_buf::Image;
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::runtime::chain::{self, Antialiasing};
@@ -71,13 +72,13 @@ pub struct SssArgs {
     output: PathBuf,
     /// Separable kernel (schema rtbake-separable-kernel/1): a path listed in the manifest of --baked-dir
     /// (checked against it), or a kernel file elsewhere (content checks only).
-    #[arg(long, value_name = "JSON", default_value = loader::SEPARABLE_KERNEL_PATH)]
+    #[arg(long, value_name = "JSON", default_value = path::SEPARABLE_KERNEL_DEFAULT)]
     kernel: String,
     /// SSS method: separable (--kernel) or gaussians (--gaussians).
     #[arg(long, value_enum, default_value = "separable")]
     method: Method,
     /// Sum-of-Gaussians fit for --method gaussians, a path listed in the manifest of --baked-dir.
-    #[arg(long, value_name = "JSON", default_value = loader::GAUSSIANS_PATH)]
+    #[arg(long, value_name = "JSON", default_value = path::GAUSSIANS_DEFAULT)]
     gaussians: String,
     /// Kernel width in world units (default: the kernel file's sss_width, else 0.012).
     #[arg(long)]

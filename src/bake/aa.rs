@@ -23,10 +23,7 @@ use crate::io::source::{c_header_u8, rust_source_u8};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// Folder of the SMAA textures inside `baked/`.
-pub const SMAA_DIR: &str = "aa/smaa";
-/// Folder of the MLAA area maps inside `baked/`.
-pub const MLAA_DIR: &str = "aa/mlaa";
+pub use crate::baked_layout::path::{MLAA_DIR, SMAA_DIR};
 
 impl From<SmaaAreaError> for BakeError {
     fn from(e: SmaaAreaError) -> Self {

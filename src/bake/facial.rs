@@ -11,73 +11,9 @@ use crate::io::{self, exr::ExrPrecision, PixelFormat};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-/// Folder of the example rig in `baked/`.
-pub const RIG_EXAMPLE_DIR: &str = "facial/hemoglobin/example";
-/// Folder of the wrinkle assets in `baked/`.
-pub const WRINKLES_DIR: &str = "facial/wrinkles";
-
-/// Schema id of `rig.json`.
-pub const RIG_SCHEMA: &str = "rtbake-hemoglobin-rig/1";
-
-/// Where one basis map of a rig came from.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RigSource {
-    pub name: String,
-    /// File name or `synthetic:…` description.
-    pub source: String,
-    /// `exr-f32`, `exr-f16`, `png16`, `png8`, `synthetic-png16`.
-    pub format: String,
-    /// How samples map to concentration.
-    pub mapping: String,
-}
-
-/// The rig description written as `rig.json` (read back by `rtbake maps rig-eval` and the GPU runtime).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RigDescription {
-    pub schema: String,
-    pub generated_by: String,
-    pub model: String,
-    pub evaluation: String,
-    pub sampling: String,
-    pub radius_texels: u32,
-    pub border: Border,
-    pub sigma_floor: f64,
-    pub sigma_floored_texels: u64,
-    pub full_size: [u32; 2],
-    pub rig_size: [u32; 2],
-    pub value_unit: String,
-    pub h0: RigH0Files,
-    pub maps: Vec<RigMapFiles>,
-    pub global_scales: serde_json::Map<String, Value>,
-    pub previews: String,
-}
-
-/// Files of H0.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RigH0Files {
-    pub definition: String,
-    pub exr: String,
-    pub exr_f16: String,
-    pub ktx2: String,
-    pub preview: String,
-    pub preview_range: [f64; 2],
-}
-
-/// Files of one basis map (index 0 is the neutral map).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RigMapFiles {
-    pub index: usize,
-    pub name: String,
-    pub scale_exr: String,
-    pub scale_exr_f16: String,
-    pub bias_exr: String,
-    pub bias_exr_f16: String,
-    /// RG16F: R = scale, G = bias.
-    pub scale_bias_ktx2: String,
-    pub scale_preview: String,
-    pub bias_preview: String,
-    pub source: RigSource,
-}
+pub use crate::baked_layout::path::{RIG_EXAMPLE_DIR, WRINKLES_DIR};
+pub use crate::baked_layout::schema::HEMOGLOBIN_RIG as RIG_SCHEMA;
+pub use crate::baked_layout::{RigDescription, RigH0Files, RigMapFiles, RigSource};
 
 #[allow(clippy::too_many_arguments)]
 fn float_meta(
@@ -261,10 +197,10 @@ pub fn hemoglobin_rig_files(
     };
     let value = serde_json::to_value(&desc).map_err(|e| BakeError::Other(e.to_string()))?;
     files.push(json_file(
-        &format!("{dir}rig.json"),
+        &format!("{dir}{}", crate::baked_layout::path::RIG_FILE_NAME),
         &value,
         "json",
-        "hemoglobin rig description (schema rtbake-hemoglobin-rig/1)",
+        &format!("hemoglobin rig description (schema {RIG_SCHEMA})"),
     ));
     Ok((files, desc))
 }
@@ -429,7 +365,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         files.extend(unorm8_texture_files(&format!("{dir}wrinkle_masks_{i}"), img, "lut", &mask_convention(i))?);
     }
     let report = json!({
-        "schema": "rtbake-wrinkles/1",
+        "schema": crate::baked_layout::schema::WRINKLES,
         "encoding": "pd",
         "input": "input/wrinkle_normal.png (synthetic)",
         "input_green": "directx",

@@ -3,6 +3,7 @@
 //! HLSL / GLSL / WGSL includes and a plot (PNG + SVG) of r·R(r).
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
+use crate::baked_layout::path::GAUSSIANS_DIR;
 use crate::diffusion::materials;
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
@@ -89,7 +90,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             json!({"kind": "preset", "name": name, "reference": "d'Eon, Luebke, Enderton, EGSR 2007; thesis Table 4.2"}),
         );
         let plot = profile_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
-        files.extend(gaussian_files(&format!("sss/gaussians/{name}"), &sum, p.stretch, extra, &plot)?);
+        files.extend(gaussian_files(&format!("{GAUSSIANS_DIR}/{name}"), &sum, p.stretch, extra, &plot)?);
     }
     Ok(files)
 }
@@ -143,7 +144,7 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         extra.insert(k.clone(), v.clone());
     }
     let mode = if p.fit.shared_variances { "shared" } else { "per_channel" };
-    let stem = format!("sss/gaussians/fit_{}_dipole_k{}_{mode}", m.name, p.fit.count);
+    let stem = format!("{GAUSSIANS_DIR}/fit_{}_dipole_k{}_{mode}", m.name, p.fit.count);
     // Plot the profile in the units that were fitted.
     let plotted: Box<dyn RadialProfile> = if p.fit.normalize {
         Box::new(NormalizedProfile { inner: &profile, totals: profile.total_reflectance() })

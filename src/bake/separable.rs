@@ -16,8 +16,7 @@ use crate::separable::{SeparableParams, PUBLISHED, PUBLISHED_SSS_WIDTH, TABLE_6_
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// Output folder of this area, relative to `baked/`.
-pub const DIR: &str = "sss/separable";
+pub use crate::baked_layout::path::SEPARABLE_DIR as DIR;
 
 pub fn assets() -> Vec<Asset> {
     vec![

@@ -4,16 +4,16 @@ use super::{float_texture_files, json_file, parse_params, text_file, Asset, Bake
 use crate::skin_color::lut::{bake_lut, IndexForm, LutLayout};
 use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::fmt::Write;
 
 /// Asset name of the skin-colour table.
 pub const SKIN_COLOR_LUT: &str = "skin-color-lut";
-/// Stem of the table's texture files (`.exr`, `_f16.exr`, `.ktx2`, `_preview_srgb.png`).
-pub const LUT_STEM: &str = "skin/skin_color_lut";
-pub const SIDECAR_PATH: &str = "skin/skin_color_lut.json";
-pub const SAMPLES_PATH: &str = "skin/skin_color_samples.csv";
-pub const SPECTRA_PATH: &str = "skin/skin_color_spectra.csv";
+pub use crate::baked_layout::path::{
+    SKIN_LUT_SIDECAR as SIDECAR_PATH, SKIN_LUT_STEM as LUT_STEM, SKIN_SAMPLES as SAMPLES_PATH,
+    SKIN_SPECTRA as SPECTRA_PATH,
+};
+use crate::baked_layout::{SkinLutFiles, SkinLutIndex, SkinLutModel, SkinLutRange, SkinLutSidecar};
 
 /// Absolute tolerance `verify` allows on the f32 table (libm differences across platforms are ~1e−15).
 pub const LUT_TOLERANCE: f64 = 1e-6;
@@ -89,63 +89,69 @@ fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Imag
         }
         IndexForm::LiteralCbrt => "u = cbrt(Cm), v = cbrt(Chd) (eq. 7.7 as printed; ranges [0, 1])",
     };
-    json!({
-        "asset": SKIN_COLOR_LUT,
-        "description": "Skin colour lookup table (Jimenez 2012, section 7.6, eq. 7.7, Fig. 7.9): total diffuse \
+    let sidecar = SkinLutSidecar {
+        asset: SKIN_COLOR_LUT.into(),
+        description: "Skin colour lookup table (Jimenez 2012, section 7.6, eq. 7.7, Fig. 7.9): total diffuse \
             reflectance of the spectral two-layer skin model (Donner et al. 2008) integrated against an illuminant and \
-            the CIE 1931 2-degree observer (see model.colorimetry), as linear sRGB albedo.",
-        "files": {
-            "linear_f32": format!("{LUT_STEM}.exr"),
-            "linear_f16": format!("{LUT_STEM}_f16.exr"),
-            "linear_f16_ktx2": format!("{LUT_STEM}.ktx2"),
-            "preview_srgb8_not_for_sampling": format!("{LUT_STEM}_preview_srgb.png"),
-            "samples": SAMPLES_PATH,
-            "spectra": SPECTRA_PATH,
+            the CIE 1931 2-degree observer (see model.colorimetry), as linear sRGB albedo."
+            .into(),
+        files: SkinLutFiles {
+            linear_f32: format!("{LUT_STEM}.exr"),
+            linear_f16: format!("{LUT_STEM}_f16.exr"),
+            linear_f16_ktx2: format!("{LUT_STEM}.ktx2"),
+            preview_srgb8_not_for_sampling: format!("{LUT_STEM}_preview_srgb.png"),
+            samples: SAMPLES_PATH.into(),
+            spectra: SPECTRA_PATH.into(),
         },
-        "color_space": "linear sRGB (IEC 61966-2-1 primaries); the PNG preview alone is sRGB-encoded",
-        "width": layout.width,
-        "height": layout.height,
-        "channels": ["R", "G", "B"],
-        "index": {
-            "form": form,
-            "u_axis": "columns, left to right: melanin fraction Cm",
-            "v_axis": "rows, top row first: dermal hemoglobin fraction Chd; row 0 (texcoord v = 0) is Chd = 0",
-            "melanin_max": cm_max,
-            "hemoglobin_max": chd_max,
-            "texel_to_concentration": format!(
+        color_space: "linear sRGB (IEC 61966-2-1 primaries); the PNG preview alone is sRGB-encoded".into(),
+        width: layout.width,
+        height: layout.height,
+        channels: ["R".into(), "G".into(), "B".into()],
+        index: SkinLutIndex {
+            form: form.into(),
+            u_axis: "columns, left to right: melanin fraction Cm".into(),
+            v_axis: "rows, top row first: dermal hemoglobin fraction Chd; row 0 (texcoord v = 0) is Chd = 0".into(),
+            melanin_max: cm_max,
+            hemoglobin_max: chd_max,
+            texel_to_concentration: format!(
                 "node-inclusive: t_i = i/(W-1), Cm = {cm_max}*t_i^3; t_j = j/(H-1), Chd = {chd_max}*t_j^3"
             ),
-            "concentration_to_texcoord": format!(
+            concentration_to_texcoord: format!(
                 "texcoord.x = (cbrt(Cm/{cm_max})*(W-1)+0.5)/W, texcoord.y = (cbrt(Chd/{chd_max})*(H-1)+0.5)/H \
                  (texel centres at the nodes; bilinear filtering)"
             ),
-            "hlsl": format!(
+            hlsl: format!(
                 "float2 SkinColorUV(float cm, float chd) {{ const float2 n = float2({w}.0, {h}.0); \
                  float2 t = pow(saturate(float2(cm / {cm_max:?}, chd / {chd_max:?})), 1.0 / 3.0); \
                  return (t * (n - 1.0) + 0.5) / n; }}",
                 w = layout.width,
                 h = layout.height
             ),
-            "epidermal_hemoglobin": format!("Che = {} * Chd", p.epidermal_hemoglobin_ratio),
+            epidermal_hemoglobin: format!("Che = {} * Chd", p.epidermal_hemoglobin_ratio),
         },
-        "value_range": { "min": lo, "max": hi },
-        "model": {
-            "layers": "epidermis over dermis; air above; per-layer multipole totals R(0), T(0) with the exact \
-                infinite image series (Donner & Jensen 2005)",
-            "adding": "symmetric: R = R1 + T1^2 R2 / (1 - R1 R2); directional: R = R1 + T1 R2 T1up / (1 - R1up R2)",
-            "dermis_bottom": "relative index eta_dermis / eta_below_dermis (default 1 = index-matched: a \
-                semi-infinite dermis has no bottom face)",
-            "colorimetry": format!(
+        value_range: SkinLutRange { min: lo, max: hi },
+        model: SkinLutModel {
+            layers: "epidermis over dermis; air above; per-layer multipole totals R(0), T(0) with the exact \
+                infinite image series (Donner & Jensen 2005)"
+                .into(),
+            adding: "symmetric: R = R1 + T1^2 R2 / (1 - R1 R2); directional: R = R1 + T1 R2 T1up / (1 - R1up R2)"
+                .into(),
+            dermis_bottom: "relative index eta_dermis / eta_below_dermis (default 1 = index-matched: a \
+                semi-infinite dermis has no bottom face)"
+                .into(),
+            colorimetry: format!(
                 "illuminant {}, {} nm steps over 380-780 nm, CIE 1931 2-degree observer, Y(perfect white) = 1, XYZ -> \
                  linear sRGB with [3.2406 -1.5372 -0.4986; -0.9689 1.8758 0.0415; 0.0557 -0.2040 1.0570]",
                 serde_json::to_value(p.illuminant).expect("enum serialises").as_str().unwrap_or("?"),
                 p.spectral_step_nm
             ),
-            "data": "hemoglobin: S. Prahl (OMLC 1999, Gratzer & Kollias), 2 nm, interpolated linearly to 1 nm; CIE \
-                1931 2-degree CMFs and D65: CIE 018:2019 / ISO 11664-2 (1 nm)",
+            data: "hemoglobin: S. Prahl (OMLC 1999, Gratzer & Kollias), 2 nm, interpolated linearly to 1 nm; CIE \
+                1931 2-degree CMFs and D65: CIE 018:2019 / ISO 11664-2 (1 nm)"
+                .into(),
         },
-        "parameters": serde_json::to_value(p).expect("params serialise"),
-    })
+        parameters: serde_json::to_value(p).expect("params serialise"),
+    };
+    serde_json::to_value(&sidecar).expect("sidecar serialises")
 }
 
 fn samples_csv(model: &TwoLayerSkinModel, layout: &LutLayout) -> Result<String, SkinColorError> {

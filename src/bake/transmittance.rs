@@ -1,6 +1,7 @@
 //! Transmittance table T(s) (thesis eq. 5.12) in `baked/transmittance/`, from d'Eon's 6-Gaussian skin preset.
 
 use super::{float_texture_files, json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
+use crate::baked_layout::{self, TransmittanceSidecar};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
@@ -36,20 +37,21 @@ pub fn table_files(
         TransmittanceForm::Published => "published",
         TransmittanceForm::Physical => "physical",
     };
+    let sidecar = TransmittanceSidecar {
+        source,
+        form: form.into(),
+        formula: settings.form.formula().into(),
+        samples: settings.samples,
+        height: settings.height,
+        s_max_mm: settings.s_max_mm,
+        texel_convention: TransmittanceSidecar::TEXEL_CONVENTION.into(),
+        shader_lookup: TransmittanceSidecar::SHADER_LOOKUP.into(),
+        variances_mm2: sum.variances_mm2.clone(),
+        weights: sum.weights.clone(),
+    };
     files.push(json_file(
-        &format!("{stem}.json"),
-        &json!({
-            "source": source,
-            "form": form,
-            "formula": settings.form.formula(),
-            "samples": settings.samples,
-            "height": settings.height,
-            "s_max_mm": settings.s_max_mm,
-            "texel_convention": "node-inclusive: texel i holds s = s_max*i/(n-1)",
-            "shader_lookup": "u = s/s_max*(n-1)/n + 0.5/n, linear filtering, clamp to edge",
-            "variances_mm2": sum.variances_mm2,
-            "weights": sum.weights,
-        }),
+        &baked_layout::path::sidecar(&format!("{stem}.exr")),
+        &serde_json::to_value(&sidecar).expect("sidecar serialises"),
         "json",
         "provenance of the transmittance table next to it",
     ));
@@ -73,7 +75,12 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         TransmittanceForm::Physical => "physical",
     };
     let source = json!({"kind": "preset", "name": p.preset, "reference": "d'Eon, Luebke, Enderton, EGSR 2007"});
-    table_files(&format!("transmittance/{}_{form}", p.preset), &RgbGaussians::from(&sog), &p.table, source)
+    table_files(
+        &format!("{}/{}_{form}", baked_layout::path::TRANSMITTANCE_DIR, p.preset),
+        &RgbGaussians::from(&sog),
+        &p.table,
+        source,
+    )
 }
 
 pub fn assets() -> Vec<Asset> {

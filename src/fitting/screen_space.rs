@@ -11,6 +11,7 @@
 //!   2.0062 − 0.2719 = 1.7343) and the shader takes its standard deviation sqrt(vᵢ − vᵢ₋₁).
 
 use super::RgbGaussians;
+use crate::baked_layout::{GaussiansFile, LodThresholds};
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use crate::io::source::{ShaderInclude, ShaderLang};
 use serde_json::{json, Value};
@@ -160,30 +161,30 @@ impl ScreenSpaceParams {
     /// The JSON keys of the CLI contract (`variances`, `weights`, `blend_weights`, `incremental_variances`,
     /// `std_devs`, `lod_thresholds`) as an object; callers add `error_percent` and provenance.
     pub fn to_json(&self) -> serde_json::Map<String, Value> {
-        let mut m = serde_json::Map::new();
-        m.insert("shared_variances".into(), json!(self.shared));
-        m.insert("variances".into(), self.variance_like(&self.variances_mm2));
-        m.insert("weights".into(), self.weight_like(&self.weights));
-        m.insert("blend_weights".into(), self.weight_like(&self.blend_weights));
-        m.insert("incremental_variances".into(), self.variance_like(&self.incremental_variances_mm2));
-        m.insert("std_devs".into(), self.variance_like(&self.std_devs_mm));
-        m.insert(
-            "lod_thresholds".into(),
-            json!({
-                "alpha": self.stretch.alpha,
-                "beta": self.stretch.beta,
-                "gamma": self.stretch.gamma,
-                "two_sqrt_v_alpha": self.variance_like(&self.lod_depth_eq46),
-                "half_sqrt_v_alpha": self.variance_like(&self.lod_depth_shipped),
-                "convention": "apply Gaussian i where linear depth d < threshold_i; two_sqrt_v_alpha is eq. 4.6 \
-                               (kernel wider than half a pixel), half_sqrt_v_alpha is the thesis' shipped value",
-            }),
-        );
-        m.insert(
-            "units".into(),
-            json!({"variances": "mm^2", "incremental_variances": "mm^2", "std_devs": "mm", "lod_thresholds": "depth units of alpha"}),
-        );
-        m
+        let file = GaussiansFile {
+            shared_variances: self.shared,
+            variances: self.variance_like(&self.variances_mm2),
+            weights: self.weight_like(&self.weights),
+            blend_weights: self.weight_like(&self.blend_weights),
+            incremental_variances: self.variance_like(&self.incremental_variances_mm2),
+            std_devs: self.variance_like(&self.std_devs_mm),
+            lod_thresholds: LodThresholds {
+                alpha: self.stretch.alpha,
+                beta: self.stretch.beta,
+                gamma: self.stretch.gamma,
+                two_sqrt_v_alpha: self.variance_like(&self.lod_depth_eq46),
+                half_sqrt_v_alpha: self.variance_like(&self.lod_depth_shipped),
+                convention: "apply Gaussian i where linear depth d < threshold_i; two_sqrt_v_alpha is eq. 4.6 \
+                             (kernel wider than half a pixel), half_sqrt_v_alpha is the thesis' shipped value"
+                    .into(),
+            },
+            units: json!({"variances": "mm^2", "incremental_variances": "mm^2", "std_devs": "mm", "lod_thresholds": "depth units of alpha"}),
+            extra: serde_json::Map::new(),
+        };
+        match serde_json::to_value(&file).expect("parameter file serialises") {
+            Value::Object(m) => m,
+            _ => unreachable!("a struct serialises to an object"),
+        }
     }
 
     /// HLSL / GLSL / WGSL include: `SSS_GAUSSIAN_COUNT`, `SSS_ALPHA/BETA/GAMMA` and per-Gaussian arrays. Shared

@@ -17,6 +17,7 @@ use super::loader::{self, LutError};
 use super::separable_sss::{SeparableSss, SssKernel, SssParams};
 use super::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
 use super::RuntimeError;
+use crate::baked_layout::path;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use std::path::Path;
@@ -52,27 +53,27 @@ pub struct DemoAssets {
 impl DemoAssets {
     /// Loads the default baked tables from `dir` (paths in [`loader`]); kernel width from the kernel file.
     pub fn load(dir: &Path) -> Result<Self, LutError> {
-        Self::load_with_kernel(dir, loader::SEPARABLE_KERNEL_PATH)
+        Self::load_with_kernel(dir, path::SEPARABLE_KERNEL_DEFAULT)
     }
 
     /// As [`DemoAssets::load`] with another kernel file of the bake directory.
     pub fn load_with_kernel(dir: &Path, kernel_path: &str) -> Result<Self, LutError> {
-        let luts = loader::load_skin_luts(dir, loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH)?;
+        let luts = loader::load_skin_luts(dir, path::SKIN_LUT, path::TRANSMITTANCE_DEFAULT)?;
         let k = loader::load_separable_kernel(dir, kernel_path)?;
-        let g = loader::load_gaussians(dir, loader::GAUSSIANS_PATH)?;
+        let g = loader::load_gaussians(dir, path::GAUSSIANS_DEFAULT)?;
         let sss = SssParams { sss_width: k.sss_width.unwrap_or(SssParams::default().sss_width), ..Default::default() };
-        let listed = crate::manifest::Manifest::load(dir)?.entry(loader::HEMOGLOBIN_RIG_PATH).is_some();
+        let listed = crate::manifest::Manifest::load(dir)?.entry(path::RIG_EXAMPLE).is_some();
         let (rig, rig_weights, rig_names, baked_rig, rig_source) = if listed {
-            let b = loader::load_hemoglobin_rig(dir, loader::HEMOGLOBIN_RIG_PATH)?;
+            let b = loader::load_hemoglobin_rig(dir, path::RIG_EXAMPLE)?;
             // 60 % neutral, 40 % joy (or the second target) — a mild flush.
             let mut wts = vec![0.0f32; b.rig.targets.len()];
             let joy = b.names.iter().position(|n| n == "joy").unwrap_or(wts.len() - 1);
             wts[0] = 0.6;
             wts[joy] += 0.4;
             let names = b.names.clone();
-            (b.rig.clone(), wts, names, Some(b), format!("baked {}", loader::HEMOGLOBIN_RIG_PATH))
+            (b.rig.clone(), wts, names, Some(b), format!("baked {}", path::RIG_EXAMPLE))
         } else {
-            let src = format!("synthetic (no {} in the bake)", loader::HEMOGLOBIN_RIG_PATH);
+            let src = format!("synthetic (no {} in the bake)", path::RIG_EXAMPLE);
             (synthetic_rig(), vec![0.4, 0.6], vec!["neutral".into(), "blush".into()], None, src)
         };
         Ok(Self {

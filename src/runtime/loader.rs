@@ -14,41 +14,15 @@
 //! (every scale/bias map and H0 of the rig JSON). JSON files may declare colour space `n/a`; texel data must be
 //! `linear`; non-raw files must also have the manifest's `size_bytes`.
 //!
-//! The paths of the baked files are the constants below — the one place to change when the bake layout moves.
+//! The paths, schema ids and sidecar types are those of [`crate::baked_layout`], which the bakers write: the one
+//! place to change when the bake layout moves.
 
+use crate::baked_layout::{
+    path, schema, GaussiansFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
+};
 use crate::io::PixelFormat;
 use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError};
 use std::path::Path;
-
-/// SMAA area texture in `baked/` (RG8 160×560).
-pub const SMAA_AREA_PATH: &str = "aa/smaa/AreaTex.bin";
-/// SMAA search texture in `baked/` (R8 64×16).
-pub const SMAA_SEARCH_PATH: &str = "aa/smaa/SearchTex.bin";
-
-/// Default separable-SSS kernel in `baked/` (schema `rtbake-separable-kernel/1`, 17 taps, published parameters).
-pub const SEPARABLE_KERNEL_PATH: &str = "sss/separable/published_n17.json";
-/// Default sum-of-Gaussians fit for the screen-space SSS in `baked/` (d'Eon's 6 Gaussians).
-pub const GAUSSIANS_PATH: &str = "sss/gaussians/deon6.json";
-/// Default transmittance table T(s) in `baked/` (EXR f32, RGB, node-inclusive); sidecar: same stem, `.json`.
-pub const TRANSMITTANCE_PATH: &str = "transmittance/deon6_published.exr";
-/// Skin colour LUT in `baked/` (EXR f32, RGB, melanin × hemoglobin); sidecar: same stem, `.json`.
-pub const SKIN_LUT_PATH: &str = "skin/skin_color_lut.exr";
-
-/// Example hemoglobin rig in `baked/` (schema `rtbake-hemoglobin-rig/1`; scale/bias EXRs and H0 beside it).
-pub const HEMOGLOBIN_RIG_PATH: &str = "facial/hemoglobin/example/rig.json";
-
-/// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
-pub fn sidecar_path(exr_path: &str) -> String {
-    match exr_path.strip_suffix(".exr") {
-        Some(stem) => format!("{stem}.json"),
-        None => format!("{exr_path}.json"),
-    }
-}
-
-/// Jimenez MLAA v1.4 area map for maximum distance `n` in `baked/` (RG8 5n×5n).
-pub fn mlaa_area_path(n: u32) -> String {
-    format!("aa/mlaa/AreaMap{n}_v1.4.bin")
-}
 
 /// What a pass expects of one LUT.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,13 +36,13 @@ pub struct LutSpec {
 
 impl LutSpec {
     pub fn smaa_area() -> Self {
-        Self { path: SMAA_AREA_PATH.into(), pixel_format: PixelFormat::R8G8Unorm, width: 160, height: 560 }
+        Self { path: path::SMAA_AREA.into(), pixel_format: PixelFormat::R8G8Unorm, width: 160, height: 560 }
     }
     pub fn smaa_search() -> Self {
-        Self { path: SMAA_SEARCH_PATH.into(), pixel_format: PixelFormat::R8Unorm, width: 64, height: 16 }
+        Self { path: path::SMAA_SEARCH.into(), pixel_format: PixelFormat::R8Unorm, width: 64, height: 16 }
     }
     pub fn mlaa_area(n: u32) -> Self {
-        Self { path: mlaa_area_path(n), pixel_format: PixelFormat::R8G8Unorm, width: 5 * n, height: 5 * n }
+        Self { path: path::mlaa_area_v1_4(n), pixel_format: PixelFormat::R8G8Unorm, width: 5 * n, height: 5 * n }
     }
 }
 
@@ -292,17 +266,14 @@ fn load_exr_f32(
     Ok(img)
 }
 
-fn field<'a>(v: &'a serde_json::Value, path: &str, key: &str) -> Result<&'a serde_json::Value, LutError> {
-    key.split('.').try_fold(v, |v, k| v.get(k).ok_or_else(|| content(path, format!("missing field \"{key}\""))))
+/// Deserialises a whole file into its contract type ([`crate::baked_layout`]), naming the field that does not fit.
+fn typed<T: serde::de::DeserializeOwned>(v: serde_json::Value, path: &str) -> Result<T, LutError> {
+    serde_json::from_value(v).map_err(|e| content(path, format!("does not match its schema: {e}")))
 }
 
-fn field_f64(v: &serde_json::Value, path: &str, key: &str) -> Result<f64, LutError> {
-    field(v, path, key)?.as_f64().ok_or_else(|| content(path, format!("field \"{key}\" must be a number")))
-}
-
-fn field_as<T: serde::de::DeserializeOwned>(v: &serde_json::Value, path: &str, key: &str) -> Result<T, LutError> {
-    serde_json::from_value(field(v, path, key)?.clone())
-        .map_err(|e| content(path, format!("field \"{key}\" has the wrong shape: {e}")))
+/// A JSON value of a contract type in the shape the pass needs.
+fn shaped<T: serde::de::DeserializeOwned>(v: &serde_json::Value, path: &str, key: &str) -> Result<T, LutError> {
+    serde_json::from_value(v.clone()).map_err(|e| content(path, format!("field \"{key}\" has the wrong shape: {e}")))
 }
 
 /// A baked separable-SSS kernel (schema `rtbake-separable-kernel/1`).
@@ -328,16 +299,13 @@ pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutE
 /// The content checks of [`load_separable_kernel`] on an already-parsed kernel file (`path` names it in errors);
 /// for kernel files outside a bake directory, which have no manifest entry to check against.
 pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<BakedKernel, LutError> {
-    let v = v.clone();
-    let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
-    if schema != crate::separable::kernel::JSON_SCHEMA {
-        return Err(content(
-            path,
-            format!("schema {schema:?}, the runtime reads {:?}", crate::separable::kernel::JSON_SCHEMA),
-        ));
+    let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
+    if found != schema::SEPARABLE_KERNEL {
+        return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::SEPARABLE_KERNEL)));
     }
-    let taps: Vec<[f32; 4]> = field_as(&v, path, "kernel")?;
-    let samples: usize = field_as(&v, path, "samples")?;
+    let file: SeparableKernelFile = typed(v.clone(), path)?;
+    let taps: Vec<[f32; 4]> = file.kernel.iter().map(|t| t.map(|x| x as f32)).collect();
+    let samples = file.samples;
     if taps.len() != samples {
         return Err(content(path, format!("\"samples\" = {samples} but \"kernel\" has {} taps", taps.len())));
     }
@@ -350,12 +318,12 @@ pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<B
             return Err(content(path, format!("channel {} weights sum to {sum}, must be 1", ["r", "g", "b"][c])));
         }
     }
-    let step = field_f64(&v, path, "step_divisor")?;
+    let step = file.step_divisor;
     if step != 3.0 {
         return Err(content(path, format!("step_divisor {step}; the separable SSS shader divides the step by 3")));
     }
-    let range = field_f64(&v, path, "range")?;
-    let sss_width = v.get("sss_width").and_then(|w| w.as_f64()).map(|w| w as f32);
+    let range = file.range;
+    let sss_width = file.sss_width.map(|w| w as f32);
     let kernel = crate::runtime::separable_sss::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))?;
     Ok(BakedKernel { kernel, range, sss_width })
 }
@@ -377,14 +345,14 @@ pub struct BakedGaussians {
 pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError> {
     use crate::runtime::gaussian_sss::{GaussianBlurs, GaussianSssParams};
     let manifest = Manifest::load(dir)?;
-    let v = load_json(dir, &manifest, path)?;
-    if field(&v, path, "shared_variances")?.as_bool() != Some(true) {
+    let file: GaussiansFile = typed(load_json(dir, &manifest, path)?, path)?;
+    if !file.shared_variances {
         return Err(content(path, "per-channel variances; the screen-space pass needs shared_variances = true"));
     }
-    let variances_mm2: Vec<f64> = field_as(&v, path, "variances")?;
-    let weights: Vec<[f64; 3]> = field_as(&v, path, "weights")?;
-    let blend: Vec<[f64; 3]> = field_as(&v, path, "blend_weights")?;
-    let incremental: Vec<f64> = field_as(&v, path, "incremental_variances")?;
+    let variances_mm2: Vec<f64> = shaped(&file.variances, path, "variances")?;
+    let weights: Vec<[f64; 3]> = shaped(&file.weights, path, "weights")?;
+    let blend: Vec<[f64; 3]> = shaped(&file.blend_weights, path, "blend_weights")?;
+    let incremental: Vec<f64> = shaped(&file.incremental_variances, path, "incremental_variances")?;
     let n = variances_mm2.len();
     if weights.len() != n || blend.len() != n || incremental.len() != n {
         return Err(content(path, format!("{n} variances but weights/blend_weights/incremental_variances differ")));
@@ -406,9 +374,9 @@ pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError
         }
     }
     let params = GaussianSssParams {
-        alpha: field_f64(&v, path, "lod_thresholds.alpha")? as f32,
-        beta: field_f64(&v, path, "lod_thresholds.beta")? as f32,
-        gamma: field_f64(&v, path, "lod_thresholds.gamma")? as f32,
+        alpha: file.lod_thresholds.alpha as f32,
+        beta: file.lod_thresholds.beta as f32,
+        gamma: file.lod_thresholds.gamma as f32,
         ..GaussianSssParams::default()
     };
     params.validate().map_err(|e| content(path, e.to_string()))?;
@@ -429,17 +397,19 @@ pub struct TransmittanceTable {
 pub fn load_transmittance(dir: &Path, path: &str) -> Result<TransmittanceTable, LutError> {
     let manifest = Manifest::load(dir)?;
     let img = load_exr_f32(dir, &manifest, path, 3, (2, 1))?;
-    let side_path = sidecar_path(path);
-    let side = load_json(dir, &manifest, &side_path)?;
-    let samples: u32 = field_as(&side, &side_path, "samples")?;
-    if samples != img.width {
-        return Err(content(&side_path, format!("samples = {samples}, the table {path} is {} wide", img.width)));
+    let side_path = path::sidecar(path);
+    let side: TransmittanceSidecar = typed(load_json(dir, &manifest, &side_path)?, &side_path)?;
+    if side.samples != img.width {
+        return Err(content(&side_path, format!("samples = {}, the table {path} is {} wide", side.samples, img.width)));
     }
-    let conv = field(&side, &side_path, "texel_convention")?.as_str().unwrap_or_default();
-    if !conv.starts_with("node-inclusive") {
-        return Err(content(&side_path, format!("texel_convention {conv:?}; the pass samples node-inclusive tables")));
+    let conv = &side.texel_convention;
+    if conv != TransmittanceSidecar::TEXEL_CONVENTION {
+        return Err(content(
+            &side_path,
+            format!("texel_convention {conv:?}; the pass samples {:?}", TransmittanceSidecar::TEXEL_CONVENTION),
+        ));
     }
-    let s_max_mm = field_f64(&side, &side_path, "s_max_mm")?;
+    let s_max_mm = side.s_max_mm;
     if !(s_max_mm.is_finite() && s_max_mm > 0.0) {
         return Err(content(&side_path, format!("s_max_mm must be > 0, got {s_max_mm}")));
     }
@@ -469,14 +439,13 @@ pub fn load_skin_lut(dir: &Path, path: &str) -> Result<AlbedoLut, LutError> {
     use crate::runtime::skin_inputs::{CHD_MAX, CM_MAX};
     let manifest = Manifest::load(dir)?;
     let img = load_exr_f32(dir, &manifest, path, 3, (2, 2))?;
-    let side_path = sidecar_path(path);
-    let side = load_json(dir, &manifest, &side_path)?;
-    let (w, h): (u32, u32) = (field_as(&side, &side_path, "width")?, field_as(&side, &side_path, "height")?);
+    let side_path = path::sidecar(path);
+    let side: SkinLutSidecar = typed(load_json(dir, &manifest, &side_path)?, &side_path)?;
+    let (w, h) = (side.width, side.height);
     if (w, h) != (img.width, img.height) {
         return Err(content(&side_path, format!("says {w}x{h}, the LUT {path} is {}x{}", img.width, img.height)));
     }
-    let cm = field_f64(&side, &side_path, "index.melanin_max")?;
-    let chd = field_f64(&side, &side_path, "index.hemoglobin_max")?;
+    let (cm, chd) = (side.index.melanin_max, side.index.hemoglobin_max);
     if cm as f32 != CM_MAX || chd as f32 != CHD_MAX {
         return Err(content(
             &side_path,
@@ -540,14 +509,15 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
     use crate::runtime::skin_inputs::{HemoglobinRig, MAX_RIG_TARGETS};
     let manifest = Manifest::load(dir)?;
     let v = load_json(dir, &manifest, path)?;
-    let schema = field(&v, path, "schema")?.as_str().unwrap_or_default();
-    if schema != "rtbake-hemoglobin-rig/1" {
-        return Err(content(path, format!("schema {schema:?}, the runtime reads \"rtbake-hemoglobin-rig/1\"")));
+    let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
+    if found != schema::HEMOGLOBIN_RIG {
+        return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::HEMOGLOBIN_RIG)));
     }
+    let desc: RigDescription = typed(v, path)?;
     let folder = path.rsplit_once('/').map(|(d, _)| format!("{d}/")).unwrap_or_default();
-    let [rw, rh]: [u32; 2] = field_as(&v, path, "rig_size")?;
-    let [fw, fh]: [u32; 2] = field_as(&v, path, "full_size")?;
-    let maps: Vec<serde_json::Value> = field_as(&v, path, "maps")?;
+    let [rw, rh] = desc.rig_size;
+    let [fw, fh] = desc.full_size;
+    let maps = &desc.maps;
     if maps.is_empty() || maps.len() > MAX_RIG_TARGETS {
         return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", maps.len())));
     }
@@ -561,12 +531,12 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
     };
     let (mut targets, mut names) = (Vec::new(), Vec::new());
     for (i, m) in maps.iter().enumerate() {
-        let name: String = field_as(m, path, "name")?;
+        let name = m.name.clone();
         if i == 0 && name != "neutral" {
             return Err(content(path, format!("maps[0] is {name:?}; eq. 7.6 needs the neutral map first")));
         }
-        let scale = map1(&field_as::<String>(m, path, "scale_exr")?, (rw, rh))?;
-        let bias = map1(&field_as::<String>(m, path, "bias_exr")?, (rw, rh))?;
+        let scale = map1(&m.scale_exr, (rw, rh))?;
+        let bias = map1(&m.bias_exr, (rw, rh))?;
         if let Some(b) = bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
             return Err(content(
                 path,
@@ -576,10 +546,8 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
         targets.push(scale.into_iter().zip(bias).map(|(s, b)| [s, b]).collect());
         names.push(name);
     }
-    let h0_file: String = field_as(&v, path, "h0.exr")?;
-    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&h0_file, (fw, fh))?);
-    let global: serde_json::Map<String, serde_json::Value> = field_as(&v, path, "global_scales")?;
-    let global_scales = global.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
+    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&desc.h0.exr, (fw, fh))?);
+    let global_scales = desc.global_scales.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
     let rig = HemoglobinRig { width: rw, height: rh, targets };
     rig.validate().map_err(|e| content(path, e.to_string()))?;
     Ok(BakedRig { rig, names, h0, global_scales })

@@ -21,10 +21,11 @@
 //! [`Precision::F32`] evaluates every step in f32 in the shader's order of operations and reproduces the shipped
 //! header's digits (whose offsets are very slightly asymmetric); [`Precision::F64`] runs the same steps in f64.
 
+use crate::baked_layout::SeparableKernelFile;
 use crate::error::{check_range, InvalidInput};
 use crate::io::source::{ShaderInclude, ShaderLang};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use super::{SeparableParams, CHANNELS};
@@ -308,22 +309,22 @@ fn generate_in<T: Real>(spec: &KernelSpec, range_f64: f64) -> Vec<[f64; 4]> {
 
 /// A JSON number carrying the shortest decimal that round-trips in the kernel's precision
 /// (f32 kernels print `0.536343`, not the f64 expansion of the f32).
-fn number(v: f64, precision: Precision) -> Value {
-    let v = match precision {
+fn rounded(v: f64, precision: Precision) -> f64 {
+    match precision {
         Precision::F32 => format!("{:?}", v as f32).parse::<f64>().unwrap_or(v),
         Precision::F64 => v,
-    };
-    serde_json::Number::from_f64(v).map(Value::Number).unwrap_or(Value::Null)
+    }
 }
 
 /// Kernel JSON schema identifier.
-pub const JSON_SCHEMA: &str = "rtbake-separable-kernel/1";
+pub use crate::baked_layout::schema::SEPARABLE_KERNEL as JSON_SCHEMA;
 
 impl Kernel {
     /// The taps as `[[r, g, b, offset], …]`, centre first.
     pub fn taps_json(&self) -> Value {
         let p = self.spec.precision;
-        Value::Array(self.taps.iter().map(|t| Value::Array(t.iter().map(|v| number(*v, p)).collect())).collect())
+        serde_json::to_value(self.taps.iter().map(|t| t.map(|v| rounded(v, p))).collect::<Vec<_>>())
+            .expect("finite taps serialise")
     }
 
     /// The kernel file: `{"schema", "samples", "range", "exponent", "step_divisor", "precision", "strength",
@@ -331,21 +332,21 @@ impl Kernel {
     /// `sss_width` is the width the parameters were made for (world units), if known.
     pub fn to_json(&self, sss_width: Option<f64>, source: &str) -> Value {
         let p = self.spec.precision;
-        let rgb = |v: [f64; 3]| Value::Array(v.iter().map(|x| number(*x, Precision::F64)).collect());
-        json!({
-            "schema": JSON_SCHEMA,
-            "source": source,
-            "samples": self.spec.samples,
-            "range": number(self.range, p),
-            "exponent": number(self.spec.exponent, p),
-            "step_divisor": SHADER_STEP_DIVISOR,
-            "precision": p.as_str(),
-            "strength": rgb(self.spec.params.strength),
-            "falloff": rgb(self.spec.params.falloff),
-            "sss_width": sss_width,
-            "layout": LAYOUT_DOC,
-            "kernel": self.taps_json(),
-        })
+        let file = SeparableKernelFile {
+            schema: JSON_SCHEMA.into(),
+            source: source.into(),
+            samples: self.spec.samples,
+            range: rounded(self.range, p),
+            exponent: rounded(self.spec.exponent, p),
+            step_divisor: SHADER_STEP_DIVISOR,
+            precision: p.as_str().into(),
+            strength: self.spec.params.strength,
+            falloff: self.spec.params.falloff,
+            sss_width,
+            layout: LAYOUT_DOC.into(),
+            kernel: self.taps.iter().map(|t| t.map(|v| rounded(v, p))).collect(),
+        };
+        serde_json::to_value(&file).expect("kernel file serialises")
     }
 
     /// HLSL / GLSL / WGSL include: `SSSS_KERNEL_N_SAMPLES`, `SSSS_KERNEL_RANGE`, `SSSS_KERNEL_EXPONENT`,

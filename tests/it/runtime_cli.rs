@@ -2,9 +2,9 @@
 
 use crate::support::*;
 use rtbake::bake::BakedFile;
+use rtbake::baked_layout::path;
 use rtbake::image_buf::Image;
 use rtbake::manifest::Manifest;
-use rtbake::runtime::loader;
 use std::path::Path;
 use std::process::Command;
 
@@ -35,16 +35,16 @@ fn write_bake(dir: &Path, files: &[BakedFile]) {
 /// Every table the demo and the passes read, copied from the committed bake.
 fn demo_tables() -> Vec<String> {
     vec![
-        loader::SMAA_AREA_PATH.into(),
-        loader::SMAA_SEARCH_PATH.into(),
-        loader::mlaa_area_path(9),
-        loader::mlaa_area_path(33),
-        loader::SEPARABLE_KERNEL_PATH.into(),
-        loader::GAUSSIANS_PATH.into(),
-        loader::TRANSMITTANCE_PATH.into(),
-        loader::sidecar_path(loader::TRANSMITTANCE_PATH),
-        loader::SKIN_LUT_PATH.into(),
-        loader::sidecar_path(loader::SKIN_LUT_PATH),
+        path::SMAA_AREA.into(),
+        path::SMAA_SEARCH.into(),
+        path::mlaa_area_v1_4(9),
+        path::mlaa_area_v1_4(33),
+        path::SEPARABLE_KERNEL_DEFAULT.into(),
+        path::GAUSSIANS_DEFAULT.into(),
+        path::TRANSMITTANCE_DEFAULT.into(),
+        path::sidecar(path::TRANSMITTANCE_DEFAULT),
+        path::SKIN_LUT.into(),
+        path::sidecar(path::SKIN_LUT),
     ]
 }
 
@@ -307,7 +307,7 @@ fn demo_refuses_a_bake_without_the_skin_lut() {
 fn sss_reads_baked_kernels_and_gaussians() {
     let t = tempfile::tempdir().unwrap();
     let mut files =
-        committed(&[loader::SEPARABLE_KERNEL_PATH, "sss/separable/published_n11.json", loader::GAUSSIANS_PATH]);
+        committed(&[path::SEPARABLE_KERNEL_DEFAULT, "sss/separable/published_n11.json", path::GAUSSIANS_DEFAULT]);
     let mut srgb = files[1].clone();
     srgb.path = "sss/separable/srgb.json".into();
     srgb.meta.color_space = "srgb".into();

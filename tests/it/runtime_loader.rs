@@ -1,6 +1,7 @@
 //! The LUT loader refuses every LUT that does not match what the pass expects, with a clear error.
 
 use rtbake::bake::{BakedFile, FileMeta};
+use rtbake::baked_layout::path;
 use rtbake::io::PixelFormat;
 use rtbake::manifest::Manifest;
 use rtbake::runtime::loader::{self, LutError, LutSpec};
@@ -24,12 +25,12 @@ fn meta(pf: PixelFormat, w: u32, h: u32, color_space: &str) -> FileMeta {
 /// Writes a bake dir with an SMAA area texture and search texture, letting `tweak` edit the area's metadata.
 fn bake_dir(dir: &Path, tweak: impl FnOnce(&mut BakedFile)) {
     let mut area = BakedFile {
-        path: loader::SMAA_AREA_PATH.into(),
+        path: path::SMAA_AREA.into(),
         bytes: (0..160 * 560 * 2).map(|i| (i % 251) as u8).collect(),
         meta: meta(PixelFormat::R8G8Unorm, 160, 560, "linear"),
     };
     let search = BakedFile {
-        path: loader::SMAA_SEARCH_PATH.into(),
+        path: path::SMAA_SEARCH.into(),
         bytes: vec![7u8; 64 * 16],
         meta: meta(PixelFormat::R8Unorm, 64, 16, "linear"),
     };
@@ -94,7 +95,7 @@ fn refuses_wrong_container() {
 fn refuses_bad_checksum() {
     let t = tempfile::tempdir().unwrap();
     bake_dir(t.path(), |_| {});
-    let p = t.path().join(loader::SMAA_AREA_PATH);
+    let p = t.path().join(path::SMAA_AREA);
     let mut bytes = std::fs::read(&p).unwrap();
     bytes[1000] ^= 1;
     std::fs::write(&p, bytes).unwrap();
@@ -107,7 +108,7 @@ fn refuses_bad_checksum() {
 fn refuses_truncated_file() {
     let t = tempfile::tempdir().unwrap();
     bake_dir(t.path(), |_| {});
-    let p = t.path().join(loader::SMAA_AREA_PATH);
+    let p = t.path().join(path::SMAA_AREA);
     let bytes = std::fs::read(&p).unwrap();
     std::fs::write(&p, &bytes[..bytes.len() - 2]).unwrap();
     let e = loader::load_smaa_textures(t.path()).unwrap_err();

@@ -3,6 +3,7 @@
 //! size is wrong or the checksum does not match (synthetic bake directories built from the committed files).
 
 use rtbake::bake::BakedFile;
+use rtbake::baked_layout::path;
 use rtbake::diffusion::sum_of_gaussians::deon6;
 use rtbake::manifest::Manifest;
 use rtbake::runtime::loader::{self, LutError};
@@ -50,26 +51,30 @@ fn corrupt(dir: &Path, path: &str, at: usize) {
 type Load = fn(&Path) -> Result<(), LutError>;
 
 fn load_kernel(d: &Path) -> Result<(), LutError> {
-    loader::load_separable_kernel(d, loader::SEPARABLE_KERNEL_PATH).map(|_| ())
+    loader::load_separable_kernel(d, path::SEPARABLE_KERNEL_DEFAULT).map(|_| ())
 }
 fn load_gaussians(d: &Path) -> Result<(), LutError> {
-    loader::load_gaussians(d, loader::GAUSSIANS_PATH).map(|_| ())
+    loader::load_gaussians(d, path::GAUSSIANS_DEFAULT).map(|_| ())
 }
 fn load_t(d: &Path) -> Result<(), LutError> {
-    loader::load_transmittance(d, loader::TRANSMITTANCE_PATH).map(|_| ())
+    loader::load_transmittance(d, path::TRANSMITTANCE_DEFAULT).map(|_| ())
 }
 fn load_skin(d: &Path) -> Result<(), LutError> {
-    loader::load_skin_lut(d, loader::SKIN_LUT_PATH).map(|_| ())
+    loader::load_skin_lut(d, path::SKIN_LUT).map(|_| ())
 }
 
 /// (the loaded file, every file the loader reads, loader).
 fn cases() -> Vec<(&'static str, Vec<String>, Load)> {
-    let side = |p: &str| loader::sidecar_path(p);
+    let side = |p: &str| path::sidecar(p);
     vec![
-        (loader::SEPARABLE_KERNEL_PATH, vec![loader::SEPARABLE_KERNEL_PATH.into()], load_kernel as Load),
-        (loader::GAUSSIANS_PATH, vec![loader::GAUSSIANS_PATH.into()], load_gaussians),
-        (loader::TRANSMITTANCE_PATH, vec![loader::TRANSMITTANCE_PATH.into(), side(loader::TRANSMITTANCE_PATH)], load_t),
-        (loader::SKIN_LUT_PATH, vec![loader::SKIN_LUT_PATH.into(), side(loader::SKIN_LUT_PATH)], load_skin),
+        (path::SEPARABLE_KERNEL_DEFAULT, vec![path::SEPARABLE_KERNEL_DEFAULT.into()], load_kernel as Load),
+        (path::GAUSSIANS_DEFAULT, vec![path::GAUSSIANS_DEFAULT.into()], load_gaussians),
+        (
+            path::TRANSMITTANCE_DEFAULT,
+            vec![path::TRANSMITTANCE_DEFAULT.into(), side(path::TRANSMITTANCE_DEFAULT)],
+            load_t,
+        ),
+        (path::SKIN_LUT, vec![path::SKIN_LUT.into(), side(path::SKIN_LUT)], load_skin),
     ]
 }
 
@@ -166,8 +171,8 @@ fn edit_json(f: &mut BakedFile, edit: impl FnOnce(&mut serde_json::Value)) {
 
 #[test]
 fn inconsistent_json_content_is_refused() {
-    let kernel = || files(&[loader::SEPARABLE_KERNEL_PATH.into()]);
-    let gauss = || files(&[loader::GAUSSIANS_PATH.into()]);
+    let kernel = || files(&[path::SEPARABLE_KERNEL_DEFAULT.into()]);
+    let gauss = || files(&[path::GAUSSIANS_DEFAULT.into()]);
     let refused = |fs: Vec<BakedFile>, edit: &dyn Fn(&mut serde_json::Value), load: Load, needle: &str| {
         let t = tempfile::tempdir().unwrap();
         bake_dir(t.path(), fs, |f| edit_json(&mut f[0], edit));
@@ -185,7 +190,7 @@ fn inconsistent_json_content_is_refused() {
 
 #[test]
 fn committed_separable_kernel_is_the_published_17_tap_kernel() {
-    let k = loader::load_separable_kernel(&baked(), loader::SEPARABLE_KERNEL_PATH).unwrap();
+    let k = loader::load_separable_kernel(&baked(), path::SEPARABLE_KERNEL_DEFAULT).unwrap();
     assert_eq!(k.kernel.taps.len(), 17);
     assert_eq!(k.range, 2.0);
     assert_eq!(k.sss_width, Some(0.012));
@@ -199,7 +204,7 @@ fn committed_separable_kernel_is_the_published_17_tap_kernel() {
 
 #[test]
 fn committed_gaussian_fit_is_deon6_with_eq_4_8_blend_weights() {
-    let g = loader::load_gaussians(&baked(), loader::GAUSSIANS_PATH).unwrap();
+    let g = loader::load_gaussians(&baked(), path::GAUSSIANS_DEFAULT).unwrap();
     assert_eq!(g.fit, deon6());
     assert_eq!(g.blurs.blend.len(), 6);
     assert_eq!(g.blurs.blend[0], [1.0; 3]);
@@ -211,7 +216,7 @@ fn committed_gaussian_fit_is_deon6_with_eq_4_8_blend_weights() {
 
 #[test]
 fn committed_transmittance_matches_eq_5_12_on_its_nodes() {
-    let t = loader::load_transmittance(&baked(), loader::TRANSMITTANCE_PATH).unwrap();
+    let t = loader::load_transmittance(&baked(), path::TRANSMITTANCE_DEFAULT).unwrap();
     assert_eq!(t.values.len(), 256);
     assert_eq!(t.s_max_mm, 8.0);
     let fit = deon6();
@@ -227,7 +232,7 @@ fn committed_transmittance_matches_eq_5_12_on_its_nodes() {
 
 #[test]
 fn committed_skin_lut_is_256_square_linear_albedo() {
-    let l = loader::load_skin_lut(&baked(), loader::SKIN_LUT_PATH).unwrap();
+    let l = loader::load_skin_lut(&baked(), path::SKIN_LUT).unwrap();
     assert_eq!((l.width, l.height, l.albedo.len()), (256, 256, 65536));
     assert!(l.albedo.iter().flatten().all(|v| (0.0..1.0).contains(v)));
     let at = |i: usize, j: usize| l.albedo[j * 256 + i];
@@ -236,13 +241,13 @@ fn committed_skin_lut_is_256_square_linear_albedo() {
     assert!((0..3).all(|c| dark[c] < pale[c]) && dark[2] / pale[2] < dark[0] / pale[0], "{pale:?} {dark:?}");
     let flushed = at(40, 255);
     assert!(flushed[1] / pale[1] < flushed[0] / pale[0], "{pale:?} {flushed:?}");
-    let luts = loader::load_skin_luts(&baked(), loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH).unwrap();
+    let luts = loader::load_skin_luts(&baked(), path::SKIN_LUT, path::TRANSMITTANCE_DEFAULT).unwrap();
     luts.validate().unwrap();
 }
 
 #[test]
 fn committed_hemoglobin_rig_loads_with_neutral_first() {
-    let r = loader::load_hemoglobin_rig(&baked(), loader::HEMOGLOBIN_RIG_PATH).unwrap();
+    let r = loader::load_hemoglobin_rig(&baked(), path::RIG_EXAMPLE).unwrap();
     assert_eq!(r.names[0], "neutral");
     assert_eq!(r.rig.targets.len(), r.names.len());
     assert_eq!((r.rig.width, r.rig.height), (32, 32));
@@ -266,11 +271,11 @@ fn hemoglobin_rig_map_declared_srgb_or_corrupted_is_refused() {
     let i = paths.iter().position(|p| p == bias).unwrap();
     let t = tempfile::tempdir().unwrap();
     bake_dir(t.path(), files(&paths), |f| f[i].meta.color_space = "srgb".into());
-    let e = loader::load_hemoglobin_rig(t.path(), loader::HEMOGLOBIN_RIG_PATH).unwrap_err();
+    let e = loader::load_hemoglobin_rig(t.path(), path::RIG_EXAMPLE).unwrap_err();
     assert!(matches!(e, LutError::ColorSpace { .. }) && e.to_string().contains(bias), "{e}");
     let t = tempfile::tempdir().unwrap();
     bake_dir(t.path(), files(&paths), |_| {});
     corrupt(t.path(), bias, 300);
-    let e = loader::load_hemoglobin_rig(t.path(), loader::HEMOGLOBIN_RIG_PATH).unwrap_err();
+    let e = loader::load_hemoglobin_rig(t.path(), path::RIG_EXAMPLE).unwrap_err();
     assert!(matches!(e, LutError::Checksum { .. }), "{e}");
 }

@@ -1,6 +1,7 @@
 //! Skin shading inputs: GPU vs CPU reference, rig evaluation (eq. 7.6), E of eq. 5.13, node-inclusive lookups.
 
 use crate::support::*;
+use rtbake::baked_layout::path;
 use rtbake::runtime::cpu::skin_inputs::skin_inputs;
 use rtbake::runtime::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
 
@@ -52,8 +53,8 @@ fn skin_inputs_gpu_matches_cpu() {
 fn skin_inputs_gpu_matches_cpu_with_the_baked_tables() {
     use rtbake::runtime::loader;
     let dir = baked_dir();
-    let l = loader::load_skin_luts(&dir, loader::SKIN_LUT_PATH, loader::TRANSMITTANCE_PATH).unwrap();
-    let r = loader::load_hemoglobin_rig(&dir, loader::HEMOGLOBIN_RIG_PATH).unwrap();
+    let l = loader::load_skin_luts(&dir, path::SKIN_LUT, path::TRANSMITTANCE_DEFAULT).unwrap();
+    let r = loader::load_hemoglobin_rig(&dir, path::RIG_EXAMPLE).unwrap();
     let mut weights = vec![0.0f32; r.rig.targets.len()];
     weights[0] = 0.5;
     weights[1] = 0.5;

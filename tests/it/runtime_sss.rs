@@ -55,7 +55,7 @@ fn scene(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
 /// The published 17-tap kernel from the committed bake, through the manifest-checked loader.
 fn baked_kernel() -> SssKernel {
     let dir = baked_dir();
-    rtbake::runtime::loader::load_separable_kernel(&dir, rtbake::runtime::loader::SEPARABLE_KERNEL_PATH)
+    rtbake::runtime::loader::load_separable_kernel(&dir, rtbake::baked_layout::path::SEPARABLE_KERNEL_DEFAULT)
         .unwrap_or_else(|e| panic!("{e}"))
         .kernel
 }

@@ -1,0 +1,289 @@
+//! The contract between the bakers and everything that reads `baked/`: where each file lives, the schema ids of
+//! its JSON files and the typed sidecars next to the float tables.
+//!
+//! The bakers (`crate::bake`) write these paths and serialise these types; the runtime loader
+//! (`crate::runtime::loader`), `rtbake maps rig-eval` and the tests read them back through the same definitions, so
+//! a renamed file or key is a compile error on both sides instead of a runtime surprise. Per-file metadata
+//! ([`crate::manifest::FileMeta`]) is the other half of the contract and lives with the manifest.
+//!
+//! Field order in the structs is the key order in the files (the committed `baked/` is byte-stable: reordering a
+//! field re-bakes the files).
+
+use crate::facial::disk_stats::Border;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// Paths relative to the bake directory (`/`-separated, as in the manifest).
+pub mod path {
+    /// Folder of the SMAA textures.
+    pub const SMAA_DIR: &str = "aa/smaa";
+    /// Folder of the Jimenez MLAA area maps.
+    pub const MLAA_DIR: &str = "aa/mlaa";
+    /// SMAA area texture, raw RG8 160×560 (the runtime's copy; `.dds`/`.ktx2`/`.png` beside it).
+    pub const SMAA_AREA: &str = "aa/smaa/AreaTex.bin";
+    /// SMAA search texture, raw R8 64×16.
+    pub const SMAA_SEARCH: &str = "aa/smaa/SearchTex.bin";
+
+    /// Jimenez MLAA v1.4 area map for maximum distance `n`, raw RG8 5n×5n.
+    pub fn mlaa_area_v1_4(n: u32) -> String {
+        format!("{MLAA_DIR}/AreaMap{n}_v1.4.bin")
+    }
+
+    /// Folder of the sum-of-Gaussians fits and their screen-space parameters.
+    pub const GAUSSIANS_DIR: &str = "sss/gaussians";
+    /// Default sum-of-Gaussians fit of the screen-space SSS (d'Eon's 6 Gaussians).
+    pub const GAUSSIANS_DEFAULT: &str = "sss/gaussians/deon6.json";
+    /// Folder of the separable-SSS kernels.
+    pub const SEPARABLE_DIR: &str = "sss/separable";
+    /// Default separable-SSS kernel (17 taps, published parameters).
+    pub const SEPARABLE_KERNEL_DEFAULT: &str = "sss/separable/published_n17.json";
+
+    /// Folder of the transmittance tables T(s).
+    pub const TRANSMITTANCE_DIR: &str = "transmittance";
+    /// Default transmittance table (EXR f32, RGB, node-inclusive); sidecar [`sidecar`] of it.
+    pub const TRANSMITTANCE_DEFAULT: &str = "transmittance/deon6_published.exr";
+
+    /// Stem of the skin-colour LUT's texture files (`.exr`, `_f16.exr`, `.ktx2`, `_preview_srgb.png`).
+    pub const SKIN_LUT_STEM: &str = "skin/skin_color_lut";
+    /// Skin-colour LUT (EXR f32, RGB, melanin × hemoglobin); sidecar [`SKIN_LUT_SIDECAR`].
+    pub const SKIN_LUT: &str = "skin/skin_color_lut.exr";
+    /// Sidecar of the skin-colour LUT ([`super::SkinLutSidecar`]).
+    pub const SKIN_LUT_SIDECAR: &str = "skin/skin_color_lut.json";
+    /// Skin colours evaluated directly by the spectral model at sample points (CSV).
+    pub const SKIN_SAMPLES: &str = "skin/skin_color_samples.csv";
+    /// Reflectance spectra R(λ) at the corner points (CSV).
+    pub const SKIN_SPECTRA: &str = "skin/skin_color_spectra.csv";
+
+    /// Folder of the example hemoglobin rig.
+    pub const RIG_EXAMPLE_DIR: &str = "facial/hemoglobin/example";
+    /// The example rig's description ([`super::RigDescription`]); its maps are named relative to its folder.
+    pub const RIG_EXAMPLE: &str = "facial/hemoglobin/example/rig.json";
+    /// File name of a rig description inside its folder.
+    pub const RIG_FILE_NAME: &str = "rig.json";
+    /// Folder of the wrinkle assets.
+    pub const WRINKLES_DIR: &str = "facial/wrinkles";
+
+    /// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
+    pub fn sidecar(exr_path: &str) -> String {
+        match exr_path.strip_suffix(".exr") {
+            Some(stem) => format!("{stem}.json"),
+            None => format!("{exr_path}.json"),
+        }
+    }
+}
+
+/// Schema ids written into the JSON files and checked by their readers.
+pub mod schema {
+    /// `baked/manifest.json`.
+    pub const MANIFEST: &str = "rtbake-manifest/1";
+    /// A separable-SSS kernel file ([`crate::separable::kernel::Kernel::to_json`]).
+    pub const SEPARABLE_KERNEL: &str = "rtbake-separable-kernel/1";
+    /// A hemoglobin rig description ([`super::RigDescription`]).
+    pub const HEMOGLOBIN_RIG: &str = "rtbake-hemoglobin-rig/1";
+    /// The wrinkle example's report.
+    pub const WRINKLES: &str = "rtbake-wrinkles/1";
+}
+
+/// Sidecar of a transmittance table T(s) (`transmittance/*.json`): provenance and the lookup convention.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TransmittanceSidecar {
+    /// Where the profile came from (preset, fit, layers …), as the command recorded it.
+    pub source: Value,
+    /// `published` (eq. 5.12 as printed) or `physical`.
+    pub form: String,
+    pub formula: String,
+    /// Texels per row (node-inclusive samples over 0..=s_max).
+    pub samples: u32,
+    /// Rows (identical; for engines that want a 2-D texture).
+    pub height: u32,
+    /// Thickness of the last node, mm.
+    pub s_max_mm: f64,
+    /// `node-inclusive: …` ([`TransmittanceSidecar::TEXEL_CONVENTION`]).
+    pub texel_convention: String,
+    pub shader_lookup: String,
+    /// The profile's Gaussians: variances (mm²) per channel.
+    pub variances_mm2: [Vec<f64>; 3],
+    /// Weights per channel.
+    pub weights: [Vec<f64>; 3],
+}
+
+impl TransmittanceSidecar {
+    /// Texel i holds s = s_max·i/(n−1).
+    pub const TEXEL_CONVENTION: &'static str = "node-inclusive: texel i holds s = s_max*i/(n-1)";
+    /// How a shader samples the table.
+    pub const SHADER_LOOKUP: &'static str = "u = s/s_max*(n-1)/n + 0.5/n, linear filtering, clamp to edge";
+}
+
+/// Sidecar of the skin-colour LUT ([`path::SKIN_LUT_SIDECAR`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkinLutSidecar {
+    pub asset: String,
+    pub description: String,
+    pub files: SkinLutFiles,
+    pub color_space: String,
+    pub width: u32,
+    pub height: u32,
+    pub channels: [String; 3],
+    pub index: SkinLutIndex,
+    pub value_range: SkinLutRange,
+    pub model: SkinLutModel,
+    /// The asset parameters that produced it.
+    pub parameters: Value,
+}
+
+/// The files of the skin-colour asset, by role.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkinLutFiles {
+    pub linear_f32: String,
+    pub linear_f16: String,
+    pub linear_f16_ktx2: String,
+    pub preview_srgb8_not_for_sampling: String,
+    pub samples: String,
+    pub spectra: String,
+}
+
+/// How texels map to (melanin Cm, dermal hemoglobin Chd), eq. 7.7.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkinLutIndex {
+    pub form: String,
+    pub u_axis: String,
+    pub v_axis: String,
+    /// Cm of the last column.
+    pub melanin_max: f64,
+    /// Chd of the last row.
+    pub hemoglobin_max: f64,
+    pub texel_to_concentration: String,
+    pub concentration_to_texcoord: String,
+    pub hlsl: String,
+    pub epidermal_hemoglobin: String,
+}
+
+/// Per-channel minimum and maximum of the table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkinLutRange {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+/// The model behind the skin-colour LUT, in words.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkinLutModel {
+    pub layers: String,
+    pub adding: String,
+    pub dermis_bottom: String,
+    pub colorimetry: String,
+    pub data: String,
+}
+
+/// Where one basis map of a rig came from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigSource {
+    pub name: String,
+    /// File name or `synthetic:…` description.
+    pub source: String,
+    /// `exr-f32`, `exr-f16`, `png16`, `png8`, `synthetic-png16`.
+    pub format: String,
+    /// How samples map to concentration.
+    pub mapping: String,
+}
+
+/// The rig description written as `rig.json` (schema [`schema::HEMOGLOBIN_RIG`]); read back by
+/// `rtbake maps rig-eval` and the GPU runtime. File names inside are relative to the rig's folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigDescription {
+    pub schema: String,
+    pub generated_by: String,
+    pub model: String,
+    pub evaluation: String,
+    pub sampling: String,
+    pub radius_texels: u32,
+    pub border: Border,
+    pub sigma_floor: f64,
+    pub sigma_floored_texels: u64,
+    pub full_size: [u32; 2],
+    pub rig_size: [u32; 2],
+    pub value_unit: String,
+    pub h0: RigH0Files,
+    pub maps: Vec<RigMapFiles>,
+    pub global_scales: serde_json::Map<String, Value>,
+    pub previews: String,
+}
+
+/// Files of H0.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigH0Files {
+    pub definition: String,
+    pub exr: String,
+    pub exr_f16: String,
+    pub ktx2: String,
+    pub preview: String,
+    pub preview_range: [f64; 2],
+}
+
+/// Files of one basis map (index 0 is the neutral map).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigMapFiles {
+    pub index: usize,
+    pub name: String,
+    pub scale_exr: String,
+    pub scale_exr_f16: String,
+    pub bias_exr: String,
+    pub bias_exr_f16: String,
+    /// RG16F: R = scale, G = bias.
+    pub scale_bias_ktx2: String,
+    pub scale_preview: String,
+    pub bias_preview: String,
+    pub source: RigSource,
+}
+
+/// A separable-SSS kernel file (schema [`schema::SEPARABLE_KERNEL`]). Numbers are already rounded to the kernel's
+/// arithmetic precision by the writer.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeparableKernelFile {
+    pub schema: String,
+    pub source: String,
+    pub samples: usize,
+    pub range: f64,
+    pub exponent: f64,
+    /// The shader's fixed step divisor (3).
+    pub step_divisor: f64,
+    /// `f32` or `f64`.
+    pub precision: String,
+    pub strength: [f64; 3],
+    pub falloff: [f64; 3],
+    /// The width (world units) the parameters were made for, if known.
+    pub sss_width: Option<f64>,
+    pub layout: String,
+    /// `[r, g, b, offset]`, centre first.
+    pub kernel: Vec<[f64; 4]>,
+}
+
+/// The keys of a sum-of-Gaussians / screen-space parameter file (`sss/gaussians/*.json`, `rtbake fit gaussians
+/// --json`) that the runtime reads. Shapes depend on `shared_variances` (shared: `variances` is one array and the
+/// weight-like keys are `[r, g, b]` per Gaussian; per channel: `[[r…], [g…], [b…]]`), so they stay JSON values
+/// here and are checked by the reader.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GaussiansFile {
+    pub shared_variances: bool,
+    pub variances: Value,
+    pub weights: Value,
+    pub blend_weights: Value,
+    pub incremental_variances: Value,
+    pub std_devs: Value,
+    pub lod_thresholds: LodThresholds,
+    pub units: Value,
+    /// Provenance, error figures and the like added by the command that wrote the file.
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, Value>,
+}
+
+/// α, β, γ of the screen-space pass (eq. 4.5–4.6) and the per-Gaussian depth thresholds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LodThresholds {
+    pub alpha: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    pub two_sqrt_v_alpha: Value,
+    pub half_sqrt_v_alpha: Value,
+    pub convention: String,
+}
