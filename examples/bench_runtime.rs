@@ -73,8 +73,10 @@ fn main() {
     let luts = loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"));
     let n = 33;
     let map = MlaaAreaMap::new(n, loader::load_mlaa_area(&dir, n).unwrap_or_else(|e| panic!("{e}"))).unwrap();
-    let kernel = loader::load_separable_kernel(&dir, loader::SEPARABLE_KERNEL_PATH).unwrap_or_else(|e| panic!("{e}"));
-    let fit = loader::load_gaussians(&dir, loader::GAUSSIANS_PATH).unwrap_or_else(|e| panic!("{e}"));
+    let kernel = loader::load_separable_kernel(&dir, rtbake::baked_layout::path::SEPARABLE_KERNEL_DEFAULT)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let fit =
+        loader::load_gaussians(&dir, rtbake::baked_layout::path::GAUSSIANS_DEFAULT).unwrap_or_else(|e| panic!("{e}"));
     println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
     for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
         let img = render_shapes(w, h, 1);
