@@ -7,10 +7,10 @@ use rtbake::io::{self, atomic::write_atomic};
 use rtbake::runtime::chain::{self, Antialiasing};
 use rtbake::runtime::demo::{self, DemoAssets, SssMethod};
 use rtbake::runtime::device::{create_headless, Gpu};
-use rtbake::runtime::gaussian_sss::{GaussianSss, GaussianSssParams};
+use rtbake::runtime::chain::Subsurface;
 use rtbake::runtime::loader;
 use rtbake::runtime::mlaa::MlaaAreaMap;
-use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
+use rtbake::runtime::separable_sss::SssParams;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -55,7 +55,7 @@ pub struct MlaaArgs {
     #[command(flatten)]
     aa: AaArgs,
     /// Maximum distance N of the area map (the bake holds aa/mlaa/AreaMap{N}_v1.4.bin).
-    #[arg(long, default_value_t = 33)]
+    #[arg(long, default_value_t = rtbake::runtime::mlaa::DEFAULT_MAX_DISTANCE)]
     max_distance: u32,
 }
 
@@ -144,9 +144,7 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
 }
 
 fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
-    if n < 3 || n.is_multiple_of(2) {
-        return Err(usage_msg(format!("--max-distance must be odd and >= 3 (e.g. 9, 17, 33, 65, 129), got {n}")));
-    }
+    rtbake::aa::mlaa_area::validate(rtbake::aa::mlaa_area::MlaaVersion::V1_4, n).map_err(usage)?;
     let bytes = loader::load_mlaa_area(baked, n).map_err(usage)?;
     Ok(MlaaAreaMap::new(n, bytes)?)
 }
@@ -266,20 +264,12 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     let gpu = device(ctx, a.common.cpu)?;
     let (w, h) = (color.width, color.height);
     let t = Instant::now();
-    let out = match (&gpu, &kernel, &gaussians) {
-        (Some(g), Some(k), _) => {
-            SeparableSss::new(&g.device, w, h, &k.kernel, &params)?.run(&g.device, &g.queue, &rgba, &d)?
-        }
-        (None, Some(k), _) => rtbake::runtime::cpu::separable_sss::separable_sss(&rgba, &d, w, h, &k.kernel, &params),
-        (_, None, Some(f)) => {
-            let gp = GaussianSssParams { alpha: f.params.alpha * h as f32 / 720.0, ..f.params };
-            match &gpu {
-                Some(g) => GaussianSss::new(&g.device, w, h, &f.blurs, &gp)?.run(&g.device, &g.queue, &rgba, &d)?,
-                None => rtbake::runtime::cpu::gaussian_sss::gaussian_sss(&rgba, &d, w, h, &f.blurs, &gp),
-            }
-        }
-        (_, None, None) => unreachable!("one SSS method is selected"),
+    let method = match (&kernel, &gaussians) {
+        (Some(k), _) => Subsurface::Separable { kernel: &k.kernel, params: &params },
+        (None, Some(f)) => Subsurface::Gaussians { blurs: &f.blurs, params: f.params },
+        (None, None) => unreachable!("one SSS method is selected"),
     };
+    let out = rtbake::runtime::chain::subsurface(gpu.as_ref(), &rgba, &d, (w, h), &method)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     let img = Image::from_vec(w, h, 4, out);
     write_atomic(&a.output, &io::exr::encode(&img, io::exr::ExrPrecision::F16)?)?;

@@ -3,7 +3,9 @@
 
 use super::cpu::{self, FilterPrecision};
 use super::device::Gpu;
+use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
 use super::mlaa::{Mlaa, MlaaAreaMap};
+use super::separable_sss::{SeparableSss, SssKernel, SssParams};
 use super::smaa::{Smaa, SmaaTextures};
 use super::RuntimeError;
 use crate::error::InvalidInput;
@@ -52,4 +54,40 @@ pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Resul
         (None, Antialiasing::Mlaa(m)) => cpu::mlaa::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output,
     };
     Ok(Image::from_vec(w, h, 4, data))
+}
+
+/// A screen-space subsurface-scattering method with its baked data.
+pub enum Subsurface<'a> {
+    /// Separable SSS (thesis ch. 6) with a baked kernel.
+    Separable { kernel: &'a SssKernel, params: &'a SssParams },
+    /// Sum-of-Gaussians screen-space SSS (thesis ch. 4); `params.alpha` as stated for the 720-pixel viewport of
+    /// eq. 4.1 — [`subsurface`] scales it to the image height.
+    Gaussians { blurs: &'a GaussianBlurs, params: GaussianSssParams },
+}
+
+/// Blurs linear RGBA f32 `rgba` (alpha = SSS strength) with linear depth `depth_linear` (one value per pixel, the
+/// units of the kernel's / α's world scale) on `gpu`, or with the CPU reference when `gpu` is `None`.
+pub fn subsurface(
+    gpu: Option<&Gpu>,
+    rgba: &[f32],
+    depth_linear: &[f32],
+    (w, h): (u32, u32),
+    method: &Subsurface,
+) -> Result<Vec<f32>, RuntimeError> {
+    crate::error::check_size("--width/--height", w as u64, h as u64)?;
+    Ok(match (gpu, method) {
+        (Some(g), Subsurface::Separable { kernel, params }) => {
+            SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear)?
+        }
+        (None, Subsurface::Separable { kernel, params }) => {
+            cpu::separable_sss::separable_sss(rgba, depth_linear, w, h, kernel, params)
+        }
+        (Some(g), Subsurface::Gaussians { blurs, params }) => {
+            let gp = params.for_viewport_height(h);
+            GaussianSss::new(&g.device, w, h, blurs, &gp)?.run(&g.device, &g.queue, rgba, depth_linear)?
+        }
+        (None, Subsurface::Gaussians { blurs, params }) => {
+            cpu::gaussian_sss::gaussian_sss(rgba, depth_linear, w, h, blurs, &params.for_viewport_height(h))
+        }
+    })
 }

@@ -12,9 +12,9 @@
 use super::chain::{self, Antialiasing};
 use super::cpu;
 use super::device::Gpu;
-use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use super::gaussian_sss::{GaussianBlurs, GaussianSssParams};
 use super::loader::{self, LutError};
-use super::separable_sss::{SeparableSss, SssKernel, SssParams};
+use super::separable_sss::{SssKernel, SssParams};
 use super::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
 use super::RuntimeError;
 use crate::baked_layout::path;
@@ -222,18 +222,11 @@ pub fn render(
         }
         diffuse[4 * i + 3] = 1.0;
     }
-    // α of eq. 4.1 is stated for a 720-pixel viewport: scale it to this one.
-    let gp = GaussianSssParams { alpha: assets.gaussian_params.alpha * h as f32 / 720.0, ..assets.gaussian_params };
-    let blurred = match (gpu, method) {
-        (Some(g), SssMethod::Separable) => {
-            SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
-        }
-        (None, SssMethod::Separable) => cpu::separable_sss::separable_sss(&diffuse, &geo.depth, w, h, kernel, params),
-        (Some(g), SssMethod::Gaussians) => {
-            GaussianSss::new(&g.device, w, h, &assets.blurs, &gp)?.run(&g.device, &g.queue, &diffuse, &geo.depth)?
-        }
-        (None, SssMethod::Gaussians) => cpu::gaussian_sss::gaussian_sss(&diffuse, &geo.depth, w, h, &assets.blurs, &gp),
+    let sss = match method {
+        SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
+        SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },
     };
+    let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
     // Composite over the hard-edged background shapes; add back-lit transmittance; encode sRGB.
     let mut rgba = super::scene::render_shapes(w, h, 1);
     for i in 0..n {

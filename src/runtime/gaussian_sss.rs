@@ -69,7 +69,16 @@ impl Default for GaussianSssParams {
     }
 }
 
+/// Viewport height (pixels) for which α of eq. 4.1 is stated.
+pub const ALPHA_VIEWPORT_HEIGHT_PX: f32 = 720.0;
+
 impl GaussianSssParams {
+    /// α scaled from the 720-pixel viewport it is stated for to a viewport `height_px` tall (the stretch of eq. 4.1
+    /// is in pixels, so it grows with the resolution); β, γ and the LOD factor are unchanged.
+    pub fn for_viewport_height(self, height_px: u32) -> Self {
+        Self { alpha: self.alpha * height_px as f32 / ALPHA_VIEWPORT_HEIGHT_PX, ..self }
+    }
+
     pub fn validate(&self) -> Result<(), InvalidInput> {
         check_positive("--alpha", self.alpha as f64, "")?;
         check_non_negative("--beta", self.beta as f64, "")?;

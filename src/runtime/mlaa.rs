@@ -7,16 +7,21 @@
 //! `Rg8Unorm` 5N×5N, output `Rgba8Unorm`. Created once in [`Mlaa::new`]; CPU twin [`super::cpu::mlaa`].
 
 use super::gpu::{self, GpuTimer};
+use crate::aa::mlaa_area::MlaaVersion;
 use super::RuntimeError;
 use crate::error::InvalidInput;
 
 /// Luma edge threshold of the MLAA listings.
 pub const MLAA_THRESHOLD: f32 = 0.1;
 
+/// Maximum distance N the runtime uses unless told otherwise (a map the default bake holds).
+pub const DEFAULT_MAX_DISTANCE: u32 = 33;
+
 /// Number of timed passes [`Mlaa::encode`] records.
 pub const MLAA_PASSES: u32 = 3;
 
-/// A Jimenez MLAA area map: 5N×5N RG8 bytes (top row first) for maximum distance N (odd, ≥ 3).
+/// A Jimenez MLAA v1.4 area map: 5N×5N RG8 bytes (top row first) for maximum distance N, validated by
+/// [`crate::aa::mlaa_area::validate`] (the one MLAA range).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MlaaAreaMap {
     pub n: u32,
@@ -25,9 +30,7 @@ pub struct MlaaAreaMap {
 
 impl MlaaAreaMap {
     pub fn new(n: u32, bytes: Vec<u8>) -> Result<Self, InvalidInput> {
-        if n < 3 || n.is_multiple_of(2) || n > 1025 {
-            return Err(InvalidInput::new("--max-distance", format!("must be odd and in 3..=1025, got {n}")));
-        }
+        crate::aa::mlaa_area::validate(MlaaVersion::V1_4, n)?;
         let want = (5 * n * 5 * n * 2) as usize;
         if bytes.len() != want {
             return Err(InvalidInput::new(
