@@ -5,13 +5,13 @@
 //!
 //! Integrating a normalised 2-D Gaussian profile over a plane at depth s gives exp(−s²/(2v)) instead
 //! ([`TransmittanceForm::Physical`], `--physical`). The weights and variances come from any preset or fitted sum of
-//! Gaussians ([`crate::fitting::RgbGaussians`]), per channel. T(0) = Σ w (= 1 for normalised profiles).
+//! Gaussians ([`crate::diffusion::sum_of_gaussians::RgbGaussians`]), per channel. T(0) = Σ w (= 1 for normalised profiles).
 //!
 //! **Table convention** (node-inclusive): texel i of n holds s = s_max·i/(n − 1); a shader samples with linear
 //! filtering at u = s/s_max·(n − 1)/n + 0.5/n (clamp to edge). The optional 2-D variant repeats the row h times.
 
+use crate::diffusion::sum_of_gaussians::RgbGaussians;
 use crate::error::{check_positive, check_range, InvalidInput};
-use crate::fitting::RgbGaussians;
 use crate::image_buf::ImageF32;
 
 /// Which exponent the table uses.

@@ -10,10 +10,11 @@
 //! a lighter shade of the channel colour; an optional sum-of-Gaussians overlay is dashed in a darker shade. Pure:
 //! returns a [`LinePlot`] pair, text or PNG bytes; callers write the files.
 
+use super::sum_of_gaussians::RgbGaussians;
 use super::table::ProfileTable;
 use super::RadialProfile;
 use crate::error::InvalidInput;
-use crate::fitting::{RgbGaussians, CHANNEL_COLORS};
+use crate::fitting::CHANNEL_COLORS;
 use crate::plot::{panels_to_image, panels_to_svg, LinePlot, Series};
 use serde_json::Value;
 use std::path::Path;

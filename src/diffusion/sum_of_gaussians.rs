@@ -76,3 +76,61 @@ pub fn preset(name: &str) -> Option<SumOfGaussians> {
 }
 
 pub const PRESET_NAMES: [&str; 2] = ["deon6", "deon4"];
+
+/// A sum of Gaussians with its own variances per channel (the general form; shared variances are the special case
+/// of three identical lists). Variances in mm², ascending per channel; weights dimensionless (profile units × mm²).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RgbGaussians {
+    pub variances_mm2: [Vec<f64>; 3],
+    pub weights: [Vec<f64>; 3],
+}
+
+impl RgbGaussians {
+    /// True when all three channels use the same variances.
+    pub fn is_shared(&self) -> bool {
+        self.variances_mm2[0] == self.variances_mm2[1] && self.variances_mm2[0] == self.variances_mm2[2]
+    }
+
+    /// Number of Gaussians per channel.
+    pub fn count(&self) -> usize {
+        self.variances_mm2[0].len()
+    }
+
+    /// The shared-variance form, if the channels share their variances.
+    pub fn to_shared(&self) -> Option<SumOfGaussians> {
+        self.is_shared().then(|| SumOfGaussians {
+            variances_mm2: self.variances_mm2[0].clone(),
+            weights: (0..self.count()).map(|i| [0, 1, 2].map(|c| self.weights[c][i])).collect(),
+        })
+    }
+
+    /// Sorts every channel by ascending variance (weights follow their variance).
+    pub fn sort_ascending(&mut self) {
+        for c in 0..3 {
+            let mut pairs: Vec<(f64, f64)> =
+                self.variances_mm2[c].iter().copied().zip(self.weights[c].iter().copied()).collect();
+            pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            self.variances_mm2[c] = pairs.iter().map(|p| p.0).collect();
+            self.weights[c] = pairs.iter().map(|p| p.1).collect();
+        }
+    }
+}
+
+impl From<&SumOfGaussians> for RgbGaussians {
+    fn from(s: &SumOfGaussians) -> Self {
+        Self {
+            variances_mm2: [0, 1, 2].map(|_| s.variances_mm2.clone()),
+            weights: [0, 1, 2].map(|c| s.weights.iter().map(|w| w[c]).collect()),
+        }
+    }
+}
+
+impl RadialProfile for RgbGaussians {
+    fn reflectance_mm2(&self, r_mm: f64) -> [f64; 3] {
+        [0, 1, 2]
+            .map(|c| self.variances_mm2[c].iter().zip(&self.weights[c]).map(|(v, w)| w * gaussian_mm2(*v, r_mm)).sum())
+    }
+    fn total_reflectance(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.weights[c].iter().sum())
+    }
+}

@@ -7,8 +7,8 @@
 //! `Rg8Unorm` 5N×5N, output `Rgba8Unorm`. Created once in [`Mlaa::new`]; CPU twin [`super::cpu::mlaa`].
 
 use super::gpu::{self, GpuTimer};
-use crate::aa::mlaa_area::MlaaVersion;
 use super::RuntimeError;
+use crate::aa::mlaa_area::MlaaVersion;
 use crate::error::InvalidInput;
 
 /// Luma edge threshold of the MLAA listings.
