@@ -187,3 +187,22 @@ pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
     let _ = std::fs::remove_file(&probe);
     Ok(())
 }
+
+/// `--adding`: how layers are combined at each spatial frequency (one flag type for every command).
+#[derive(Clone, Copy, Debug, Default, clap::ValueEnum)]
+pub enum AddingArg {
+    /// DJ05 as printed (top-lit R, T in both roles).
+    #[default]
+    Symmetric,
+    /// Kubelka 1954 (R↓, T↓, R↑, T↑ kept apart).
+    Directional,
+}
+
+impl From<AddingArg> for rtbake::diffusion::layered::Adding {
+    fn from(a: AddingArg) -> Self {
+        match a {
+            AddingArg::Symmetric => Self::Symmetric,
+            AddingArg::Directional => Self::Directional,
+        }
+    }
+}

@@ -2,11 +2,10 @@
 //! error table.
 
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
-use rtbake::diffusion::materials;
-use rtbake::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
-use rtbake::diffusion::{FdrForm, RadialProfile};
+use crate::profile_source::Named;
+use rtbake::diffusion::RadialProfile;
 use rtbake::fitting::screen_space::{ScreenSpaceParams, StretchParams, DEFAULT_ALPHA, DEFAULT_BETA, DEFAULT_GAMMA};
-use rtbake::fitting::{error_table, fit_sum_of_gaussians, profile_plot, FitError, FitSettings, RgbGaussians};
+use rtbake::fitting::{error_table, fit_sum_of_gaussians, profile_plot, FitError, FitSettings};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -68,20 +67,14 @@ fn profile_from_args(a: &FitGaussiansArgs) -> anyhow::Result<(Box<dyn RadialProf
     if let Some(resolved) = a.layered.resolve()? {
         return Ok(resolved);
     }
-    if let Some(name) = &a.material {
-        let m = materials::find(name).ok_or_else(|| {
-            usage_msg(format!("--material: unknown material '{name}' (known: {})", materials::names().join(", ")))
-        })?;
-        let src = json!({"kind": "dipole", "material": m.name, "eta": materials::JENSEN_2001_ETA, "fdr": "dj05",
-                         "reference": "Jensen et al. 2001"});
-        return Ok((Box::new(m.dipole(FdrForm::Dj05)), src, format!("{}_dipole", m.name)));
-    }
-    if let Some(name) = &a.profile_preset {
-        let sog = preset(name).ok_or_else(|| {
-            usage_msg(format!("--profile-preset: unknown preset '{name}' (known: {})", PRESET_NAMES.join(", ")))
-        })?;
-        let lower = name.to_ascii_lowercase();
-        return Ok((Box::new(RgbGaussians::from(&sog)), json!({"kind": "preset", "name": lower}), lower));
+    let named = match (&a.material, &a.profile_preset) {
+        (Some(name), _) => Some(Named::Material { flag: "--material", name }),
+        (None, Some(name)) => Some(Named::Preset { flag: "--profile-preset", name }),
+        (None, None) => None,
+    };
+    if let Some(n) = named {
+        let (src, profile, stem) = crate::profile_source::named(n)?;
+        return Ok((profile, src.provenance(), stem));
     }
     Err(usage_msg(
         "one of --material NAME, --profile-preset NAME, --layers FILE, --skin-melanin CM --skin-hemoglobin CHD or --error-table is required",

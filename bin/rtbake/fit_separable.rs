@@ -2,7 +2,8 @@
 //! exact 2-D kernel of a diffusion profile (thesis eq. 6.1–6.3; library: `rtbake::separable::fit`).
 
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
-use rtbake::diffusion::{materials, sum_of_gaussians, FdrForm, RadialProfile};
+use crate::profile_source::{named, Named};
+use rtbake::diffusion::RadialProfile;
 use rtbake::separable::fit::{self, ObjectiveSpec, TargetKernel, Weighting};
 use rtbake::separable::kernel::{self, KernelSpec};
 use std::path::PathBuf;
@@ -88,23 +89,17 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let (profile, name, description): (Box<dyn RadialProfile>, String, String) = match (&args.material, &args.profile) {
         _ if layered.is_some() => {
             let (profile, provenance, stem) = layered.expect("checked");
-            let kind =
-                if provenance.get("physiological_skin").is_some() { "physiological skin" } else { "layer stack" };
+            let kind = if provenance.get("skin").is_some() { "physiological skin" } else { "layer stack" };
             (profile, stem.clone(), format!("layered profile ({kind} {stem})"))
         }
         (Some(m), _) => {
-            let mat = materials::find(m).ok_or_else(|| {
-                usage_msg(format!("--material must be one of {}, got {m:?}", materials::names().join(", ")))
-            })?;
-            let d = mat.dipole(FdrForm::default());
-            (Box::new(d), mat.name.to_string(), format!("{} (Jensen et al. 2001) dipole, eta 1.3", mat.name))
+            let (_, profile, stem) = named(Named::Material { flag: "--material", name: m })?;
+            (profile, stem.trim_end_matches("_dipole").to_string(), format!("{m} (Jensen et al. 2001) dipole, eta 1.3"))
         }
         (None, p) => {
             let p = p.as_deref().unwrap_or("deon6");
-            let sog = sum_of_gaussians::preset(p).ok_or_else(|| {
-                usage_msg(format!("--profile must be one of {}, got {p:?}", sum_of_gaussians::PRESET_NAMES.join(", ")))
-            })?;
-            (Box::new(sog), p.to_ascii_lowercase(), format!("{p} profile preset (sum of Gaussians)"))
+            let (_, profile, stem) = named(Named::Preset { flag: "--profile", name: p })?;
+            (profile, stem, format!("{p} profile preset (sum of Gaussians)"))
         }
     };
     if let Some(dir) = &args.out {

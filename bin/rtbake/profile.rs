@@ -2,8 +2,9 @@
 //! print / write it as JSON or CSV, and plot it (`--plot`, PNG or SVG, optionally with a fitted sum of Gaussians).
 //! Parsing and validation only; the maths is `rtbake::diffusion` and `rtbake::fitting`.
 
+use crate::cli::AddingArg;
 use crate::cli::{parse_f64_list, usage, usage_msg, Ctx};
-use rtbake::diffusion::layered::{Adding, LayerStack};
+use rtbake::diffusion::layered::LayerStack;
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::plot::{profile_panels, render, PlotFormat};
 use rtbake::diffusion::source::{MaterialModel, ProfileSource};
@@ -27,14 +28,6 @@ pub enum FdrArg {
     Dj05,
     /// Jensen et al. 2001 polynomial as printed (rounded).
     Jensen01,
-}
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum AddingArg {
-    /// DJ05 as printed (top-lit R, T in both roles).
-    Symmetric,
-    /// Kubelka 1954 (R↓, T↓, R↑, T↑ kept apart).
-    Directional,
 }
 
 #[derive(clap::Args)]
@@ -161,21 +154,9 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
         let stack = LayerStack::from_json_str(&text).map_err(|e| flag_error(e, Some(path)))?;
-        let adding = match args.adding {
-            AddingArg::Symmetric => Adding::Symmetric,
-            AddingArg::Directional => Adding::Directional,
-        };
-        ProfileSource::Layers { stack, adding, series, fdr }
+        ProfileSource::Layers { stack, adding: args.adding.into(), series, fdr }
     } else if let (Some(cm), Some(chd)) = (args.skin_melanin, args.skin_hemoglobin) {
-        use rtbake::spectral::skin_layers::{two_layer_skin_rgb, RgbReduction, SkinPhysiology};
-        let skin = two_layer_skin_rgb(&SkinPhysiology::default(), cm, chd, false, &RgbReduction::default())
-            .map_err(|e| usage(anyhow::anyhow!("--skin-melanin/--skin-hemoglobin: {e}")))?;
-        let stack = skin.layer_stack().map_err(|e| usage(anyhow::anyhow!("physiological skin: {e}")))?;
-        let adding = match args.adding {
-            AddingArg::Symmetric => Adding::Symmetric,
-            AddingArg::Directional => Adding::Directional,
-        };
-        ProfileSource::Layers { stack, adding, series, fdr }
+        crate::profile_source::physiological_skin(cm, chd, args.adding.into(), series, fdr)?.0
     } else {
         return Err(usage_msg("one of --material, --profile-preset or --layers is required"));
     };

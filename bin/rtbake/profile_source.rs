@@ -1,12 +1,12 @@
 //! Profile inputs shared by `fit gaussians` and `fit separable` beyond the named materials and presets:
 //! a user layer stack (`--layers FILE`) or the physiological two-layer skin (`--skin-melanin`, `--skin-hemoglobin`).
 
-use crate::cli::{usage, usage_msg};
+use crate::cli::{usage, usage_msg, AddingArg};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
-use rtbake::diffusion::source::ProfileSource;
+use rtbake::diffusion::source::{MaterialModel, ProfileSource};
 use rtbake::diffusion::{FdrForm, RadialProfile};
-use rtbake::spectral::skin_layers::{two_layer_skin_rgb, RgbReduction, SkinPhysiology};
+use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -29,8 +29,8 @@ pub struct LayeredArgs {
     #[arg(long, value_name = "CHD", requires = "skin_melanin")]
     pub skin_hemoglobin: Option<f64>,
     /// Layer adding for --layers / --skin-*: symmetric (DJ05 as printed, default) or directional (Kubelka)
-    #[arg(long, value_name = "MODE", default_value = "symmetric")]
-    pub adding: String,
+    #[arg(long, value_enum, default_value = "symmetric")]
+    pub adding: AddingArg,
     /// Truncate the multipole image series to i = -N..N (default: exact infinite series)
     #[arg(long, value_name = "N")]
     pub dipole_pairs: Option<u32>,
@@ -49,33 +49,27 @@ impl LayeredArgs {
         if self.layers.is_some() && self.skin_melanin.is_some() {
             return Err(usage_msg("--layers and --skin-melanin/--skin-hemoglobin are exclusive"));
         }
-        let adding = Adding::parse("--adding", &self.adding).map_err(usage)?;
+        let adding = Adding::from(self.adding);
         if let Some(n) = self.dipole_pairs {
             if n > 10_000 {
                 return Err(usage_msg(format!("--dipole-pairs must be in 0..=10000, got {n}")));
             }
         }
         let series = self.dipole_pairs.map(|pairs| Series::Truncated { pairs }).unwrap_or_default();
-        let (stack, extra, stem) = if let Some(path) = &self.layers {
+        let (src, extra, stem) = if let Some(path) = &self.layers {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
             let stack = LayerStack::from_json_str(&text)
                 .map_err(|e| usage(anyhow::anyhow!("--layers {}: {e}", path.display())))?;
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "layers".into());
-            (stack, json!({"file": path.display().to_string()}), stem)
+            let src = ProfileSource::Layers { stack, adding, series, fdr: FdrForm::Dj05 };
+            (src, json!({"file": path.display().to_string()}), stem)
         } else {
             let cm = self.skin_melanin.expect("checked");
             let chd = self.skin_hemoglobin.expect("required by clap");
-            let skin = two_layer_skin_rgb(&SkinPhysiology::default(), cm, chd, false, &RgbReduction::default())
-                .map_err(|e| usage(anyhow::anyhow!("--skin-melanin/--skin-hemoglobin: {e}")))?;
-            let stack = skin.layer_stack().map_err(|e| usage(anyhow::anyhow!("physiological skin: {e}")))?;
-            let extra = json!({
-                "physiological_skin": {"melanin": cm, "hemoglobin": chd, "physiology": "skin-color.md defaults",
-                                       "rgb_reduction": "D65 x linear-sRGB sensitivity weighted spectral mean"}
-            });
-            (stack, extra, format!("skin_cm{cm}_chd{chd}"))
+            let (src, extra) = physiological_skin(cm, chd, adding, series, FdrForm::Dj05)?;
+            (src, extra, format!("skin_cm{cm}_chd{chd}"))
         };
-        let src = ProfileSource::Layers { stack, adding, series, fdr: FdrForm::Dj05 };
         let profile = src.build().map_err(usage)?;
         let mut provenance = src.provenance();
         if let (Value::Object(p), Value::Object(e)) = (&mut provenance, extra) {
@@ -83,4 +77,50 @@ impl LayeredArgs {
         }
         Ok(Some((profile, provenance, stem)))
     }
+}
+
+/// `--skin-melanin CM --skin-hemoglobin CHD` with the default physiology and RGB reduction, through the library's
+/// one resolver; errors name the flags.
+pub fn physiological_skin(
+    cm: f64,
+    chd: f64,
+    adding: Adding,
+    series: Series,
+    fdr: FdrForm,
+) -> anyhow::Result<(ProfileSource, Value)> {
+    physiological_skin_source(&SkinPhysiology::default(), &RgbReduction::default(), cm, chd, adding, series, fdr)
+        .map_err(|e| {
+            let flag = match e.param.as_str() {
+                "melanin_fraction" => "--skin-melanin",
+                "hemoglobin_fraction" => "--skin-hemoglobin",
+                _ => "--skin-melanin/--skin-hemoglobin",
+            };
+            usage(anyhow::anyhow!("{flag}: {e}"))
+        })
+}
+
+/// A Jensen 2001 material as a dipole (η = 1.3, DJ05 Fdr) or a sum-of-Gaussians preset, through
+/// [`ProfileSource`] (the library's one resolver and provenance shape); `flag` names the option the user typed.
+pub fn named(kind: Named<'_>) -> anyhow::Result<(ProfileSource, Box<dyn RadialProfile + Send>, String)> {
+    let (src, flag, stem) = match kind {
+        Named::Material { flag, name } => (
+            ProfileSource::Material {
+                name: name.to_string(),
+                model: MaterialModel::Dipole,
+                fdr: FdrForm::Dj05,
+                series: Series::Exact,
+            },
+            flag,
+            format!("{}_dipole", name.to_ascii_lowercase()),
+        ),
+        Named::Preset { flag, name } => (ProfileSource::Preset(name.to_string()), flag, name.to_ascii_lowercase()),
+    };
+    let profile = src.build().map_err(|e| usage(anyhow::anyhow!("{flag}: {}", e.message)))?;
+    Ok((src, profile, stem))
+}
+
+/// What [`named`] resolves.
+pub enum Named<'a> {
+    Material { flag: &'a str, name: &'a str },
+    Preset { flag: &'a str, name: &'a str },
 }

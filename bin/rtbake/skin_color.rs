@@ -2,11 +2,12 @@
 //! melanin × hemoglobin lookup table into `--out DIR` (thesis §7.6, eq. 7.7). Glue only: flags → `SkinColorParams`
 //! → library.
 
+use crate::cli::AddingArg;
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::skin_color::lut::{IndexForm, LutEvaluation};
-use rtbake::skin_color::two_layer::{Adding, SkinColorError, ThinLayer};
+use rtbake::skin_color::two_layer::{SkinColorError, ThinLayer};
 use rtbake::skin_color::SkinColorParams;
 use rtbake::spectral::colorimetry::Illuminant;
 use std::path::PathBuf;
@@ -99,11 +100,6 @@ pub enum IlluminantArg {
     EqualEnergy,
 }
 #[derive(Clone, Copy, clap::ValueEnum)]
-pub enum AddingArg {
-    Symmetric,
-    Directional,
-}
-#[derive(Clone, Copy, clap::ValueEnum)]
 pub enum FdrArg {
     Dj05,
     Jensen01,
@@ -163,10 +159,7 @@ fn params(a: &ModelFlags) -> anyhow::Result<SkinColorParams> {
         };
     }
     if let Some(v) = a.adding {
-        p.adding = match v {
-            AddingArg::Symmetric => Adding::Symmetric,
-            AddingArg::Directional => Adding::Directional,
-        };
+        p.adding = v.into();
     }
     if let Some(v) = a.fdr_form {
         p.fdr_form = match v {

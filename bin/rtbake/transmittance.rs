@@ -1,10 +1,9 @@
 //! `rtbake transmittance`: evaluate T(s) (thesis eq. 5.12) at given distances, or bake the table files.
 
 use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
+use crate::profile_source::{named, Named};
 use rtbake::bake::BakedFile;
-use rtbake::diffusion::materials;
-use rtbake::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
-use rtbake::diffusion::FdrForm;
+use rtbake::diffusion::sum_of_gaussians::preset;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings, RgbGaussians};
 use rtbake::transmittance::{evaluate, TableSettings, TransmittanceForm, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
 use serde_json::{json, Value};
@@ -74,9 +73,7 @@ pub fn write_file_set(dir: &Path, files: &[BakedFile]) -> anyhow::Result<()> {
 
 fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
     if let Some(name) = &a.material {
-        let m = materials::find(name).ok_or_else(|| {
-            usage_msg(format!("--material: unknown material '{name}' (known: {})", materials::names().join(", ")))
-        })?;
+        let (src, profile, _) = named(Named::Material { flag: "--material", name })?;
         let settings = FitSettings {
             count: a.count,
             shared_variances: !a.per_channel,
@@ -84,18 +81,16 @@ fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, Str
             ..FitSettings::default()
         };
         settings.validate().map_err(usage)?;
-        let fit = fit_sum_of_gaussians(&m.dipole(FdrForm::Dj05), &settings).map_err(crate::fit::fit_error)?;
-        let src = json!({"kind": "fit", "material": m.name, "profile": "dipole, eta 1.3, DJ05 Fdr",
-                         "count": a.count, "shared_variances": !a.per_channel, "normalize": a.normalize,
+        let fit = fit_sum_of_gaussians(profile.as_ref(), &settings).map_err(crate::fit::fit_error)?;
+        let provenance = json!({"kind": "fit", "profile": src.provenance(), "count": a.count,
+                         "shared_variances": !a.per_channel, "normalize": a.normalize,
                          "error_percent": fit.error_percent});
-        return Ok((fit.sum, src, format!("{}_k{}", m.name, a.count)));
+        return Ok((fit.sum, provenance, format!("{}_k{}", name.to_ascii_lowercase(), a.count)));
     }
     let name = a.profile_preset.clone().unwrap_or_else(|| "deon6".into());
-    let sog = preset(&name).ok_or_else(|| {
-        usage_msg(format!("--profile-preset: unknown preset '{name}' (known: {})", PRESET_NAMES.join(", ")))
-    })?;
-    let src = json!({"kind": "preset", "name": name.to_ascii_lowercase()});
-    Ok((RgbGaussians::from(&sog), src, name.to_ascii_lowercase()))
+    let (src, _, stem) = named(Named::Preset { flag: "--profile-preset", name: &name })?;
+    let sog = preset(&name).expect("resolved by ProfileSource");
+    Ok((RgbGaussians::from(&sog), src.provenance(), stem))
 }
 
 pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {

@@ -5,6 +5,7 @@
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::GAUSSIANS_DIR;
 use crate::diffusion::materials;
+use crate::diffusion::source::{with_reference, MaterialModel, ProfileSource};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
 use crate::error::InvalidInput;
@@ -87,7 +88,10 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         let mut extra = serde_json::Map::new();
         extra.insert(
             "source".into(),
-            json!({"kind": "preset", "name": name, "reference": "d'Eon, Luebke, Enderton, EGSR 2007; thesis Table 4.2"}),
+            with_reference(
+                ProfileSource::Preset(name.clone()).provenance(),
+                "d'Eon, Luebke, Enderton, EGSR 2007; thesis Table 4.2",
+            ),
         );
         let plot = profile_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
         files.extend(gaussian_files(&format!("{GAUSSIANS_DIR}/{name}"), &sum, p.stretch, extra, &plot)?);
@@ -134,8 +138,16 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         crate::fitting::FitError::Invalid(i) => BakeError::Invalid(i),
         other => BakeError::Other(other.to_string()),
     })?;
-    let source = json!({"kind": "dipole", "material": m.name, "eta": materials::JENSEN_2001_ETA, "fdr": "dj05",
-                        "reference": "Jensen et al. 2001"});
+    let source = with_reference(
+        ProfileSource::Material {
+            name: m.name.into(),
+            model: MaterialModel::Dipole,
+            fdr: FdrForm::Dj05,
+            series: crate::diffusion::multipole::Series::Exact,
+        }
+        .provenance(),
+        "Jensen et al. 2001",
+    );
     let prov = fit_provenance(source, &p.fit);
     let mut extra = serde_json::Map::new();
     extra.insert("error_percent".into(), json!(fit.error_percent));

@@ -29,7 +29,7 @@ use crate::diffusion::source::{MaterialModel, ProfileSource};
 use crate::diffusion::table::{self, ProfileTable};
 use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
-use crate::spectral::skin_layers::{two_layer_skin_rgb, RgbReduction, SkinPhysiology};
+use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::collections::BTreeSet;
@@ -190,21 +190,15 @@ fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Val
     let physiology = SkinPhysiology::default();
     let reduction = RgbReduction::default();
     for (i, s) in p.skin.iter().enumerate() {
-        let skin = two_layer_skin_rgb(&physiology, s.melanin_fraction, s.hemoglobin_fraction, false, &reduction)
-            .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
-        let stack = skin.layer_stack().map_err(|e| InvalidInput::new(format!("skin[{i}]"), e.to_string()))?;
         let (cm, chd) = (s.melanin_fraction, s.hemoglobin_fraction);
+        let (source, provenance) =
+            physiological_skin_source(&physiology, &reduction, cm, chd, p.skin_adding, Series::Exact, p.fdr)
+                .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
         out.push((
             format!("skin/two_layer_cm{cm}_chd{chd}"),
             format!("two-layer skin, Cm {cm}, Chd {chd}"),
-            ProfileSource::Layers { stack, adding: p.skin_adding, series: Series::Exact, fdr: p.fdr },
-            json!({"skin": {
-                "melanin_fraction": cm,
-                "hemoglobin_fraction": chd,
-                "physiology": physiology,
-                "rgb_reduction": reduction,
-                "reference": "Donner & Jensen 2006 coefficients (specs/skin-color.md); layers by DJ05 adding",
-            }}),
+            source,
+            provenance,
         ));
     }
     for (i, s) in p.stacks.iter().enumerate() {

@@ -7,7 +7,7 @@ use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
 use crate::transmittance::{table, TableSettings, TransmittanceForm};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 /// Absolute tolerance `verify` allows on the f32 payloads.
 pub const VERIFY_TOLERANCE: f64 = 1e-6;
@@ -74,7 +74,10 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         TransmittanceForm::Published => "published",
         TransmittanceForm::Physical => "physical",
     };
-    let source = json!({"kind": "preset", "name": p.preset, "reference": "d'Eon, Luebke, Enderton, EGSR 2007"});
+    let source = crate::diffusion::source::with_reference(
+        crate::diffusion::source::ProfileSource::Preset(p.preset.clone()).provenance(),
+        "d'Eon, Luebke, Enderton, EGSR 2007",
+    );
     table_files(
         &format!("{}/{}_{form}", baked_layout::path::TRANSMITTANCE_DIR, p.preset),
         &RgbGaussians::from(&sog),

@@ -210,6 +210,14 @@ impl ProfileSource {
     }
 }
 
+/// A provenance object with the publication it comes from added as `"reference"`.
+pub fn with_reference(mut provenance: Value, reference: &str) -> Value {
+    if let Value::Object(m) = &mut provenance {
+        m.insert("reference".into(), json!(reference));
+    }
+    provenance
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

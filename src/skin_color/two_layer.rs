@@ -31,16 +31,9 @@ use crate::spectral::colorimetry::{srgb8, ColorWeights, Illuminant, SpectralGrid
 use crate::spectral::skin_layers::{dermis_sigma_a_per_mm, epidermis_sigma_a_mixed, SkinPhysiology};
 use serde::{Deserialize, Serialize};
 
-/// How the two layers' totals are combined at k = 0.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Adding {
-    /// R = R1 + T1² R2 / (1 − R1 R2) with the top-lit R1, T1 (DJ05 as printed; the published LUT's form).
-    #[default]
-    Symmetric,
-    /// R = R1↓ + T1↓ R2 T1↑ / (1 − R1↑ R2) (Kubelka 1954).
-    Directional,
-}
+/// How the two layers' totals are combined at k = 0: the same choice as for layered profiles
+/// (symmetric = DJ05 as printed, the published LUT's form; directional = Kubelka 1954).
+pub use crate::diffusion::layered::Adding;
 
 /// What to do where the epidermis is thinner than its transport mean free path 1/σt′.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -344,3 +344,30 @@ impl TwoLayerSkinRgb {
         LayerStack::new(1.0, self.eta_below_dermis, vec![layer(&self.epidermis), layer(&self.dermis)])
     }
 }
+
+/// The physiological two-layer skin as a diffusion-profile source: the one place `profile`, `fit gaussians`,
+/// `fit separable` and the `diffusion-profiles` bake resolve `--skin-melanin/--skin-hemoglobin` (or the bake's
+/// `skin[i]`). Returns the layered source and the provenance to record beside the source's own
+/// ([`ProfileSource::provenance`](crate::diffusion::source::ProfileSource::provenance)):
+/// `{"skin": {"melanin_fraction", "hemoglobin_fraction", "physiology", "rgb_reduction", "reference"}}`.
+/// Errors name `melanin_fraction`, `hemoglobin_fraction`, a physiology field, or the layer stack.
+pub fn physiological_skin_source(
+    physiology: &SkinPhysiology,
+    reduction: &RgbReduction,
+    cm: f64,
+    chd: f64,
+    adding: crate::diffusion::layered::Adding,
+    series: crate::diffusion::multipole::Series,
+    fdr: crate::diffusion::FdrForm,
+) -> Result<(crate::diffusion::source::ProfileSource, serde_json::Value), InvalidInput> {
+    let skin = two_layer_skin_rgb(physiology, cm, chd, false, reduction)?;
+    let stack = skin.layer_stack()?;
+    let provenance = serde_json::json!({"skin": {
+        "melanin_fraction": cm,
+        "hemoglobin_fraction": chd,
+        "physiology": physiology,
+        "rgb_reduction": reduction,
+        "reference": "Donner & Jensen 2006 coefficients (specs/skin-color.md); layers by DJ05 adding",
+    }});
+    Ok((crate::diffusion::source::ProfileSource::Layers { stack, adding, series, fdr }, provenance))
+}

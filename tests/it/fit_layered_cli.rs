@@ -48,7 +48,7 @@ fn sum_of_gaussians_fits_a_layer_stack_and_physiological_skin() {
         "4",
         "--json",
     ]));
-    assert_eq!(v["source"]["physiological_skin"]["melanin"], 0.05);
+    assert_eq!(v["source"]["skin"]["melanin_fraction"], 0.05);
     let err: Vec<f64> = serde_json::from_value(v["error_percent"].clone()).unwrap();
     assert!(err.iter().all(|e| *e < 2.0), "{err:?}");
 }

@@ -73,7 +73,7 @@ fn fit_per_channel_json_contract_and_out_files() {
     assert_eq!(names, expect);
     let file: Value = serde_json::from_slice(&std::fs::read(out_dir.join(format!("{stem}.json"))).unwrap()).unwrap();
     assert_eq!(file["variances"], v["variances"]);
-    assert_eq!(file["source"]["name"], "deon6");
+    assert_eq!(file["source"]["profile_preset"], "deon6");
 }
 
 #[test]
