@@ -5,7 +5,7 @@ use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use crate::profile_source::Named;
 use rtbake::diffusion::RadialProfile;
 use rtbake::fitting::screen_space::{ScreenSpaceParams, StretchParams, DEFAULT_ALPHA, DEFAULT_BETA, DEFAULT_GAMMA};
-use rtbake::fitting::{error_table, fit_sum_of_gaussians, profile_plot, FitError, FitSettings};
+use rtbake::fitting::{error_table, fit_sum_of_gaussians, profile_plot, FitSettings, GaussianFitError};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -50,9 +50,9 @@ pub struct FitGaussiansArgs {
 }
 
 /// Library input errors are bad usage (exit 2); optimiser failures are runtime errors (exit 1).
-pub fn fit_error(e: FitError) -> anyhow::Error {
+pub fn fit_error(e: GaussianFitError) -> anyhow::Error {
     match e {
-        FitError::Invalid(i) => usage(i),
+        GaussianFitError::Invalid(i) => usage(i),
         other => anyhow::anyhow!(other),
     }
 }

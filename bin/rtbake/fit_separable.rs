@@ -177,9 +177,9 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
 }
 
 /// Bad input from the library exits 2, anything else 1.
-fn lib_err(e: fit::FitError) -> anyhow::Error {
+fn lib_err(e: fit::SeparableFitError) -> anyhow::Error {
     match e {
-        fit::FitError::Invalid(i) => usage(i),
+        fit::SeparableFitError::Invalid(i) => usage(i),
         other => other.into(),
     }
 }

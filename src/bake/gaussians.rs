@@ -135,7 +135,7 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     })?;
     let profile = m.dipole(FdrForm::Dj05);
     let fit = fit_sum_of_gaussians(&profile, &p.fit).map_err(|e| match e {
-        crate::fitting::FitError::Invalid(i) => BakeError::Invalid(i),
+        crate::fitting::GaussianFitError::Invalid(i) => BakeError::Invalid(i),
         other => BakeError::Other(other.to_string()),
     })?;
     let source = with_reference(

@@ -153,8 +153,8 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         )
     })?;
     let description = format!("{} profile preset (sum of Gaussians)", p.profile);
-    let map = |e: fit::FitError| match e {
-        fit::FitError::Invalid(i) => BakeError::Invalid(i),
+    let map = |e: fit::SeparableFitError| match e {
+        fit::SeparableFitError::Invalid(i) => BakeError::Invalid(i),
         other => BakeError::Other(other.to_string()),
     };
     let target = TargetKernel::from_profile(&profile, &p.objective, &description).map_err(map)?;

@@ -18,7 +18,9 @@ use crate::diffusion::RadialProfile;
 
 /// The per-channel sum of Gaussians is a profile and lives in [`crate::diffusion::sum_of_gaussians`].
 pub use crate::diffusion::sum_of_gaussians::RgbGaussians;
-pub use sum_of_gaussians_fit::{error_table, fit_sum_of_gaussians, ErrorTableRow, FitError, FitSettings, GaussianFit};
+pub use sum_of_gaussians_fit::{
+    error_table, fit_sum_of_gaussians, ErrorTableRow, FitSettings, GaussianFit, GaussianFitError,
+};
 
 /// A profile divided by its per-channel totals (what `FitSettings::normalize` fits; used to plot it).
 pub struct NormalizedProfile<'a> {

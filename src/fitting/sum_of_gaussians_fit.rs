@@ -65,7 +65,7 @@ impl FitSettings {
 
 /// Errors of [`fit_sum_of_gaussians`].
 #[derive(Debug, thiserror::Error)]
-pub enum FitError {
+pub enum GaussianFitError {
     #[error(transparent)]
     Invalid(#[from] InvalidInput),
     #[error("optimiser failed: {0}")]
@@ -240,7 +240,7 @@ fn nelder_mead(
     step: f64,
     rel_tol: f64,
     max_iters: u64,
-) -> Result<(Vec<f64>, f64), FitError> {
+) -> Result<(Vec<f64>, f64), GaussianFitError> {
     // Stop when the simplex's costs agree to `rel_tol` of the starting cost (argmin's sd criterion is absolute), or
     // to 1e−25 absolute: relative residuals below 1e−22 are exact fits (see `optimise`).
     let f0 = problem.profiled_cost(x0);
@@ -252,23 +252,24 @@ fn nelder_mead(
     }
     let solver = NelderMead::new(simplex)
         .with_sd_tolerance((rel_tol * f0).max(1e-25))
-        .map_err(|e| FitError::Optimiser(e.to_string()))?;
+        .map_err(|e| GaussianFitError::Optimiser(e.to_string()))?;
     let res = Executor::new(problem, solver)
         .configure(|s| s.max_iters(max_iters))
         .run()
-        .map_err(|e| FitError::Optimiser(e.to_string()))?;
+        .map_err(|e| GaussianFitError::Optimiser(e.to_string()))?;
     let best = res.state.best_param.clone().unwrap_or_else(|| x0.to_vec());
     let cost = problem.profiled_cost(&best);
     Ok((best, cost))
 }
 
 /// Multi-start search plus restart polishing; returns the best log-variances and their cost.
-fn optimise(problem: &Problem, k: usize, n_starts: usize) -> Result<(Vec<f64>, f64), FitError> {
+fn optimise(problem: &Problem, k: usize, n_starts: usize) -> Result<(Vec<f64>, f64), GaussianFitError> {
     let iters = 300 * k as u64;
-    let candidates: Vec<Result<(Vec<f64>, f64), FitError>> = starts(problem.grid, &problem.targets, k, n_starts)
-        .into_par_iter()
-        .map(|x0| nelder_mead(problem, &x0, 0.7, 1e-6, iters))
-        .collect();
+    let candidates: Vec<Result<(Vec<f64>, f64), GaussianFitError>> =
+        starts(problem.grid, &problem.targets, k, n_starts)
+            .into_par_iter()
+            .map(|x0| nelder_mead(problem, &x0, 0.7, 1e-6, iters))
+            .collect();
     let mut best: Option<(Vec<f64>, f64)> = None;
     for c in candidates {
         let c = c?;
@@ -295,7 +296,10 @@ fn optimise(problem: &Problem, k: usize, n_starts: usize) -> Result<(Vec<f64>, f
 }
 
 /// Fits a sum of k Gaussians to `profile` (thesis eq. 2.2). See the module docs for the method.
-pub fn fit_sum_of_gaussians(profile: &dyn RadialProfile, settings: &FitSettings) -> Result<GaussianFit, FitError> {
+pub fn fit_sum_of_gaussians(
+    profile: &dyn RadialProfile,
+    settings: &FitSettings,
+) -> Result<GaussianFit, GaussianFitError> {
     settings.validate()?;
     let grid = RadialGrid::standard();
     let totals = profile.total_reflectance();
@@ -375,7 +379,7 @@ pub struct ErrorTableRow {
 
 /// Per-channel 4-Gaussian fits of the 11 Jensen et al. 2001 materials as dipoles (η = 1.3, DJ05 Fdr): the 33-entry
 /// error table behind d'Eon et al.'s "errors between 1.52 and 0.0793 percent".
-pub fn error_table() -> Result<Vec<ErrorTableRow>, FitError> {
+pub fn error_table() -> Result<Vec<ErrorTableRow>, GaussianFitError> {
     let settings = FitSettings { count: 4, shared_variances: false, normalize: false, starts: 8 };
     JENSEN_2001
         .par_iter()

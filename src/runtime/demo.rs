@@ -15,7 +15,7 @@ use super::device::Gpu;
 use super::gaussian_sss::{GaussianBlurs, GaussianSssParams};
 use super::loader::{self, LutError};
 use super::separable_sss::{SssKernel, SssParams};
-use super::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
+use super::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinInputs, SkinLuts};
 use super::RuntimeError;
 use crate::baked_layout::path;
 use crate::error::InvalidInput;
@@ -39,7 +39,7 @@ pub struct DemoAssets {
     pub sss: SssParams,
     pub blurs: GaussianBlurs,
     pub gaussian_params: GaussianSssParams,
-    pub rig: HemoglobinRig,
+    pub rig: RigScaleBiasMaps,
     /// One weight per rig target (eq. 7.6), summing to 1.
     pub rig_weights: Vec<f32>,
     /// Target names, same order as the weights.
@@ -120,7 +120,7 @@ impl DemoAssets {
 }
 
 /// A synthetic two-target rig (neutral, blush) at 16×16: (scale, bias) per texel, eq. 7.6.
-pub fn synthetic_rig() -> HemoglobinRig {
+pub fn synthetic_rig() -> RigScaleBiasMaps {
     let s = 16u32;
     let neutral = vec![[1.0f32, 0.06]; (s * s) as usize];
     let blush = (0..s * s)
@@ -130,7 +130,7 @@ pub fn synthetic_rig() -> HemoglobinRig {
             [1.0 + 0.8 * cheeks, 0.06 + 0.12 * cheeks]
         })
         .collect();
-    HemoglobinRig { width: s, height: s, targets: vec![neutral, blush] }
+    RigScaleBiasMaps { width: s, height: s, targets: vec![neutral, blush] }
 }
 
 struct Geometry {

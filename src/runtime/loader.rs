@@ -476,7 +476,7 @@ pub fn load_skin_luts(
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedRig {
     /// Targets in the file's order (`maps[0]` = neutral).
-    pub rig: crate::runtime::skin_inputs::HemoglobinRig,
+    pub rig: crate::runtime::skin_inputs::RigScaleBiasMaps,
     /// Target names, same order.
     pub names: Vec<String>,
     /// Mean-free neutral hemoglobin H0 (eq. 7.4), `full_size`, top row first.
@@ -506,7 +506,7 @@ impl BakedRig {
 /// `full_size`. Refuses more targets than the pass holds ([`crate::runtime::skin_inputs::MAX_RIG_TARGETS`]), a
 /// first map that is not the neutral one, and values outside the dermal-hemoglobin range the skin LUT indexes.
 pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError> {
-    use crate::runtime::skin_inputs::{HemoglobinRig, MAX_RIG_TARGETS};
+    use crate::runtime::skin_inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
     let manifest = Manifest::load(dir)?;
     let v = load_json(dir, &manifest, path)?;
     let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
@@ -548,7 +548,7 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
     }
     let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&desc.h0.exr, (fw, fh))?);
     let global_scales = desc.global_scales.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
-    let rig = HemoglobinRig { width: rw, height: rh, targets };
+    let rig = RigScaleBiasMaps { width: rw, height: rh, targets };
     rig.validate().map_err(|e| content(path, e.to_string()))?;
     Ok(BakedRig { rig, names, h0, global_scales })
 }

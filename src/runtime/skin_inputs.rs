@@ -30,7 +30,7 @@ pub struct SkinLuts {
 
 /// The hemoglobin rig (eq. 7.6): per target i, low-resolution scale_i and bias_i maps.
 #[derive(Clone, Debug, PartialEq)]
-pub struct HemoglobinRig {
+pub struct RigScaleBiasMaps {
     pub width: u32,
     pub height: u32,
     /// Per target: (scale, bias) per texel, row-major, top row first.
@@ -73,7 +73,7 @@ impl SkinLuts {
     }
 }
 
-impl HemoglobinRig {
+impl RigScaleBiasMaps {
     pub fn validate(&self) -> Result<(), InvalidInput> {
         let n = (self.width * self.height) as usize;
         if self.targets.is_empty() || self.targets.len() > MAX_RIG_TARGETS || self.targets.iter().any(|t| t.len() != n)
@@ -157,7 +157,7 @@ impl SkinInputs {
         width: u32,
         height: u32,
         luts: &SkinLuts,
-        rig: &HemoglobinRig,
+        rig: &RigScaleBiasMaps,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
         luts.validate()?;

@@ -70,7 +70,7 @@ use super::{SeparableParams, CHANNELS, TABLE_6_1, TABLE_6_1_WIDTH};
 
 /// Errors of the separable fit.
 #[derive(Debug, thiserror::Error)]
-pub enum FitError {
+pub enum SeparableFitError {
     #[error(transparent)]
     Invalid(#[from] InvalidInput),
     #[error("separable fit: optimiser failed: {0}")]
@@ -239,7 +239,7 @@ impl TargetKernel {
         profile: &dyn RadialProfile,
         spec: &ObjectiveSpec,
         description: &str,
-    ) -> Result<Self, FitError> {
+    ) -> Result<Self, SeparableFitError> {
         spec.validate()?;
         let nodes = spec.grid_nodes_mm();
         let values = radial_matrix(profile, &nodes, spec.pixel_variance_mm2())?;
@@ -247,7 +247,7 @@ impl TargetKernel {
     }
 
     /// A synthetic, exactly separable target s̃⊗s̃ made with known parameters (for validating the fitter).
-    pub fn from_separable(params: &SeparableParams, spec: &ObjectiveSpec) -> Result<Self, FitError> {
+    pub fn from_separable(params: &SeparableParams, spec: &ObjectiveSpec) -> Result<Self, SeparableFitError> {
         spec.validate()?;
         validate_params(params)?;
         let nodes = spec.grid_nodes_mm();
@@ -270,7 +270,7 @@ impl TargetKernel {
 }
 
 /// Pixel-filtered, normalised target at every (x_i, x_j) of `nodes` (symmetric), per channel.
-fn radial_matrix(profile: &dyn RadialProfile, nodes: &[f64], sigma2: f64) -> Result<[Vec<f64>; 3], FitError> {
+fn radial_matrix(profile: &dyn RadialProfile, nodes: &[f64], sigma2: f64) -> Result<[Vec<f64>; 3], SeparableFitError> {
     let totals = profile.total_reflectance();
     for (c, t) in totals.iter().enumerate() {
         if !(t.is_finite() && *t > 0.0) {
@@ -502,18 +502,18 @@ fn nelder_mead(
     problem: ChannelProblem<'_>,
     start: Vector2<f64>,
     step: f64,
-) -> Result<(Vector2<f64>, f64, u64), FitError> {
-    let f0 = problem.cost(&start).map_err(|e| FitError::Solver(e.to_string()))?;
+) -> Result<(Vector2<f64>, f64, u64), SeparableFitError> {
+    let f0 = problem.cost(&start).map_err(|e| SeparableFitError::Solver(e.to_string()))?;
     let simplex = vec![start, start + Vector2::new(step, 0.0), start + Vector2::new(0.0, step)];
     let solver = NelderMead::new(simplex)
         .with_sd_tolerance(1e-15 * f0.max(1e-300))
-        .map_err(|e| FitError::Solver(e.to_string()))?;
+        .map_err(|e| SeparableFitError::Solver(e.to_string()))?;
     let res = Executor::new(problem, solver)
         .configure(|state| state.max_iters(2000))
         .run()
-        .map_err(|e| FitError::Solver(e.to_string()))?;
+        .map_err(|e| SeparableFitError::Solver(e.to_string()))?;
     let state = res.state();
-    let best = *state.get_best_param().ok_or_else(|| FitError::Solver("no best parameter".into()))?;
+    let best = *state.get_best_param().ok_or_else(|| SeparableFitError::Solver("no best parameter".into()))?;
     Ok((best, state.get_best_cost(), state.get_iter()))
 }
 
@@ -547,7 +547,7 @@ impl FitResult {
 
 /// Fits strength and falloff per channel (width fixed at `target.spec.width`) by Nelder–Mead with multiple
 /// starts (module docs). Deterministic.
-pub fn fit(target: &TargetKernel) -> Result<FitResult, FitError> {
+pub fn fit(target: &TargetKernel) -> Result<FitResult, SeparableFitError> {
     let spec = target.spec;
     spec.validate()?;
     let model = Model::new(&spec);
@@ -611,7 +611,7 @@ pub struct Separability {
 
 /// Singular values of each channel's pixel-filtered, normalised target kernel matrix K[i, j] = S̃(x_i, x_j) on a
 /// uniform grid of pixel footprint `spec.pixel_mm` over [−X, X]² (nalgebra SVD).
-pub fn separability(profile: &dyn RadialProfile, spec: &ObjectiveSpec) -> Result<Separability, FitError> {
+pub fn separability(profile: &dyn RadialProfile, spec: &ObjectiveSpec) -> Result<Separability, SeparableFitError> {
     spec.validate()?;
     let half = (spec.grid_extent_mm / spec.pixel_mm).floor() as usize;
     let nodes: Vec<f64> = (0..=2 * half).map(|i| (i as f64 - half as f64) * spec.pixel_mm).collect();
@@ -621,7 +621,10 @@ pub fn separability(profile: &dyn RadialProfile, spec: &ObjectiveSpec) -> Result
 }
 
 /// Shorthand for [`separability`]`.energy`.
-pub fn first_singular_value_energy(profile: &dyn RadialProfile, spec: &ObjectiveSpec) -> Result<[f64; 3], FitError> {
+pub fn first_singular_value_energy(
+    profile: &dyn RadialProfile,
+    spec: &ObjectiveSpec,
+) -> Result<[f64; 3], SeparableFitError> {
     Ok(separability(profile, spec)?.energy)
 }
 

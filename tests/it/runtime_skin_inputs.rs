@@ -3,7 +3,7 @@
 use crate::support::*;
 use rtbake::baked_layout::path;
 use rtbake::runtime::cpu::skin_inputs::skin_inputs;
-use rtbake::runtime::skin_inputs::{HemoglobinRig, SkinFrame, SkinInputs, SkinLuts};
+use rtbake::runtime::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinInputs, SkinLuts};
 
 fn luts() -> SkinLuts {
     let (w, h) = (16u32, 12u32);
@@ -20,11 +20,11 @@ fn luts() -> SkinLuts {
     SkinLuts { albedo_size: (w, h), albedo, transmittance: transmittance.collect(), s_max_mm: 8.0 }
 }
 
-fn rig() -> HemoglobinRig {
+fn rig() -> RigScaleBiasMaps {
     let (w, h) = (8u32, 8u32);
     let neutral = vec![[1.0f32, 0.05]; 64];
     let blush = (0..w * h).map(|i| [1.5 + 0.1 * (i % w) as f32, 0.08 + 0.01 * (i / w) as f32]).collect();
-    HemoglobinRig { width: w, height: h, targets: vec![neutral, blush] }
+    RigScaleBiasMaps { width: w, height: h, targets: vec![neutral, blush] }
 }
 
 fn frame(w: u32, h: u32) -> SkinFrame {
@@ -61,7 +61,7 @@ fn skin_inputs_gpu_matches_cpu_with_the_baked_tables() {
     gpu_matches_cpu(&l, &r.rig, &weights);
 }
 
-fn gpu_matches_cpu(l: &SkinLuts, r: &HemoglobinRig, weights: &[f32]) {
+fn gpu_matches_cpu(l: &SkinLuts, r: &RigScaleBiasMaps, weights: &[f32]) {
     let (w, h) = (128, 96);
     let g = gpu();
     let f = frame(w, h);
@@ -96,7 +96,7 @@ fn neutral_weights_reproduce_neutral_hemoglobin_and_e_follows_eq_5_13() {
     let mut f0 = frame(4, 4);
     f0.melanin.iter_mut().for_each(|m| *m = 0.0);
     f0.h0.iter_mut().for_each(|m| *m = 0.0);
-    let zero = HemoglobinRig { width: 1, height: 1, targets: vec![vec![[1.0, 0.0]]] };
+    let zero = RigScaleBiasMaps { width: 1, height: 1, targets: vec![vec![[1.0, 0.0]]] };
     let mut p0 = SkinInputs::new(&g.device, &g.queue, 4, 4, &l, &zero).unwrap();
     let (a, _) = p0.run(&g.device, &g.queue, &f0, &[1.0], light).unwrap();
     for (got, want) in a[..3].iter().zip(l.albedo[0]) {

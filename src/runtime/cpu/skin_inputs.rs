@@ -2,7 +2,7 @@
 //! [`crate::runtime::skin_inputs`]). LUTs and rig maps are rounded to f16 as on the GPU; fetches are bilinear
 //! in f32; outputs are rounded to f16.
 
-use crate::runtime::skin_inputs::{HemoglobinRig, SkinFrame, SkinLuts};
+use crate::runtime::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinLuts};
 use rayon::prelude::*;
 
 fn f16r(v: f32) -> f32 {
@@ -36,7 +36,7 @@ fn node(t: f32, n: f32) -> f32 {
 pub fn skin_inputs(
     frame: &SkinFrame,
     luts: &SkinLuts,
-    rig: &HemoglobinRig,
+    rig: &RigScaleBiasMaps,
     rig_weights: &[f32],
     light_dir: [f32; 3],
 ) -> (Vec<f32>, Vec<f32>) {
