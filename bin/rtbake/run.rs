@@ -50,6 +50,17 @@ pub struct AaArgs {
     common: Common,
 }
 
+/// `run demo --aa`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum DemoAa {
+    /// SMAA 1x with the baked area and search textures.
+    Smaa,
+    /// Jimenez MLAA with the baked v1.4 area map of the default maximum distance.
+    Mlaa,
+    /// No antialiasing.
+    None,
+}
+
 #[derive(clap::Args)]
 pub struct MlaaArgs {
     #[command(flatten)]
@@ -110,9 +121,9 @@ pub struct DemoArgs {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Antialiasing of the final frame: smaa, mlaa or none.
-    #[arg(long, default_value = "smaa")]
-    aa: String,
+    /// Antialiasing of the final frame.
+    #[arg(long, value_enum, default_value = "smaa")]
+    aa: DemoAa,
     /// SSS pass of the demo: separable (baked kernel) or gaussians (baked sum-of-Gaussians fit).
     #[arg(long, value_enum, default_value = "separable")]
     sss: Method,
@@ -285,11 +296,12 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
 fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     check_output(&d.output)?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
-    let aa = match d.aa.as_str() {
-        "smaa" => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),
-        "mlaa" => Some(Antialiasing::Mlaa(load_mlaa(&d.common.baked, 33)?)),
-        "none" => None,
-        other => return Err(usage_msg(format!("--aa must be smaa, mlaa or none, got {other:?}"))),
+    let aa = match d.aa {
+        DemoAa::Smaa => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),
+        DemoAa::Mlaa => {
+            Some(Antialiasing::Mlaa(load_mlaa(&d.common.baked, rtbake::runtime::mlaa::DEFAULT_MAX_DISTANCE)?))
+        }
+        DemoAa::None => None,
     };
     let mut assets = DemoAssets::load(&d.common.baked).map_err(usage)?;
     if let Some(p) = &d.rig_weights {
