@@ -76,7 +76,12 @@ pub fn usage_msg(msg: impl Into<String>) -> anyhow::Error {
 
 /// True if the error (or any cause) is bad input: a `Usage` marker or a library `InvalidInput`.
 pub fn is_usage(e: &anyhow::Error) -> bool {
-    e.downcast_ref::<Usage>().is_some() || e.chain().any(|c| c.is::<Usage>() || c.is::<rtbake::error::InvalidInput>())
+    e.downcast_ref::<Usage>().is_some()
+        || e.chain().any(|c| {
+            c.is::<Usage>()
+                || c.is::<rtbake::error::InvalidInput>()
+                || matches!(c.downcast_ref::<rtbake::bake::BakeError>(), Some(rtbake::bake::BakeError::Invalid(_)))
+        })
 }
 
 /// Prints `error: …` with its cause chain and exits 2 (bad input) or 1 (runtime failure).

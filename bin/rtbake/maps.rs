@@ -9,7 +9,7 @@ use rtbake::bake::facial::{self as bf, RigDescription, RigSource};
 use rtbake::bake::{BakedFile, FileMeta};
 use rtbake::error::InvalidInput;
 use rtbake::facial::disk_stats::Border;
-use rtbake::facial::hemoglobin_rig::{self, HemoglobinRig, RigMap, RigSettings};
+use rtbake::facial::hemoglobin_rig::{self, RigSettings};
 use rtbake::facial::inputs::{self, ValueRange};
 use rtbake::facial::{synthetic, wrinkles};
 use rtbake::image_buf::Image;
@@ -273,23 +273,6 @@ fn file_name(p: &Path) -> String {
     p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| p.display().to_string())
 }
 
-fn load_rig_map(dir: &Path, file: &str, w: u32, h: u32) -> Result<Vec<f32>> {
-    let p = dir.join(file);
-    let bytes = read_input("--rig", &p)?;
-    let (img, _) =
-        io::exr::decode(&bytes, &p.display().to_string()).map_err(|e| usage(anyhow::anyhow!("--rig: {e}")))?;
-    if (img.width, img.height, img.channels) != (w, h, 1) {
-        return Err(usage_msg(format!(
-            "--rig: {} is {}x{}x{}, rig.json says {w}x{h}x1",
-            p.display(),
-            img.width,
-            img.height,
-            img.channels
-        )));
-    }
-    Ok(img.data)
-}
-
 fn parse_weights(s: &str) -> Result<Vec<(String, f64)>> {
     s.split(',')
         .map(|t| {
@@ -307,45 +290,15 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         .map_err(|e| usage(anyhow::anyhow!("--rig {}: cannot read: {e}", a.rig.display())))?;
     let desc: RigDescription = serde_json::from_str(&text)
         .map_err(|e| usage(anyhow::anyhow!("--rig {}: not a valid rig description: {e}", a.rig.display())))?;
-    if desc.schema != bf::RIG_SCHEMA {
-        return Err(usage_msg(format!(
-            "--rig {}: schema '{}', expected '{}'",
-            a.rig.display(),
-            desc.schema,
-            bf::RIG_SCHEMA
-        )));
-    }
     let names: Vec<String> = desc.maps.iter().map(|m| m.name.clone()).collect();
     let weights = hemoglobin_rig::rig_weights(&names, &pairs, a.normalize_weights)?;
-    let dir = a.rig.parent().unwrap_or(Path::new("."));
-    let [w, h] = desc.full_size;
-    let [rw, rh] = desc.rig_size;
-    rtbake::error::check_size("--rig full_size", w as u64, h as u64)?;
-    rtbake::error::check_size("--rig rig_size", rw as u64, rh as u64)?;
-    let h0 = load_rig_map(dir, &desc.h0.exr, w, h)?;
-    let mut maps = Vec::new();
-    for m in &desc.maps {
-        maps.push(RigMap {
-            name: m.name.clone(),
-            scale: load_rig_map(dir, &m.scale_exr, rw, rh)?,
-            bias: load_rig_map(dir, &m.bias_exr, rw, rh)?,
-        });
-    }
-    let rig = HemoglobinRig {
-        width: w,
-        height: h,
-        rig_width: rw,
-        rig_height: rh,
-        settings: RigSettings {
-            radius_texels: desc.radius_texels,
-            border: desc.border,
-            sigma_floor: desc.sigma_floor,
-            rig_size: rw.max(rh),
-        },
-        h0,
-        maps,
-        sigma_floored_texels: desc.sigma_floored_texels,
-    };
+    let dir = a.rig.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let param = format!("--rig {}", a.rig.display());
+    let rig = bf::rig_from_description(&param, &desc, &mut |file| {
+        let p = dir.join(file);
+        std::fs::read(&p).map_err(|e| InvalidInput::new(param.clone(), format!("{}: cannot read: {e}", p.display())))
+    })?;
+    let (w, h) = (rig.width, rig.height);
     let out = hemoglobin_rig::evaluate(&rig, &weights, a.global_scale);
     let precision = if a.precision == "f16" { io::exr::ExrPrecision::F16 } else { io::exr::ExrPrecision::F32 };
     let bytes = io::exr::encode(&Image::from_vec(w, h, 1, out), precision)?;
@@ -409,35 +362,20 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
         report["wrinkle"] = json!({"files": "wrinkle_difference.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8B8A8_UNORM", "range_clamped_texels": clamped});
         ctx.info(format!("difference map {ow}x{oh}: {clamped} texels had components outside [-1, 1] and were clamped"));
     } else {
-        let pd = wrinkles::normals_to_pd("--normal", &normal, green, cone)?;
-        let mut cone_clamped = pd.cone_clamped;
-        let (values, range_clamped) = match &base {
-            Some(b) => {
-                let bpd = wrinkles::normals_to_pd("--base", b, green, cone)?;
-                cone_clamped += bpd.cone_clamped;
-                files.extend(rtbake::bake::unorm8_texture_files(
-                    "base_pd",
-                    &wrinkles::pd_to_rg8(w, h, &bpd.pd),
-                    "lut",
-                    bf::PD_CONVENTION,
-                )?);
-                report["base"] = json!({"files": "base_pd.{bin,dds,ktx2,png}", "size": [w, h], "format": "R8G8_UNORM", "cone_clamped_texels": bpd.cone_clamped});
-                wrinkles::pd_delta(&pd, &bpd)
-            }
-            None => (pd.pd.clone(), 0),
-        };
-        let (ow, oh, small) = wrinkles::downsample(&values, w, h, 2, a.size);
-        files.extend(rtbake::bake::unorm8_texture_files(
-            "wrinkle_pd",
-            &wrinkles::pd_to_rg8(ow, oh, &small),
-            "lut",
-            bf::PD_CONVENTION,
-        )?);
-        report["wrinkle"] = json!({
-            "files": "wrinkle_pd.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8_UNORM",
-            "relative_to_base": base.is_some(),
-            "cone_clamped_texels": pd.cone_clamped, "range_clamped_texels": range_clamped,
-        });
+        let (pd_files, mut wrinkle, base_report) =
+            bf::pd_wrinkle_files("", &normal, base.as_ref(), green, cone, a.size)?;
+        files.extend(pd_files);
+        let count = |v: &serde_json::Value, k: &str| v[k].as_u64().unwrap_or(0);
+        let cone_clamped = count(&wrinkle, "cone_clamped_texels")
+            + base_report.as_ref().map(|b| count(b, "cone_clamped_texels")).unwrap_or(0);
+        let range_clamped = count(&wrinkle, "range_clamped_texels");
+        wrinkle["relative_to_base"] = json!(base.is_some());
+        wrinkle["range_clamped_texels"] = json!(range_clamped);
+        if let Some(b) = base_report {
+            report["base"] = b;
+        }
+        let (ow, oh) = (wrinkle["size"][0].as_u64().unwrap_or(0), wrinkle["size"][1].as_u64().unwrap_or(0));
+        report["wrinkle"] = wrinkle;
         ctx.info(format!(
             "PD wrinkle map {ow}x{oh}: {cone_clamped} texels clamped to the 45-degree cone, {range_clamped} clamped to [-1, 1]"
         ));

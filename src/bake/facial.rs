@@ -3,6 +3,7 @@
 //! (thesis ch. 8). Also the file encoders shared with `rtbake maps` (the CLI writes the same files).
 
 use super::{json_file, parse_params, unorm8_texture_files, Asset, BakeError, BakedFile, FileMeta};
+use crate::error::InvalidInput;
 use crate::facial::disk_stats::Border;
 use crate::facial::hemoglobin_rig::{self, HemoglobinRig, RigSettings};
 use crate::facial::{synthetic, wrinkles};
@@ -345,19 +346,15 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         3,
         normal.data.iter().map(|&s| (2.0 * s as f64 / 255.0 - 1.0) as f32).collect(),
     );
-    let pd = wrinkles::normals_to_pd(
-        "wrinkle-maps-example",
+    let (pd_files, wrinkle_report, _) = pd_wrinkle_files(
+        &dir,
         &decoded,
+        None,
         wrinkles::GreenConvention::DirectX,
         wrinkles::ConeMode::Clamp,
+        p.wrinkle_size,
     )?;
-    let (ow, oh, small) = wrinkles::downsample(&pd.pd, p.size, p.size, 2, p.wrinkle_size);
-    files.extend(unorm8_texture_files(
-        &format!("{dir}wrinkle_pd"),
-        &wrinkles::pd_to_rg8(ow, oh, &small),
-        "lut",
-        PD_CONVENTION,
-    )?);
+    files.extend(pd_files);
     let masks = synthetic::wrinkle_zone_masks(p.size);
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);
@@ -370,7 +367,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "input": "input/wrinkle_normal.png (synthetic)",
         "input_green": "directx",
         "output_green": "directx",
-        "wrinkle": {"files": "wrinkle_pd.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8_UNORM", "cone_clamped_texels": pd.cone_clamped},
+        "wrinkle": wrinkle_report,
         "masks": {"files": ["wrinkle_masks_0.{bin,dds,ktx2,png}", "wrinkle_masks_1.{bin,dds,ktx2,png}"], "size": [p.mask_size.min(p.size), p.mask_size.min(p.size)], "format": "R8G8B8A8_UNORM", "zones": wrinkles::ZONES},
         "weights": "../expression_weights.json",
     });
@@ -408,4 +405,105 @@ pub fn assets() -> Vec<Asset> {
             bake: bake_wrinkle_example,
         },
     ]
+}
+
+/// Rebuilds a rig from its description (`rig.json`, [`RigDescription`]) and the EXR files it names, for
+/// `rtbake maps rig-eval`. `read(file)` returns the bytes of a file named relative to the rig's folder (the caller
+/// does the I/O); every map is checked to be single-channel at the size the description states. Errors name
+/// `param` (the flag the user gave) and the file.
+pub fn rig_from_description(
+    param: &str,
+    desc: &RigDescription,
+    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, InvalidInput>,
+) -> Result<HemoglobinRig, InvalidInput> {
+    if desc.schema != RIG_SCHEMA {
+        return Err(InvalidInput::new(param, format!("schema '{}', expected '{RIG_SCHEMA}'", desc.schema)));
+    }
+    let [w, h] = desc.full_size;
+    let [rw, rh] = desc.rig_size;
+    crate::error::check_size(&format!("{param} full_size"), w as u64, h as u64)?;
+    crate::error::check_size(&format!("{param} rig_size"), rw as u64, rh as u64)?;
+    let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, InvalidInput> {
+        let bytes = read(file)?;
+        let (img, _) = io::exr::decode(&bytes, file).map_err(|e| InvalidInput::new(param, e.to_string()))?;
+        if (img.width, img.height, img.channels) != (mw, mh, 1) {
+            return Err(InvalidInput::new(
+                param,
+                format!("{file} is {}x{}x{}, the rig says {mw}x{mh}x1", img.width, img.height, img.channels),
+            ));
+        }
+        Ok(img.data)
+    };
+    let h0 = map(&desc.h0.exr, (w, h))?;
+    let mut maps = Vec::with_capacity(desc.maps.len());
+    for m in &desc.maps {
+        maps.push(hemoglobin_rig::RigMap {
+            name: m.name.clone(),
+            scale: map(&m.scale_exr, (rw, rh))?,
+            bias: map(&m.bias_exr, (rw, rh))?,
+        });
+    }
+    Ok(HemoglobinRig {
+        width: w,
+        height: h,
+        rig_width: rw,
+        rig_height: rh,
+        settings: RigSettings {
+            radius_texels: desc.radius_texels,
+            border: desc.border,
+            sigma_floor: desc.sigma_floor,
+            rig_size: rw.max(rh),
+        },
+        h0,
+        maps,
+        sigma_floored_texels: desc.sigma_floored_texels,
+    })
+}
+
+/// A partial-derivative wrinkle map (thesis ch. 8) from decoded unit normals: PD conversion (cone handling
+/// `cone`), optional difference against a base map's PD, area downsampling to `size` and the 8-bit texture
+/// files `{prefix}wrinkle_pd.*` (and `{prefix}base_pd.*` with a base). Returns the files, the `"wrinkle"` report
+/// object (sizes, clamp counts) and, with a base, the `"base"` one. Shared by `rtbake maps wrinkles` and the
+/// `wrinkle-maps-example` bake.
+pub fn pd_wrinkle_files(
+    prefix: &str,
+    normal: &Image<f32>,
+    base: Option<&Image<f32>>,
+    green: wrinkles::GreenConvention,
+    cone: wrinkles::ConeMode,
+    size: u32,
+) -> Result<(Vec<BakedFile>, Value, Option<Value>), BakeError> {
+    let (w, h) = (normal.width, normal.height);
+    let pd = wrinkles::normals_to_pd("--normal", normal, green, cone)?;
+    let mut files = Vec::new();
+    let (values, range_clamped, base_report) = match base {
+        Some(b) => {
+            let bpd = wrinkles::normals_to_pd("--base", b, green, cone)?;
+            files.extend(unorm8_texture_files(
+                &format!("{prefix}base_pd"),
+                &wrinkles::pd_to_rg8(w, h, &bpd.pd),
+                "lut",
+                PD_CONVENTION,
+            )?);
+            let report = json!({"files": "base_pd.{bin,dds,ktx2,png}", "size": [w, h], "format": "R8G8_UNORM",
+                                "cone_clamped_texels": bpd.cone_clamped});
+            let (values, clamped) = wrinkles::pd_delta(&pd, &bpd);
+            (values, clamped, Some(report))
+        }
+        None => (pd.pd.clone(), 0, None),
+    };
+    let (ow, oh, small) = wrinkles::downsample(&values, w, h, 2, size);
+    files.extend(unorm8_texture_files(
+        &format!("{prefix}wrinkle_pd"),
+        &wrinkles::pd_to_rg8(ow, oh, &small),
+        "lut",
+        PD_CONVENTION,
+    )?);
+    let mut report = json!({"files": "wrinkle_pd.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8_UNORM"});
+    if base.is_some() {
+        report["relative_to_base"] = json!(true);
+        report["range_clamped_texels"] = json!(range_clamped);
+    }
+    report["cone_clamped_texels"] = json!(pd.cone_clamped);
+    Ok((files, report, base_report))
 }
