@@ -53,12 +53,6 @@ fn legendre_and_derivative(n: usize, z: f64) -> (f64, f64) {
     (p1, d)
 }
 
-/// The 16-point rule, computed once.
-pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
-    static R: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    R.get_or_init(|| gauss_legendre(16))
-}
-
 /// The 32-point rule, computed once.
 pub fn gl32() -> &'static (Vec<f64>, Vec<f64>) {
     static R: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();

@@ -265,19 +265,6 @@ impl TwoLayerSkinModel {
         self.bands.iter().zip(&dermis.0).map(|(b, &r2)| self.stack_reflectance(b, cm, che, r2)).collect()
     }
 
-    /// Linear sRGB of (Cm, Chd) given the dermis reflectance for that Chd; no range checks.
-    pub fn linear_rgb_unchecked(&self, cm: f64, chd: f64, dermis: &DermisReflectance) -> [f64; 3] {
-        let che = self.physiology.epidermal_hemoglobin(chd);
-        let mut acc = [0.0; 3];
-        for ((b, &r2), w) in self.bands.iter().zip(&dermis.0).zip(&self.weights.linear_srgb) {
-            let r = self.stack_reflectance(b, cm, che, r2);
-            acc[0] += w[0] * r;
-            acc[1] += w[1] * r;
-            acc[2] += w[2] * r;
-        }
-        acc
-    }
-
     /// Bounds of the epidermal σa over [0, cm_max] × [0, chd_max] at `band` (σa is linear in Cm and Che, so the
     /// corners bound it).
     fn epidermis_sigma_a_range(&self, band: &Band, cm_max: f64, chd_max: f64) -> (f64, f64) {
