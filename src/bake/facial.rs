@@ -101,6 +101,7 @@ fn float_meta(
         color_space: "linear".into(),
         convention: conv.into(),
         verify_tolerance: Some(tol),
+        supercompression: None,
     }
 }
 
@@ -126,6 +127,7 @@ fn preview_file(
         color_space: "linear".into(),
         convention: format!("viewing only: gray = ({what} - {lo}) / ({hi} - {lo}), clamped; not for sampling"),
         verify_tolerance: Some(1.0),
+        supercompression: None,
     };
     Ok(BakedFile { path, bytes, meta })
 }
@@ -323,6 +325,7 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
                 color_space: "linear".into(),
                 convention: "synthetic hemoglobin map: dermal volume fraction = sample / 65535".into(),
                 verify_tolerance: None,
+                supercompression: None,
             },
         });
         sources.push(RigSource {
@@ -401,6 +404,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             color_space: "linear".into(),
             convention: "synthetic tangent-space normal map, n = 2*rgb/255 - 1, DirectX green convention".into(),
             verify_tolerance: None,
+            supercompression: None,
         },
     }];
     let decoded = Image::from_vec(

@@ -57,7 +57,7 @@ pub mod skin;
 pub mod transmittance;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
-/// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
+/// layout for the manifest. PNG of RG data is RGB with B = 0 (what engines and browsers load as R, G), tagged linear.
 pub fn unorm8_texture_files(
     stem: &str,
     img: &Image<u8>,
@@ -76,10 +76,13 @@ pub fn unorm8_texture_files(
         color_space: "linear".into(),
         convention: convention.into(),
         verify_tolerance: None,
+        supercompression: None,
     };
     let mut png_meta = meta("png");
     if img.channels == 2 {
-        png_meta.convention = format!("{convention}; PNG stores R as gray and G as alpha");
+        png_meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
+        png_meta.channels = 3;
+        png_meta.pixel_format = None;
     }
     Ok(vec![
         BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") },
@@ -110,6 +113,7 @@ pub fn float_texture_files(
         color_space: cs.into(),
         convention: convention.into(),
         verify_tolerance: tol,
+        supercompression: None,
     };
     let half_tol = tolerance.max(1e-3);
     let mut preview = meta("png", None, "u8", "srgb", Some(1.0));

@@ -130,7 +130,10 @@ pub fn render(panels: &[LinePlot], format: PlotFormat, provenance: &Value) -> Re
             let (head, body) = svg.split_once('\n').unwrap_or((&svg, ""));
             Ok(format!("{head}\n<desc>rtbake profile: {desc}</desc>\n{body}").into_bytes())
         }
-        PlotFormat::Png => crate::io::png::encode_u8(&panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT)),
+        PlotFormat::Png => crate::io::png::encode_u8_as(
+            &panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT),
+            crate::io::png::PngColor::Srgb,
+        ),
     }
 }
 
