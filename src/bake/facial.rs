@@ -132,10 +132,19 @@ fn preview_file(
     Ok(BakedFile { path, bytes, meta })
 }
 
-/// Encodes the float map files of one single-channel map: `{stem}.exr` (f32) and `{stem}_f16.exr`.
+/// Encodes the float map files of one single-channel map: `{stem}.exr` (f32, one `Y` channel, for engines that
+/// read named channels), `{stem}_f16.exr`, and `{stem}_rgb.exr` (f32 `R`,`G`,`B` with the value in R and
+/// G = B = 0): the layout the `image` crate's EXR decoder, and so Bevy's EXR loader, requires.
 fn exr_pair(dir: &str, stem: &str, w: u32, h: u32, v: &[f32], conv: &str) -> Result<Vec<BakedFile>, BakeError> {
     let img = Image::from_vec(w, h, 1, v.to_vec());
+    let rgb = Image::from_vec(w, h, 3, v.iter().flat_map(|&x| [x, 0.0, 0.0]).collect());
+    let rgb_conv = format!("{conv}; value in R, G = B = 0 (RGB EXR for the image crate / Bevy)");
     Ok(vec![
+        BakedFile {
+            path: format!("{dir}{stem}_rgb.exr"),
+            bytes: io::exr::encode(&rgb, ExrPrecision::F32)?,
+            meta: float_meta("exr", "f32", w, h, 3, None, &rgb_conv, 1e-6),
+        },
         BakedFile {
             path: format!("{dir}{stem}.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F32)?,

@@ -78,7 +78,10 @@ fn default_kernels_params() -> Value {
     serde_json::to_value(KernelsParams { kernels: default_kernels() }).expect("params serialise")
 }
 
-/// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl` (pure; `rtbake kernel --out` uses it too).
+/// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl`, the upstream-form `{stem}_SeparableSSS.h`
+/// kernel (pasted in place of `SeparableSSS.h`'s preset of the same N) and the raw little-endian
+/// `{stem}_f32x4.bin` (N taps of `[r, g, b, offset]`, the runtime upload path). Pure; `rtbake kernel --out` uses
+/// it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
     let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
     let convention = kernel::LAYOUT_DOC;
@@ -93,6 +96,32 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
             convention,
         ));
     }
+    files.push(text_file(
+        &format!("{prefix}{stem}_SeparableSSS.h"),
+        k.separable_sss_h(source),
+        "shader-include",
+        "hlsl",
+        "SeparableSSS.h form: #define SSSS_N_SAMPLES N + static const float4 kernel[N] (rgb = weight, a = offset), \
+         to replace the header's built-in preset of the same N",
+    ));
+    let n = k.taps.len() as u32;
+    files.push(BakedFile {
+        path: format!("{prefix}{stem}_f32x4.bin"),
+        bytes: k.f32x4_le_bytes(),
+        meta: crate::manifest::FileMeta {
+            kind: "kernel".into(),
+            format: "raw".into(),
+            pixel_format: Some(crate::io::PixelFormat::R32G32B32A32Sfloat),
+            width: n,
+            height: 1,
+            channels: 4,
+            sample_type: "f32".into(),
+            color_space: "n/a".into(),
+            convention: format!("{convention}; little-endian f32 x 4 x {n}, no header (SeparableSSS.h runtime kernel)"),
+            verify_tolerance: None,
+            supercompression: None,
+        },
+    });
     files
 }
 
