@@ -143,6 +143,17 @@ pub fn float_texture_files(
     ])
 }
 
+/// Rewrites every uncompressed KTX2 file of `files` with Zstandard supercompression at `level` (1..=22) and records
+/// it in the file's metadata (`supercompression: zstd-<level>`). Other files are left as they are.
+pub fn supercompress_ktx2(files: &mut [BakedFile], level: i32) -> Result<(), BakeError> {
+    crate::error::check_range("zstd level", level, 1, 22, "")?;
+    for f in files.iter_mut().filter(|f| f.meta.format == "ktx2" && f.meta.supercompression.is_none()) {
+        f.bytes = io::ktx2::supercompress(&f.bytes, &f.path, level)?;
+        f.meta.supercompression = Some(io::ktx2::Supercompression::Zstd(level).label());
+    }
+    Ok(())
+}
+
 /// A pretty-printed JSON file (stable key order, trailing newline).
 pub fn json_file(path: &str, value: &Value, kind: &str, convention: &str) -> BakedFile {
     let mut text = serde_json::to_string_pretty(value).expect("JSON values always serialise");

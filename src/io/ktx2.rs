@@ -212,6 +212,33 @@ pub fn encode_f16_with(img: &Image<f32>, sc: Supercompression) -> Result<Vec<u8>
     encode_raw_with(img.width, img.height, format, bytemuck::cast_slice(&h), sc)
 }
 
+/// The [`PixelFormat`] of a VkFormat value rtbake writes.
+pub fn pixel_format_of_vk(vk: u32) -> Option<PixelFormat> {
+    use PixelFormat as P;
+    [
+        P::R8Unorm,
+        P::R8G8Unorm,
+        P::R8G8B8A8Unorm,
+        P::R16Sfloat,
+        P::R16G16Sfloat,
+        P::R16G16B16A16Sfloat,
+        P::R32Sfloat,
+        P::R32G32B32A32Sfloat,
+    ]
+    .into_iter()
+    .find(|&p| vk_format(p) == vk)
+}
+
+/// Re-encodes a single-level KTX2 file written by rtbake with Zstandard supercompression at `level`.
+pub fn supercompress(bytes: &[u8], path: &str, level: i32) -> Result<Vec<u8>, IoError> {
+    let (vk, width, height, payload, _) = decode(bytes, path)?;
+    let format = pixel_format_of_vk(vk).ok_or_else(|| IoError::Decode {
+        path: path.to_string(),
+        detail: format!("VkFormat {vk} not written by rtbake"),
+    })?;
+    encode_raw_with(width, height, format, &payload, Supercompression::Zstd(level))
+}
+
 /// Reads a KTX2 back with the `ktx2` crate: (vkFormat, width, height, level-0 bytes, transfer is linear).
 /// Zstandard-supercompressed level data is decompressed (as Bevy's loader does).
 pub fn decode(bytes: &[u8], path: &str) -> Result<(u32, u32, u32, Vec<u8>, bool), IoError> {

@@ -10,8 +10,8 @@
 //! a lighter shade of the channel colour; an optional sum-of-Gaussians overlay is dashed in a darker shade. Pure:
 //! returns a [`LinePlot`] pair, text or PNG bytes; callers write the files.
 
-use super::table::ProfileTable;
-use super::RadialProfile;
+use crate::diffusion::table::ProfileTable;
+use crate::diffusion::RadialProfile;
 use crate::error::InvalidInput;
 use crate::fitting::{RgbGaussians, CHANNEL_COLORS};
 use crate::plot::{panels_to_image, panels_to_svg, LinePlot, Series};
