@@ -100,7 +100,15 @@ pub fn exit_with(e: &anyhow::Error, json: bool) -> ! {
     // A command that already printed its JSON result (e.g. `verify`'s report listing the failures) keeps stdout to
     // that one object.
     if json && !JSON_EMITTED.load(std::sync::atomic::Ordering::SeqCst) {
-        let param = e.chain().find_map(|c| c.downcast_ref::<rtbake::error::InvalidInput>()).map(|i| i.param.clone());
+        let invalid = e.chain().find_map(|c| {
+            c.downcast_ref::<rtbake::error::InvalidInput>()
+                .or_else(|| c.downcast_ref::<Usage>().and_then(|u| u.0.downcast_ref::<rtbake::error::InvalidInput>()))
+        });
+        // Without a typed validation error, a message that starts with a flag (`--out …: exists`) names it.
+        let param = invalid.map(|i| i.param.clone()).or_else(|| {
+            let first = chain[0].split([' ', ':', '=']).next().unwrap_or("");
+            (first.starts_with("--") && first.len() > 2).then(|| first.to_string())
+        });
         emit_json_error(&chain.join(": "), param.as_deref(), code);
     }
     std::process::exit(code);

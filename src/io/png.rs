@@ -55,17 +55,14 @@ fn encode(bytes: &[u8], w: u32, h: u32, channels: u32, sixteen: bool, color: Png
             CICP_TRANSFER_SRGB
         }
     };
-    info.coding_independent_code_points = Some(png::CodingIndependentCodePoints {
-        color_primaries: 1,
-        transfer_function: transfer,
-        matrix_coefficients: 0,
-        is_video_full_range_image: true,
-    });
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::with_info(&mut out, info).map_err(err)?;
         enc.set_compression(png::Compression::High);
         let mut writer = enc.write_header().map_err(err)?;
+        // cICP (PNG Third Edition §11.3.2.6): BT.709 primaries, transfer, RGB (matrix 0), full range. The
+        // encoder does not write `Info::coding_independent_code_points`, so the chunk is written here, before IDAT.
+        writer.write_chunk(png::chunk::cICP, &[1, transfer, 0, 1]).map_err(err)?;
         writer.write_image_data(bytes).map_err(err)?;
         writer.finish().map_err(err)?;
     }
