@@ -236,7 +236,13 @@ mod tests {
     #[test]
     fn default_kernels_bake_to_json_and_three_includes_each() {
         let files = bake_kernels(&default_kernels_params()).unwrap();
-        assert_eq!(files.len(), 6 * 4);
+        assert_eq!(files.len(), 6 * 6, "json, 3 includes, SeparableSSS.h form and raw f32x4 per kernel");
+        let raw = files.iter().find(|f| f.path == "sss/separable/published_n17_f32x4.bin").unwrap();
+        assert_eq!(raw.bytes.len(), 17 * 16);
+        let upstream = files.iter().find(|f| f.path == "sss/separable/published_n17_SeparableSSS.h").unwrap();
+        let text = std::str::from_utf8(&upstream.bytes).unwrap();
+        assert!(text.contains("#define SSSS_N_SAMPLES 17\nstatic const float4 kernel[] = {\n"), "{text}");
+        assert_eq!(text.matches("float4(").count(), 17);
         assert!(files.iter().all(|f| f.path.starts_with("sss/separable/")));
         let j = files.iter().find(|f| f.path == "sss/separable/published_n17.json").unwrap();
         let v: Value = serde_json::from_slice(&j.bytes).unwrap();
@@ -272,7 +278,9 @@ mod tests {
                 "sss/separable/fit_deon6_n17.json",
                 "sss/separable/fit_deon6_n17.hlsl",
                 "sss/separable/fit_deon6_n17.glsl",
-                "sss/separable/fit_deon6_n17.wgsl"
+                "sss/separable/fit_deon6_n17.wgsl",
+                "sss/separable/fit_deon6_n17_SeparableSSS.h",
+                "sss/separable/fit_deon6_n17_f32x4.bin"
             ]
         );
         let v: Value = serde_json::from_slice(&a[0].bytes).unwrap();
