@@ -17,8 +17,9 @@ mod tests {
     fn mid_grey_and_ends() {
         assert_eq!(super::encode(0.0), 0.0);
         assert!((super::encode(1.0) - 1.0).abs() < 1e-12);
-        // Linear 0.214041 is sRGB 128/255 (the usual mid grey) after rounding; 0.5 encodes to 0.7354.
-        assert_eq!((super::encode(0.214_041_14) * 255.0).round(), 128.0);
+        // 18 % grey encodes to 0.4614; the linear segment ends at 0.0031308 -> 0.04045.
+        assert!((super::encode(0.18) - 0.461_356_1).abs() < 1e-6);
+        assert!((super::encode(0.003_130_8) - 0.040_449_9).abs() < 1e-6);
         assert!((super::encode(0.5) - 0.735_356_6).abs() < 1e-6);
         assert_eq!(super::encode(2.0), super::encode(1.0));
     }
