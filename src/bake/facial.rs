@@ -169,9 +169,10 @@ fn min_max(v: &[f32]) -> (f64, f64) {
 }
 
 /// All files of a rig, paths prefixed by `dir` (e.g. `facial/hemoglobin/example/` or empty), plus the
-/// description written to `{dir}rig.json`.
+/// description written to `{dir}rig.json`. `made_by` names the command that made them (recorded as `generated_by`).
 pub fn hemoglobin_rig_files(
     rig: &HemoglobinRig,
+    made_by: &str,
     dir: &str,
     sources: &[RigSource],
     value_unit: &str,
@@ -242,7 +243,7 @@ pub fn hemoglobin_rig_files(
     }
     let desc = RigDescription {
         schema: RIG_SCHEMA.into(),
-        generated_by: format!("rtbake {} (do not edit; regenerate with rtbake maps hemoglobin)", env!("CARGO_PKG_VERSION")),
+        generated_by: format!("rtbake {} from {made_by}; do not edit", env!("CARGO_PKG_VERSION")),
         model: "Jimenez et al. 2010, 'A practical appearance model for dynamic facial color' (thesis ch. 7, eq. 7.1-7.6)".into(),
         evaluation: "H = g * (sum_i w_i * bias_i + H0 * sum_i w_i * scale_i), weights w_i over maps[] summing to 1 (eq. 7.6); \
                      g = 1 or a global state factor (global_scales); maps[0] is the neutral map (scale = 1, bias = mu_neutral)"
@@ -352,7 +353,13 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     };
     let targets: Vec<(String, &[f32])> = conc[1..].iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
     let rig = hemoglobin_rig::build_rig(&conc[0].1, p.size, p.size, &targets, &settings)?;
-    let (rig_files, _) = hemoglobin_rig_files(&rig, &dir, &sources, "dermal hemoglobin volume fraction")?;
+    let (rig_files, _) = hemoglobin_rig_files(
+        &rig,
+        "`rtbake bake hemoglobin-rig-example`",
+        &dir,
+        &sources,
+        "dermal hemoglobin volume fraction",
+    )?;
     files.extend(rig_files);
     Ok(files)
 }
