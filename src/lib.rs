@@ -8,6 +8,7 @@ pub mod aa;
 pub mod bake;
 pub mod baked_dir;
 pub mod baked_layout;
+pub mod color;
 pub mod diffusion;
 pub mod error;
 pub mod facial;

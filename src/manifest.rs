@@ -34,6 +34,9 @@ pub struct FileMeta {
     /// Absolute tolerance used by `verify` for float payloads (None: must be byte-identical).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub verify_tolerance: Option<f64>,
+    /// KTX2 supercompression of the level data (`zstd-<level>`); absent: stored uncompressed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub supercompression: Option<String>,
 }
 
 impl FileMeta {
@@ -50,6 +53,7 @@ impl FileMeta {
             color_space: "n/a".into(),
             convention: convention.into(),
             verify_tolerance: None,
+            supercompression: None,
         }
     }
 }

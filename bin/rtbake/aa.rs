@@ -58,11 +58,11 @@ pub enum AaFormat {
     Dds,
     /// KTX2 with VK_FORMAT_R8G8_UNORM / R8_UNORM, linear transfer.
     Ktx2,
-    /// PNG (RG as gray + alpha).
+    /// PNG (RG as RGB with B = 0; tagged linear).
     Png,
     /// C header (upstream AreaTex.h / SearchTex.h names and defines).
     H,
-    /// Rust source (`pub const AREATEX_BYTES: [u8; N]` etc.).
+    /// Rust source (smaa-rs' items: `AREATEX_WIDTH: u32`, `AREATEX_SIZE: usize`, `static AREATEX_BYTES`, etc.).
     Rs,
     /// All of the above.
     All,
@@ -120,6 +120,9 @@ pub struct AaArgs {
     /// File name stem (default: the upstream name, e.g. AreaTex, SearchTex, AreaMap33_v1.4).
     #[arg(long, value_name = "NAME")]
     pub stem: Option<String>,
+    /// Zstandard-supercompress the KTX2 output at this level (1..=22; Bevy ships its SMAA LUTs at 15).
+    #[arg(long, value_name = "LEVEL")]
+    pub zstd: Option<i32>,
 }
 
 fn is_smaa_area(t: AaTexture) -> bool {
@@ -264,6 +267,11 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             mlaa_files(v, n, &stem, true, &from).map_err(bake_err)?
         }
     };
+    let mut files = files;
+    if let Some(level) = a.zstd {
+        rtbake::error::check_range("--zstd", level, 1, 22, "(Zstandard level)").map_err(usage)?;
+        rtbake::bake::supercompress_ktx2(&mut files, level).map_err(bake_err)?;
+    }
     let all = a.format.contains(&AaFormat::All);
     let wanted: Vec<&BakedFile> = files
         .iter()

@@ -19,6 +19,7 @@ impl Ctx {
 
     /// Prints a JSON value on stdout (one object, pretty, trailing newline).
     pub fn emit_json(&self, v: &serde_json::Value) {
+        JSON_EMITTED.store(true, std::sync::atomic::Ordering::SeqCst);
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(v).expect("JSON values serialise")));
     }
 
@@ -84,19 +85,70 @@ pub fn is_usage(e: &anyhow::Error) -> bool {
         })
 }
 
-/// Prints `error: …` with its cause chain and exits 2 (bad input) or 1 (runtime failure).
-pub fn exit_with(e: &anyhow::Error) -> ! {
+/// Prints `error: …` with its cause chain on stderr and exits 2 (bad input) or 1 (runtime failure). With
+/// `--json`, also prints one object `{"error": …, "param": …, "exit_code": …}` on stdout, so scripts parse every
+/// outcome with one parser (`param` is the flag/field of a validation error, else null).
+pub fn exit_with(e: &anyhow::Error, json: bool) -> ! {
     let mut msg = format!("error: {e}");
     let mut last = e.to_string();
+    let mut chain = vec![last.clone()];
     for cause in e.chain().skip(1) {
         let c = cause.to_string();
         if !last.contains(&c) {
             msg.push_str(&format!("\n  caused by: {c}"));
+            chain.push(c.clone());
         }
         last = c;
     }
     eprintln!("{msg}");
-    std::process::exit(if is_usage(e) { 2 } else { 1 });
+    let code = if is_usage(e) { 2 } else { 1 };
+    // A command that already printed its JSON result (e.g. `verify`'s report listing the failures) keeps stdout to
+    // that one object.
+    if json && !JSON_EMITTED.load(std::sync::atomic::Ordering::SeqCst) {
+        let invalid = e.chain().find_map(|c| {
+            c.downcast_ref::<rtbake::error::InvalidInput>()
+                .or_else(|| c.downcast_ref::<Usage>().and_then(|u| u.0.downcast_ref::<rtbake::error::InvalidInput>()))
+        });
+        // Without a typed validation error, a message that starts with a flag (`--out …: exists`) names it.
+        let param = invalid.map(|i| i.param.clone()).or_else(|| {
+            let first = chain[0].split([' ', ':', '=']).next().unwrap_or("");
+            (first.starts_with("--") && first.len() > 2).then(|| first.to_string())
+        });
+        emit_json_error(&chain.join(": "), param.as_deref(), code);
+    }
+    std::process::exit(code);
+}
+
+/// Set once a command has printed its JSON result.
+static JSON_EMITTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// The `--json` error object on stdout.
+pub fn emit_json_error(error: &str, param: Option<&str>, exit_code: i32) {
+    let v = serde_json::json!({"error": error, "param": param, "exit_code": exit_code});
+    print_stdout(&format!("{}\n", serde_json::to_string_pretty(&v).expect("JSON values serialise")));
+}
+
+/// Whether `--json` is on the raw command line (for errors before the flags are parsed).
+pub fn json_requested(argv: &[OsString]) -> bool {
+    argv.iter().skip(1).take_while(|a| *a != "--").any(|a| a == "--json")
+}
+
+/// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
+pub fn exit_clap(e: clap::Error, json: bool) -> ! {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let code = e.exit_code();
+    if !json || matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) || code == 0 {
+        e.exit();
+    }
+    let rendered = e.render().to_string();
+    eprint!("{rendered}");
+    let first = rendered.lines().next().unwrap_or("").trim_start_matches("error: ").to_string();
+    let param = match e.get(ContextKind::InvalidArg) {
+        Some(ContextValue::String(s)) => Some(s.split_whitespace().next().unwrap_or(s).to_string()),
+        _ => None,
+    };
+    emit_json_error(&first, param.as_deref(), code);
+    std::process::exit(code);
 }
 
 /// Expands `--params FILE` (a JSON object of flag names to values) into flags inserted right after the

@@ -76,16 +76,16 @@ fn main() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let argv = match cli::expand_params_file::<Cli>(std::env::args_os().collect()) {
+    let raw: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    let json = cli::json_requested(&raw);
+    let argv = match cli::expand_params_file::<Cli>(raw) {
         Ok(a) => a,
-        Err(e) => cli::exit_with(&e),
+        Err(e) => cli::exit_with(&e, json),
     };
     let parsed = match Cli::try_parse_from(argv) {
         Ok(c) => c,
-        Err(e) => {
-            // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
-            e.exit();
-        }
+        // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
+        Err(e) => cli::exit_clap(e, json),
     };
     let ctx = Ctx { json: parsed.json, quiet: parsed.quiet };
     let result = match parsed.command {
@@ -102,6 +102,6 @@ fn main() {
         Command::Run(c) => run::run(c, &ctx),
     };
     if let Err(e) = result {
-        cli::exit_with(&e);
+        cli::exit_with(&e, ctx.json);
     }
 }

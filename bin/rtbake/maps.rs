@@ -244,8 +244,13 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         bar.set_position(k as u64)
     })?;
     bar.finish_and_clear();
-    let (files, desc) =
-        bf::hemoglobin_rig_files(&rig, "", &sources, "as given by the input value mapping (see maps[].source)")?;
+    let (files, desc) = bf::hemoglobin_rig_files(
+        &rig,
+        "`rtbake maps hemoglobin`",
+        "",
+        &sources,
+        "as given by the input value mapping (see maps[].source)",
+    )?;
     write_files("--out", &a.out, &files)?;
     let pct = 100.0 * rig.sigma_floored_texels as f64 / (w as f64 * h as f64);
     ctx.info(format!(

@@ -6,12 +6,12 @@ use crate::cli::AddingArg;
 use crate::cli::{parse_f64_list, usage, usage_msg, Ctx};
 use rtbake::diffusion::layered::LayerStack;
 use rtbake::diffusion::multipole::Series;
-use rtbake::diffusion::plot::{profile_panels, render, PlotFormat};
 use rtbake::diffusion::source::{MaterialModel, ProfileSource};
 use rtbake::diffusion::table::{self, ProfileTable};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings};
+use rtbake::plot::profile::{profile_panels, render, PlotFormat};
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]

@@ -2,16 +2,17 @@
 //!
 //! | asset | parameters (JSON, defaults) | files (each as `.bin`, `.dds`, `.ktx2`, `.png`) |
 //! | --- | --- | --- |
-//! | `smaa-area` | [`SmaaAreaParams`] (16, 20, 7 + 5 offsets, U smoothing) | `aa/smaa/AreaTex` + `AreaTex.h`, `AreaTex.rs` |
+//! | `smaa-area` | [`SmaaAreaParams`] (16, 20, 7 + 5 offsets, U smoothing) | `aa/smaa/AreaTex` + `AreaTex.h`, `AreaTex.rs`, `SMAAAreaLUT.ktx2` |
 //! | `smaa-area-v2.8` | [`SmaaAreaParams`] with `u_smoothing: false` | `aa/smaa/AreaTex_v2.8` |
-//! | `smaa-search` | `{}` | `aa/smaa/SearchTex` + `SearchTex.h`, `SearchTex.rs` |
+//! | `smaa-search` | `{}` | `aa/smaa/SearchTex` + `SearchTex.h`, `SearchTex.rs`, `SMAASearchLUT.ktx2` |
 //! | `smaa-search-v2.8` | `{}` | `aa/smaa/SearchTex_v2.8` (0/1/2) and `aa/smaa/SearchTex_logical_precrop` (0/127/254) |
 //! | `mlaa-v1.4` | [`MlaaBakeParams`] `{"max_distances": [9, 17, 33, 65, 129]}` | `aa/mlaa/AreaMap{N}_v1.4` |
 //! | `mlaa-v1.3` | `{"max_distances": [9, 16, 32]}` | `aa/mlaa/AreaMap{N}_v1.3` |
 //! | `mlaa-v2` | `{"max_distances": [15]}` | `aa/mlaa/AreaTex_MLAAv2` (`AreaTex{N}_MLAAv2` for N ≠ 15) |
 //!
 //! The `.bin` payloads of the defaults are byte-identical to the published textures (`tests/aa_golden.rs`). PNGs of
-//! RG textures store R as gray and G as alpha. The same file builders serve `rtbake aa` (variants).
+//! RG textures are RGB with B = 0. `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2` are the same payloads named and stored
+//! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
 use super::{parse_params, text_file, unorm8_texture_files, Asset, BakeError, BakedFile};
 use crate::aa::mlaa_area::{mlaa_area_map, MlaaAreaError, MlaaVersion};
@@ -19,7 +20,7 @@ use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
 use crate::aa::smaa_search;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
-use crate::io::source::{c_header_u8, rust_source_u8};
+use crate::io::source::{c_header_u8, rust_source_u8, DataNotice};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -192,6 +193,30 @@ pub fn mlaa_files(
     texture_with_sources(stem, &img, &mlaa_convention(version, n), sources.then_some(("AREAMAP", "areaMapBytes")), from)
 }
 
+/// Bevy's file names for the SMAA LUTs (`bevy_anti_alias/src/smaa/`).
+pub const BEVY_AREA_LUT: &str = "SMAAAreaLUT.ktx2";
+pub const BEVY_SEARCH_LUT: &str = "SMAASearchLUT.ktx2";
+
+/// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`io::ktx2::BEVY_ZSTD_LEVEL`]).
+pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<BakedFile, BakeError> {
+    use crate::io::{self, ktx2::Supercompression, PixelFormat};
+    let sc = Supercompression::Zstd(io::ktx2::BEVY_ZSTD_LEVEL);
+    let meta = crate::manifest::FileMeta {
+        kind: "lut".into(),
+        format: "ktx2".into(),
+        pixel_format: PixelFormat::unorm8_for(img.channels),
+        width: img.width,
+        height: img.height,
+        channels: img.channels,
+        sample_type: "u8".into(),
+        color_space: "linear".into(),
+        convention: format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it"),
+        verify_tolerance: None,
+        supercompression: Some(sc.label()),
+    };
+    Ok(BakedFile { path: path.into(), bytes: io::ktx2::encode_u8_with(img, sc)?, meta })
+}
+
 fn texture_with_sources(
     stem: &str,
     img: &Image<u8>,
@@ -202,8 +227,11 @@ fn texture_with_sources(
     let mut files = unorm8_texture_files(stem, img, "lut", convention)?;
     if let Some((prefix, array)) = sources {
         let note = format!("{convention}; generated source, bytes identical to {stem}.bin");
-        files.push(text_file(&format!("{stem}.h"), c_header_u8(prefix, array, img, from), "c-header", "c", &note));
-        files.push(text_file(&format!("{stem}.rs"), rust_source_u8(prefix, img, from), "rust-source", "rust", &note));
+        let notice = if prefix == "AREAMAP" { DataNotice::Mlaa } else { DataNotice::Smaa };
+        let header = c_header_u8(prefix, array, img, from, notice);
+        files.push(text_file(&format!("{stem}.h"), header, "c-header", "c", &note));
+        let rust = rust_source_u8(prefix, img, from, notice);
+        files.push(text_file(&format!("{stem}.rs"), rust, "rust-source", "rust", &note));
     }
     Ok(files)
 }
@@ -244,7 +272,13 @@ pub fn assets() -> Vec<Asset> {
             default_params: || json(SmaaAreaParams::default()),
             bake: |v| {
                 let p: SmaaAreaParams = parse_params("smaa-area", v)?;
-                smaa_area_files(&format!("{SMAA_DIR}/AreaTex"), &p, true, &from_line("smaa-area"))
+                let img = smaa_area_texture(&p)?;
+                let convention = smaa_area_convention(&p, img.width, img.height);
+                let stem = format!("{SMAA_DIR}/AreaTex");
+                let sources = Some(("AREATEX", "areaTexBytes"));
+                let mut files = texture_with_sources(&stem, &img, &convention, sources, &from_line("smaa-area"))?;
+                files.push(bevy_zstd_file(&format!("{SMAA_DIR}/{BEVY_AREA_LUT}"), &img, &convention)?);
+                Ok(files)
             },
         },
         Asset {
@@ -262,7 +296,16 @@ pub fn assets() -> Vec<Asset> {
             default_params: || json(NoParams {}),
             bake: |v| {
                 let _: NoParams = parse_params("smaa-search", v)?;
-                search_files(SearchKind::Current, &format!("{SMAA_DIR}/SearchTex"), true, &from_line("smaa-search"))
+                let mut files = search_files(
+                    SearchKind::Current,
+                    &format!("{SMAA_DIR}/SearchTex"),
+                    true,
+                    &from_line("smaa-search"),
+                )?;
+                let convention = search_convention(SearchKind::Current);
+                let path = format!("{SMAA_DIR}/{BEVY_SEARCH_LUT}");
+                files.push(bevy_zstd_file(&path, &smaa_search::search_texture(), &convention)?);
+                Ok(files)
             },
         },
         Asset {
@@ -345,7 +388,7 @@ mod tests {
         assert!(h.contains("#define SEARCHTEX_WIDTH 64") && h.contains("#define SEARCHTEX_HEIGHT 16"));
         assert!(h.contains("static const unsigned char searchTexBytes[]"));
         let rs = std::str::from_utf8(&f.iter().find(|f| f.path == "SearchTex.rs").unwrap().bytes).unwrap().to_string();
-        assert!(rs.contains("pub const SEARCHTEX_BYTES: [u8; 1024]"));
+        assert!(rs.contains("pub static SEARCHTEX_BYTES: [u8; SEARCHTEX_SIZE]"));
         let conv = smaa_area_convention(&SmaaAreaParams::default(), 160, 560);
         assert!(conv.contains("SMAA_AREATEX_MAX_DISTANCE 16") && conv.contains("SMAA_AREATEX_MAX_DISTANCE_DIAG 20"));
         assert!(conv.contains("SMAA_AREATEX_SUBTEX_SIZE (1.0 / 7.0)") && !conv.contains("NOTE"));
@@ -353,7 +396,7 @@ mod tests {
 
     #[test]
     fn containers_hold_the_raw_bytes_as_linear_unorm() {
-        use crate::io::{self, png::DecodedPng, PixelFormat};
+        use crate::io::{self, PixelFormat};
         let mut files = search_files(SearchKind::Current, "s", false, "test").unwrap();
         files.extend(mlaa_files(MlaaVersion::V1_4, 9, "m", false, "test").unwrap());
         for stem in ["s", "m"] {
@@ -367,10 +410,8 @@ mod tests {
             assert_eq!(vk, io::ktx2::vk_format(want_pf));
             assert!(linear, "KTX2 transfer function must be linear, not sRGB");
             assert_eq!(&ktx, raw);
-            match io::png::decode(&get("png").bytes, "png").unwrap() {
-                DecodedPng::U8(img) => assert_eq!(&img.data, raw),
-                DecodedPng::U16(_) => panic!("8-bit PNG expected"),
-            }
+            let png = io::png::decode(&get("png").bytes, "png").unwrap();
+            assert_eq!(&png.into_u8_channels(want_pf.channels()).expect("8-bit PNG").data, raw);
         }
     }
 }

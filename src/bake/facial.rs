@@ -38,6 +38,7 @@ fn float_meta(
         color_space: "linear".into(),
         convention: conv.into(),
         verify_tolerance: Some(tol),
+        supercompression: None,
     }
 }
 
@@ -63,14 +64,24 @@ fn preview_file(
         color_space: "linear".into(),
         convention: format!("viewing only: gray = ({what} - {lo}) / ({hi} - {lo}), clamped; not for sampling"),
         verify_tolerance: Some(1.0),
+        supercompression: None,
     };
     Ok(BakedFile { path, bytes, meta })
 }
 
-/// Encodes the float map files of one single-channel map: `{stem}.exr` (f32) and `{stem}_f16.exr`.
+/// Encodes the float map files of one single-channel map: `{stem}.exr` (f32, one `Y` channel, for engines that
+/// read named channels), `{stem}_f16.exr`, and `{stem}_rgb.exr` (f32 `R`,`G`,`B` with the value in R and
+/// G = B = 0): the layout the `image` crate's EXR decoder, and so Bevy's EXR loader, requires.
 fn exr_pair(dir: &str, stem: &str, w: u32, h: u32, v: &[f32], conv: &str) -> Result<Vec<BakedFile>, BakeError> {
     let img = Image::from_vec(w, h, 1, v.to_vec());
+    let rgb = Image::from_vec(w, h, 3, v.iter().flat_map(|&x| [x, 0.0, 0.0]).collect());
+    let rgb_conv = format!("{conv}; value in R, G = B = 0 (RGB EXR for the image crate / Bevy)");
     Ok(vec![
+        BakedFile {
+            path: format!("{dir}{stem}_rgb.exr"),
+            bytes: io::exr::encode(&rgb, ExrPrecision::F32)?,
+            meta: float_meta("exr", "f32", w, h, 3, None, &rgb_conv, 1e-6),
+        },
         BakedFile {
             path: format!("{dir}{stem}.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F32)?,
@@ -95,9 +106,10 @@ fn min_max(v: &[f32]) -> (f64, f64) {
 }
 
 /// All files of a rig, paths prefixed by `dir` (e.g. `facial/hemoglobin/example/` or empty), plus the
-/// description written to `{dir}rig.json`.
+/// description written to `{dir}rig.json`. `made_by` names the command that made them (recorded as `generated_by`).
 pub fn hemoglobin_rig_files(
     rig: &HemoglobinRig,
+    made_by: &str,
     dir: &str,
     sources: &[RigSource],
     value_unit: &str,
@@ -168,7 +180,7 @@ pub fn hemoglobin_rig_files(
     }
     let desc = RigDescription {
         schema: RIG_SCHEMA.into(),
-        generated_by: format!("rtbake {} (do not edit; regenerate with rtbake maps hemoglobin)", env!("CARGO_PKG_VERSION")),
+        generated_by: format!("rtbake {} from {made_by}; do not edit", env!("CARGO_PKG_VERSION")),
         model: "Jimenez et al. 2010, 'A practical appearance model for dynamic facial color' (thesis ch. 7, eq. 7.1-7.6)".into(),
         evaluation: "H = g * (sum_i w_i * bias_i + H0 * sum_i w_i * scale_i), weights w_i over maps[] summing to 1 (eq. 7.6); \
                      g = 1 or a global state factor (global_scales); maps[0] is the neutral map (scale = 1, bias = mu_neutral)"
@@ -260,6 +272,7 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
                 color_space: "linear".into(),
                 convention: "synthetic hemoglobin map: dermal volume fraction = sample / 65535".into(),
                 verify_tolerance: None,
+                supercompression: None,
             },
         });
         sources.push(RigSource {
@@ -277,7 +290,13 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     };
     let targets: Vec<(String, &[f32])> = conc[1..].iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
     let rig = hemoglobin_rig::build_rig(&conc[0].1, p.size, p.size, &targets, &settings)?;
-    let (rig_files, _) = hemoglobin_rig_files(&rig, &dir, &sources, "dermal hemoglobin volume fraction")?;
+    let (rig_files, _) = hemoglobin_rig_files(
+        &rig,
+        "`rtbake bake hemoglobin-rig-example`",
+        &dir,
+        &sources,
+        "dermal hemoglobin volume fraction",
+    )?;
     files.extend(rig_files);
     Ok(files)
 }
@@ -338,6 +357,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             color_space: "linear".into(),
             convention: "synthetic tangent-space normal map, n = 2*rgb/255 - 1, DirectX green convention".into(),
             verify_tolerance: None,
+            supercompression: None,
         },
     }];
     let decoded = Image::from_vec(

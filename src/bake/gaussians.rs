@@ -58,7 +58,11 @@ pub fn gaussian_files(
     png_meta.channels = 3;
     png_meta.sample_type = "u8".into();
     png_meta.color_space = "srgb".into();
-    files.push(BakedFile { path: format!("{stem}_plot.png"), bytes: crate::io::png::encode_u8(&img)?, meta: png_meta });
+    files.push(BakedFile {
+        path: format!("{stem}_plot.png"),
+        bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
+        meta: png_meta,
+    });
     files.push(text_file(
         &format!("{stem}_plot.svg"),
         plot.to_svg(PLOT_WIDTH, PLOT_HEIGHT),

@@ -57,7 +57,7 @@ pub mod skin;
 pub mod transmittance;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
-/// layout for the manifest. PNG of RG data is gray + alpha (R in gray, G in alpha).
+/// layout for the manifest. PNG of RG data is RGB with B = 0 (what engines and browsers load as R, G), tagged linear.
 pub fn unorm8_texture_files(
     stem: &str,
     img: &Image<u8>,
@@ -76,10 +76,13 @@ pub fn unorm8_texture_files(
         color_space: "linear".into(),
         convention: convention.into(),
         verify_tolerance: None,
+        supercompression: None,
     };
     let mut png_meta = meta("png");
     if img.channels == 2 {
-        png_meta.convention = format!("{convention}; PNG stores R as gray and G as alpha");
+        png_meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
+        png_meta.channels = 3;
+        png_meta.pixel_format = None;
     }
     Ok(vec![
         BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") },
@@ -110,6 +113,7 @@ pub fn float_texture_files(
         color_space: cs.into(),
         convention: convention.into(),
         verify_tolerance: tol,
+        supercompression: None,
     };
     let half_tol = tolerance.max(1e-3);
     let mut preview = meta("png", None, "u8", "srgb", Some(1.0));
@@ -137,6 +141,17 @@ pub fn float_texture_files(
             meta: preview,
         },
     ])
+}
+
+/// Rewrites every uncompressed KTX2 file of `files` with Zstandard supercompression at `level` (1..=22) and records
+/// it in the file's metadata (`supercompression: zstd-<level>`). Other files are left as they are.
+pub fn supercompress_ktx2(files: &mut [BakedFile], level: i32) -> Result<(), BakeError> {
+    crate::error::check_range("zstd level", level, 1, 22, "")?;
+    for f in files.iter_mut().filter(|f| f.meta.format == "ktx2" && f.meta.supercompression.is_none()) {
+        f.bytes = io::ktx2::supercompress(&f.bytes, &f.path, level)?;
+        f.meta.supercompression = Some(io::ktx2::Supercompression::Zstd(level).label());
+    }
+    Ok(())
 }
 
 /// A pretty-printed JSON file (stable key order, trailing newline).

@@ -1,6 +1,6 @@
 //! Diffusion-profile tables and plots in `baked/profiles/` (`specs/diffusion.md`, "Outputs"): R(r) (and T(r) for
 //! layer stacks) per channel on a log radius grid, with the totals R̂(0), T̂(0) and the model options, as CSV and
-//! JSON ([`ProfileTable`]), plus a two-panel plot ([`crate::diffusion::plot`]: r·R(r) over log r, R(r) log–log) as
+//! JSON ([`ProfileTable`]), plus a two-panel plot ([`crate::plot::profile`]: r·R(r) over log r, R(r) log–log) as
 //! SVG for every profile and as PNG for the few listed in `png_plots`.
 //!
 //! Default profiles:
@@ -24,11 +24,11 @@
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::diffusion::layered::{Adding, LayerStack};
 use crate::diffusion::multipole::Series;
-use crate::diffusion::plot::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::diffusion::source::{MaterialModel, ProfileSource};
 use crate::diffusion::table::{self, ProfileTable};
 use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
+use crate::plot::profile::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};

@@ -77,7 +77,10 @@ fn default_kernels_params() -> Value {
     serde_json::to_value(KernelsParams { kernels: default_kernels() }).expect("params serialise")
 }
 
-/// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl` (pure; `rtbake kernel --out` uses it too).
+/// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl`, the upstream-form `{stem}_SeparableSSS.h`
+/// kernel (pasted in place of `SeparableSSS.h`'s preset of the same N) and the raw little-endian
+/// `{stem}_f32x4.bin` (N taps of `[r, g, b, offset]`, the runtime upload path). Pure; `rtbake kernel --out` uses
+/// it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
     let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
     let convention = kernel::LAYOUT_DOC;
@@ -92,6 +95,32 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
             convention,
         ));
     }
+    files.push(text_file(
+        &format!("{prefix}{stem}_SeparableSSS.h"),
+        k.separable_sss_h(source),
+        "shader-include",
+        "hlsl",
+        "SeparableSSS.h form: #define SSSS_N_SAMPLES N + static const float4 kernel[N] (rgb = weight, a = offset), \
+         to replace the header's built-in preset of the same N",
+    ));
+    let n = k.taps.len() as u32;
+    files.push(BakedFile {
+        path: format!("{prefix}{stem}_f32x4.bin"),
+        bytes: k.f32x4_le_bytes(),
+        meta: crate::manifest::FileMeta {
+            kind: "kernel".into(),
+            format: "raw".into(),
+            pixel_format: Some(crate::io::PixelFormat::R32G32B32A32Sfloat),
+            width: n,
+            height: 1,
+            channels: 4,
+            sample_type: "f32".into(),
+            color_space: "n/a".into(),
+            convention: format!("{convention}; little-endian f32 x 4 x {n}, no header (SeparableSSS.h runtime kernel)"),
+            verify_tolerance: None,
+            supercompression: None,
+        },
+    });
     files
 }
 
@@ -206,7 +235,13 @@ mod tests {
     #[test]
     fn default_kernels_bake_to_json_and_three_includes_each() {
         let files = bake_kernels(&default_kernels_params()).unwrap();
-        assert_eq!(files.len(), 6 * 4);
+        assert_eq!(files.len(), 6 * 6, "json, 3 includes, SeparableSSS.h form and raw f32x4 per kernel");
+        let raw = files.iter().find(|f| f.path == "sss/separable/published_n17_f32x4.bin").unwrap();
+        assert_eq!(raw.bytes.len(), 17 * 16);
+        let upstream = files.iter().find(|f| f.path == "sss/separable/published_n17_SeparableSSS.h").unwrap();
+        let text = std::str::from_utf8(&upstream.bytes).unwrap();
+        assert!(text.contains("#define SSSS_N_SAMPLES 17\nstatic const float4 kernel[] = {\n"), "{text}");
+        assert_eq!(text.matches("float4(").count(), 17);
         assert!(files.iter().all(|f| f.path.starts_with("sss/separable/")));
         let j = files.iter().find(|f| f.path == "sss/separable/published_n17.json").unwrap();
         let v: Value = serde_json::from_slice(&j.bytes).unwrap();
@@ -242,7 +277,9 @@ mod tests {
                 "sss/separable/fit_deon6_n17.json",
                 "sss/separable/fit_deon6_n17.hlsl",
                 "sss/separable/fit_deon6_n17.glsl",
-                "sss/separable/fit_deon6_n17.wgsl"
+                "sss/separable/fit_deon6_n17.wgsl",
+                "sss/separable/fit_deon6_n17_SeparableSSS.h",
+                "sss/separable/fit_deon6_n17_f32x4.bin"
             ]
         );
         let v: Value = serde_json::from_slice(&a[0].bytes).unwrap();

@@ -12,7 +12,7 @@
 //! - [`materials`], [`sum_of_gaussians`]: the Jensen 2001 materials and d'Eon's Gaussian presets.
 //! - [`source::ProfileSource`]: the one way commands resolve "material / preset / layer stack" into a
 //!   `Box<dyn RadialProfile>` plus provenance; [`table::ProfileTable`]: R, T on a radius grid as CSV / JSON;
-//!   [`plot`]: a table as a two-panel plot (r·R(r) over log r, R(r) log–log) in PNG or SVG.
+//!   `crate::plot::profile`: a table as a two-panel plot (r·R(r) over log r, R(r) log–log) in PNG or SVG.
 //! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
 pub mod bessel;
@@ -21,7 +21,6 @@ pub mod hankel;
 pub mod layered;
 pub mod materials;
 pub mod multipole;
-pub mod plot;
 pub mod quadrature;
 pub mod source;
 pub mod sum_of_gaussians;

@@ -1,6 +1,10 @@
 //! DDS with the DX10 extended header (via `ddsfile`): real two-channel formats, unlike the 24-bit RGB files
 //! upstream SMAA ships labelled as R8G8. Supported: `R8_UNORM`, `R8G8_UNORM`, `R8G8B8A8_UNORM`,
 //! `R16G16B16A16_FLOAT`, `R32G32B32A32_FLOAT`. Data textures are non-sRGB.
+//!
+//! The legacy pixel-format block of a DX10 file says FourCC only (`dwFlags = DDPF_FOURCC`, bit count and masks
+//! 0), as the DDS programming guide specifies: `ddsfile` also sets `DDPF_RGB` and a bit count there, and readers
+//! that follow the flags (Pillow, ImageMagick) then decode the file as uncompressed RGB — black or garbage.
 
 use super::{IoError, PixelFormat};
 use crate::image_buf::Image;
@@ -40,7 +44,21 @@ fn build(width: u32, height: u32, format: PixelFormat, payload: Vec<u8>) -> Resu
     dds.data = payload;
     let mut out = Vec::new();
     dds.write(&mut out).map_err(|e| IoError::Unsupported { what: "dds", detail: e.to_string() })?;
+    fourcc_only_pixel_format(&mut out);
     Ok(out)
+}
+
+/// File offsets of the DDS_PIXELFORMAT fields (after the 4-byte magic and 72 header bytes).
+const PF_FLAGS: usize = 4 + 72 + 4;
+const PF_FOURCC: usize = PF_FLAGS + 4;
+const PF_BITCOUNT_AND_MASKS: std::ops::Range<usize> = PF_FOURCC + 4..PF_FOURCC + 24;
+const DDPF_FOURCC: u32 = 0x4;
+
+/// Rewrites the pixel-format block of a DX10 file to `DDPF_FOURCC` with zero bit count and masks.
+fn fourcc_only_pixel_format(file: &mut [u8]) {
+    debug_assert_eq!(&file[PF_FOURCC..PF_FOURCC + 4], b"DX10");
+    file[PF_FLAGS..PF_FLAGS + 4].copy_from_slice(&DDPF_FOURCC.to_le_bytes());
+    file[PF_BITCOUNT_AND_MASKS].fill(0);
 }
 
 /// 8-bit UNORM texture with 1, 2 or 4 channels.
@@ -99,6 +117,9 @@ mod tests {
         let img = Image::from_vec(4, 3, 2, (0..24u8).collect());
         let bytes = encode_u8(&img).unwrap();
         assert_eq!(&bytes[84..88], b"DX10");
+        // Pixel-format flags: FourCC only; bit count and masks zero.
+        assert_eq!(u32::from_le_bytes(bytes[80..84].try_into().unwrap()), DDPF_FOURCC);
+        assert!(bytes[88..108].iter().all(|&b| b == 0));
         let (f, w, h, data) = decode(&bytes, "t").unwrap();
         assert_eq!((f, w, h), (PixelFormat::R8G8Unorm, 4, 3));
         assert_eq!(data, img.data);

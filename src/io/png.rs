@@ -1,48 +1,93 @@
-//! PNG encoding/decoding (via the `image` crate).
+//! PNG encoding (via the `png` crate, for the colour chunks) and decoding (via the `image` crate).
 //!
-//! Channel mapping: 1 channel → gray, **2 channels (RG) → gray + alpha** (R in gray, G in alpha),
-//! 3 → RGB, 4 → RGBA. 8-bit PNGs of data textures hold the raw bytes (linear data, no gamma chunk);
-//! previews of float data are sRGB-encoded and labelled as such in the manifest.
+//! Channel mapping for what engines load (Bevy, three.js, browsers, Unity): 1 channel → gray, **2 channels (RG) →
+//! RGB with R, G in red and green and B = 0** (gray + alpha would be expanded to (R, R, R, G) and put G in `.a`),
+//! 3 → RGB, 4 → RGBA. Every PNG says its colour space so colour-managed readers (OIIO, browsers) do not guess
+//! (PNG Third Edition §11.3.2): data is tagged [`PngColor::Linear`] (`gAMA` 1.0 and `cICP` BT.709 / linear /
+//! full range), viewing images [`PngColor::Srgb`] (`sRGB` chunk with its `gAMA`/`cHRM` fallbacks and `cICP`
+//! BT.709 / IEC 61966-2-1 / full range).
 
 use super::IoError;
 use crate::image_buf::{Image, ImageF32};
-use image::{ExtendedColorType, ImageEncoder};
 
-fn color_type(channels: u32, sixteen: bool) -> Result<ExtendedColorType, IoError> {
-    Ok(match (channels, sixteen) {
-        (1, false) => ExtendedColorType::L8,
-        (2, false) => ExtendedColorType::La8,
-        (3, false) => ExtendedColorType::Rgb8,
-        (4, false) => ExtendedColorType::Rgba8,
-        (1, true) => ExtendedColorType::L16,
-        (2, true) => ExtendedColorType::La16,
-        (3, true) => ExtendedColorType::Rgb16,
-        (4, true) => ExtendedColorType::Rgba16,
+/// Colour space a PNG declares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngColor {
+    /// Linear data (LUTs, maps): `gAMA` = 100000 (γ 1.0), `cICP` 1/8/0/1.
+    Linear,
+    /// sRGB-encoded image for viewing: `sRGB` (perceptual), `gAMA` 45455, `cHRM` BT.709, `cICP` 1/13/0/1.
+    Srgb,
+}
+
+/// ITU-T H.273 transfer characteristics: 8 = linear, 13 = IEC 61966-2-1 (sRGB).
+const CICP_TRANSFER_LINEAR: u8 = 8;
+const CICP_TRANSFER_SRGB: u8 = 13;
+
+fn color_type(channels: u32) -> Result<png::ColorType, IoError> {
+    Ok(match channels {
+        1 => png::ColorType::Grayscale,
+        3 => png::ColorType::Rgb,
+        4 => png::ColorType::Rgba,
         _ => return Err(IoError::Unsupported { what: "png", detail: format!("{channels} channels") }),
     })
 }
 
-fn encode(bytes: &[u8], w: u32, h: u32, ct: ExtendedColorType) -> Result<Vec<u8>, IoError> {
+/// Samples of a 2-channel image widened to RGB with B = 0 (`zero` is the zero sample).
+fn rg_to_rgb<T: Copy>(data: &[T], zero: T) -> Vec<T> {
+    data.chunks_exact(2).flat_map(|rg| [rg[0], rg[1], zero]).collect()
+}
+
+fn encode(bytes: &[u8], w: u32, h: u32, channels: u32, sixteen: bool, color: PngColor) -> Result<Vec<u8>, IoError> {
+    let err = |e: png::EncodingError| IoError::Unsupported { what: "png", detail: e.to_string() };
+    let mut info = png::Info::with_size(w, h);
+    info.color_type = color_type(channels)?;
+    info.bit_depth = if sixteen { png::BitDepth::Sixteen } else { png::BitDepth::Eight };
+    let transfer = match color {
+        PngColor::Linear => {
+            info.source_gamma = Some(png::ScaledFloat::from_scaled(100_000));
+            CICP_TRANSFER_LINEAR
+        }
+        PngColor::Srgb => {
+            info.srgb = Some(png::SrgbRenderingIntent::Perceptual);
+            info.source_gamma = Some(png::ScaledFloat::from_scaled(45_455));
+            info.source_chromaticities =
+                Some(png::SourceChromaticities::new((0.3127, 0.3290), (0.64, 0.33), (0.30, 0.60), (0.15, 0.06)));
+            CICP_TRANSFER_SRGB
+        }
+    };
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new_with_quality(
-        &mut out,
-        image::codecs::png::CompressionType::Best,
-        image::codecs::png::FilterType::Adaptive,
-    )
-    .write_image(bytes, w, h, ct)
-    .map_err(|e| IoError::Unsupported { what: "png", detail: e.to_string() })?;
+    {
+        let mut enc = png::Encoder::with_info(&mut out, info).map_err(err)?;
+        enc.set_compression(png::Compression::High);
+        let mut writer = enc.write_header().map_err(err)?;
+        // cICP (PNG Third Edition §11.3.2.6): BT.709 primaries, transfer, RGB (matrix 0), full range. The
+        // encoder does not write `Info::coding_independent_code_points`, so the chunk is written here, before IDAT.
+        writer.write_chunk(png::chunk::cICP, &[1, transfer, 0, 1]).map_err(err)?;
+        writer.write_image_data(bytes).map_err(err)?;
+        writer.finish().map_err(err)?;
+    }
     Ok(out)
 }
 
-/// 8-bit PNG holding the bytes of `img` unchanged.
+/// 8-bit PNG of linear data: the bytes of `img` unchanged (RG widened to RGB with B = 0), tagged linear.
 pub fn encode_u8(img: &Image<u8>) -> Result<Vec<u8>, IoError> {
-    encode(&img.data, img.width, img.height, color_type(img.channels, false)?)
+    encode_u8_as(img, PngColor::Linear)
 }
 
-/// 16-bit PNG holding the samples of `img` unchanged.
+/// 8-bit PNG holding the bytes of `img` (RG widened to RGB with B = 0) with the given colour tag.
+pub fn encode_u8_as(img: &Image<u8>, color: PngColor) -> Result<Vec<u8>, IoError> {
+    if img.channels == 2 {
+        return encode(&rg_to_rgb(&img.data, 0), img.width, img.height, 3, false, color);
+    }
+    encode(&img.data, img.width, img.height, img.channels, false, color)
+}
+
+/// 16-bit PNG of linear data: the samples of `img` unchanged (RG widened to RGB with B = 0), tagged linear.
 pub fn encode_u16(img: &Image<u16>) -> Result<Vec<u8>, IoError> {
-    // The encoder takes native-endian samples and writes big-endian PNG.
-    encode(bytemuck::cast_slice(&img.data), img.width, img.height, color_type(img.channels, true)?)
+    let (data, channels) =
+        if img.channels == 2 { (rg_to_rgb(&img.data, 0), 3) } else { (img.data.clone(), img.channels) };
+    let be: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
+    encode(&be, img.width, img.height, channels, true, PngColor::Linear)
 }
 
 /// Linear float → 16-bit linear PNG: value v in [0, 1] stored as round(65535·v) (clamped).
@@ -51,17 +96,7 @@ pub fn encode_linear16(img: &ImageF32) -> Result<Vec<u8>, IoError> {
     encode_u16(&Image::from_vec(img.width, img.height, img.channels, data))
 }
 
-/// IEC 61966-2-1 sRGB encoding of a linear value in [0, 1].
-pub fn srgb_encode(linear: f64) -> f64 {
-    let v = linear.clamp(0.0, 1.0);
-    if v <= 0.0031308 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// Linear float → 8-bit **sRGB-encoded** preview (for viewing only; alpha, if any, stays linear).
+/// Linear float → 8-bit **sRGB-encoded** preview tagged sRGB (for viewing only; alpha, if any, stays linear).
 pub fn encode_srgb_preview(img: &ImageF32) -> Result<Vec<u8>, IoError> {
     let ch = img.channels;
     let data: Vec<u8> = img
@@ -70,11 +105,23 @@ pub fn encode_srgb_preview(img: &ImageF32) -> Result<Vec<u8>, IoError> {
         .enumerate()
         .map(|(i, &v)| {
             let c = i as u32 % ch;
-            let e = if ch == 4 && c == 3 { (v as f64).clamp(0.0, 1.0) } else { srgb_encode(v as f64) };
+            let e = if ch == 4 && c == 3 { (v as f64).clamp(0.0, 1.0) } else { crate::color::srgb::encode(v as f64) };
             (e * 255.0).round() as u8
         })
         .collect();
-    encode_u8(&Image::from_vec(img.width, img.height, ch, data))
+    encode_u8_as(&Image::from_vec(img.width, img.height, ch, data), PngColor::Srgb)
+}
+
+/// The chunk types of a PNG file in order (`IHDR`, `gAMA`, …), for tests and checks.
+pub fn chunk_types(bytes: &[u8]) -> Vec<[u8; 4]> {
+    let mut out = Vec::new();
+    let mut at = 8;
+    while at + 8 <= bytes.len() {
+        let len = u32::from_be_bytes(bytes[at..at + 4].try_into().expect("4 bytes")) as usize;
+        out.push(bytes[at + 4..at + 8].try_into().expect("4 bytes"));
+        at += 12 + len;
+    }
+    out
 }
 
 /// A decoded PNG: 8- or 16-bit samples.
@@ -107,18 +154,55 @@ pub fn decode(bytes: &[u8], path: &str) -> Result<DecodedPng, IoError> {
     })
 }
 
+impl DecodedPng {
+    /// The 8-bit samples as `channels` channels: an RG texture stored as RGB (B = 0) comes back as RG.
+    /// `None` if the file is 16-bit or its layout does not hold `channels` channels that way.
+    pub fn into_u8_channels(self, channels: u32) -> Option<Image<u8>> {
+        match self {
+            DecodedPng::U8(img) if img.channels == channels => Some(img),
+            DecodedPng::U8(img) if channels == 2 && img.channels == 3 => {
+                let rg = img.data.chunks_exact(3).flat_map(|p| [p[0], p[1]]).collect();
+                Some(Image::from_vec(img.width, img.height, 2, rg))
+            }
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn rg8_round_trips_as_gray_alpha() {
-        let img = Image::from_vec(3, 2, 2, (0..12u8).map(|v| v * 20).collect());
+    fn rg8_is_stored_as_rgb_with_zero_blue_and_tagged_linear() {
+        let img = Image::from_vec(3, 2, 2, (0..12u8).map(|v| v * 20 + 1).collect());
         let bytes = encode_u8(&img).unwrap();
+        // IHDR colour type 2 (truecolour), bit depth 8.
+        assert_eq!((bytes[24], bytes[25]), (8, 2));
         match decode(&bytes, "t").unwrap() {
-            DecodedPng::U8(back) => assert_eq!(back, img),
+            DecodedPng::U8(rgb) => {
+                assert_eq!(rgb.channels, 3);
+                assert!(rgb.data.chunks_exact(3).all(|p| p[2] == 0));
+                assert_eq!(DecodedPng::U8(rgb).into_u8_channels(2).unwrap(), img);
+            }
             _ => panic!("expected 8-bit"),
         }
+        let chunks = chunk_types(&bytes);
+        assert!(chunks.contains(b"gAMA") && chunks.contains(b"cICP") && !chunks.contains(b"sRGB"), "{chunks:?}");
+        let at = bytes.windows(4).position(|w| w == b"gAMA").unwrap();
+        assert_eq!(u32::from_be_bytes(bytes[at + 4..at + 8].try_into().unwrap()), 100_000);
+        let at = bytes.windows(4).position(|w| w == b"cICP").unwrap();
+        assert_eq!(&bytes[at + 4..at + 8], &[1, 8, 0, 1]);
+    }
+
+    #[test]
+    fn previews_are_tagged_srgb() {
+        let img = Image::from_vec(1, 1, 3, vec![0.5f32; 3]);
+        let bytes = encode_srgb_preview(&img).unwrap();
+        let chunks = chunk_types(&bytes);
+        assert!(chunks.contains(b"sRGB") && chunks.contains(b"cICP"), "{chunks:?}");
+        let at = bytes.windows(4).position(|w| w == b"cICP").unwrap();
+        assert_eq!(&bytes[at + 4..at + 8], &[1, 13, 0, 1]);
     }
 
     #[test]

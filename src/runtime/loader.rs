@@ -296,6 +296,42 @@ pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutE
     separable_kernel_from_json(&v, path)
 }
 
+/// Loads a separable-SSS kernel from its raw little-endian `f32 × 4 × N` file (`{stem}_f32x4.bin`, the layout
+/// `SeparableSSS.h`'s runtime `kernel[SSSS_N_SAMPLES]` takes) after the manifest checks (format raw, f32,
+/// R32G32B32A32, 1 row); the taps get the same content checks as the JSON (centre first, channels sum to 1).
+pub fn load_separable_kernel_f32x4(
+    dir: &Path,
+    path: &str,
+) -> Result<crate::runtime::separable_sss::SssKernel, LutError> {
+    let manifest = Manifest::load(dir)?;
+    let expect = Expect {
+        format: "raw",
+        pixel_format: Some(PixelFormat::R32G32B32A32Sfloat),
+        size: None,
+        channels: Some(4),
+        sample_type: "f32",
+        data: DataKind::Table,
+    };
+    let (bytes, entry) = read_checked(dir, &manifest, path, &expect)?;
+    let taps = crate::separable::kernel::taps_from_f32x4_le(&bytes).map_err(|e| content(path, e.to_string()))?;
+    if taps.len() != entry.meta.width as usize || entry.meta.height != 1 {
+        return Err(content(
+            path,
+            format!("{} taps, manifest says {}x{}", taps.len(), entry.meta.width, entry.meta.height),
+        ));
+    }
+    if taps[0][3] != 0.0 {
+        return Err(content(path, "kernel[0] must be the centre tap (offset 0)"));
+    }
+    for c in 0..3 {
+        let sum: f64 = taps.iter().map(|t| t[c] as f64).sum();
+        if (sum - 1.0).abs() > 1e-4 {
+            return Err(content(path, format!("channel {c} weights sum to {sum}, expected 1 (±1e-4)")));
+        }
+    }
+    crate::runtime::separable_sss::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))
+}
+
 /// The content checks of [`load_separable_kernel`] on an already-parsed kernel file (`path` names it in errors);
 /// for kernel files outside a bake directory, which have no manifest entry to check against.
 pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<BakedKernel, LutError> {

@@ -382,6 +382,51 @@ impl Kernel {
     }
 }
 
+impl Kernel {
+    /// The kernel in the form `SeparableSSS.h` takes (Jimenez et al., github.com/iryoku/separable-sss): a
+    /// `#define SSSS_N_SAMPLES N` and a `float4 kernel[] = { … };` array, to paste in place of the header's
+    /// built-in preset of the same N (the block under `#if SSSS_QUALITY == …`). The array is `static const`:
+    /// a plain global would be a uniform of `$Global` whose initializer D3D without the Effects framework and
+    /// glslang both drop (measured: glslang's SPIR-V holds no kernel constants then), while `static const`
+    /// compiles the taps into the shader. Taps are printed with 9 significant digits (f32 round-trip).
+    pub fn separable_sss_h(&self, from: &str) -> String {
+        let s = &self.spec;
+        let mut t = format!("/* {} */\n", crate::io::source::preamble_text(from));
+        t.push_str(&format!(
+            "/* Separable SSS kernel for SeparableSSS.h: strength {:?}, falloff {:?}, range {}, exponent {}.\n   \
+             Replace the preset block with N = {} (#define SSSS_N_SAMPLES ... float4 kernel[] = {{...}};) by this text. */\n",
+            s.params.strength, s.params.falloff, self.range, s.exponent, s.samples
+        ));
+        t.push_str(&format!("#define SSSS_N_SAMPLES {}\nstatic const float4 kernel[] = {{\n", s.samples));
+        for tap in &self.taps {
+            let c: Vec<String> = tap.iter().map(|v| format!("{:.8e}", *v as f32)).collect();
+            t.push_str(&format!("    float4({}),\n", c.join(", ")));
+        }
+        t.push_str("};\n");
+        t
+    }
+
+    /// The taps as raw little-endian `f32 × 4 × N` (`[r, g, b, offset]` per tap, centre first): the runtime
+    /// upload path of `SeparableSSS.h` (`#define SSSS_N_SAMPLES N` before the include, then set `kernel`).
+    pub fn f32x4_le_bytes(&self) -> Vec<u8> {
+        self.taps.iter().flat_map(|t| t.iter().flat_map(|&v| (v as f32).to_le_bytes())).collect()
+    }
+}
+
+/// Parses raw little-endian `f32 × 4 × N` taps (see [`Kernel::f32x4_le_bytes`]).
+pub fn taps_from_f32x4_le(bytes: &[u8]) -> Result<Vec<[f32; 4]>, InvalidInput> {
+    if bytes.is_empty() || !bytes.len().is_multiple_of(16) {
+        return Err(InvalidInput::new(
+            "kernel",
+            format!("raw f32x4 kernel must be a non-empty multiple of 16 bytes, got {}", bytes.len()),
+        ));
+    }
+    Ok(bytes
+        .chunks_exact(16)
+        .map(|t| std::array::from_fn(|i| f32::from_le_bytes(t[4 * i..4 * i + 4].try_into().expect("4 bytes"))))
+        .collect())
+}
+
 /// How the `kernel` array is laid out (recorded in every kernel file).
 pub const LAYOUT_DOC: &str = "kernel[i] = [r, g, b, offset]: per-channel weight (each channel sums to 1 over all \
 taps) and offset in kernel units (mm of the profile); kernel[0] is the centre (offset 0), then offsets from -range \

@@ -160,7 +160,7 @@ pub fn xyz_to_linear_srgb(xyz: [f64; 3]) -> [f64; 3] {
 /// Linear sRGB → 8-bit sRGB-encoded (IEC 61966-2-1 transfer function, clamped to [0, 1], rounded), the same
 /// encoding as the viewing-preview PNGs.
 pub fn srgb8(linear: [f64; 3]) -> [u8; 3] {
-    linear.map(|v| (crate::io::png::srgb_encode(v) * 255.0).round() as u8)
+    linear.map(|v| (crate::color::srgb::encode(v) * 255.0).round() as u8)
 }
 
 #[cfg(test)]

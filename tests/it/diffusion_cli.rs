@@ -24,7 +24,14 @@ fn bad(args: &[&str], needle: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {err}");
     assert!(err.contains(needle), "{args:?}: stderr should name {needle:?}: {err}");
-    assert!(out.stdout.is_empty(), "{args:?}: nothing on stdout on error");
+    if args.contains(&"--json") {
+        // With --json, stdout holds exactly the error object.
+        let v: Value = serde_json::from_slice(&out.stdout).expect("--json error object on stdout");
+        assert_eq!(v["exit_code"], 2, "{args:?}: {v}");
+        assert!(v["error"].as_str().unwrap().contains(needle), "{args:?}: {v}");
+    } else {
+        assert!(out.stdout.is_empty(), "{args:?}: nothing on stdout on error");
+    }
 }
 
 const STACK: &str = r#"{"eta_above": 1.0, "eta_below": 1.0, "layers": [

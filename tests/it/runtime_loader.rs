@@ -19,6 +19,7 @@ fn meta(pf: PixelFormat, w: u32, h: u32, color_space: &str) -> FileMeta {
         color_space: color_space.into(),
         convention: "test".into(),
         verify_tolerance: None,
+        supercompression: None,
     }
 }
 

@@ -58,7 +58,10 @@ fn kernel_out_writes_json_and_three_includes() {
     let mut names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, vec!["skin.glsl", "skin.hlsl", "skin.json", "skin.wgsl"]);
+    assert_eq!(
+        names,
+        vec!["skin.glsl", "skin.hlsl", "skin.json", "skin.wgsl", "skin_SeparableSSS.h", "skin_f32x4.bin"]
+    );
     let file: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("skin.json")).unwrap()).unwrap();
     assert!((file["kernel"][0][0].as_f64().unwrap() - 0.560479).abs() <= 5e-7);
     assert_eq!(file["range"].as_f64().unwrap(), 2.0);
@@ -145,7 +148,10 @@ fn fit_separable_bad_input_exits_2_and_writes_nothing() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
         assert!(stderr.contains(flag), "{extra:?}: {stderr}");
-        assert!(out.stdout.is_empty());
+        // --json: the only thing on stdout is the error object.
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("--json error object on stdout");
+        assert_eq!(v["exit_code"], 2, "{extra:?}: {v}");
+        assert!(v["error"].as_str().unwrap().contains(flag), "{extra:?}: {v}");
         assert!(dir_is_empty(&dir), "{extra:?} wrote files");
     }
 }

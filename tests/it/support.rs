@@ -145,3 +145,31 @@ pub fn pixels_within(a: &[u8], b: &[u8], ch: usize, tol: u8) -> f64 {
         a.chunks(ch).zip(b.chunks(ch)).filter(|(p, q)| p.iter().zip(*q).all(|(x, y)| x.abs_diff(*y) <= tol)).count();
     ok as f64 / n as f64
 }
+
+/// Whether an external program runs (`cmd args…` exits 0); otherwise the one rule for missing inputs applies to
+/// `what` (SKIPPED on stderr, or a failure under `RTBAKE_REQUIRE_REFERENCE=1`). `install` says how CI gets it.
+pub fn tool_available(what: &str, cmd: &str, args: &[&str], install: &str) -> bool {
+    let ok = std::process::Command::new(cmd)
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !ok {
+        let msg = format!("SKIPPED: {what} — `{cmd} {}` does not run ({install}; .ci/run installs it)", args.join(" "));
+        if external_inputs_required() {
+            panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
+        }
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "{msg}");
+    }
+    ok
+}
+
+/// The files of the committed bake whose manifest entry has this container format, as (path, entry).
+pub fn baked_files_of_format(format: &str) -> Vec<(PathBuf, rtbake::manifest::Entry)> {
+    let dir = baked_dir();
+    let manifest = rtbake::manifest::Manifest::load(&dir).expect("baked/manifest.json");
+    manifest.files.into_iter().filter(|e| e.meta.format == format).map(|e| (dir.join(&e.path), e)).collect()
+}

@@ -10,9 +10,9 @@
 //! a lighter shade of the channel colour; an optional sum-of-Gaussians overlay is dashed in a darker shade. Pure:
 //! returns a [`LinePlot`] pair, text or PNG bytes; callers write the files.
 
-use super::sum_of_gaussians::RgbGaussians;
-use super::table::ProfileTable;
-use super::RadialProfile;
+use crate::diffusion::sum_of_gaussians::RgbGaussians;
+use crate::diffusion::table::ProfileTable;
+use crate::diffusion::RadialProfile;
 use crate::error::InvalidInput;
 use crate::fitting::CHANNEL_COLORS;
 use crate::plot::{panels_to_image, panels_to_svg, LinePlot, Series};
@@ -131,7 +131,10 @@ pub fn render(panels: &[LinePlot], format: PlotFormat, provenance: &Value) -> Re
             let (head, body) = svg.split_once('\n').unwrap_or((&svg, ""));
             Ok(format!("{head}\n<desc>rtbake profile: {desc}</desc>\n{body}").into_bytes())
         }
-        PlotFormat::Png => crate::io::png::encode_u8(&panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT)),
+        PlotFormat::Png => crate::io::png::encode_u8_as(
+            &panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT),
+            crate::io::png::PngColor::Srgb,
+        ),
     }
 }
 

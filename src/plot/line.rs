@@ -1,10 +1,11 @@
-//! Minimal line plots as SVG text and as raster images (for PNG), without fonts or plotting dependencies.
+//! Minimal line plots as SVG text and as raster images (for PNG), without system fonts or plotting dependencies.
 //!
-//! Why not `plotters`: its text rendering needs system fonts (or the `ab_glyph` feature plus a bundled font), and
-//! the plots here are a few polylines on a linear or log₁₀ x axis. The SVG is written directly (ticks, numeric tick
-//! labels, axis labels, legend). The raster version draws the same axes, ticks, grid and polylines into an
-//! `Image<u8>` and writes its numeric tick labels with a built-in 3×5 pixel digit font; axis titles and the legend
-//! text appear only in the SVG (the PNG legend is colour swatches in series order). The y axis may be log₁₀ too
+//! Why not `plotters`: its text needs system fonts or the `ab_glyph` feature plus a bundled TrueType font (and the
+//! crate's compile time) for plots that are a few polylines on a linear or log₁₀ x axis. The SVG is written
+//! directly (title, ticks, tick labels, axis labels with units, legend). The raster version draws the same axes,
+//! ticks, grid, polylines, title, axis labels (the y label rotated) and legend names into an `Image<u8>` with a
+//! built-in 3×5 pixel capital font scaled ×2 (lower case is drawn as capitals; `²`, `⁻`, `μ`, `·` map to `2`,
+//! `-`, `U`, `*`), so both formats carry the same text. The y axis may be log₁₀ too
 //! (decade ticks; at most [`LOG_Y_DECADES`] decades below the largest value are shown). Several plots can be stacked
 //! vertically into one document ([`panels_to_svg`], [`panels_to_image`]). Pure: returns text / pixels.
 
@@ -233,6 +234,11 @@ impl LinePlot {
                     format!("{px:.2},{py:.2}")
                 })
                 .collect();
+            // A polyline needs at least two points (ImageMagick refuses an empty `points`); a series with nothing
+            // in the visible range keeps only its legend entry.
+            if pts.len() < 2 {
+                continue;
+            }
             let [r, g, b] = series.color;
             let dash = if series.dashed { r#" stroke-dasharray="6,4""# } else { "" };
             let _ = writeln!(
@@ -315,11 +321,17 @@ impl LinePlot {
                 phase += ((p[1].0 - p[0].0).powi(2) + (p[1].1 - p[0].1).powi(2)).sqrt();
             }
         }
+        // Legend: swatch and name, right-aligned inside the frame's top-right corner.
+        let widest = self.series.iter().map(|s| text_width(&s.label)).fold(0.0, f64::max);
         for (i, series) in self.series.iter().enumerate() {
-            let y = MARGIN_T + 8.0 + 10.0 * i as f64;
-            let x = w - MARGIN_R - 40.0;
+            let y = MARGIN_T + 8.0 + 14.0 * i as f64;
+            let x = w - MARGIN_R - 40.0 - widest;
             c.line(x, y, x + 24.0, y, series.color, series.dashed);
+            c.text(&series.label, x + 30.0, y - 5.0, false, black);
         }
+        c.text(&self.title, w / 2.0, MARGIN_T - 24.0, true, black);
+        c.text(&self.x_label, (ax0 + ax1) / 2.0, h - 16.0, true, black);
+        c.text_vertical(&self.y_label, 6.0, (ay0 + ay1) / 2.0, black);
         c.img
     }
 }
@@ -355,9 +367,25 @@ pub fn panels_to_image(panels: &[LinePlot], width: u32, panel_height: u32) -> Im
     Image::from_vec(width, panel_height * panels.len() as u32, 3, data)
 }
 
-/// 3×5 digit font: each glyph is 5 rows of 3 bits (MSB = left column).
+/// The glyph drawn for `ch`: lower case as capitals, a few symbols folded to ASCII, unknown as `?`.
+fn normalize(ch: char) -> char {
+    match ch {
+        '²' => '2',
+        '³' => '3',
+        '¹' => '1',
+        '⁻' | '−' | '–' => '-',
+        '₀' => '0',
+        '₁' => '1',
+        'μ' | 'µ' => 'U',
+        '·' | '×' => '*',
+        '′' => '\'',
+        c => c.to_ascii_uppercase(),
+    }
+}
+
+/// 3×5 font: each glyph is 5 rows of 3 bits (MSB = left column).
 fn glyph(ch: char) -> Option<[u8; 5]> {
-    Some(match ch {
+    Some(match normalize(ch) {
         '0' => [7, 5, 5, 5, 7],
         '1' => [2, 6, 2, 2, 7],
         '2' => [7, 1, 7, 4, 7],
@@ -368,14 +396,58 @@ fn glyph(ch: char) -> Option<[u8; 5]> {
         '7' => [7, 1, 1, 1, 1],
         '8' => [7, 5, 7, 5, 7],
         '9' => [7, 5, 7, 1, 7],
+        'A' => [2, 5, 7, 5, 5],
+        'B' => [6, 5, 6, 5, 6],
+        'C' => [3, 4, 4, 4, 3],
+        'D' => [6, 5, 5, 5, 6],
+        'E' => [7, 4, 6, 4, 7],
+        'F' => [7, 4, 6, 4, 4],
+        'G' => [3, 4, 5, 5, 3],
+        'H' => [5, 5, 7, 5, 5],
+        'I' => [7, 2, 2, 2, 7],
+        'J' => [1, 1, 1, 5, 2],
+        'K' => [5, 5, 6, 5, 5],
+        'L' => [4, 4, 4, 4, 7],
+        'M' => [5, 7, 7, 5, 5],
+        'N' => [6, 5, 5, 5, 5],
+        'O' => [2, 5, 5, 5, 2],
+        'P' => [6, 5, 6, 4, 4],
+        'Q' => [2, 5, 5, 6, 3],
+        'R' => [6, 5, 6, 5, 5],
+        'S' => [3, 4, 2, 1, 6],
+        'T' => [7, 2, 2, 2, 2],
+        'U' => [5, 5, 5, 5, 7],
+        'V' => [5, 5, 5, 5, 2],
+        'W' => [5, 5, 7, 7, 5],
+        'X' => [5, 5, 2, 5, 5],
+        'Y' => [5, 5, 2, 2, 2],
+        'Z' => [7, 1, 2, 4, 7],
         '.' => [0, 0, 0, 0, 2],
+        ',' => [0, 0, 0, 2, 4],
+        ':' => [0, 2, 0, 2, 0],
+        ';' => [0, 2, 0, 2, 4],
         '-' => [0, 0, 7, 0, 0],
-        'e' => [0, 7, 7, 4, 7],
-        _ => return None,
+        '+' => [0, 2, 7, 2, 0],
+        '=' => [0, 7, 0, 7, 0],
+        '*' => [0, 5, 2, 5, 0],
+        '/' => [1, 1, 2, 4, 4],
+        '(' => [1, 2, 2, 2, 1],
+        ')' => [4, 2, 2, 2, 4],
+        '[' => [3, 2, 2, 2, 3],
+        ']' => [6, 2, 2, 2, 6],
+        '^' => [2, 5, 0, 0, 0],
+        '_' => [0, 0, 0, 0, 7],
+        '\'' => [2, 2, 0, 0, 0],
+        '%' => [5, 1, 2, 4, 5],
+        '<' => [1, 2, 4, 2, 1],
+        '>' => [4, 2, 1, 2, 4],
+        '|' => [2, 2, 2, 2, 2],
+        ' ' => [0, 0, 0, 0, 0],
+        _ => [6, 1, 2, 0, 2],
     })
 }
 
-/// Pixel scale of the digit font.
+/// Pixel scale of the font.
 const FONT_SCALE: f64 = 2.0;
 
 fn text_width(s: &str) -> f64 {
@@ -421,7 +493,32 @@ impl Canvas {
         }
     }
 
-    /// Draws `s` with the digit font; (x, y) is the top-left corner, or the top-centre when `centered`.
+    /// Draws `s` rotated 90° counter-clockwise (reading bottom to top), centred vertically on `y`, left edge at `x`.
+    fn text_vertical(&mut self, s: &str, x: f64, y: f64, color: [u8; 3]) {
+        let y0 = y + text_width(s) / 2.0;
+        for (i, ch) in s.chars().enumerate() {
+            let Some(rows) = glyph(ch) else { continue };
+            let gy = y0 - i as f64 * 4.0 * FONT_SCALE;
+            for (ry, bits) in rows.iter().enumerate() {
+                for cx in 0..3 {
+                    if bits & (4 >> cx) != 0 {
+                        for sy in 0..FONT_SCALE as i64 {
+                            for sx in 0..FONT_SCALE as i64 {
+                                // Glyph column → up the page, glyph row → right.
+                                self.put(
+                                    (x + ry as f64 * FONT_SCALE).round() as i64 + sx,
+                                    (gy - cx as f64 * FONT_SCALE).round() as i64 - sy,
+                                    color,
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Draws `s` with the built-in font; (x, y) is the top-left corner, or the top-centre when `centered`.
     fn text(&mut self, s: &str, x: f64, y: f64, centered: bool, color: [u8; 3]) {
         let x = if centered { x - text_width(s) / 2.0 } else { x };
         for (i, ch) in s.chars().enumerate() {
@@ -524,6 +621,41 @@ mod tests {
         p.series[0].dashed = true;
         let dashed = count(&p);
         assert!((dashed as f64) < 0.75 * solid as f64 && dashed as f64 > 0.45 * solid as f64, "{dashed} vs {solid}");
+    }
+
+    #[test]
+    fn raster_draws_title_axis_labels_and_legend_names() {
+        let (w, h) = (400u32, 240u32);
+        let dark = |img: &Image<u8>, x0: u32, x1: u32, y0: u32, y1: u32| {
+            (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).filter(|&(x, y)| img.get(x, y, 0) < 64).count()
+        };
+        let mut titled = sample();
+        titled.title = "Title".into();
+        let with = titled.to_image(w, h);
+        let mut blank = sample();
+        blank.title.clear();
+        blank.x_label.clear();
+        blank.y_label.clear();
+        for s in &mut blank.series {
+            s.label.clear();
+        }
+        let without = blank.to_image(w, h);
+        // Title band above the frame, x-label band below the tick labels, y-label band left of the tick labels.
+        for (x0, x1, y0, y1, what) in
+            [(0, w, 0, 20, "title"), (60, w, h - 18, h, "x label"), (0, 18, 40, h - 60, "y label")]
+        {
+            assert!(dark(&with, x0, x1, y0, y1) > 10, "{what} not drawn");
+            assert_eq!(dark(&without, x0, x1, y0, y1), 0, "{what} band not empty without text");
+        }
+        assert!(glyph('a') == glyph('A') && glyph('μ') == glyph('U') && glyph('²') == glyph('2'));
+    }
+
+    #[test]
+    fn series_without_visible_points_write_no_empty_polyline() {
+        let mut p = sample();
+        p.series[0].points = vec![(-1.0, 1.0), (0.0, 2.0)];
+        let svg = p.to_svg(400, 240);
+        assert!(!svg.contains(r#"points="""#), "{svg}");
     }
 
     #[test]

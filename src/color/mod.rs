@@ -1,0 +1,3 @@
+//! Colour transfer functions shared by the physics modules and the encoders.
+
+pub mod srgb;

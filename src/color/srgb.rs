@@ -1,0 +1,26 @@
+//! The sRGB transfer curve, IEC 61966-2-1:1999 §5.2 (piecewise: 12.92·v below 0.0031308, else
+//! 1.055·v^(1/2.4) − 0.055).
+
+/// sRGB encoding of a linear value, clamped to [0, 1] first.
+pub fn encode(linear: f64) -> f64 {
+    let v = linear.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn mid_grey_and_ends() {
+        assert_eq!(super::encode(0.0), 0.0);
+        assert!((super::encode(1.0) - 1.0).abs() < 1e-12);
+        // 18 % grey encodes to 0.4614; the linear segment ends at 0.0031308 -> 0.04045.
+        assert!((super::encode(0.18) - 0.461_356_1).abs() < 1e-6);
+        assert!((super::encode(0.003_130_8) - 0.040_449_9).abs() < 1e-6);
+        assert!((super::encode(0.5) - 0.735_356_6).abs() < 1e-6);
+        assert_eq!(super::encode(2.0), super::encode(1.0));
+    }
+}

@@ -1,0 +1,7 @@
+//! Plots, in one place: [`line`] draws line plots as SVG and as raster images (for PNG) with a built-in font;
+//! [`profile`] turns a diffusion-profile table into its two-panel plot. Pure: text or pixels; callers write files.
+
+pub mod line;
+pub mod profile;
+
+pub use line::{panels_to_image, panels_to_svg, LinePlot, Series, LOG_Y_DECADES};
