@@ -7,6 +7,8 @@ use std::path::Path;
 pub struct Ctx {
     pub json: bool,
     pub quiet: bool,
+    /// Fail at once (exit 3) instead of waiting when another rtbake process holds an output directory's lock.
+    pub no_wait: bool,
 }
 
 impl Ctx {
@@ -20,6 +22,17 @@ impl Ctx {
     /// Prints a JSON value on stdout (one object, pretty, trailing newline).
     pub fn emit_json(&self, v: &serde_json::Value) {
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(v).expect("JSON values serialise")));
+    }
+
+    /// Runs `f` with the lock-waiting policy of this invocation (waiting prints a message unless --quiet).
+    pub fn with_wait<T>(&self, f: impl FnOnce(&rtbake::io::file_set::Wait) -> T) -> T {
+        use rtbake::io::file_set::Wait;
+        let say = |m: &str| self.info(m);
+        if self.no_wait {
+            f(&Wait::No)
+        } else {
+            f(&Wait::Yes(&say))
+        }
     }
 
     /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
@@ -74,6 +87,28 @@ pub fn usage_msg(msg: impl Into<String>) -> anyhow::Error {
     usage(anyhow::anyhow!(msg.into()))
 }
 
+/// Marks an error as "an output directory is locked by another process" under --no-wait (exit 3).
+#[derive(Debug)]
+pub struct Busy(pub anyhow::Error);
+
+impl std::fmt::Display for Busy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl std::error::Error for Busy {}
+
+/// Classifies a file-set error: locked → exit 3, output = input or unusable path → exit 2, I/O → exit 1.
+pub fn file_set_err(e: rtbake::io::file_set::FileSetError) -> anyhow::Error {
+    use rtbake::io::file_set::FileSetError as E;
+    match e {
+        E::Busy { .. } => anyhow::Error::new(Busy(anyhow::Error::new(e))),
+        E::OutputIsInput { .. } | E::Unusable { .. } => usage(e),
+        E::Io(_) => anyhow::Error::new(e),
+    }
+}
+
 /// True if the error (or any cause) is bad input: a `Usage` marker or a library `InvalidInput`.
 pub fn is_usage(e: &anyhow::Error) -> bool {
     e.downcast_ref::<Usage>().is_some() || e.chain().any(|c| c.is::<Usage>() || c.is::<rtbake::error::InvalidInput>())
@@ -91,7 +126,14 @@ pub fn exit_with(e: &anyhow::Error) -> ! {
         last = c;
     }
     eprintln!("{msg}");
-    std::process::exit(if is_usage(e) { 2 } else { 1 });
+    let busy = e.chain().any(|c| c.is::<Busy>());
+    std::process::exit(if busy {
+        3
+    } else if is_usage(e) {
+        2
+    } else {
+        1
+    });
 }
 
 /// Expands `--params FILE` (a JSON object of flag names to values) into flags inserted right after the

@@ -1,7 +1,8 @@
 //! `rtbake`: command-line glue over the `rtbake` library. Parsing happens in two layers: clap turns flags into
 //! raw arguments, each subcommand validates them into library settings; no maths lives here.
 //!
-//! Exit codes: 0 success, 1 runtime failure, 2 bad usage or input.
+//! Exit codes: 0 success, 1 runtime failure, 2 bad usage or input, 3 an output directory is locked by another
+//! rtbake process and `--no-wait` was given.
 
 mod aa;
 mod bake;
@@ -33,6 +34,10 @@ struct Cli {
     /// No progress bars or informational messages.
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// When another rtbake process is writing (or verifying) the same directory, fail at once with exit 3 instead of
+    /// waiting for it.
+    #[arg(long, global = true)]
+    no_wait: bool,
     /// Read parameters from a JSON object {"flag-name": value, ...}; flags given on the command line override it.
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<std::path::PathBuf>,
@@ -87,7 +92,7 @@ fn main() {
             e.exit();
         }
     };
-    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet };
+    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet, no_wait: parsed.no_wait };
     let result = match parsed.command {
         Command::Bake(a) => bake::run_bake(a, &ctx),
         Command::Verify(a) => bake::run_verify(a, &ctx),
