@@ -1,15 +1,23 @@
 //! The bake directory (`baked/` by default): writing assets with their manifest, and verifying them.
 //!
 //! Invariants:
+//! - One writer at a time: a bake holds the directory's advisory lock (`.NAME.rtbake-lock` beside it, see
+//!   [`crate::io::file_set`]) exclusively from reading the old manifest to the swap; `verify` holds it shared. A
+//!   second bake or verify waits (or fails with `Busy` under `--no-wait`) instead of racing: no lost update.
 //! - A bake is all-or-nothing. Every file and the manifest are first written into a hidden staging directory
-//!   beside the target (`.NAME.rtbake-stage-PID`), fsynced, then swapped in with two renames. An interrupted bake
-//!   leaves either the old directory or the new one (a leftover hidden staging/old directory is recovered or
-//!   removed by the next `bake`/`verify`), never a truncated file or a manifest pointing at stale data.
-//! - Every asset is computed in memory before anything is written: a bad parameter writes nothing.
-//! - Files in the target that the manifest does not know (user files) are carried over untouched.
+//!   beside the target (`.NAME.rtbake-stage-PID`), fsynced, then exchanged with the target in one
+//!   `renameat2(RENAME_EXCHANGE)` (Linux; a rolled-forward two-rename fallback elsewhere). The path always names
+//!   the old or the new directory. Leftover staging directories are removed only under the exclusive lock, so a
+//!   live one is never touched.
+//! - Every asset is computed in memory before anything is written (and before locking): a bad parameter writes
+//!   nothing.
+//! - Files in the target that the manifest does not know (user files) are carried over untouched; rtbake's own
+//!   transient names (temp files, probes of older versions) never are.
 //! - `verify` re-runs each asset's pure `bake` function from the parameters recorded in the manifest and compares:
-//!   byte for byte, or within the file's `verify_tolerance` for float payloads; it also checks every sha256 and
-//!   reports missing, extra, modified and stale files.
+//!   byte for byte, or within the tolerance the code (not the manifest) gives; it also checks every sha256 and
+//!   reports missing, extra, modified and stale files. Nothing the code can recompute is trusted from the
+//!   manifest: unknown, missing or duplicated asset records, duplicated entries, edited metadata or conventions
+//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps.
 
 use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
@@ -250,8 +258,8 @@ pub fn verify_with(
     wait: &Wait,
 ) -> Result<VerifyReport, BakeDirError> {
     let mut lock = DirLock::acquire(dir, LockMode::Shared, wait)?;
-    if !lock.dir().exists() {
-        // Only a bake killed inside the two-rename fallback swap leaves no directory; finish it first.
+    if file_set::swap_interrupted(lock.dir()) {
+        // Only a bake killed inside the two-rename fallback swap gets here; finish it first.
         lock = lock.into_exclusive(wait)?;
         file_set::recover(&lock)?;
     }

@@ -225,6 +225,18 @@ pub fn probe_writable(dir: &Path) -> Result<(), FileSetError> {
     fs::remove_dir(&probe).map_err(|e| io_err(&probe, e))
 }
 
+/// Whether a killed writer left `dir` inside a fallback swap (missing, or a finished "ready" directory beside it):
+/// a reader must then take the exclusive lock and [`recover`] before reading.
+pub fn swap_interrupted(dir: &Path) -> bool {
+    if !dir.exists() {
+        return true;
+    }
+    let prefix = format!(".{}.rtbake-ready-", dir_name(dir));
+    fs::read_dir(parent_of(dir))
+        .map(|rd| rd.flatten().any(|e| e.file_name().to_string_lossy().starts_with(&prefix)))
+        .unwrap_or(false)
+}
+
 /// Under an exclusive lock: finishes or discards whatever a killed writer of `lock.dir()` left. Returns a
 /// description of what was done, if anything.
 pub fn recover(lock: &DirLock) -> Result<Option<String>, FileSetError> {
@@ -249,13 +261,18 @@ pub fn recover(lock: &DirLock) -> Result<Option<String>, FileSetError> {
             }
         }
     }
-    // A writer killed between the two renames of the fallback swap: its new directory was complete ("ready"), so
-    // roll forward; otherwise the old directory comes back.
-    if !dir.exists() {
-        if let Some(r) = ready.pop() {
-            fs::rename(&r, dir).map_err(|e| io_err(dir, e))?;
-            note.push(format!("installed the finished bake of an interrupted run into {}", dir.display()));
-        } else if let Some(o) = old.pop() {
+    // A writer killed inside the fallback swap: once its new directory was complete and renamed to "ready" it had
+    // committed, so roll forward; otherwise the old directory stays or comes back.
+    if let Some(r) = ready.pop() {
+        if dir.exists() {
+            let aside = sibling(dir, "old");
+            fs::rename(dir, &aside).map_err(|e| io_err(dir, e))?;
+            old.push(aside);
+        }
+        fs::rename(&r, dir).map_err(|e| io_err(dir, e))?;
+        note.push(format!("installed the finished result of an interrupted run into {}", dir.display()));
+    } else if !dir.exists() {
+        if let Some(o) = old.pop() {
             fs::rename(&o, dir).map_err(|e| io_err(dir, e))?;
             note.push(format!("restored {} from an interrupted run", dir.display()));
         }

@@ -25,6 +25,7 @@ mod fitting_determinism;
 mod fitting_published;
 mod profiles_bake;
 mod profiles_cli;
+mod reliability_dir;
 mod runtime_cli;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
