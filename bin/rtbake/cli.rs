@@ -218,14 +218,28 @@ pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
     Ok([v[0], v[1], v[2]])
 }
 
-/// Checks that an output directory exists (or can be created) and is writable, before any work.
+/// Checks that an output directory exists (or can be created) and is writable, before any work. Nothing is
+/// written to probe it (a kill cannot leave a probe file among the user's files).
 #[allow(dead_code)]
 pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir)
         .map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
-    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    rtbake::io::file_set::check_dir_writable(dir)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))
+}
+
+/// Writes a command's output files into `dir` as one set with the library's `write_file_set`: under the
+/// directory's lock, all or nothing (a kill is rolled forward by the next command), an output that is one of
+/// `inputs` refused (exit 2, both paths named), a lock held elsewhere under --no-wait exit 3.
+#[allow(dead_code)]
+pub fn write_set(
+    ctx: &Ctx,
+    flag: &str,
+    dir: &Path,
+    files: &[rtbake::bake::BakedFile],
+    inputs: &[&Path],
+) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
+    ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
+        .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
 }

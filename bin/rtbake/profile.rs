@@ -265,7 +265,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Before any work: `path` must not be a directory, and its directory must exist and accept a new file (probed).
+/// Before any work: `path` must not be a directory, and its directory must exist and accept a new file.
 fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
     if path.is_dir() {
         return Err(usage_msg(format!("{flag} {}: is a directory, expected a file path", path.display())));
@@ -274,11 +274,8 @@ fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
     if !dir.is_dir() {
         return Err(usage_msg(format!("{flag} {}: directory {} does not exist", path.display(), dir.display())));
     }
-    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", path.display())))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    rtbake::io::file_set::check_dir_writable(dir)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", path.display())))
 }
 
 /// Plot title naming the profile.

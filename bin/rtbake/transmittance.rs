@@ -1,14 +1,13 @@
 //! `rtbake transmittance`: evaluate T(s) (thesis eq. 5.12) at given distances, or bake the table files.
 
 use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
-use rtbake::bake::BakedFile;
 use rtbake::diffusion::materials;
 use rtbake::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use rtbake::diffusion::FdrForm;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings, RgbGaussians};
 use rtbake::transmittance::{evaluate, TableSettings, TransmittanceForm, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct TransmittanceArgs {
@@ -45,31 +44,6 @@ pub struct TransmittanceArgs {
     /// Table domain end s_max in mm (> 0); texel i holds s = s_max*i/(n-1).
     #[arg(long = "s-max", default_value_t = DEFAULT_S_MAX_MM, allow_hyphen_values = true)]
     pub s_max: f64,
-}
-
-/// Writes a file set under `dir`: every file is staged (temp + fsync) first, then all are renamed, so an error
-/// leaves no partial set of new files.
-pub fn write_file_set(dir: &Path, files: &[BakedFile]) -> anyhow::Result<()> {
-    let mut staged = Vec::new();
-    for f in files {
-        let path = dir.join(&f.path);
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| anyhow::anyhow!("{}: {e}", parent.display()))?;
-        }
-        match rtbake::io::atomic::stage(&path, &f.bytes) {
-            Ok(tmp) => staged.push((tmp, path)),
-            Err(e) => {
-                for (tmp, _) in &staged {
-                    let _ = std::fs::remove_file(tmp);
-                }
-                return Err(e.into());
-            }
-        }
-    }
-    for (tmp, path) in &staged {
-        rtbake::io::atomic::commit(tmp, path)?;
-    }
-    Ok(())
 }
 
 fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
@@ -132,7 +106,7 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
             .map_err(|e| anyhow::anyhow!(e))?;
         prepare_out_dir("--out", dir)?;
-        write_file_set(dir, &files)?;
+        crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         result["files"] = json!(files.iter().map(|f| dir.join(&f.path).display().to_string()).collect::<Vec<_>>());
         result["convention"] = json!(table.convention());
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));

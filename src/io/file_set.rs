@@ -210,6 +210,28 @@ impl DirLock {
     }
 }
 
+/// Whether this process may create files in the existing directory `dir`, checked without creating anything
+/// (`access(W_OK | X_OK)` on Unix, which also reports a read-only file system), so a kill leaves no probe behind.
+pub fn check_dir_writable(dir: &Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).map_err(std::io::Error::other)?;
+        // SAFETY: a valid NUL-terminated path; access does not retain it.
+        if unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) } != 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        Ok(())
+    }
+    #[cfg(not(unix))]
+    {
+        if fs::metadata(dir)?.permissions().readonly() {
+            return Err(std::io::Error::from(std::io::ErrorKind::PermissionDenied));
+        }
+        Ok(())
+    }
+}
+
 /// Before any work: the directory that will hold `dir` exists (created) and accepts a new entry. The probe is an
 /// empty staging directory beside `dir`; a probe left by a kill is a stale staging directory that the next locked
 /// command removes — never a file inside `dir`.
@@ -373,6 +395,7 @@ struct Journal {
 fn settle_locked(dir: &Path) -> Result<Option<String>, FileSetError> {
     let mut done = 0usize;
     let mut journals = Vec::new();
+    let mut orphans = Vec::new();
     if let Ok(rd) = fs::read_dir(dir) {
         for e in rd.flatten() {
             let n = e.file_name().to_string_lossy().into_owned();
@@ -380,10 +403,11 @@ fn settle_locked(dir: &Path) -> Result<Option<String>, FileSetError> {
                 journals.push(e.path());
             } else if super::atomic::is_temp_name(&n) || n.starts_with(".rtbake-write-probe-") {
                 // Includes a journal's own temp (never committed) and the probes older versions could leave.
-                let _ = fs::remove_file(e.path());
+                orphans.push(e.path());
             }
         }
     }
+    // Committed sets first (their temps are not orphans), then whatever temp file is left.
     for j in journals {
         let text = fs::read_to_string(&j).map_err(|e| io_err(&j, e))?;
         let journal: Journal = serde_json::from_str(&text).map_err(|e| FileSetError::Unusable {
@@ -401,6 +425,9 @@ fn settle_locked(dir: &Path) -> Result<Option<String>, FileSetError> {
         }
         fs::remove_file(&j).map_err(|e| io_err(&j, e))?;
         done += 1;
+    }
+    for o in orphans {
+        let _ = fs::remove_file(o);
     }
     Ok((done > 0).then(|| format!("completed {done} interrupted file-set write(s) in {}", dir.display())))
 }

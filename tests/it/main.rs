@@ -26,6 +26,7 @@ mod fitting_published;
 mod profiles_bake;
 mod profiles_cli;
 mod reliability_dir;
+mod reliability_files;
 mod runtime_cli;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
