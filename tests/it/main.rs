@@ -27,6 +27,7 @@ mod profiles_bake;
 mod profiles_cli;
 mod reliability_dir;
 mod reliability_files;
+mod reliability_limits;
 mod runtime_cli;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
