@@ -16,7 +16,7 @@ mod run;
 mod skin_color;
 mod transmittance;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use cli::Ctx;
 
 #[derive(Parser)]
@@ -74,6 +74,16 @@ enum Command {
     Run(run::RunCommand),
 }
 
+/// The command line, with every value-taking flag of every subcommand accepting a negative number after a space
+/// (`--thickness-mm -1`), so the range check names the flag instead of clap reporting an unexpected `-1`.
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| if a.get_action().takes_values() { a.allow_negative_numbers(true) } else { a })
+            .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 fn main() {
     // Behave like other Unix tools when stdout is closed early (`rtbake … | head`): end quietly, no panic.
     #[cfg(unix)]
@@ -85,7 +95,7 @@ fn main() {
         Ok(a) => a,
         Err(e) => cli::exit_with(&e),
     };
-    let parsed = match Cli::try_parse_from(argv) {
+    let parsed = match command().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         Err(e) => {
             // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.

@@ -125,6 +125,23 @@ fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
     usage(InvalidInput::new(param, e.message))
 }
 
+/// A non-finite result names the input that produced it (the layer file, material or preset).
+fn non_finite_error(e: InvalidInput, args: &ProfileArgs) -> anyhow::Error {
+    if e.param != "profile" {
+        return flag_error(e, None);
+    }
+    let input = if let Some(l) = &args.layers {
+        format!("--layers {}", l.display())
+    } else if let Some(m) = &args.material {
+        format!("--material {m}")
+    } else if let Some(p) = &args.profile_preset {
+        format!("--profile-preset {p}")
+    } else {
+        "--skin-melanin/--skin-hemoglobin".to_string()
+    };
+    usage(InvalidInput::new(format!("{input}:"), e.message))
+}
+
 pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let fdr = match args.fdr {
         FdrArg::Dj05 => FdrForm::Dj05,
@@ -206,7 +223,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
 
     let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
     let table =
-        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| flag_error(e, None))?;
+        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| non_finite_error(e, &args))?;
     let json = table.to_json();
     let plot_bytes = match plot_format {
         Some(format) => {

@@ -25,6 +25,7 @@ mod fitting_determinism;
 mod fitting_published;
 mod profiles_bake;
 mod profiles_cli;
+mod reliability_cli;
 mod reliability_dir;
 mod reliability_files;
 mod reliability_limits;
