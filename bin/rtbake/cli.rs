@@ -9,6 +9,8 @@ pub struct Ctx {
     pub quiet: bool,
     /// Fail at once (exit 3) instead of waiting when another rtbake process holds an output directory's lock.
     pub no_wait: bool,
+    /// `--max-memory` in bytes (None: half of physical memory).
+    pub max_memory: Option<u64>,
 }
 
 impl Ctx {
@@ -33,6 +35,34 @@ impl Ctx {
         } else {
             f(&Wait::Yes(&say))
         }
+    }
+
+    /// The memory budget: `--max-memory`, else half of physical memory (8 GiB where it cannot be read).
+    pub fn memory_budget(&self) -> (u64, String) {
+        match self.max_memory {
+            Some(b) => (b, format!("--max-memory {}", fmt_bytes(b))),
+            None => {
+                let phys = physical_memory_bytes();
+                match phys {
+                    Some(p) => (p / 2, format!("default --max-memory: half of this machine's {}", fmt_bytes(p))),
+                    None => (8 << 30, "default --max-memory (physical memory unknown)".into()),
+                }
+            }
+        }
+    }
+
+    /// Refuses, before allocating, work whose memory estimate exceeds the budget (exit 2, estimate and limit named).
+    pub fn check_memory(&self, flags: &str, estimate_bytes: u64) -> anyhow::Result<()> {
+        let (budget, source) = self.memory_budget();
+        if estimate_bytes > budget {
+            return Err(usage_msg(format!(
+                "{flags}: this needs about {} of memory, more than the budget of {} ({source}); choose smaller sizes \
+                 or raise --max-memory",
+                fmt_bytes(estimate_bytes),
+                fmt_bytes(budget)
+            )));
+        }
+        Ok(())
     }
 
     /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
@@ -242,4 +272,50 @@ pub fn write_set(
     let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
     ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
+}
+
+/// `1.5 GiB`-style size.
+pub fn fmt_bytes(b: u64) -> String {
+    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = b as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < units.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", units[u])
+    }
+}
+
+/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`.
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let v: f64 = num.trim().parse().map_err(|_| format!("expected a size like 512M or 12G, got {s:?}"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("must be a size > 0, got {s:?}"));
+    }
+    Ok((v * (1u64 << shift) as f64) as u64)
+}
+
+/// Physical memory of this machine, if the platform says.
+fn physical_memory_bytes() -> Option<u64> {
+    #[cfg(unix)]
+    {
+        // SAFETY: sysconf only reads system configuration.
+        let (pages, size) = unsafe { (libc::sysconf(libc::_SC_PHYS_PAGES), libc::sysconf(libc::_SC_PAGESIZE)) };
+        if pages > 0 && size > 0 {
+            return Some(pages as u64 * size as u64);
+        }
+    }
+    None
 }

@@ -38,6 +38,10 @@ struct Cli {
     /// waiting for it.
     #[arg(long, global = true)]
     no_wait: bool,
+    /// Memory budget for one command (e.g. 12G, 512M): sizes whose estimated peak memory exceeds it are refused
+    /// before anything is allocated. Default: half of physical memory.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = cli::parse_bytes)]
+    max_memory: Option<u64>,
     /// Read parameters from a JSON object {"flag-name": value, ...}; flags given on the command line override it.
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<std::path::PathBuf>,
@@ -102,7 +106,7 @@ fn main() {
             e.exit();
         }
     };
-    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet, no_wait: parsed.no_wait };
+    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet, no_wait: parsed.no_wait, max_memory: parsed.max_memory };
     let result = match parsed.command {
         Command::Bake(a) => bake::run_bake(a, &ctx),
         Command::Verify(a) => bake::run_verify(a, &ctx),

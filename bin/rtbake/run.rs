@@ -294,6 +294,10 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
 fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     check_output(&d.output)?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
+    ctx.check_memory(
+        &format!("--width {} --height {}", d.width, d.height),
+        demo::memory_estimate_bytes(d.width, d.height),
+    )?;
     let aa = match d.aa.as_str() {
         "smaa" => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),
         "mlaa" => Some(Antialiasing::Mlaa(load_mlaa(&d.common.baked, 33)?)),

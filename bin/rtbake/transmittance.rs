@@ -85,6 +85,9 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     };
     let table = TableSettings { samples: a.samples, height: a.height, s_max_mm: a.s_max, form };
     table.validate().map_err(usage)?;
+    if a.out.is_some() {
+        ctx.check_memory(&format!("--samples {} --height {}", a.samples, a.height), table.memory_estimate_bytes())?;
+    }
     if s_mm.is_none() && a.out.is_none() {
         return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));
     }

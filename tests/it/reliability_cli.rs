@@ -85,3 +85,36 @@ fn asset_params_type_errors_name_the_field() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn sizes_beyond_the_memory_budget_are_refused_before_allocating_with_estimate_and_limit() {
+    let t = tempfile::tempdir().unwrap();
+    let png = t.path().join("d.png");
+    let table = t.path().join("tr");
+    for (args, flags) in [
+        (
+            vec!["run", "demo", "--cpu", "--width", "4096", "--height", "4096", "--max-memory", "1G", "--output"],
+            "--width 4096 --height 4096",
+        ),
+        (
+            vec!["transmittance", "--samples", "16384", "--height", "16384", "--max-memory", "4G", "--out"],
+            "--samples 16384 --height 16384",
+        ),
+    ] {
+        let mut args = args.clone();
+        let out = if args[0] == "run" { &png } else { &table };
+        args.push(out.to_str().unwrap());
+        let o = rtbake(&args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(flags) && err.contains("GiB") && err.contains("--max-memory"), "{err}");
+        assert!(!out.exists());
+    }
+    // Within the budget it runs.
+    let o =
+        rtbake(&["transmittance", "--samples", "64", "--max-memory", "64M", "--out", table.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = rtbake(&["transmittance", "--samples", "64", "--max-memory", "lots", "--out", table.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--max-memory"), "{}", stderr(&o));
+}
