@@ -329,6 +329,15 @@ fn exchange(_a: &Path, _b: &Path) -> std::io::Result<()> {
     Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
 }
 
+/// The kernel or file system cannot exchange (old kernel, NFS, …): use the fallback swap.
+fn exchange_unsupported(e: &std::io::Error) -> bool {
+    #[cfg(target_os = "linux")]
+    if matches!(e.raw_os_error(), Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::EOPNOTSUPP)) {
+        return true;
+    }
+    e.kind() == std::io::ErrorKind::Unsupported
+}
+
 fn sync_dir(dir: &Path) {
     if let Ok(d) = fs::File::open(dir) {
         let _ = d.sync_all();
@@ -358,9 +367,7 @@ pub fn install_dir(lock: &DirLock, stage: &Path) -> Result<(), FileSetError> {
                 let _ = fs::remove_dir_all(stage);
                 return Ok(());
             }
-            Err(e)
-                if matches!(e.raw_os_error(), Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::EOPNOTSUPP))
-                    || e.kind() == std::io::ErrorKind::Unsupported => {}
+            Err(e) if exchange_unsupported(&e) => {}
             Err(e) => {
                 let _ = fs::remove_dir_all(stage);
                 return Err(io_err(dir, e));
