@@ -209,6 +209,9 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
         if let Some(p) = path {
             check_output_file(flag, p)?;
+            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
+            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
+                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
         }
     }
     let plot_format = match &args.plot {

@@ -145,3 +145,24 @@ fn a_second_writer_of_an_output_directory_waits_or_fails_fast() {
         "{names:?}"
     );
 }
+
+#[test]
+fn single_file_outputs_equal_to_an_input_are_refused_too() {
+    let t = tempfile::tempdir().unwrap();
+    let layers = t.path().join("l.json");
+    let text = r#"{"eta_above": 1.0, "eta_below": 1.0, "layers": [{"thickness_mm": 1.0, "eta": 1.4, "sigma_a": [0.1, 0.1, 0.1], "sigma_s_prime": [1, 1, 1]}]}"#;
+    std::fs::write(&layers, text).unwrap();
+    for flag in ["--out", "--csv"] {
+        let o = rtbake(&["profile", "--layers", s(&layers), "--count", "4", flag, s(&layers)]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(flag) && stderr(&o).contains("refusing to overwrite the input"), "{}", stderr(&o));
+        assert_eq!(std::fs::read_to_string(&layers).unwrap(), text);
+    }
+    let png = t.path().join("in.png");
+    std::fs::copy(fixture("neutral"), &png).unwrap();
+    let before = std::fs::read(&png).unwrap();
+    let o = rtbake(&["run", "smaa", "--cpu", "--input", s(&png), "--output", s(&t.path().join(".").join("in.png"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--output") && stderr(&o).contains("refusing to overwrite the input"));
+    assert_eq!(std::fs::read(&png).unwrap(), before);
+}
