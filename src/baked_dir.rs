@@ -1,23 +1,32 @@
 //! The bake directory (`baked/` by default): writing assets with their manifest, and verifying them.
 //!
 //! Invariants:
+//! - One writer at a time: a bake holds the directory's advisory lock (`.NAME.rtbake-lock` beside it, see
+//!   [`crate::io::file_set`]) exclusively from reading the old manifest to the swap; `verify` holds it shared. A
+//!   second bake or verify waits (or fails with `Busy` under `--no-wait`) instead of racing: no lost update.
 //! - A bake is all-or-nothing. Every file and the manifest are first written into a hidden staging directory
-//!   beside the target (`.NAME.rtbake-stage-PID`), fsynced, then swapped in with two renames. An interrupted bake
-//!   leaves either the old directory or the new one (a leftover hidden staging/old directory is recovered or
-//!   removed by the next `bake`/`verify`), never a truncated file or a manifest pointing at stale data.
-//! - Every asset is computed in memory before anything is written: a bad parameter writes nothing.
-//! - Files in the target that the manifest does not know (user files) are carried over untouched.
+//!   beside the target (`.NAME.rtbake-stage-PID`), fsynced, then exchanged with the target in one
+//!   `renameat2(RENAME_EXCHANGE)` (Linux; a rolled-forward two-rename fallback elsewhere). The path always names
+//!   the old or the new directory. Leftover staging directories are removed only under the exclusive lock, so a
+//!   live one is never touched.
+//! - Every asset is computed in memory before anything is written (and before locking): a bad parameter writes
+//!   nothing.
+//! - Files in the target that the manifest does not know (user files) are carried over untouched; rtbake's own
+//!   transient names (temp files, probes of older versions) never are.
 //! - `verify` re-runs each asset's pure `bake` function from the parameters recorded in the manifest and compares:
-//!   byte for byte, or within the file's `verify_tolerance` for float payloads; it also checks every sha256 and
-//!   reports missing, extra, modified and stale files.
+//!   byte for byte, or within the tolerance the code (not the manifest) gives; it also checks every sha256 and
+//!   reports missing, extra, modified and stale files. Nothing the code can recompute is trusted from the
+//!   manifest: unknown, missing or duplicated asset records, duplicated entries, edited metadata or conventions
+//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps.
 
 use crate::bake::{Asset, BakeError, BakedFile};
+use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
 use crate::io::{self, IoError};
-use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError, MANIFEST_NAME};
+use crate::manifest::{sha256_hex, Manifest, ManifestError, MANIFEST_NAME};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Errors of `bake` / `verify` on a directory.
 #[derive(Debug, thiserror::Error)]
@@ -30,39 +39,22 @@ pub enum BakeDirError {
     Manifest(#[from] ManifestError),
     #[error("{path}: {detail}")]
     Unusable { path: String, detail: String },
+    #[error(transparent)]
+    Dir(#[from] FileSetError),
 }
 
 fn io_err(path: &Path, e: std::io::Error) -> BakeDirError {
     BakeDirError::Io(IoError::io(path, e))
 }
 
-fn sibling(dir: &Path, tag: &str) -> PathBuf {
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "baked".into());
-    dir.with_file_name(format!(".{name}.rtbake-{tag}-{}", std::process::id()))
+/// Finishes or discards what a killed bake of `dir` left (see [`file_set::recover`]), waiting for the directory's
+/// lock. Returns a description of what was done, if anything.
+pub fn recover(dir: &Path) -> Result<Option<String>, BakeDirError> {
+    let lock = DirLock::acquire(dir, LockMode::Exclusive, &Wait::Yes(&|_| {}))?;
+    Ok(file_set::recover(&lock)?)
 }
 
-/// Restores `dir` from a leftover `.NAME.rtbake-old-*` if a previous bake died between its two renames, and
-/// removes leftover staging directories. Returns a description of what was done, if anything.
-pub fn recover(dir: &Path) -> Option<String> {
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = dir.file_name()?.to_string_lossy().into_owned();
-    let mut note = None;
-    for e in fs::read_dir(parent).ok()?.flatten() {
-        let n = e.file_name().to_string_lossy().into_owned();
-        if n.starts_with(&format!(".{name}.rtbake-old-")) {
-            if !dir.exists() && fs::rename(e.path(), dir).is_ok() {
-                note = Some(format!("restored {} from an interrupted bake", dir.display()));
-            } else {
-                let _ = fs::remove_dir_all(e.path());
-            }
-        } else if n.starts_with(&format!(".{name}.rtbake-stage-")) {
-            let _ = fs::remove_dir_all(e.path());
-        }
-    }
-    note
-}
-
-/// All regular files under `dir`, as `/`-separated relative paths (hidden temp files included).
+/// All regular files under `dir`, as `/`-separated relative paths (rtbake's own transient files excluded).
 fn list_files(dir: &Path) -> Result<BTreeSet<String>, BakeDirError> {
     let mut out = BTreeSet::new();
     fn walk(base: &Path, d: &Path, out: &mut BTreeSet<String>) -> Result<(), BakeDirError> {
@@ -73,7 +65,10 @@ fn list_files(dir: &Path) -> Result<BTreeSet<String>, BakeDirError> {
                 walk(base, &p, out)?;
             } else {
                 let rel = p.strip_prefix(base).expect("under base");
-                out.insert(rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/"));
+                let rel = rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/");
+                if !file_set::is_internal_name(&rel) {
+                    out.insert(rel);
+                }
             }
         }
         Ok(())
@@ -104,18 +99,31 @@ pub struct BakeSummary {
     pub files_removed: Vec<String>,
 }
 
-/// Computes `jobs` (asset + parameters) and installs them into `dir` with an updated manifest, atomically.
+/// Computes `jobs` (asset + parameters) and installs them into `dir` with an updated manifest, atomically,
+/// waiting silently for the directory's lock.
 pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Result<BakeSummary, BakeDirError> {
-    // 1. Compute everything in memory (pure; a bad parameter writes nothing).
+    bake_into_with(dir, jobs, git_revision, &Wait::Yes(&|_| {}))
+}
+
+/// [`bake_into`] with a choice of waiting for the lock another process holds on `dir`.
+pub fn bake_into_with(
+    dir: &Path,
+    jobs: &[(&Asset, Value)],
+    git_revision: &str,
+    wait: &Wait,
+) -> Result<BakeSummary, BakeDirError> {
+    // 1. Compute everything in memory (pure; a bad parameter writes nothing). No lock is needed for this.
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
     for (asset, params) in jobs {
         let files = (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
         produced.push((asset, params, files));
     }
-    // 2. Existing state.
-    recover(dir);
-    let old_manifest = if dir.join(MANIFEST_NAME).exists() { Some(Manifest::load(dir)?) } else { None };
-    if dir.exists() && old_manifest.is_none() && !list_files(dir)?.is_empty() {
+    // 2. From here to the swap, the directory is ours: the existing state read below cannot change under us.
+    let lock = DirLock::acquire(dir, LockMode::Exclusive, wait)?;
+    let real = lock.dir().to_path_buf();
+    file_set::recover(&lock)?;
+    let old_manifest = if real.join(MANIFEST_NAME).exists() { Some(Manifest::load(&real)?) } else { None };
+    if real.exists() && old_manifest.is_none() && !list_files(&real)?.is_empty() {
         return Err(BakeDirError::Unusable {
             path: dir.display().to_string(),
             detail:
@@ -137,23 +145,21 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
         }
     }
 
-    // 3. Stage the new directory.
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    fs::create_dir_all(parent).map_err(|e| io_err(parent, e))?;
-    let stage = sibling(dir, "stage");
+    // 3. Stage the new directory beside the target (a stale stage of ours was removed by the recovery).
+    let stage = file_set::sibling(&real, "stage");
     let _ = fs::remove_dir_all(&stage);
     let result = (|| -> Result<(u64, usize), BakeDirError> {
         fs::create_dir_all(&stage).map_err(|e| io_err(&stage, e))?;
         let mut bytes = 0u64;
         let mut count = 0usize;
         // Carry over files of other assets and user files.
-        for rel in list_files(dir)? {
+        for rel in list_files(&real)? {
             let rebaked = produced.iter().any(|(a, _, _)| manifest.entry(&rel).is_some_and(|e| e.asset == a.name));
             let dropped = old_paths.contains(&rel) && !new_paths.contains(&rel);
-            if rel == MANIFEST_NAME || rebaked || dropped || io::atomic::is_temp_name(&rel) {
+            if rel == MANIFEST_NAME || rebaked || dropped {
                 continue;
             }
-            let src = dir.join(&rel);
+            let src = real.join(&rel);
             let dst = stage.join(&rel);
             if let Some(p) = dst.parent() {
                 fs::create_dir_all(p).map_err(|e| io_err(p, e))?;
@@ -170,6 +176,9 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
             }
         }
         write_synced(&stage.join(MANIFEST_NAME), manifest.to_text().as_bytes())?;
+        if let Ok(d) = fs::File::open(&stage) {
+            let _ = d.sync_all();
+        }
         Ok((bytes, count))
     })();
     let (bytes_written, files_written) = match result {
@@ -179,24 +188,9 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
             return Err(e);
         }
     };
-    // 4. Swap.
-    if dir.exists() {
-        let old = sibling(dir, "old");
-        fs::rename(dir, &old).map_err(|e| {
-            let _ = fs::remove_dir_all(&stage);
-            io_err(dir, e)
-        })?;
-        fs::rename(&stage, dir).map_err(|e| {
-            let _ = fs::rename(&old, dir);
-            io_err(dir, e)
-        })?;
-        let _ = fs::remove_dir_all(&old);
-    } else {
-        fs::rename(&stage, dir).map_err(|e| io_err(dir, e))?;
-    }
-    if let Ok(d) = fs::File::open(parent) {
-        let _ = d.sync_all();
-    }
+    file_set::fault_point("staged");
+    // 4. Swap: the path names the old or the new directory at every instant.
+    file_set::install_dir(&lock, &stage)?;
     Ok(BakeSummary {
         dir: dir.display().to_string(),
         assets: produced.iter().map(|(a, _, _)| a.name.to_string()).collect(),
@@ -221,6 +215,9 @@ pub enum FileStatus {
     Stale,
     /// The asset's recomputation no longer produces this file, or produces a file the manifest lacks.
     Unlisted,
+    /// The manifest disagrees with what this rtbake knows: an unknown, missing or duplicated asset record, a
+    /// duplicated entry, metadata or tolerance that differ from the code, or a manifest that differs from `--pin`.
+    Tampered,
 }
 
 /// One line of a verify report.
@@ -245,8 +242,48 @@ impl VerifyReport {
     }
 }
 
-/// Verifies `dir` against its manifest and against a recomputation of every asset with `registry`.
+/// Verifies `dir` against its manifest and against a recomputation of every asset with `registry`, waiting
+/// silently for a bake of `dir` to finish.
 pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirError> {
+    verify_with(dir, registry, None, &Wait::Yes(&|_| {}))
+}
+
+/// [`verify`] with an optional pinned manifest digest (`sha256sum` output or a bare hex digest; see
+/// [`check_pin`]) and a choice of waiting for the directory's lock. The directory is read under a shared lock,
+/// so no bake can swap it in the middle.
+pub fn verify_with(
+    dir: &Path,
+    registry: &[Asset],
+    pin: Option<&str>,
+    wait: &Wait,
+) -> Result<VerifyReport, BakeDirError> {
+    let mut lock = DirLock::acquire(dir, LockMode::Shared, wait)?;
+    if file_set::swap_interrupted(lock.dir()) {
+        // Only a bake killed inside the two-rename fallback swap gets here; finish it first.
+        lock = lock.into_exclusive(wait)?;
+        file_set::recover(&lock)?;
+    }
+    let mut report = verify_locked(lock.dir(), registry, pin)?;
+    report.dir = dir.display().to_string();
+    Ok(report)
+}
+
+/// Compares the sha256 of the manifest's bytes with a pin: the first whitespace-separated token of `pin_text`
+/// (so `sha256sum baked/manifest.json > baked.pin` makes one).
+pub fn check_pin(manifest_bytes: &[u8], pin_text: &str) -> Result<(), String> {
+    let want = pin_text.split_whitespace().next().unwrap_or("").to_ascii_lowercase();
+    if want.len() != 64 || !want.bytes().all(|b| b.is_ascii_hexdigit()) {
+        return Err(format!("pin is not a sha256 digest (64 hex digits), got {want:?}"));
+    }
+    let got = sha256_hex(manifest_bytes);
+    if got != want {
+        return Err(format!("manifest.json sha256 {got} differs from the pinned {want}"));
+    }
+    Ok(())
+}
+
+/// The verification itself, on a directory the caller has locked (or knows to be quiet).
+fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<VerifyReport, BakeDirError> {
     let manifest = Manifest::load(dir)?;
     let on_disk = list_files(dir)?;
     let mut reports: BTreeMap<String, FileReport> = BTreeMap::new();
@@ -261,6 +298,43 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
             e.detail = detail;
         }
     };
+    // Nothing in the manifest that the code can recompute is trusted: the manifest's own header first.
+    if let Some(pin) = pin {
+        let bytes = fs::read(dir.join(MANIFEST_NAME)).map_err(|e| io_err(&dir.join(MANIFEST_NAME), e))?;
+        if let Err(why) = check_pin(&bytes, pin) {
+            set(MANIFEST_NAME, FileStatus::Tampered, why);
+        }
+    }
+    if manifest.conventions != crate::manifest::conventions() {
+        set(MANIFEST_NAME, FileStatus::Tampered, "conventions differ from this rtbake's".into());
+    }
+    let mut seen_assets = BTreeSet::new();
+    for record in &manifest.assets {
+        if !seen_assets.insert(record.name.as_str()) {
+            set(MANIFEST_NAME, FileStatus::Tampered, format!("asset {:?} is recorded twice", record.name));
+        }
+        if !registry.iter().any(|a| a.name == record.name) {
+            set(MANIFEST_NAME, FileStatus::Tampered, format!("asset {:?} is unknown to this rtbake", record.name));
+        }
+    }
+    let mut seen_paths = BTreeSet::new();
+    for entry in &manifest.files {
+        if !seen_paths.insert(entry.path.as_str()) {
+            set(&entry.path, FileStatus::Tampered, "listed twice in manifest.json".into());
+        }
+        if !registry.iter().any(|a| a.name == entry.asset) {
+            set(&entry.path, FileStatus::Tampered, format!("asset {:?} is unknown to this rtbake", entry.asset));
+        } else if !seen_assets.contains(entry.asset.as_str()) {
+            set(
+                &entry.path,
+                FileStatus::Tampered,
+                format!(
+                    "asset {:?} has no record (parameters) in manifest.json, so it cannot be recomputed",
+                    entry.asset
+                ),
+            );
+        }
+    }
     let mut bytes_of: BTreeMap<String, Vec<u8>> = BTreeMap::new();
     for entry in &manifest.files {
         let p = dir.join(&entry.path);
@@ -291,14 +365,13 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
             set(rel, FileStatus::Extra, "on disk, not listed in manifest.json".into());
         }
     }
-    // Recompute every asset from the recorded parameters.
+    // Recompute every asset from the recorded parameters; metadata and tolerances come from the recomputation.
+    let mut recomputed = BTreeSet::new();
     for record in &manifest.assets {
-        let Some(asset) = registry.iter().find(|a| a.name == record.name) else {
-            for e in manifest.files.iter().filter(|e| e.asset == record.name) {
-                set(&e.path, FileStatus::Stale, format!("asset {:?} is unknown to this rtbake", record.name));
-            }
+        let Some(asset) = registry.iter().find(|a| a.name == record.name) else { continue };
+        if !recomputed.insert(record.name.as_str()) {
             continue;
-        };
+        }
         let files = match (asset.bake)(&record.params) {
             Ok(f) => f,
             Err(err) => {
@@ -319,11 +392,18 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
                 None => {
                     set(&f.path, FileStatus::Unlisted, format!("asset {} produces it, manifest lacks it", record.name))
                 }
+                Some(entry) if entry.asset != record.name => set(
+                    &f.path,
+                    FileStatus::Tampered,
+                    format!("manifest attributes it to asset {:?}, the code to {}", entry.asset, record.name),
+                ),
                 Some(entry) => {
-                    if let Some(disk) = bytes_of.get(&f.path) {
-                        if let Err(why) = compare(entry, disk, &f.bytes) {
-                            set(&f.path, FileStatus::Stale, why);
-                        }
+                    // Content first (a changed parameter shows as stale content), then the metadata the code gives.
+                    let content = bytes_of.get(&f.path).map(|disk| compare(&f.meta, &f.path, disk, &f.bytes));
+                    if let Some(Err(why)) = content {
+                        set(&f.path, FileStatus::Stale, why);
+                    } else if let Some(why) = meta_difference(&entry.meta, &f.meta) {
+                        set(&f.path, FileStatus::Tampered, why);
                     }
                 }
             }
@@ -334,12 +414,33 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
     Ok(VerifyReport { dir: dir.display().to_string(), files, problems })
 }
 
+/// The first metadata field where the manifest differs from what the code produces, described.
+fn meta_difference(recorded: &crate::manifest::FileMeta, code: &crate::manifest::FileMeta) -> Option<String> {
+    // The manifest went through JSON text; so does the code's metadata before comparing (float parsing).
+    let code: crate::manifest::FileMeta =
+        serde_json::from_str(&serde_json::to_string(code).ok()?).unwrap_or_else(|_| code.clone());
+    let code = &code;
+    if recorded == code {
+        return None;
+    }
+    let (a, b) = (serde_json::to_value(recorded).ok()?, serde_json::to_value(code).ok()?);
+    let (Value::Object(a), Value::Object(b)) = (&a, &b) else { return Some("metadata differs from the code".into()) };
+    let keys: BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+    for k in keys {
+        let (x, y) = (a.get(k).unwrap_or(&Value::Null), b.get(k).unwrap_or(&Value::Null));
+        if x != y {
+            return Some(format!("metadata field {k}: manifest says {x}, the code produces {y}"));
+        }
+    }
+    Some("metadata differs from the code".into())
+}
+
 /// Compares the file on disk with its recomputation: identical bytes, or floats within tolerance.
-fn compare(entry: &Entry, disk: &[u8], fresh: &[u8]) -> Result<(), String> {
+fn compare(meta: &crate::manifest::FileMeta, path: &str, disk: &[u8], fresh: &[u8]) -> Result<(), String> {
     if disk == fresh {
         return Ok(());
     }
-    let Some(tol) = entry.meta.verify_tolerance else {
+    let Some(tol) = meta.verify_tolerance else {
         let first = disk.iter().zip(fresh).position(|(a, b)| a != b).unwrap_or(disk.len().min(fresh.len()));
         return Err(format!(
             "differs from recomputation (byte-exact format): first difference at byte {first}, sizes {} vs {}",
@@ -347,8 +448,8 @@ fn compare(entry: &Entry, disk: &[u8], fresh: &[u8]) -> Result<(), String> {
             fresh.len()
         ));
     };
-    let a = decode_samples(entry, disk).map_err(|e| format!("cannot decode file on disk: {e}"))?;
-    let b = decode_samples(entry, fresh).map_err(|e| format!("cannot decode recomputation: {e}"))?;
+    let a = decode_samples(meta, path, disk).map_err(|e| format!("cannot decode file on disk: {e}"))?;
+    let b = decode_samples(meta, path, fresh).map_err(|e| format!("cannot decode recomputation: {e}"))?;
     if a.len() != b.len() {
         return Err(format!("sample count {} vs recomputed {}", a.len(), b.len()));
     }
@@ -366,21 +467,20 @@ fn compare(entry: &Entry, disk: &[u8], fresh: &[u8]) -> Result<(), String> {
 }
 
 /// Decodes a file's samples as f64 for tolerant comparison.
-fn decode_samples(entry: &Entry, bytes: &[u8]) -> Result<Vec<f64>, String> {
-    let path = entry.path.as_str();
-    match entry.meta.format.as_str() {
+fn decode_samples(meta: &crate::manifest::FileMeta, path: &str, bytes: &[u8]) -> Result<Vec<f64>, String> {
+    match meta.format.as_str() {
         "exr" => io::exr::decode(bytes, path)
             .map(|(img, _)| img.data.iter().map(|&v| v as f64).collect())
             .map_err(|e| e.to_string()),
         "ktx2" => {
             let (_, _, _, data, _) = io::ktx2::decode(bytes, path).map_err(|e| e.to_string())?;
-            Ok(payload_samples(&data, &entry.meta.sample_type))
+            Ok(payload_samples(&data, &meta.sample_type))
         }
         "dds" => {
             let (_, _, _, data) = io::dds::decode(bytes, path).map_err(|e| e.to_string())?;
-            Ok(payload_samples(&data, &entry.meta.sample_type))
+            Ok(payload_samples(&data, &meta.sample_type))
         }
-        "raw" => Ok(payload_samples(bytes, &entry.meta.sample_type)),
+        "raw" => Ok(payload_samples(bytes, &meta.sample_type)),
         "png" => match io::png::decode(bytes, path).map_err(|e| e.to_string())? {
             io::png::DecodedPng::U8(i) => Ok(i.data.iter().map(|&v| v as f64).collect()),
             io::png::DecodedPng::U16(i) => Ok(i.data.iter().map(|&v| v as f64).collect()),
@@ -445,6 +545,18 @@ mod tests {
         vec![Asset { name: "ramp", summary: "test", default_params: || serde_json::json!({"size": 8}), bake: ramp }]
     }
 
+    /// Entries of `dir` other than lock files.
+    fn siblings(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| !n.ends_with(".rtbake-lock"))
+            .collect();
+        v.sort();
+        v
+    }
+
     fn baked(dir: &Path) -> Vec<Asset> {
         let reg = registry();
         bake_into(dir, &[(&reg[0], (reg[0].default_params)())], "test").unwrap();
@@ -461,8 +573,8 @@ mod tests {
         let before = fs::read(dir.join(MANIFEST_NAME)).unwrap();
         baked(&dir);
         assert_eq!(before, fs::read(dir.join(MANIFEST_NAME)).unwrap());
-        // No staging leftovers beside the directory.
-        assert_eq!(fs::read_dir(t.path()).unwrap().count(), 1);
+        // No staging leftovers beside the directory (only its lock file).
+        assert_eq!(siblings(t.path()), ["baked"]);
     }
 
     #[test]
@@ -538,9 +650,9 @@ mod tests {
         fs::rename(&dir, &old).unwrap();
         fs::create_dir_all(t.path().join(".baked.rtbake-stage-999/test")).unwrap();
         fs::write(t.path().join(".baked.rtbake-stage-999/test/ramp.bin"), b"trunc").unwrap();
-        assert!(recover(&dir).is_some());
+        assert!(recover(&dir).unwrap().is_some());
         assert!(verify(&dir, &registry()).unwrap().is_ok());
-        assert_eq!(fs::read_dir(t.path()).unwrap().count(), 1);
+        assert_eq!(siblings(t.path()), ["baked"]);
     }
 
     #[test]
@@ -556,10 +668,119 @@ mod tests {
     #[test]
     fn float_files_compare_within_tolerance() {
         let meta = FileMeta::text("json", "json", "");
-        let mut entry = Entry { path: "x.json".into(), asset: "a".into(), meta, size_bytes: 0, sha256: String::new() };
-        assert!(compare(&entry, b"[1.0, 2.0]", b"[1.0, 2.0000001]").is_err());
-        entry.meta.verify_tolerance = Some(1e-6);
-        assert!(compare(&entry, b"[1.0, 2.0]", b"[1.0, 2.0000001]").is_ok());
-        assert!(compare(&entry, b"[1.0, 2.0]", b"[1.0, 2.01]").is_err());
+        let mut meta = meta;
+        assert!(compare(&meta, "x.json", b"[1.0, 2.0]", b"[1.0, 2.0000001]").is_err());
+        meta.verify_tolerance = Some(1e-6);
+        assert!(compare(&meta, "x.json", b"[1.0, 2.0]", b"[1.0, 2.0000001]").is_ok());
+        assert!(compare(&meta, "x.json", b"[1.0, 2.0]", b"[1.0, 2.01]").is_err());
+    }
+
+    type Edit = Box<dyn Fn(&mut Value)>;
+
+    /// Issue 15 finding 4: a file tampered together with its sha256 must fail whatever else the manifest says.
+    #[test]
+    fn manifest_cannot_switch_verification_off() {
+        let t = tempfile::tempdir().unwrap();
+        let dir = t.path().join("baked");
+        let reg = baked(&dir);
+        let pristine = fs::read_to_string(dir.join(MANIFEST_NAME)).unwrap();
+        let target = "test/ramp_f.ktx2";
+        let orig = fs::read(dir.join(target)).unwrap();
+        // Tamper the float file (within 1e9, far beyond the code's tolerance) and record its new sha256.
+        let mut bad = orig.clone();
+        let n = bad.len();
+        bad[n - 2..].copy_from_slice(&half::f16::from_f32(60000.0).to_le_bytes());
+        let tampered = |edit: &dyn Fn(&mut Value)| {
+            let mut m: Value = serde_json::from_str(&pristine).unwrap();
+            for f in m["files"].as_array_mut().unwrap() {
+                if f["path"] == target {
+                    f["sha256"] = sha256_hex(&bad).into();
+                }
+            }
+            edit(&mut m);
+            fs::write(dir.join(target), &bad).unwrap();
+            fs::write(dir.join(MANIFEST_NAME), serde_json::to_string_pretty(&m).unwrap()).unwrap();
+            let r = verify(&dir, &reg).unwrap();
+            fs::write(dir.join(target), &orig).unwrap();
+            fs::write(dir.join(MANIFEST_NAME), &pristine).unwrap();
+            r
+        };
+        let file_edit = |key: &'static str, v: Value| {
+            move |m: &mut Value| {
+                for f in m["files"].as_array_mut().unwrap() {
+                    if f["path"] == target {
+                        f[key] = v.clone();
+                    }
+                }
+            }
+        };
+        let cases: Vec<(&str, Edit)> = vec![
+            ("sha256 only", Box::new(|_: &mut Value| {})),
+            ("asset record removed", Box::new(|m: &mut Value| m["assets"] = serde_json::json!([]))),
+            ("asset record renamed", Box::new(|m: &mut Value| m["assets"][0]["name"] = "other".into())),
+            (
+                "asset of the entries renamed",
+                Box::new(|m: &mut Value| {
+                    for f in m["files"].as_array_mut().unwrap() {
+                        f["asset"] = "other".into();
+                    }
+                }),
+            ),
+            ("tolerance raised", Box::new(file_edit("verify_tolerance", 1e9.into()))),
+        ];
+        for (what, edit) in &cases {
+            let r = tampered(edit.as_ref());
+            assert!(!r.is_ok(), "{what}: verify passed");
+            assert!(r.files.iter().any(|f| f.path == target && f.status != FileStatus::Ok), "{what}: {r:?}");
+        }
+        // Metadata edits alone (file untouched): each is reported.
+        let meta_cases: Vec<(&str, Edit)> = vec![
+            ("color_space", Box::new(file_edit("color_space", "srgb".into()))),
+            ("width", Box::new(file_edit("width", 9.into()))),
+            ("pixel_format", Box::new(file_edit("pixel_format", "R32_SFLOAT".into()))),
+            (
+                "duplicate entry",
+                Box::new(|m: &mut Value| {
+                    let files = m["files"].as_array_mut().unwrap();
+                    let first = files[0].clone();
+                    files.push(first);
+                }),
+            ),
+            (
+                "duplicate asset",
+                Box::new(|m: &mut Value| {
+                    let a = m["assets"].as_array_mut().unwrap();
+                    let first = a[0].clone();
+                    a.push(first);
+                }),
+            ),
+            ("conventions", Box::new(|m: &mut Value| m["conventions"]["row_order"] = "bottom first".into())),
+        ];
+        for (what, edit) in &meta_cases {
+            let mut m: Value = serde_json::from_str(&pristine).unwrap();
+            edit(&mut m);
+            fs::write(dir.join(MANIFEST_NAME), serde_json::to_string_pretty(&m).unwrap()).unwrap();
+            let r = verify(&dir, &reg).unwrap();
+            fs::write(dir.join(MANIFEST_NAME), &pristine).unwrap();
+            assert!(r.files.iter().any(|f| f.status == FileStatus::Tampered), "{what}: {r:?}");
+        }
+        assert!(verify(&dir, &reg).unwrap().is_ok());
+    }
+
+    #[test]
+    fn pin_detects_any_manifest_edit() {
+        let t = tempfile::tempdir().unwrap();
+        let dir = t.path().join("baked");
+        let reg = baked(&dir);
+        let text = fs::read(dir.join(MANIFEST_NAME)).unwrap();
+        let pin = format!("{}  manifest.json\n", sha256_hex(&text));
+        assert!(verify_with(&dir, &reg, Some(&pin), &Wait::No).unwrap().is_ok());
+        // A consistent edit: different parameters, re-baked, so files, sha256 and recomputation all agree.
+        bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 9}))], "test").unwrap();
+        assert!(verify(&dir, &reg).unwrap().is_ok());
+        let r = verify_with(&dir, &reg, Some(&pin), &Wait::No).unwrap();
+        let line = r.files.iter().find(|f| f.path == MANIFEST_NAME).unwrap();
+        assert_eq!(line.status, FileStatus::Tampered, "{r:?}");
+        assert!(check_pin(b"x", "not-a-digest").unwrap_err().contains("64 hex"));
     }
 }

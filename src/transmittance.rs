@@ -117,6 +117,12 @@ impl TableSettings {
         Ok(())
     }
 
+    /// Peak memory of baking this table with its files (f32 table, f16 copies, EXR/KTX2/PNG encodings), in bytes:
+    /// 56 bytes per texel + 32 MiB, from peak RSS measured at 512² and 2048² texels (51 B/texel; issue 15).
+    pub fn memory_estimate_bytes(&self) -> u64 {
+        56 * self.samples as u64 * self.height as u64 + (32 << 20)
+    }
+
     /// s of texel i (node-inclusive).
     pub fn s_of_texel(&self, i: u32) -> f64 {
         self.s_max_mm * i as f64 / (self.samples - 1) as f64

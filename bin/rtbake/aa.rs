@@ -279,10 +279,11 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
         .collect();
 
     prepare_out_dir("--out", &a.out)?;
+    let set: Vec<BakedFile> = wanted.iter().map(|f| (*f).clone()).collect();
+    crate::cli::write_set(ctx, "--out", &a.out, &set, &[])?;
     let mut written = Vec::new();
     for f in wanted {
         let path = a.out.join(&f.path);
-        rtbake::io::atomic::write_atomic(&path, &f.bytes)?;
         let sha: String = Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect();
         ctx.info(format!("wrote {} ({} bytes, sha256 {sha})", path.display(), f.bytes.len()));
         written.push(serde_json::json!({

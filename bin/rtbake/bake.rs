@@ -1,6 +1,6 @@
 //! `rtbake bake`, `rtbake verify`, `rtbake assets`.
 
-use crate::cli::{usage, usage_msg, Ctx};
+use crate::cli::{file_set_err, usage, usage_msg, Ctx};
 use rtbake::baked_dir::{self, FileStatus};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -22,6 +22,10 @@ pub struct VerifyArgs {
     /// Bake directory holding manifest.json.
     #[arg(long, default_value = "baked", value_name = "DIR")]
     pub dir: PathBuf,
+    /// File holding the expected sha256 of manifest.json (e.g. `sha256sum baked/manifest.json > baked.pin`, kept
+    /// in version control): any edit of the manifest, however consistent, fails verification.
+    #[arg(long, value_name = "FILE")]
+    pub pin: Option<PathBuf>,
 }
 
 /// `git rev-parse --short=12 HEAD`, with `-dirty` when sources differ from it; `unknown` outside a checkout.
@@ -101,7 +105,8 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
     check_out_dir(&a.out)?;
     let pb = ctx.progress(1, "baking");
     let t0 = std::time::Instant::now();
-    let summary = baked_dir::bake_into(&a.out, &jobs, &git_revision()).map_err(classify)?;
+    let revision = git_revision();
+    let summary = ctx.with_wait(|wait| baked_dir::bake_into_with(&a.out, &jobs, &revision, wait)).map_err(classify)?;
     pb.finish_and_clear();
     if ctx.json {
         ctx.emit_json(&serde_json::to_value(&summary)?);
@@ -117,11 +122,13 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Bad parameters and unusable directories are the user's to fix (exit 2); I/O failures are runtime (exit 1).
+/// Bad parameters and unusable directories are the user's to fix (exit 2); a directory locked by another process
+/// under --no-wait exits 3; I/O failures are runtime (exit 1).
 fn classify(e: baked_dir::BakeDirError) -> anyhow::Error {
     use baked_dir::BakeDirError as E;
     match e {
         E::Asset { source: rtbake::bake::BakeError::Invalid(_), .. } | E::Unusable { .. } | E::Manifest(_) => usage(e),
+        E::Dir(d) => file_set_err(d),
         other => anyhow::Error::new(other),
     }
 }
@@ -130,27 +137,31 @@ fn check_out_dir(dir: &Path) -> anyhow::Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(usage_msg(format!("--out {}: exists and is not a directory", dir.display())));
     }
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let probe_dir = if dir.exists() { dir } else { parent };
-    if !probe_dir.exists() {
-        std::fs::create_dir_all(probe_dir)
-            .map_err(|e| usage(anyhow::anyhow!("--out {}: cannot create directory: {e}", dir.display())))?;
-    }
-    let probe = probe_dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(|e| usage(anyhow::anyhow!("--out {}: not writable: {e}", dir.display())))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    // The probe is a staging directory beside DIR, never a file inside it (a kill cannot leave a user file behind).
+    rtbake::io::file_set::probe_writable(dir)
+        .map_err(|e| usage(anyhow::anyhow!("--out {}: not writable: {e}", dir.display())))
 }
 
 pub fn run_verify(a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
-    if let Some(note) = baked_dir::recover(&a.dir) {
-        ctx.info(note);
-    }
-    if !a.dir.join(rtbake::manifest::MANIFEST_NAME).exists() {
+    if a.dir.is_dir() && !a.dir.join(rtbake::manifest::MANIFEST_NAME).exists() {
         return Err(usage_msg(format!("--dir {}: no manifest.json (not a bake directory)", a.dir.display())));
     }
+    let pin = match &a.pin {
+        None => None,
+        Some(p) => Some(
+            std::fs::read_to_string(p)
+                .map_err(|e| usage(anyhow::anyhow!("--pin {}: cannot read: {e}", p.display())))?,
+        ),
+    };
     let registry = rtbake::bake::registry();
-    let report = baked_dir::verify(&a.dir, &registry).map_err(anyhow::Error::new)?;
+    let report =
+        ctx.with_wait(|wait| baked_dir::verify_with(&a.dir, &registry, pin.as_deref(), wait)).map_err(|e| match e {
+            baked_dir::BakeDirError::Manifest(rtbake::manifest::ManifestError::Read { .. }) => usage(anyhow::anyhow!(
+                "--dir {}: no readable manifest.json (not a bake directory): {e}",
+                a.dir.display()
+            )),
+            other => classify(other),
+        })?;
     if ctx.json {
         ctx.emit_json(&serde_json::to_value(&report)?);
     }

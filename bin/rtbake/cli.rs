@@ -7,6 +7,10 @@ use std::path::Path;
 pub struct Ctx {
     pub json: bool,
     pub quiet: bool,
+    /// Fail at once (exit 3) instead of waiting when another rtbake process holds an output directory's lock.
+    pub no_wait: bool,
+    /// `--max-memory` in bytes (None: half of physical memory).
+    pub max_memory: Option<u64>,
 }
 
 impl Ctx {
@@ -21,6 +25,45 @@ impl Ctx {
     pub fn emit_json(&self, v: &serde_json::Value) {
         JSON_EMITTED.store(true, std::sync::atomic::Ordering::SeqCst);
         print_stdout(&format!("{}\n", serde_json::to_string_pretty(v).expect("JSON values serialise")));
+    }
+
+    /// Runs `f` with the lock-waiting policy of this invocation (waiting prints a message unless --quiet).
+    pub fn with_wait<T>(&self, f: impl FnOnce(&rtbake::io::file_set::Wait) -> T) -> T {
+        use rtbake::io::file_set::Wait;
+        let say = |m: &str| self.info(m);
+        if self.no_wait {
+            f(&Wait::No)
+        } else {
+            f(&Wait::Yes(&say))
+        }
+    }
+
+    /// The memory budget: `--max-memory`, else half of physical memory (8 GiB where it cannot be read).
+    pub fn memory_budget(&self) -> (u64, String) {
+        match self.max_memory {
+            Some(b) => (b, format!("--max-memory {}", fmt_bytes(b))),
+            None => {
+                let phys = physical_memory_bytes();
+                match phys {
+                    Some(p) => (p / 2, format!("default --max-memory: half of this machine's {}", fmt_bytes(p))),
+                    None => (8 << 30, "default --max-memory (physical memory unknown)".into()),
+                }
+            }
+        }
+    }
+
+    /// Refuses, before allocating, work whose memory estimate exceeds the budget (exit 2, estimate and limit named).
+    pub fn check_memory(&self, flags: &str, estimate_bytes: u64) -> anyhow::Result<()> {
+        let (budget, source) = self.memory_budget();
+        if estimate_bytes > budget {
+            return Err(usage_msg(format!(
+                "{flags}: this needs about {} of memory, more than the budget of {} ({source}); choose smaller sizes \
+                 or raise --max-memory",
+                fmt_bytes(estimate_bytes),
+                fmt_bytes(budget)
+            )));
+        }
+        Ok(())
     }
 
     /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
@@ -75,6 +118,28 @@ pub fn usage_msg(msg: impl Into<String>) -> anyhow::Error {
     usage(anyhow::anyhow!(msg.into()))
 }
 
+/// Marks an error as "an output directory is locked by another process" under --no-wait (exit 3).
+#[derive(Debug)]
+pub struct Busy(pub anyhow::Error);
+
+impl std::fmt::Display for Busy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl std::error::Error for Busy {}
+
+/// Classifies a file-set error: locked → exit 3, output = input or unusable path → exit 2, I/O → exit 1.
+pub fn file_set_err(e: rtbake::io::file_set::FileSetError) -> anyhow::Error {
+    use rtbake::io::file_set::FileSetError as E;
+    match e {
+        E::Busy { .. } => anyhow::Error::new(Busy(anyhow::Error::new(e))),
+        E::OutputIsInput { .. } | E::Unusable { .. } => usage(e),
+        E::Io(_) => anyhow::Error::new(e),
+    }
+}
+
 /// True if the error (or any cause) is bad input: a `Usage` marker or a library `InvalidInput`.
 pub fn is_usage(e: &anyhow::Error) -> bool {
     e.downcast_ref::<Usage>().is_some()
@@ -101,7 +166,14 @@ pub fn exit_with(e: &anyhow::Error, json: bool) -> ! {
         last = c;
     }
     eprintln!("{msg}");
-    let code = if is_usage(e) { 2 } else { 1 };
+    let busy = e.chain().any(|c| c.is::<Busy>());
+    let code = if busy {
+        3
+    } else if is_usage(e) {
+        2
+    } else {
+        1
+    };
     // A command that already printed its JSON result (e.g. `verify`'s report listing the failures) keeps stdout to
     // that one object.
     if json && !JSON_EMITTED.load(std::sync::atomic::Ordering::SeqCst) {
@@ -233,16 +305,76 @@ pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
     Ok([v[0], v[1], v[2]])
 }
 
-/// Checks that an output directory exists (or can be created) and is writable, before any work.
+/// Checks that an output directory exists (or can be created) and is writable, before any work. Nothing is
+/// written to probe it (a kill cannot leave a probe file among the user's files).
 #[allow(dead_code)]
 pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir)
         .map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
-    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    rtbake::io::file_set::check_dir_writable(dir)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", dir.display())))
+}
+
+/// Writes a command's output files into `dir` as one set with the library's `write_file_set`: under the
+/// directory's lock, all or nothing (a kill is rolled forward by the next command), an output that is one of
+/// `inputs` refused (exit 2, both paths named), a lock held elsewhere under --no-wait exit 3.
+#[allow(dead_code)]
+pub fn write_set(
+    ctx: &Ctx,
+    flag: &str,
+    dir: &Path,
+    files: &[rtbake::bake::BakedFile],
+    inputs: &[&Path],
+) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
+    ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
+        .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
+}
+
+/// `1.5 GiB`-style size.
+pub fn fmt_bytes(b: u64) -> String {
+    let units = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = b as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < units.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", units[u])
+    }
+}
+
+/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`.
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let v: f64 = num.trim().parse().map_err(|_| format!("expected a size like 512M or 12G, got {s:?}"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("must be a size > 0, got {s:?}"));
+    }
+    Ok((v * (1u64 << shift) as f64) as u64)
+}
+
+/// Physical memory of this machine, if the platform says.
+fn physical_memory_bytes() -> Option<u64> {
+    #[cfg(unix)]
+    {
+        // SAFETY: sysconf only reads system configuration.
+        let (pages, size) = unsafe { (libc::sysconf(libc::_SC_PHYS_PAGES), libc::sysconf(libc::_SC_PAGESIZE)) };
+        if pages > 0 && size > 0 {
+            return Some(pages as u64 * size as u64);
+        }
+    }
+    None
 }
 
 /// `--adding`: how layers are combined at each spatial frequency (one flag type for every command).

@@ -129,22 +129,8 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
     }
     if let Some(dir) = &args.out {
         files.push(rtbake::bake::json_file(&format!("fit_{name}.json"), &report, "json", "separable fit report"));
-        let mut staged = Vec::new();
-        for f in &files {
-            let path = dir.join(&f.path);
-            match rtbake::io::atomic::stage(&path, &f.bytes) {
-                Ok(tmp) => staged.push((tmp, path)),
-                Err(e) => {
-                    for (tmp, _) in &staged {
-                        let _ = std::fs::remove_file(tmp);
-                    }
-                    return Err(e.into());
-                }
-            }
-        }
-        for (tmp, path) in &staged {
-            rtbake::io::atomic::commit(tmp, path)?;
-        }
+        let inputs: Vec<&std::path::Path> = args.layered.layers.iter().map(|p| p.as_path()).collect();
+        crate::cli::write_set(ctx, "--out", dir, &files, &inputs)?;
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));
     }
 

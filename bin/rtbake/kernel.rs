@@ -90,23 +90,7 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
             precision.as_str()
         );
         let files = rtbake::bake::separable::kernel_files("", &stem, &k, args.sss_width, &source);
-        // Stage every file first, then rename: a failure leaves no partial set.
-        let mut staged = Vec::new();
-        for f in &files {
-            let path = dir.join(&f.path);
-            match rtbake::io::atomic::stage(&path, &f.bytes) {
-                Ok(tmp) => staged.push((tmp, path)),
-                Err(e) => {
-                    for (tmp, _) in &staged {
-                        let _ = std::fs::remove_file(tmp);
-                    }
-                    return Err(e.into());
-                }
-            }
-        }
-        for (tmp, path) in &staged {
-            rtbake::io::atomic::commit(tmp, path)?;
-        }
+        crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));
     }
 

@@ -1,7 +1,8 @@
 //! `rtbake`: command-line glue over the `rtbake` library. Parsing happens in two layers: clap turns flags into
 //! raw arguments, each subcommand validates them into library settings; no maths lives here.
 //!
-//! Exit codes: 0 success, 1 runtime failure, 2 bad usage or input.
+//! Exit codes: 0 success, 1 runtime failure, 2 bad usage or input, 3 an output directory is locked by another
+//! rtbake process and `--no-wait` was given.
 
 mod aa;
 mod bake;
@@ -15,7 +16,7 @@ mod run;
 mod skin_color;
 mod transmittance;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use cli::Ctx;
 
 #[derive(Parser)]
@@ -33,6 +34,14 @@ struct Cli {
     /// No progress bars or informational messages.
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// When another rtbake process is writing (or verifying) the same directory, fail at once with exit 3 instead of
+    /// waiting for it.
+    #[arg(long, global = true)]
+    no_wait: bool,
+    /// Memory budget for one command (e.g. 12G, 512M): sizes whose estimated peak memory exceeds it are refused
+    /// before anything is allocated. Default: half of physical memory.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = cli::parse_bytes)]
+    max_memory: Option<u64>,
     /// Read parameters from a JSON object {"flag-name": value, ...}; flags given on the command line override it.
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<std::path::PathBuf>,
@@ -69,6 +78,16 @@ enum Command {
     Run(run::RunCommand),
 }
 
+/// The command line, with every value-taking flag of every subcommand accepting a negative number after a space
+/// (`--thickness-mm -1`), so the range check names the flag instead of clap reporting an unexpected `-1`.
+fn command() -> clap::Command {
+    fn negatives(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| if a.get_action().takes_values() { a.allow_negative_numbers(true) } else { a })
+            .mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
 fn main() {
     // Behave like other Unix tools when stdout is closed early (`rtbake … | head`): end quietly, no panic.
     #[cfg(unix)]
@@ -82,12 +101,12 @@ fn main() {
         Ok(a) => a,
         Err(e) => cli::exit_with(&e, json),
     };
-    let parsed = match Cli::try_parse_from(argv) {
+    let parsed = match command().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
         Err(e) => cli::exit_clap(e, json),
     };
-    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet };
+    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet, no_wait: parsed.no_wait, max_memory: parsed.max_memory };
     let result = match parsed.command {
         Command::Bake(a) => bake::run_bake(a, &ctx),
         Command::Verify(a) => bake::run_verify(a, &ctx),

@@ -167,16 +167,10 @@ fn parse_border(s: &str) -> Border {
     }
 }
 
-/// Writes files below `dir` (paths relative to it), creating subdirectories; every write is atomic.
-fn write_files(flag: &str, dir: &Path, files: &[BakedFile]) -> Result<()> {
+/// Writes files below `dir` (paths relative to it) as one set: locked, all or nothing, never over an input.
+fn write_files(ctx: &Ctx, flag: &str, dir: &Path, files: &[BakedFile], inputs: &[&Path]) -> Result<()> {
     prepare_out_dir(flag, dir)?;
-    for f in files {
-        let p = dir.join(&f.path);
-        if let Some(parent) = p.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| anyhow::anyhow!("{}: {e}", parent.display()))?;
-        }
-        io::atomic::write_atomic(&p, &f.bytes)?;
-    }
+    crate::cli::write_set(ctx, flag, dir, files, inputs)?;
     Ok(())
 }
 
@@ -251,7 +245,9 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         &sources,
         "as given by the input value mapping (see maps[].source)",
     )?;
-    write_files("--out", &a.out, &files)?;
+    let mut input_paths: Vec<&Path> = vec![a.neutral.as_path()];
+    input_paths.extend(pairs.iter().map(|(_, p)| p.as_path()));
+    write_files(ctx, "--out", &a.out, &files, &input_paths)?;
     let pct = 100.0 * rig.sigma_floored_texels as f64 / (w as f64 * h as f64);
     ctx.info(format!(
         "wrote {} files to {} (rig {}x{}); sigma_neutral floored at {} in {} texels ({pct:.3} %)",
@@ -291,6 +287,12 @@ fn parse_weights(s: &str) -> Result<Vec<(String, f64)>> {
 fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
     let pairs = parse_weights(&a.weights)?;
     rtbake::error::check_range("--global-scale", a.global_scale, 0.0, 10.0, "")?;
+    // A `maps hemoglobin` killed while renaming its set left a committed journal: finish it, so the rig read
+    // below is the whole new set, never a mix of new and old maps.
+    let rig_dir = a.rig.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if let Some(note) = ctx.with_wait(|w| io::file_set::settle(rig_dir, w)).map_err(crate::cli::file_set_err)? {
+        ctx.info(note);
+    }
     let text = std::fs::read_to_string(&a.rig)
         .map_err(|e| usage(anyhow::anyhow!("--rig {}: cannot read: {e}", a.rig.display())))?;
     let desc: RigDescription = serde_json::from_str(&text)
@@ -312,7 +314,16 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
             return Err(usage_msg(format!("--out {}: directory {} does not exist", a.out.display(), parent.display())));
         }
     }
-    io::atomic::write_atomic(&a.out, &bytes).map_err(|e| usage(anyhow::anyhow!("--out: {e}")))?;
+    let out_name = a.out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let out_dir = a.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let mut read: Vec<PathBuf> = vec![a.rig.clone(), dir.join(&desc.h0.exr)];
+    for m in &desc.maps {
+        read.push(dir.join(&m.scale_exr));
+        read.push(dir.join(&m.bias_exr));
+    }
+    let read_refs: Vec<&Path> = read.iter().map(PathBuf::as_path).collect();
+    let file = BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text("map", "exr", "") };
+    crate::cli::write_set(ctx, "--out", out_dir, &[file], &read_refs)?;
     let used: Vec<String> = names.iter().zip(&weights).map(|(n, w)| format!("{n}={w}")).collect();
     ctx.info(format!("wrote {} ({w}x{h}) with weights {}", a.out.display(), used.join(",")));
     if ctx.json {
@@ -387,7 +398,8 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
     }
     report["composition"] = json!("n = normalize(base.xy + sum_z mask_z * weight_z * wrinkle.xy, 1), texel.rg -> 2*rg - 1 (thesis Listing 8.1; read .rg, not .gr)");
     files.push(rtbake::bake::json_file("wrinkles.json", &report, "json", "wrinkle conversion report"));
-    write_files("--out", &a.out, &files)?;
+    let inputs_read: Vec<&Path> = std::iter::once(a.normal.as_path()).chain(a.base.as_deref()).collect();
+    write_files(ctx, "--out", &a.out, &files, &inputs_read)?;
     if ctx.json {
         ctx.emit_json(&report);
     }
@@ -440,7 +452,13 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         "zones_given": given,
     });
     files.push(rtbake::bake::json_file("wrinkle_masks.json", &report, "json", "wrinkle mask packing"));
-    write_files("--out", &a.out, &files)?;
+    let inputs_read: Vec<&Path> = a
+        .zones
+        .iter()
+        .flat_map(|z| z.split(','))
+        .filter_map(|z| z.split_once('=').map(|(_, f)| Path::new(f)))
+        .collect();
+    write_files(ctx, "--out", &a.out, &files, &inputs_read)?;
     ctx.info(format!(
         "packed {} zone masks into 2 RGBA8 textures {}x{}",
         given.len(),
@@ -462,7 +480,7 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
         let bytes = io::png::encode_u16(img)?;
         files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text("input", "png", "") });
     }
-    write_files("--out", &a.out, &files)?;
+    write_files(ctx, "--out", &a.out, &files, &[])?;
     ctx.info(format!(
         "wrote {} synthetic maps ({}x{}, concentration = sample/65535) to {}",
         set.len(),

@@ -118,6 +118,23 @@ fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
     usage(InvalidInput::new(param, e.message))
 }
 
+/// A non-finite result names the input that produced it (the layer file, material or preset).
+fn non_finite_error(e: InvalidInput, args: &ProfileArgs) -> anyhow::Error {
+    if e.param != "profile" {
+        return flag_error(e, None);
+    }
+    let input = if let Some(l) = &args.layers {
+        format!("--layers {}", l.display())
+    } else if let Some(m) = &args.material {
+        format!("--material {m}")
+    } else if let Some(p) = &args.profile_preset {
+        format!("--profile-preset {p}")
+    } else {
+        "--skin-melanin/--skin-hemoglobin".to_string()
+    };
+    usage(InvalidInput::new(format!("{input}:"), e.message))
+}
+
 pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let fdr = match args.fdr {
         FdrArg::Dj05 => FdrForm::Dj05,
@@ -173,6 +190,9 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
         if let Some(p) = path {
             check_output_file(flag, p)?;
+            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
+            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
+                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
         }
     }
     let plot_format = match &args.plot {
@@ -187,7 +207,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
 
     let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
     let table =
-        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| flag_error(e, None))?;
+        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| non_finite_error(e, &args))?;
     let json = table.to_json();
     let plot_bytes = match plot_format {
         Some(format) => {
@@ -246,7 +266,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Before any work: `path` must not be a directory, and its directory must exist and accept a new file (probed).
+/// Before any work: `path` must not be a directory, and its directory must exist and accept a new file.
 fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
     if path.is_dir() {
         return Err(usage_msg(format!("{flag} {}: is a directory, expected a file path", path.display())));
@@ -255,11 +275,8 @@ fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
     if !dir.is_dir() {
         return Err(usage_msg(format!("{flag} {}: directory {} does not exist", path.display(), dir.display())));
     }
-    let probe = dir.join(format!(".rtbake-write-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", path.display())))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
+    rtbake::io::file_set::check_dir_writable(dir)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: directory is not writable: {e}", path.display())))
 }
 
 /// Plot title naming the profile.

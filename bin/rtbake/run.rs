@@ -138,13 +138,13 @@ pub struct DemoArgs {
 pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
     match cmd {
         RunCommand::Smaa(a) => {
-            check_output(&a.output)?;
+            check_output(&a.output, &[&a.input])?;
             let img = read_png(&a.input)?;
             let aa = Antialiasing::Smaa(loader::load_smaa_textures(&a.common.baked).map_err(usage)?);
             antialias_file(ctx, &a, img, &aa, "smaa")
         }
         RunCommand::Mlaa(m) => {
-            check_output(&m.aa.output)?;
+            check_output(&m.aa.output, &[&m.aa.input])?;
             let map = load_mlaa(&m.aa.common.baked, m.max_distance)?;
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
@@ -161,12 +161,14 @@ fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
 }
 
 /// The output's directory must exist and be writable before any work is done.
-fn check_output(path: &Path) -> anyhow::Result<()> {
+/// `--output` must be in an existing directory and must not be one of the command's `inputs` (exit 2, both named).
+fn check_output(path: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         return Err(usage_msg(format!("--output {}: directory {} does not exist", path.display(), dir.display())));
     }
-    Ok(())
+    rtbake::io::file_set::check_outputs_not_inputs(&[path.to_path_buf()], inputs)
+        .map_err(|e| usage(anyhow::anyhow!("--output: {e}")))
 }
 
 fn read_png(path: &Path) -> anyhow::Result<Image<u8>> {
@@ -242,7 +244,7 @@ fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::
 }
 
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
-    check_output(&a.output)?;
+    check_output(&a.output, &[&a.color, &a.depth])?;
     let baked = &a.common.baked;
     let (kernel, gaussians) = match a.method {
         Method::Separable => (Some(read_kernel(ctx, baked, &a.kernel)?), None),
@@ -294,8 +296,12 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
 }
 
 fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
-    check_output(&d.output)?;
+    check_output(&d.output, &[])?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
+    ctx.check_memory(
+        &format!("--width {} --height {}", d.width, d.height),
+        demo::memory_estimate_bytes(d.width, d.height),
+    )?;
     let aa = match d.aa {
         DemoAa::Smaa => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),
         DemoAa::Mlaa => {

@@ -239,7 +239,10 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let mut written = Vec::new();
     if let (Some(dir), Some(files)) = (&a.out, &files) {
         prepare_out_dir("--out", dir)?;
-        written = write_all_atomic(dir, files)?;
+        written = crate::cli::write_set(ctx, "--out", dir, files, &[])?
+            .iter()
+            .map(|p| p.strip_prefix(dir).unwrap_or(p).to_string_lossy().into_owned())
+            .collect();
         ctx.info(format!("wrote {} files of the skin-colour table to {}", written.len(), dir.display()));
     }
     if let Some(s) = &sample {
@@ -268,33 +271,4 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
         ctx.emit_json(&serde_json::json!({ "written": written }));
     }
     Ok(())
-}
-
-/// Stages every file (temp + fsync) before renaming any, so a failure leaves no partial table.
-fn write_all_atomic(dir: &std::path::Path, files: &[rtbake::bake::BakedFile]) -> anyhow::Result<Vec<String>> {
-    use rtbake::io::atomic;
-    let mut staged = Vec::new();
-    for f in files {
-        let path = dir.join(&f.path);
-        let result = path
-            .parent()
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .map_err(|e| anyhow::anyhow!("{}: cannot create directory: {e}", path.display()))
-            .and_then(|()| atomic::stage(&path, &f.bytes).map_err(anyhow::Error::new));
-        match result {
-            Ok(tmp) => staged.push((tmp, path)),
-            Err(e) => {
-                for (tmp, _) in &staged {
-                    let _ = std::fs::remove_file(tmp);
-                }
-                return Err(e);
-            }
-        }
-    }
-    let mut written = Vec::new();
-    for ((tmp, path), f) in staged.iter().zip(files) {
-        atomic::commit(tmp, path)?;
-        written.push(f.path.clone());
-    }
-    Ok(written)
 }

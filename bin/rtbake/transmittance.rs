@@ -2,12 +2,11 @@
 
 use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
 use crate::profile_source::{named, Named};
-use rtbake::bake::BakedFile;
 use rtbake::diffusion::sum_of_gaussians::preset;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings, RgbGaussians};
 use rtbake::transmittance::{evaluate, TableSettings, TransmittanceForm, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct TransmittanceArgs {
@@ -46,31 +45,6 @@ pub struct TransmittanceArgs {
     pub s_max: f64,
 }
 
-/// Writes a file set under `dir`: every file is staged (temp + fsync) first, then all are renamed, so an error
-/// leaves no partial set of new files.
-pub fn write_file_set(dir: &Path, files: &[BakedFile]) -> anyhow::Result<()> {
-    let mut staged = Vec::new();
-    for f in files {
-        let path = dir.join(&f.path);
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| anyhow::anyhow!("{}: {e}", parent.display()))?;
-        }
-        match rtbake::io::atomic::stage(&path, &f.bytes) {
-            Ok(tmp) => staged.push((tmp, path)),
-            Err(e) => {
-                for (tmp, _) in &staged {
-                    let _ = std::fs::remove_file(tmp);
-                }
-                return Err(e.into());
-            }
-        }
-    }
-    for (tmp, path) in &staged {
-        rtbake::io::atomic::commit(tmp, path)?;
-    }
-    Ok(())
-}
-
 fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
     if let Some(name) = &a.material {
         let (src, profile, _) = named(Named::Material { flag: "--material", name })?;
@@ -106,6 +80,9 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     };
     let table = TableSettings { samples: a.samples, height: a.height, s_max_mm: a.s_max, form };
     table.validate().map_err(usage)?;
+    if a.out.is_some() {
+        ctx.check_memory(&format!("--samples {} --height {}", a.samples, a.height), table.memory_estimate_bytes())?;
+    }
     if s_mm.is_none() && a.out.is_none() {
         return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));
     }
@@ -127,7 +104,7 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
             .map_err(|e| anyhow::anyhow!(e))?;
         prepare_out_dir("--out", dir)?;
-        write_file_set(dir, &files)?;
+        crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         result["files"] = json!(files.iter().map(|f| dir.join(&f.path).display().to_string()).collect::<Vec<_>>());
         result["convention"] = json!(table.convention());
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));

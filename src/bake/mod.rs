@@ -168,6 +168,42 @@ pub fn text_file(path: &str, text: String, kind: &str, format: &str, convention:
 
 /// Deserialises asset parameters, naming the asset in the error.
 pub fn parse_params<T: serde::de::DeserializeOwned>(asset: &str, params: &Value) -> Result<T, BakeError> {
-    serde_json::from_value(params.clone())
-        .map_err(|e| BakeError::Invalid(crate::error::InvalidInput::new(format!("{asset} parameters"), e.to_string())))
+    serde_json::from_value(params.clone()).map_err(|e| {
+        // serde names unknown and missing fields itself; a wrong type is located against the asset's defaults.
+        let field = registry()
+            .iter()
+            .find(|a| a.name == asset)
+            .and_then(|a| type_mismatch(&(a.default_params)(), params, String::new()));
+        let param = match field {
+            Some(path) => format!("{asset} parameter {path}:"),
+            None => format!("{asset} parameters"),
+        };
+        BakeError::Invalid(crate::error::InvalidInput::new(param, e.to_string()))
+    })
+}
+
+/// The first path (`table.samples`, `kernels[0].strength[2]`) where `given` has another JSON type than the
+/// asset's default `template` (a null default accepts anything; an integer default refuses fractions and
+/// negative numbers).
+fn type_mismatch(template: &Value, given: &Value, path: String) -> Option<String> {
+    let here = || if path.is_empty() { "(top level)".to_string() } else { path.clone() };
+    match (template, given) {
+        (Value::Null, _) => None,
+        (Value::Object(t), Value::Object(g)) => g.iter().find_map(|(k, v)| {
+            let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+            t.get(k).and_then(|tv| type_mismatch(tv, v, p))
+        }),
+        (Value::Array(t), Value::Array(g)) => {
+            let elem = t.first()?;
+            g.iter().enumerate().find_map(|(i, v)| type_mismatch(elem, v, format!("{path}[{i}]")))
+        }
+        (Value::Number(t), Value::Number(g)) => {
+            let integer = t.is_u64() || t.is_i64();
+            let unsigned = t.is_u64();
+            let bad = (integer && !(g.is_u64() || g.is_i64())) || (unsigned && !g.is_u64());
+            bad.then(here)
+        }
+        (Value::Bool(_), Value::Bool(_)) | (Value::String(_), Value::String(_)) => None,
+        _ => Some(here()),
+    }
 }

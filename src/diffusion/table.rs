@@ -66,12 +66,39 @@ impl ProfileTable {
     pub fn compute(profile: &dyn RadialProfile, radii_mm: &[f64], provenance: Value) -> Result<Self, InvalidInput> {
         check_radii("radii", radii_mm)?;
         let (reflectance_mm2, transmittance_mm2) = profile.profile_many(radii_mm);
+        let (total_reflectance, total_transmittance) = (profile.total_reflectance(), profile.total_transmittance());
+        // Nothing non-finite is ever written: huge but finite coefficients or thicknesses can overflow the model.
+        let columns = [("R", Some(&reflectance_mm2)), ("T", transmittance_mm2.as_ref())];
+        for (name, col) in columns {
+            for (r, v) in radii_mm.iter().zip(col.into_iter().flatten()) {
+                if let Some(c) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(InvalidInput::new(
+                        "profile",
+                        format!(
+                            "{name}(r) is not finite ({}) at r = {r} mm, channel {}: the model's inputs (coefficients, \
+                             thicknesses) are beyond what it evaluates in double precision; nothing was written",
+                            v[c],
+                            ["r", "g", "b"][c]
+                        ),
+                    ));
+                }
+            }
+        }
+        let totals = [("total R", Some(total_reflectance)), ("total T", total_transmittance)];
+        for (name, t) in totals {
+            if let Some(t) = t.filter(|t| t.iter().any(|x| !x.is_finite())) {
+                return Err(InvalidInput::new(
+                    "profile",
+                    format!("{name} is not finite ({t:?}): the model's inputs are beyond what it evaluates; nothing was written"),
+                ));
+            }
+        }
         Ok(Self {
             r_mm: radii_mm.to_vec(),
             reflectance_mm2,
             transmittance_mm2,
-            total_reflectance: profile.total_reflectance(),
-            total_transmittance: profile.total_transmittance(),
+            total_reflectance,
+            total_transmittance,
             provenance,
         })
     }

@@ -187,6 +187,12 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
     g
 }
 
+/// Peak host memory of [`render`] at `w`×`h`, in bytes: 120 bytes per pixel + 64 MiB, from peak RSS of the CPU
+/// path measured at 512² and 1024² (115 B/pixel; issue 15). The GPU path keeps the same host-side buffers.
+pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
+    120 * w as u64 * h as u64 + (64 << 20)
+}
+
 /// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased.
 pub fn render(
     gpu: Option<&Gpu>,

@@ -5,6 +5,9 @@
 //! command, the tests and the benchmark use. It honours `WGPU_BACKEND` (e.g. `vulkan`, `gl`) and
 //! `WGPU_ADAPTER_NAME` (case-insensitive substring of the adapter name) and reports the adapter it got, so that
 //! figures measured on a software rasteriser (lavapipe, llvmpipe) are never mistaken for GPU figures.
+//!
+//! The device is created with the adapter's own limits; [`check_image_fits`] compares an image with them before a
+//! pass allocates anything (wgpu panics on an over-limit texture or buffer), and refuses with the limit named.
 
 use super::RuntimeError;
 
@@ -88,10 +91,50 @@ async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError
         .request_device(&wgpu::DeviceDescriptor {
             label: Some("rtbake runtime"),
             required_features,
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            // The adapter's real limits (not wgpu's 256 MiB default buffer cap): every pass checks its image against
+            // them with `check_image_fits` before allocating, so an oversized image is refused, never a panic.
+            required_limits: adapter.limits(),
             ..Default::default()
         })
         .await
         .map_err(|e| RuntimeError::NoAdapter(format!("{}: cannot create a device: {e}", info.name)))?;
     Ok(Gpu { device, queue, adapter_info: info, timestamps })
+}
+
+/// Refuses, before any allocation, a `width`×`height` image that the device cannot hold: its 2-D texture edge
+/// limit, or the largest buffer the pass needs (a tightly padded read-back of `bytes_per_texel`-byte texels).
+/// The error is bad input (exit 2) naming the limit and the way out (`--cpu`, or a smaller image).
+pub fn check_image_fits(
+    device: &wgpu::Device,
+    width: u32,
+    height: u32,
+    bytes_per_texel: u32,
+) -> Result<(), RuntimeError> {
+    let limits = device.limits();
+    let edge = limits.max_texture_dimension_2d;
+    if width > edge || height > edge {
+        return Err(crate::error::InvalidInput::new(
+            "image",
+            format!(
+                "{width}x{height} exceeds this GPU's largest 2-D texture, {edge}x{edge} texels \
+                 (max_texture_dimension_2d); use --cpu or an image of at most {edge} texels per side"
+            ),
+        )
+        .into());
+    }
+    let row = (width as u64 * bytes_per_texel as u64).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
+    let bytes = row * height as u64;
+    if bytes > limits.max_buffer_size {
+        return Err(crate::error::InvalidInput::new(
+            "image",
+            format!(
+                "{width}x{height} needs a {bytes}-byte GPU buffer, this GPU allows at most {} bytes (max_buffer_size); \
+                 use --cpu or a smaller image",
+                limits.max_buffer_size
+            ),
+        )
+        .into());
+    }
+    Ok(())
 }

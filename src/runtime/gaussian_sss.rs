@@ -124,6 +124,7 @@ impl GaussianSss {
         params: &GaussianSssParams,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
+        super::device::check_image_fits(device, width, height, 8)?;
         params.validate()?;
         use wgpu::TextureFormat as F;
         let input = gpu::texture(device, "gsss input", width, height, F::Rgba16Float);

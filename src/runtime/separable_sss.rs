@@ -93,6 +93,7 @@ impl SeparableSss {
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
+        super::device::check_image_fits(device, width, height, 8)?;
         params.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "sss colour", width, height, F::Rgba16Float);

@@ -160,6 +160,7 @@ impl SkinInputs {
         rig: &RigScaleBiasMaps,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
+        super::device::check_image_fits(device, width, height, 16)?;
         luts.validate()?;
         rig.validate()?;
         use wgpu::TextureFormat as F;

@@ -130,6 +130,7 @@ impl Smaa {
         subsample: SubsampleIndices,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
+        super::device::check_image_fits(device, width, height, 4)?;
         subsample.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "smaa colour", width, height, F::Rgba8Unorm);
