@@ -105,7 +105,9 @@ pub struct BakeSummary {
 }
 
 /// Computes `jobs` (asset + parameters) and installs them into `dir` with an updated manifest, atomically.
-pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Result<BakeSummary, BakeDirError> {
+///
+/// The manifest records this build's provenance ([`crate::manifest::SOURCE_TREE`]), never the caller's directory.
+pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)]) -> Result<BakeSummary, BakeDirError> {
     // 1. Compute everything in memory (pure; a bad parameter writes nothing).
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
     for (asset, params) in jobs {
@@ -123,8 +125,8 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Re
                     .into(),
         });
     }
-    let mut manifest = old_manifest.clone().unwrap_or_else(|| Manifest::new(git_revision.into()));
-    manifest.git_revision = git_revision.into();
+    let mut manifest = old_manifest.clone().unwrap_or_default();
+    manifest.stamp_provenance();
     let old_paths: BTreeSet<String> = manifest.files.iter().map(|f| f.path.clone()).collect();
     for (asset, params, files) in &produced {
         manifest.set_asset(asset.name, (*params).clone(), files);
@@ -447,7 +449,7 @@ mod tests {
 
     fn baked(dir: &Path) -> Vec<Asset> {
         let reg = registry();
-        bake_into(dir, &[(&reg[0], (reg[0].default_params)())], "test").unwrap();
+        bake_into(dir, &[(&reg[0], (reg[0].default_params)())]).unwrap();
         reg
     }
 
@@ -522,7 +524,7 @@ mod tests {
         let reg = baked(&dir);
         let before = list_files(&dir).unwrap();
         let manifest_before = fs::read(dir.join(MANIFEST_NAME)).unwrap();
-        let err = bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 1_000_000}))], "test").unwrap_err();
+        let err = bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 1_000_000}))]).unwrap_err();
         assert!(err.to_string().contains("size"), "{err}");
         assert_eq!(before, list_files(&dir).unwrap());
         assert_eq!(manifest_before, fs::read(dir.join(MANIFEST_NAME)).unwrap());
@@ -548,7 +550,7 @@ mod tests {
         let t = tempfile::tempdir().unwrap();
         fs::write(t.path().join("notes.txt"), b"mine").unwrap();
         let reg = registry();
-        let err = bake_into(t.path(), &[(&reg[0], (reg[0].default_params)())], "x").unwrap_err();
+        let err = bake_into(t.path(), &[(&reg[0], (reg[0].default_params)())]).unwrap_err();
         assert!(matches!(err, BakeDirError::Unusable { .. }));
         assert_eq!(fs::read(t.path().join("notes.txt")).unwrap(), b"mine");
     }

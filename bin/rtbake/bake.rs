@@ -24,31 +24,6 @@ pub struct VerifyArgs {
     pub dir: PathBuf,
 }
 
-/// `git rev-parse --short=12 HEAD`, with `-dirty` when sources differ from it; `unknown` outside a checkout.
-fn git_revision() -> String {
-    let run = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .stderr(std::process::Stdio::null())
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    match run(&["rev-parse", "--short=12", "HEAD"]) {
-        Some(rev) if !rev.is_empty() => {
-            let dirty = run(&["status", "--porcelain", "--", "src", "bin", "Cargo.toml", "Cargo.lock"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty {
-                format!("{rev}-dirty")
-            } else {
-                rev
-            }
-        }
-        _ => "unknown".into(),
-    }
-}
-
 fn merge(base: &mut Value, over: &Value) {
     match (base, over) {
         (Value::Object(b), Value::Object(o)) => {
@@ -101,7 +76,7 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
     check_out_dir(&a.out)?;
     let pb = ctx.progress(1, "baking");
     let t0 = std::time::Instant::now();
-    let summary = baked_dir::bake_into(&a.out, &jobs, &git_revision()).map_err(classify)?;
+    let summary = baked_dir::bake_into(&a.out, &jobs).map_err(classify)?;
     pb.finish_and_clear();
     if ctx.json {
         ctx.emit_json(&serde_json::to_value(&summary)?);

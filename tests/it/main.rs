@@ -23,6 +23,7 @@ mod fitting_bake;
 mod fitting_cli;
 mod fitting_determinism;
 mod fitting_published;
+mod newcomer_provenance;
 mod profiles_bake;
 mod profiles_cli;
 mod runtime_cli;
