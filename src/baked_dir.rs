@@ -108,12 +108,24 @@ pub struct BakeSummary {
 ///
 /// The manifest records this build's provenance ([`crate::manifest::SOURCE_TREE`]), never the caller's directory.
 pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)]) -> Result<BakeSummary, BakeDirError> {
+    bake_into_with_progress(dir, jobs, &|_, _| {})
+}
+
+/// [`bake_into`], calling `progress(k, name)` before computing the k-th job (0-based) and `progress(jobs.len(),
+/// "writing")` before the directory is written, so a caller can show per-asset progress.
+pub fn bake_into_with_progress(
+    dir: &Path,
+    jobs: &[(&Asset, Value)],
+    progress: &dyn Fn(usize, &str),
+) -> Result<BakeSummary, BakeDirError> {
     // 1. Compute everything in memory (pure; a bad parameter writes nothing).
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
-    for (asset, params) in jobs {
+    for (k, (asset, params)) in jobs.iter().enumerate() {
+        progress(k, asset.name);
         let files = (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
         produced.push((asset, params, files));
     }
+    progress(jobs.len(), "writing");
     // 2. Existing state.
     recover(dir);
     let old_manifest = if dir.join(MANIFEST_NAME).exists() { Some(Manifest::load(dir)?) } else { None };
@@ -451,6 +463,19 @@ mod tests {
         let reg = registry();
         bake_into(dir, &[(&reg[0], (reg[0].default_params)())]).unwrap();
         reg
+    }
+
+    #[test]
+    fn progress_reports_each_asset_then_the_write() {
+        let t = tempfile::tempdir().unwrap();
+        let reg = registry();
+        let seen = std::sync::Mutex::new(Vec::new());
+        let jobs = [(&reg[0], serde_json::json!({"size": 4})), (&reg[0], serde_json::json!({"size": 4}))];
+        bake_into_with_progress(&t.path().join("b"), &jobs, &|k, name| {
+            seen.lock().unwrap().push((k, name.to_string()))
+        })
+        .unwrap();
+        assert_eq!(*seen.lock().unwrap(), [(0, "ramp".into()), (1, "ramp".into()), (2, "writing".to_string())]);
     }
 
     #[test]

@@ -74,9 +74,18 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
         })
         .collect();
     check_out_dir(&a.out)?;
-    let pb = ctx.progress(1, "baking");
+    let pb = ctx.progress(jobs.len() as u64, "baking");
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} assets, {elapsed}: {msg}")
+            .expect("valid template"),
+    );
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
     let t0 = std::time::Instant::now();
-    let summary = baked_dir::bake_into(&a.out, &jobs).map_err(classify)?;
+    let summary = baked_dir::bake_into_with_progress(&a.out, &jobs, &|k, name| {
+        pb.set_position(k as u64);
+        pb.set_message(name.to_string());
+    })
+    .map_err(classify)?;
     pb.finish_and_clear();
     if ctx.json {
         ctx.emit_json(&serde_json::to_value(&summary)?);
