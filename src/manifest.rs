@@ -1,4 +1,4 @@
-//! `baked/manifest.json`: what every baked file is, how it was made, and its sha256 (`specs/outputs.md`).
+//! `baked/manifest.json`: what every baked file is, how it was made, and its sha256.
 //!
 //! Written deterministically: stable key order, no timestamps, entries sorted by path. Re-baking with the same
 //! rtbake sources and parameters changes no byte of any file, the manifest included.

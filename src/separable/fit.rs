@@ -1,5 +1,5 @@
 //! Fitting the separable kernel's strength and falloff to the exact 2-D kernel of a diffusion profile
-//! (thesis eq. 6.1–6.3; `specs/sss-fitting.md` §2 "Fitting width / strength / falloff").
+//! (thesis eq. 6.1–6.3).
 //!
 //! # The objective (eq. 6.3), made explicit
 //!

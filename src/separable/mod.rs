@@ -1,7 +1,7 @@
 //! Separable subsurface scattering (J. Jimenez, *Practical Real-Time Strategies for Photorealistic Skin Rendering
 //! and Antialiasing*, PhD thesis, 2012, ch. 6; J. Jimenez et al., "Separable Subsurface Scattering and Photorealistic
 //! Eyes Rendering", SIGGRAPH 2012 course *Advances in Real-Time Rendering in Games*, with the published
-//! `SeparableSSS` shader and demo; `specs/sss-fitting.md` §2).
+//! `SeparableSSS` shader and demo).
 //!
 //! The 2-D diffusion kernel `S[x, y]` of skin is replaced by the product `s[x]·s[y]` of one 1-D kernel (eq. 6.1)
 //!
