@@ -269,7 +269,7 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             ctx.info(format!(
                 "{:.1} MiB table: writing bin, dds, ktx2, png; the C/Rust sources (~{} MiB each) only with --format h,rs",
                 payload as f64 / (1u64 << 20) as f64,
-                6 * payload >> 20
+                (6 * payload) >> 20
             ));
             vec![AaFormat::Bin, AaFormat::Dds, AaFormat::Ktx2, AaFormat::Png]
         };
@@ -278,7 +278,7 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if sources && 6 * payload > LARGE_SOURCE_WARN_BYTES {
         eprintln!(
             "warning: writing C/Rust sources of ~{} MiB each (payload {} bytes); --format bin,dds,ktx2,png skips them",
-            6 * payload >> 20,
+            (6 * payload) >> 20,
             payload
         );
     }
