@@ -101,23 +101,37 @@ pub struct BakeSummary {
 
 /// Computes `jobs` (asset + parameters) and installs them into `dir` with an updated manifest, atomically,
 /// waiting silently for the directory's lock.
-pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)], git_revision: &str) -> Result<BakeSummary, BakeDirError> {
-    bake_into_with(dir, jobs, git_revision, &Wait::Yes(&|_| {}))
+///
+/// The manifest records this build's provenance ([`crate::manifest::SOURCE_TREE`]), never the caller's directory.
+pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)]) -> Result<BakeSummary, BakeDirError> {
+    bake_into_with(dir, jobs, &|_, _| {}, &Wait::Yes(&|_| {}))
 }
 
-/// [`bake_into`] with a choice of waiting for the lock another process holds on `dir`.
+/// [`bake_into`], calling `progress(k, name)` before computing the k-th job (0-based) and `progress(jobs.len(),
+/// "writing")` before the directory is written, so a caller can show per-asset progress.
+pub fn bake_into_with_progress(
+    dir: &Path,
+    jobs: &[(&Asset, Value)],
+    progress: &dyn Fn(usize, &str),
+) -> Result<BakeSummary, BakeDirError> {
+    bake_into_with(dir, jobs, progress, &Wait::Yes(&|_| {}))
+}
+
+/// [`bake_into_with_progress`] with a choice of waiting for the lock another process holds on `dir`.
 pub fn bake_into_with(
     dir: &Path,
     jobs: &[(&Asset, Value)],
-    git_revision: &str,
+    progress: &dyn Fn(usize, &str),
     wait: &Wait,
 ) -> Result<BakeSummary, BakeDirError> {
     // 1. Compute everything in memory (pure; a bad parameter writes nothing). No lock is needed for this.
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
-    for (asset, params) in jobs {
+    for (k, (asset, params)) in jobs.iter().enumerate() {
+        progress(k, asset.name);
         let files = (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
         produced.push((asset, params, files));
     }
+    progress(jobs.len(), "writing");
     // 2. From here to the swap, the directory is ours: the existing state read below cannot change under us.
     let lock = DirLock::acquire(dir, LockMode::Exclusive, wait)?;
     let real = lock.dir().to_path_buf();
@@ -131,8 +145,8 @@ pub fn bake_into_with(
                     .into(),
         });
     }
-    let mut manifest = old_manifest.clone().unwrap_or_else(|| Manifest::new(git_revision.into()));
-    manifest.git_revision = git_revision.into();
+    let mut manifest = old_manifest.clone().unwrap_or_default();
+    manifest.stamp_provenance();
     let old_paths: BTreeSet<String> = manifest.files.iter().map(|f| f.path.clone()).collect();
     for (asset, params, files) in &produced {
         manifest.set_asset(asset.name, (*params).clone(), files);
@@ -559,8 +573,21 @@ mod tests {
 
     fn baked(dir: &Path) -> Vec<Asset> {
         let reg = registry();
-        bake_into(dir, &[(&reg[0], (reg[0].default_params)())], "test").unwrap();
+        bake_into(dir, &[(&reg[0], (reg[0].default_params)())]).unwrap();
         reg
+    }
+
+    #[test]
+    fn progress_reports_each_asset_then_the_write() {
+        let t = tempfile::tempdir().unwrap();
+        let reg = registry();
+        let seen = std::sync::Mutex::new(Vec::new());
+        let jobs = [(&reg[0], serde_json::json!({"size": 4})), (&reg[0], serde_json::json!({"size": 4}))];
+        bake_into_with_progress(&t.path().join("b"), &jobs, &|k, name| {
+            seen.lock().unwrap().push((k, name.to_string()))
+        })
+        .unwrap();
+        assert_eq!(*seen.lock().unwrap(), [(0, "ramp".into()), (1, "ramp".into()), (2, "writing".to_string())]);
     }
 
     #[test]
@@ -634,7 +661,7 @@ mod tests {
         let reg = baked(&dir);
         let before = list_files(&dir).unwrap();
         let manifest_before = fs::read(dir.join(MANIFEST_NAME)).unwrap();
-        let err = bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 1_000_000}))], "test").unwrap_err();
+        let err = bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 1_000_000}))]).unwrap_err();
         assert!(err.to_string().contains("size"), "{err}");
         assert_eq!(before, list_files(&dir).unwrap());
         assert_eq!(manifest_before, fs::read(dir.join(MANIFEST_NAME)).unwrap());
@@ -660,7 +687,7 @@ mod tests {
         let t = tempfile::tempdir().unwrap();
         fs::write(t.path().join("notes.txt"), b"mine").unwrap();
         let reg = registry();
-        let err = bake_into(t.path(), &[(&reg[0], (reg[0].default_params)())], "x").unwrap_err();
+        let err = bake_into(t.path(), &[(&reg[0], (reg[0].default_params)())]).unwrap_err();
         assert!(matches!(err, BakeDirError::Unusable { .. }));
         assert_eq!(fs::read(t.path().join("notes.txt")).unwrap(), b"mine");
     }
@@ -776,7 +803,7 @@ mod tests {
         let pin = format!("{}  manifest.json\n", sha256_hex(&text));
         assert!(verify_with(&dir, &reg, Some(&pin), &Wait::No).unwrap().is_ok());
         // A consistent edit: different parameters, re-baked, so files, sha256 and recomputation all agree.
-        bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 9}))], "test").unwrap();
+        bake_into(&dir, &[(&reg[0], serde_json::json!({"size": 9}))]).unwrap();
         assert!(verify(&dir, &reg).unwrap().is_ok());
         let r = verify_with(&dir, &reg, Some(&pin), &Wait::No).unwrap();
         let line = r.files.iter().find(|f| f.path == MANIFEST_NAME).unwrap();

@@ -1,7 +1,14 @@
-//! `baked/manifest.json`: what every baked file is, how it was made, and its sha256 (`specs/outputs.md`).
+//! `baked/manifest.json`: what every baked file is, how it was made, and its sha256.
 //!
-//! Written deterministically: stable key order, no timestamps, entries sorted by path. Re-baking an unchanged
-//! tree changes no byte of any file; only `git_revision` follows the source tree it was baked from.
+//! Written deterministically: stable key order, no timestamps, entries sorted by path. Re-baking with the same
+//! rtbake sources and parameters changes no byte of any file, the manifest included.
+//!
+//! Provenance is rtbake's own, captured when rtbake was compiled (not the directory the bake runs in):
+//! `tool_version` (the crate version), `source_tree` (the git tree id of rtbake's `src/`, equal to
+//! `git rev-parse <commit>:src` for a clean checkout of that commit) and `cargo_lock` (the git blob id of the
+//! `Cargo.lock` it was built with, which pins the encoders, or `absent`). A tree id rather than a commit id: a commit
+//! that only re-bakes `baked/` or edits docs moves HEAD but not the tree, so re-baking the same sources keeps the
+//! manifest byte-identical.
 
 use crate::io::PixelFormat;
 use serde::{Deserialize, Serialize};
@@ -11,6 +18,13 @@ use std::path::Path;
 
 pub const MANIFEST_NAME: &str = "manifest.json";
 pub const SCHEMA: &str = "rtbake-manifest/1";
+
+/// Git tree id of the `src/` this rtbake was compiled from (computed by `build.rs` from the files, so it also
+/// names uncommitted sources; `git rev-parse <commit>:src` prints the same id for a clean checkout).
+pub const SOURCE_TREE: &str = env!("RTBAKE_SOURCE_TREE");
+/// Git blob id of the `Cargo.lock` this rtbake was compiled with (`git rev-parse <commit>:Cargo.lock`), or `absent`
+/// when built as a dependency without one.
+pub const CARGO_LOCK: &str = env!("RTBAKE_CARGO_LOCK");
 
 /// Metadata recorded in the manifest for one file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -92,8 +106,13 @@ pub struct Manifest {
     pub schema: String,
     pub tool: String,
     pub tool_version: String,
-    /// `git describe --always --dirty` of the tree that baked it, or `unknown`.
-    pub git_revision: String,
+    /// [`SOURCE_TREE`] of the rtbake that baked it (manifests written before 0.1.0's provenance fix stored the
+    /// working directory's commit here under the name `git_revision`).
+    #[serde(alias = "git_revision")]
+    pub source_tree: String,
+    /// [`CARGO_LOCK`] of the rtbake that baked it.
+    #[serde(default)]
+    pub cargo_lock: String,
     pub conventions: Value,
     pub assets: Vec<AssetRecord>,
     pub files: Vec<Entry>,
@@ -124,17 +143,33 @@ pub fn conventions() -> Value {
     })
 }
 
+impl Default for Manifest {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Manifest {
-    pub fn new(git_revision: String) -> Self {
+    /// An empty manifest stamped with this build's provenance.
+    pub fn new() -> Self {
         Self {
             schema: SCHEMA.into(),
             tool: "rtbake".into(),
             tool_version: env!("CARGO_PKG_VERSION").into(),
-            git_revision,
+            source_tree: SOURCE_TREE.into(),
+            cargo_lock: CARGO_LOCK.into(),
             conventions: conventions(),
             assets: Vec::new(),
             files: Vec::new(),
         }
+    }
+
+    /// Stamps this build's provenance (`tool_version`, `source_tree`, `cargo_lock`) over what was recorded.
+    pub fn stamp_provenance(&mut self) {
+        let fresh = Self::new();
+        self.tool_version = fresh.tool_version;
+        self.source_tree = fresh.source_tree;
+        self.cargo_lock = fresh.cargo_lock;
     }
 
     /// Replaces (or adds) an asset and its files; keeps assets and files sorted.

@@ -1,7 +1,9 @@
 //! Transmittance through thin regions as a function of the distance s travelled inside the object (Jimenez,
 //! Whelan, Sundstedt, Gutierrez, "Real-Time Realistic Skin Translucency", IEEE CG&A 30(4), 2010; thesis ch. 5):
 //!
-//!     T_c(s) = Σᵢ wᵢ,c · exp(−s²/vᵢ)                 // eq. 5.12 (published form, also the published shader's)
+//! ```text
+//! T_c(s) = Σᵢ wᵢ,c · exp(−s²/vᵢ)                 // eq. 5.12 (published form, also the published shader's)
+//! ```
 //!
 //! Integrating a normalised 2-D Gaussian profile over a plane at depth s gives exp(−s²/(2v)) instead
 //! ([`TransmittanceForm::Physical`], `--physical`). The weights and variances come from any preset or fitted sum of

@@ -114,8 +114,10 @@ pub struct AaArgs {
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// File formats to write, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
+    /// File formats to write, comma-separated. Default: all for tables up to 1 MiB; above, the binary formats
+    /// (bin,dds,ktx2,png) only — the C/Rust sources are ~6 bytes of text per texel byte (AreaMap1023 ≈ 300 MB
+    /// each) and are written only when named (`--format h,rs` or `all`).
+    #[arg(long, value_enum, value_delimiter = ',')]
     pub format: Vec<AaFormat>,
     /// File name stem (default: the upstream name, e.g. AreaTex, SearchTex, AreaMap33_v1.4).
     #[arg(long, value_name = "NAME")]
@@ -239,8 +241,50 @@ fn bake_err(e: BakeError) -> anyhow::Error {
     }
 }
 
-pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
+/// Payloads above this size get only the binary formats unless sources are asked for by name.
+const SOURCES_BY_DEFAULT_MAX_BYTES: u64 = 1 << 20;
+/// Generated sources above this size are announced on stderr before they are written.
+const LARGE_SOURCE_WARN_BYTES: u64 = 64 << 20;
+
+/// Texture payload in bytes (before anything is computed), for the format defaults.
+fn payload_bytes(a: &AaArgs) -> anyhow::Result<u64> {
+    Ok(match a.texture {
+        AaTexture::SmaaArea | AaTexture::SmaaAreaV28 => {
+            let (w, h) = smaa_params(a)?.validate().map_err(usage)?;
+            w as u64 * h as u64 * 2
+        }
+        AaTexture::SmaaSearch | AaTexture::SmaaSearchV28 | AaTexture::SmaaSearchPrecrop => 66 * 33,
+        AaTexture::MlaaV14 | AaTexture::MlaaV13 | AaTexture::MlaaV2 => {
+            let v = mlaa_version(a.texture).expect("MLAA texture");
+            let n = a.max_distance.unwrap_or(default_mlaa_n(v)) as u64;
+            25 * n * n * 2
+        }
+    })
+}
+
+pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     check_applicable(&a)?;
+    let payload = payload_bytes(&a)?;
+    if a.format.is_empty() {
+        a.format = if payload <= SOURCES_BY_DEFAULT_MAX_BYTES {
+            vec![AaFormat::All]
+        } else {
+            ctx.info(format!(
+                "{:.1} MiB table: writing bin, dds, ktx2, png; the C/Rust sources (~{} MiB each) only with --format h,rs",
+                payload as f64 / (1u64 << 20) as f64,
+                (6 * payload) >> 20
+            ));
+            vec![AaFormat::Bin, AaFormat::Dds, AaFormat::Ktx2, AaFormat::Png]
+        };
+    }
+    let sources = a.format.iter().any(|f| matches!(f, AaFormat::All | AaFormat::H | AaFormat::Rs));
+    if sources && 6 * payload > LARGE_SOURCE_WARN_BYTES {
+        eprintln!(
+            "warning: writing C/Rust sources of ~{} MiB each (payload {} bytes); --format bin,dds,ktx2,png skips them",
+            (6 * payload) >> 20,
+            payload
+        );
+    }
     let name = clap::ValueEnum::to_possible_value(&a.texture).map(|v| v.get_name().to_string()).unwrap_or_default();
     // Everything is computed and validated before the output directory is touched.
     let files: Vec<BakedFile> = match a.texture {
@@ -248,7 +292,7 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let p = smaa_params(&a)?;
             let default_stem = if a.texture == AaTexture::SmaaArea { "AreaTex" } else { "AreaTex_v2.8" };
             let from = format!("`{}`", smaa_command(&name, &p));
-            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, true, &from).map_err(bake_err)?
+            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, sources, &from).map_err(bake_err)?
         }
         AaTexture::SmaaSearch | AaTexture::SmaaSearchV28 | AaTexture::SmaaSearchPrecrop => {
             let (kind, stem) = match a.texture {
@@ -256,7 +300,7 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 AaTexture::SmaaSearchV28 => (SearchKind::V2_8, "SearchTex_v2.8"),
                 _ => (SearchKind::LogicalPrecrop, "SearchTex_logical_precrop"),
             };
-            search_files(kind, a.stem.as_deref().unwrap_or(stem), true, &format!("`rtbake aa {name}`"))
+            search_files(kind, a.stem.as_deref().unwrap_or(stem), sources, &format!("`rtbake aa {name}`"))
                 .map_err(bake_err)?
         }
         AaTexture::MlaaV14 | AaTexture::MlaaV13 | AaTexture::MlaaV2 => {
@@ -264,7 +308,7 @@ pub fn run(a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let n = a.max_distance.unwrap_or(default_mlaa_n(v));
             let stem = a.stem.clone().unwrap_or_else(|| mlaa_stem(v, n));
             let from = format!("`rtbake aa {name} --max-distance {n}`");
-            mlaa_files(v, n, &stem, true, &from).map_err(bake_err)?
+            mlaa_files(v, n, &stem, sources, &from).map_err(bake_err)?
         }
     };
     let mut files = files;

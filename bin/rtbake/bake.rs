@@ -28,31 +28,6 @@ pub struct VerifyArgs {
     pub pin: Option<PathBuf>,
 }
 
-/// `git rev-parse --short=12 HEAD`, with `-dirty` when sources differ from it; `unknown` outside a checkout.
-fn git_revision() -> String {
-    let run = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .stderr(std::process::Stdio::null())
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    match run(&["rev-parse", "--short=12", "HEAD"]) {
-        Some(rev) if !rev.is_empty() => {
-            let dirty = run(&["status", "--porcelain", "--", "src", "bin", "Cargo.toml", "Cargo.lock"])
-                .is_some_and(|s| !s.is_empty());
-            if dirty {
-                format!("{rev}-dirty")
-            } else {
-                rev
-            }
-        }
-        _ => "unknown".into(),
-    }
-}
-
 fn merge(base: &mut Value, over: &Value) {
     match (base, over) {
         (Value::Object(b), Value::Object(o)) => {
@@ -103,10 +78,18 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
         })
         .collect();
     check_out_dir(&a.out)?;
-    let pb = ctx.progress(1, "baking");
+    let pb = ctx.progress(jobs.len() as u64, "baking");
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} assets, {elapsed}: {msg}")
+            .expect("valid template"),
+    );
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
     let t0 = std::time::Instant::now();
-    let revision = git_revision();
-    let summary = ctx.with_wait(|wait| baked_dir::bake_into_with(&a.out, &jobs, &revision, wait)).map_err(classify)?;
+    let progress = |k: usize, name: &str| {
+        pb.set_position(k as u64);
+        pb.set_message(name.to_string());
+    };
+    let summary = ctx.with_wait(|wait| baked_dir::bake_into_with(&a.out, &jobs, &progress, wait)).map_err(classify)?;
     pb.finish_and_clear();
     if ctx.json {
         ctx.emit_json(&serde_json::to_value(&summary)?);

@@ -32,14 +32,17 @@ pub struct FitGaussiansArgs {
     /// Deterministic optimiser starts (1..=64).
     #[arg(long, default_value_t = 8)]
     pub starts: usize,
-    /// Global SSS level α for the depth-LOD thresholds (thesis eq. 4.1–4.6).
-    #[arg(long, default_value_t = DEFAULT_ALPHA)]
+    /// Global SSS level α of the stretch factor s = α / (d + β·min(|∇d|, γ)) (thesis eq. 4.1–4.2) and of the
+    /// depth-LOD thresholds (eq. 4.6), for a 720-pixel-high viewport; any finite value > 0 (thesis: 31.5).
+    #[arg(long, default_value_t = DEFAULT_ALPHA, value_name = "ALPHA")]
     pub alpha: f64,
-    /// β of the stretch factors (eq. 4.1–4.2).
-    #[arg(long, default_value_t = DEFAULT_BETA)]
+    /// β of the stretch factor above: how strongly the depth gradient |∇d| shrinks the kernel (eq. 4.1–4.2);
+    /// any finite value >= 0 (thesis: 800).
+    #[arg(long, default_value_t = DEFAULT_BETA, value_name = "BETA")]
     pub beta: f64,
-    /// γ of the stretch factors (eq. 4.1–4.2).
-    #[arg(long, default_value_t = DEFAULT_GAMMA)]
+    /// γ of the stretch factor above: the clamp of |∇d| (depth units per pixel) (eq. 4.1–4.2); any finite value
+    /// >= 0 (thesis: 0.001).
+    #[arg(long, default_value_t = DEFAULT_GAMMA, value_name = "GAMMA")]
     pub gamma: f64,
     /// Print the 33-entry error table of per-channel 4-Gaussian fits of the Jensen 2001 materials instead.
     #[arg(long, conflicts_with_all = ["material", "profile_preset", "out"])]

@@ -33,7 +33,8 @@ pub enum MapsCommand {
 
 #[derive(clap::Args)]
 pub struct HemoglobinArgs {
-    /// Neutral hemoglobin map Hn: single-channel EXR (f16/f32), 16-bit PNG, or 8-bit PNG with --value-range.
+    /// Neutral hemoglobin map Hn: EXR (f16/f32), 16-bit PNG, or 8-bit PNG with --value-range; single-channel, or
+    /// multi-channel with --channel.
     #[arg(long, value_name = "FILE")]
     neutral: PathBuf,
     /// Target map as NAME=FILE (repeatable, or comma-separated), e.g. anger=anger.exr; names use [a-z0-9_-],
@@ -56,6 +57,11 @@ pub struct HemoglobinArgs {
     /// 16-bit PNGs default to 0,1 (concentration = s/65535). Ignored for EXR (values used as stored).
     #[arg(long, value_name = "MIN,MAX")]
     value_range: Option<String>,
+    /// Channel that holds the concentration in multi-channel maps (RGB/RGBA EXR or PNG, gray+alpha PNG): R, G, B,
+    /// A, Y (gray), or luminance = 0.2126 R + 0.7152 G + 0.0722 B. Applies to every map; single-channel maps are
+    /// read as they are.
+    #[arg(long, value_name = "R|G|B|A|Y|luminance")]
+    channel: Option<String>,
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
@@ -185,6 +191,7 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
             Some(ValueRange::new("--value-range", v[0], v[1])?)
         }
     };
+    let channel = a.channel.as_deref().map(|c| inputs::ChannelSelect::parse("--channel", c)).transpose()?;
     let border = parse_border(&a.border);
     // Parse target names first (cheap errors before reading files).
     let mut pairs = Vec::new();
@@ -198,8 +205,13 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         pairs.push((name.to_string(), PathBuf::from(file)));
     }
     let neutral_path = a.neutral.display().to_string();
-    let neutral =
-        inputs::decode_concentration("--neutral", &neutral_path, &read_input("--neutral", &a.neutral)?, range)?;
+    let neutral = inputs::decode_concentration_channel(
+        "--neutral",
+        &neutral_path,
+        &read_input("--neutral", &a.neutral)?,
+        range,
+        channel,
+    )?;
     let (w, h) = (neutral.image.width, neutral.image.height);
     let mut sources = vec![RigSource {
         name: "neutral".into(),
@@ -211,7 +223,7 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     for (name, path) in &pairs {
         let flag = format!("--target {name}");
         let p = path.display().to_string();
-        let m = inputs::decode_concentration(&flag, &p, &read_input(&flag, path)?, range)?;
+        let m = inputs::decode_concentration_channel(&flag, &p, &read_input(&flag, path)?, range, channel)?;
         if (m.image.width, m.image.height) != (w, h) {
             return Err(usage(InvalidInput::new(
                 flag,
@@ -488,5 +500,15 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
         a.size,
         a.out.display()
     ));
+    if ctx.json {
+        ctx.emit_json(&json!({
+            "out": a.out.display().to_string(),
+            "width": a.size,
+            "height": a.size,
+            "format": "png16",
+            "mapping": "concentration = sample / 65535",
+            "files": files.iter().map(|f| f.path.clone()).collect::<Vec<_>>(),
+        }));
+    }
     Ok(())
 }

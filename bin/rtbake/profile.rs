@@ -243,14 +243,17 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         rtbake::io::atomic::write_atomic(path, bytes)?;
         ctx.info(format!("wrote {}", path.display()));
     }
+    // Totals are messages (stderr); stdout is pure CSV, and only when no file was asked for.
+    let t = &table.total_reflectance;
+    ctx.info(format!("total R (r, g, b): {:.6} {:.6} {:.6}", t[0], t[1], t[2]));
+    if let Some(t) = &table.total_transmittance {
+        ctx.info(format!("total T (r, g, b): {:.6} {:.6} {:.6}", t[0], t[1], t[2]));
+    }
+    let wrote_file = args.csv.is_some() || args.out.is_some() || args.plot.is_some();
     if ctx.json {
         ctx.emit_json(&json);
-    } else {
-        let t = &table.total_reflectance;
-        let mut text = format!("total R (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]);
-        if let Some(t) = &table.total_transmittance {
-            text.push_str(&format!("total T (r, g, b): {:.6} {:.6} {:.6}\n", t[0], t[1], t[2]));
-        }
+    } else if !wrote_file {
+        let mut text = String::new();
         for line in table.to_csv().lines().filter(|l| !l.starts_with('#')) {
             text.push_str(line);
             text.push('\n');

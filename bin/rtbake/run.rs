@@ -75,7 +75,10 @@ pub struct SssArgs {
     /// Linear HDR diffuse irradiance, EXR with RGB or RGBA (alpha = per-pixel strength, 0 = not skin; RGB: 1).
     #[arg(long, value_name = "EXR")]
     color: PathBuf,
-    /// Linear depth, EXR (first channel used), same size.
+    /// Linear view-space depth (distance along the view axis, > 0), EXR of --color's size: the channel read is
+    /// the only one of a single-channel (Y) file, else R. Same world units as --sss-width (default 0.012, the
+    /// published demo's value); only the ratio sss-width / depth enters the kernel's screen size.
+    /// `rtbake run demo --sss-inputs DIR` writes a matching pair.
     #[arg(long, value_name = "EXR")]
     depth: PathBuf,
     /// Output EXR (RGBA f16).
@@ -114,12 +117,14 @@ pub enum Method {
 
 #[derive(clap::Args)]
 pub struct DemoArgs {
-    /// Output PNG.
+    /// Output PNG (RGBA8, sRGB-encoded).
     #[arg(long, value_name = "PNG")]
     output: PathBuf,
-    #[arg(long, default_value_t = 1280)]
+    /// Frame width in pixels, 1..=16384.
+    #[arg(long, default_value_t = 1280, value_name = "PIXELS")]
     width: u32,
-    #[arg(long, default_value_t = 720)]
+    /// Frame height in pixels, 1..=16384; the sum-of-Gaussians α is scaled from its 720-pixel viewport to it.
+    #[arg(long, default_value_t = 720, value_name = "PIXELS")]
     height: u32,
     /// Antialiasing of the final frame.
     #[arg(long, value_enum, default_value = "smaa")]
@@ -127,6 +132,10 @@ pub struct DemoArgs {
     /// SSS pass of the demo: separable (baked kernel) or gaussians (baked sum-of-Gaussians fit).
     #[arg(long, value_enum, default_value = "separable")]
     sss: Method,
+    /// Also write the scene's SSS inputs into DIR, as `rtbake run sss` reads them: irradiance.exr (linear RGBA
+    /// f32, alpha = SSS strength) and depth.exr (linear view-space depth, one channel Y, f32).
+    #[arg(long, value_name = "DIR")]
+    sss_inputs: Option<PathBuf>,
     /// Hemoglobin rig weights (eq. 7.6): JSON file {"target name": weight, ...} summing to 1 (default: neutral 0.6,
     /// joy 0.4 with the baked example rig).
     #[arg(long, value_name = "JSON")]
@@ -136,6 +145,7 @@ pub struct DemoArgs {
 }
 
 pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
+    ensure_runtime_dir();
     match cmd {
         RunCommand::Smaa(a) => {
             check_output(&a.output, &[&a.input])?;
@@ -154,8 +164,48 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
     }
 }
 
+/// Mesa's Vulkan and GL drivers print "XDG_RUNTIME_DIR is invalid or not set" when the session has none (SSH,
+/// containers, CI). Give this process a private one (`$TMPDIR/rtbake-runtime-UID`, mode 0700) in that case;
+/// a valid directory set by the session is kept.
+fn ensure_runtime_dir() {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+        let valid = |p: &Path| std::fs::metadata(p).is_ok_and(|m| m.is_dir() && m.mode() & 0o077 == 0);
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| valid(Path::new(&d))) {
+            return;
+        }
+        // SAFETY: getuid has no preconditions and cannot fail.
+        let uid = unsafe { libc::getuid() };
+        let dir = std::env::temp_dir().join(format!("rtbake-runtime-{uid}"));
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        let owned = std::fs::metadata(&dir).is_ok_and(|m| m.uid() == uid);
+        if owned {
+            let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+        }
+        if owned && valid(&dir) {
+            // Single-threaded here: no device, no rayon pool has started yet.
+            std::env::set_var("XDG_RUNTIME_DIR", &dir);
+        }
+    }
+}
+
 fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
     rtbake::aa::mlaa_area::validate(rtbake::aa::mlaa_area::MlaaVersion::V1_4, n).map_err(usage)?;
+    let listed = rtbake::manifest::Manifest::load(baked)
+        .ok()
+        .is_some_and(|m| m.entry(&rtbake::baked_layout::path::mlaa_area_v1_4(n)).is_some());
+    if !listed && baked.join(rtbake::manifest::MANIFEST_NAME).is_file() {
+        // The default bake holds the published sizes only; say how to bake another one (not "re-run rtbake bake",
+        // which would not produce it).
+        return Err(usage_msg(format!(
+            "--max-distance {n}: {dir} has no {path}. Bake it into a bake directory first: \
+             echo '{{\"mlaa-v1.4\": {{\"max_distances\": [{n}]}}}}' > p.json && \
+             rtbake bake mlaa-v1.4 --asset-params p.json --out {dir}",
+            dir = baked.display(),
+            path = rtbake::baked_layout::path::mlaa_area_v1_4(n),
+        )));
+    }
     let bytes = loader::load_mlaa_area(baked, n).map_err(usage)?;
     Ok(MlaaAreaMap::new(n, bytes)?)
 }
@@ -326,7 +376,19 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     let t = Instant::now();
     let out = demo::render(gpu.as_ref(), d.width, d.height, &assets, method, aa.as_ref())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
+    let inputs = match &d.sss_inputs {
+        Some(dir) => Some((dir, demo::sss_inputs(gpu.as_ref(), d.width, d.height, &assets)?)),
+        None => None,
+    };
     write_atomic(&d.output, &io::png::encode_u8(&out)?)?;
+    if let Some((dir, i)) = inputs {
+        crate::cli::prepare_out_dir("--sss-inputs", dir)?;
+        let color = Image::from_vec(i.width, i.height, 4, i.irradiance_rgba);
+        let depth = Image::from_vec(i.width, i.height, 1, i.depth);
+        write_atomic(&dir.join("irradiance.exr"), &io::exr::encode(&color, io::exr::ExrPrecision::F32)?)?;
+        write_atomic(&dir.join("depth.exr"), &io::exr::encode(&depth, io::exr::ExrPrecision::F32)?)?;
+        ctx.info(format!("wrote the SSS inputs irradiance.exr and depth.exr to {}", dir.display()));
+    }
     report(ctx, "demo", &d.output, &out, gpu.as_ref(), ms);
     Ok(())
 }

@@ -236,6 +236,16 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
         })?),
         None => None,
     };
+    // `--out DIR` receives the files themselves, like `transmittance`, `fit` and `kernel` (the bake's `skin/`
+    // subdirectory is the bake layout, not this command's).
+    let files = files.map(|fs| {
+        fs.into_iter()
+            .map(|mut f| {
+                f.path = f.path.strip_prefix("skin/").map(str::to_string).unwrap_or(f.path);
+                f
+            })
+            .collect::<Vec<_>>()
+    });
     let mut written = Vec::new();
     if let (Some(dir), Some(files)) = (&a.out, &files) {
         prepare_out_dir("--out", dir)?;

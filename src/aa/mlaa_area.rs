@@ -7,7 +7,7 @@
 //! `i²` (MLAA 2.0). R = area where the crossing edge is of type 3, G = type 1. The shader point-samples
 //! `(N·round(4e) + distance)/(5N − 1)` (Listing 9.4).
 //!
-//! Coverage (`specs/smaa-mlaa.md`): `d = left + right + 1`, `m = d/2`; the left half of the revectorised line has
+//! Coverage: `d = left + right + 1`, `m = d/2`; the left half of the revectorised line has
 //! height `y(t) = 0.5·(m − t)/m`; its area over the pixel is the trapezoid `(y(left) + y(left+1))/2` if
 //! `left < right`, the triangle `y(left)·0.5/2` if `left = right`, else 0. The right half mirrors it. Each half is
 //! quantised separately (`floor(255·a)`) and the bytes are added per channel (a symmetric U gives 2·31 = 62, not 63).

@@ -1,4 +1,4 @@
-//! Antialiasing lookup textures (thesis ch. 9 and 10; `specs/smaa-mlaa.md`): pure computation, no I/O.
+//! Antialiasing lookup textures (thesis ch. 9 and 10): pure computation, no I/O.
 //!
 //! * [`smaa_area`] — SMAA area texture (160 × 560 RG8): [`smaa_area_ortho`] orthogonal cells (7 subsample slices,
 //!   U-shape smoothing since SMAA 2.8) and [`smaa_area_diag`] diagonal cells (5 slices, 30 × 30 supersampling);

@@ -6,14 +6,14 @@
 //! Fig. 10.11: the line ends are moved by the subsample's vertical offset so that the subsample groups average to the
 //! pixel centre) and, since SMAA 2.8, smoothing of short U shapes.
 //!
-//! Frame (per edge, `specs/smaa-mlaa.md` § "Orthogonal coverage"): the edge lies on `y = 0` from `x = 0` to
+//! Frame (per edge): the edge lies on `y = 0` from `x = 0` to
 //! `x = d = left + right + 1`, the current pixel spans `x ∈ [left, left + 1]`. A crossing edge of type 1 puts the line
 //! end at height `o1 = 0.5 + offset`, type 3 at `o2 = offset − 0.5`. The revectorised line passes through `(d/2, 0)`.
 //! The area of the line over the pixel is returned as `(R, G)` = (area on the negative side, area on the positive
 //! side).
 //!
 //! Every expression below keeps the floating-point evaluation order that produced the published bytes (f64, no fused
-//! multiply-add); see `specs/smaa-mlaa.md` § "Quantisation".
+//! multiply-add).
 
 /// Distance (pixels) over which short U shapes are smoothed towards the plain revectorisation (SMAA 2.8+).
 pub const SMOOTH_MAX_DISTANCE: f64 = 32.0;

@@ -1,4 +1,4 @@
-//! Diffusion-profile tables and plots in `baked/profiles/` (`specs/diffusion.md`, "Outputs"): R(r) (and T(r) for
+//! Diffusion-profile tables and plots in `baked/profiles/`: R(r) (and T(r) for
 //! layer stacks) per channel on a log radius grid, with the totals R̂(0), T̂(0) and the model options, as CSV and
 //! JSON ([`ProfileTable`]), plus a two-panel plot ([`crate::plot::profile`]: r·R(r) over log r, R(r) log–log) as
 //! SVG for every profile and as PNG for the few listed in `png_plots`.
@@ -8,8 +8,8 @@
 //!   Model for Subsurface Light Transport", SIGGRAPH 2001, as semi-infinite dipoles (η = 1.3, DJ05 Fdr);
 //! - `profiles/presets/deon6`, `deon4`: d'Eon, Luebke, Enderton, "Efficient Rendering of Human Skin", EGSR 2007
 //!   (6 Gaussians) and thesis Table 4.2 (4 Gaussians);
-//! - `profiles/skin/two_layer_cm<Cm>_chd<Chd>`: the physiological two-layer skin (Donner & Jensen 2006 coefficients,
-//!   `specs/skin-color.md`; epidermis 0.25 mm over dermis 20 mm, η = 1.4; D65 × linear-sRGB-sensitivity weighted
+//! - `profiles/skin/two_layer_cm<Cm>_chd<Chd>`: the physiological two-layer skin (Donner & Jensen 2006 coefficients
+//!   as in `spectral::skin_layers`; epidermis 0.25 mm over dermis 20 mm, η = 1.4; D65 × linear-sRGB-sensitivity weighted
 //!   per-channel coefficients) at (Cm, Chd) = (0.02, 0.05), (0.1, 0.1), (0.3, 0.05), symmetric adding (DJ05);
 //! - `profiles/layered/skin3_example`: an illustrative three-layer stack, **not a measured material** (DJ05's
 //!   three-layer skin coefficients are not public): a thin, translucent skin fold (ear rim, nostril) with air on both

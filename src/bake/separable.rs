@@ -1,4 +1,4 @@
-//! Separable-SSS kernels in `baked/sss/separable/` (thesis ch. 6; `specs/sss-fitting.md` §2).
+//! Separable-SSS kernels in `baked/sss/separable/` (thesis ch. 6).
 //!
 //! Asset `sss-separable-kernels`: the published SeparableSSS presets (strength 0.48, 0.41, 0.28; falloff 1.0,
 //! 0.37, 0.3) for N = 11, 17, 25 and the thesis' Table 6.1 parameters (width 0.014; strength 0.78, 0.70, 0.75;

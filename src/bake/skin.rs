@@ -55,6 +55,12 @@ pub fn convention(layout: &LutLayout) -> String {
 }
 
 /// Every file of the skin-colour asset for `p`.
+/// File name relative to the sidecar's own directory (the sidecar sits beside the files it lists, whether in a
+/// bake's `skin/` or in `rtbake skin-color --out DIR`).
+fn sibling(path: &str) -> &str {
+    path.rsplit('/').next().unwrap_or(path)
+}
+
 pub fn skin_color_lut_files(p: &SkinColorParams) -> Result<Vec<BakedFile>, BakeError> {
     let layout = p.layout().map_err(invalid)?;
     let model = p.model().map_err(invalid)?;
@@ -96,12 +102,12 @@ fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Imag
             the CIE 1931 2-degree observer (see model.colorimetry), as linear sRGB albedo."
             .into(),
         files: SkinLutFiles {
-            linear_f32: format!("{LUT_STEM}.exr"),
-            linear_f16: format!("{LUT_STEM}_f16.exr"),
-            linear_f16_ktx2: format!("{LUT_STEM}.ktx2"),
-            preview_srgb8_not_for_sampling: format!("{LUT_STEM}_preview_srgb.png"),
-            samples: SAMPLES_PATH.into(),
-            spectra: SPECTRA_PATH.into(),
+            linear_f32: sibling(&format!("{LUT_STEM}.exr")).into(),
+            linear_f16: sibling(&format!("{LUT_STEM}_f16.exr")).into(),
+            linear_f16_ktx2: sibling(&format!("{LUT_STEM}.ktx2")).into(),
+            preview_srgb8_not_for_sampling: sibling(&format!("{LUT_STEM}_preview_srgb.png")).into(),
+            samples: sibling(SAMPLES_PATH).into(),
+            spectra: sibling(SPECTRA_PATH).into(),
         },
         color_space: "linear sRGB (IEC 61966-2-1 primaries); the PNG preview alone is sRGB-encoded".into(),
         width: layout.width,

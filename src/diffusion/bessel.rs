@@ -1,5 +1,5 @@
 //! Bessel function of the first kind J0(x) to ~1e−15 absolute accuracy, for the inverse Hankel transform
-//! R(r) = (1/2π) ∫₀^∞ R̂(k) J0(kr) k dk (Donner & Jensen 2005, eq. 9; `specs/diffusion.md`).
+//! R(r) = (1/2π) ∫₀^∞ R̂(k) J0(kr) k dk (Donner & Jensen 2005, eq. 9).
 //!
 //! * |x| < 25: piecewise Chebyshev interpolants (degree 15 on unit panels), whose samples are computed once, at
 //!   first use, from Bessel's integral J0(x) = (1/π) ∫₀^π cos(x sin θ) dθ (DLMF 10.9.1) by the trapezoid rule; the

@@ -1,7 +1,7 @@
 //! Layered translucent materials by Kubelka–Munk adding of multipole slabs in frequency space
 //! (C. Donner, H. W. Jensen, "Light Diffusion in Multi-Layered Translucent Materials", SIGGRAPH 2005, eqs. 14–15;
 //! P. Kubelka, "New contributions to the optics of intensely light-scattering materials. Part II: Nonhomogeneous
-//! layers", JOSA 1954; thesis §2; `specs/diffusion.md`).
+//! layers", JOSA 1954; thesis §2).
 //!
 //! Each layer j is a [`Slab`] with face indices η0 = n_j/n_(j−1) (top) and ηd = n_j/n_(j+1) (bottom); its Hankel
 //! transforms R̂↓, T̂↓ (lit from above) and R̂↑, T̂↑ (the flipped slab) are combined per radial frequency k, folding

@@ -1,5 +1,5 @@
 //! Measured scattering coefficients of Jensen et al. 2001 (Table in "A Practical Model for Subsurface Light
-//! Transport", SIGGRAPH 2001; reproduced in `specs/diffusion.md`). σs′ and σa in **mm⁻¹** for R, G, B; η = 1.3.
+//! Transport", SIGGRAPH 2001, Table 2). σs′ and σa in **mm⁻¹** for R, G, B; η = 1.3.
 
 use super::dipole::{Dipole, DipoleRgb};
 use super::FdrForm;

@@ -1,4 +1,4 @@
-//! Diffusion profiles (thesis ch. 2 and 5.2; `specs/diffusion.md`).
+//! Diffusion profiles (thesis ch. 2 and 5.2).
 //!
 //! Units everywhere: lengths in mm, coefficients in mm⁻¹, radial profiles R(r), T(r) in mm⁻²
 //! (fraction of incident power per unit area). These modules know nothing about files or the GPU.
@@ -69,7 +69,7 @@ pub enum FdrForm {
     Jensen01,
 }
 
-/// Average diffuse Fresnel reflectance Fdr(η), η = n_inside / n_outside (`specs/diffusion.md`).
+/// Average diffuse Fresnel reflectance Fdr(η), η = n_inside / n_outside.
 pub fn fdr(eta: f64, form: FdrForm) -> f64 {
     if eta >= 1.0 {
         match form {

@@ -1,5 +1,5 @@
 //! Multipole diffusion for a slab of finite thickness (Donner & Jensen, "Light Diffusion in Multi-Layered
-//! Translucent Materials", SIGGRAPH 2005, "DJ05"; thesis §2; `specs/diffusion.md`).
+//! Translucent Materials", SIGGRAPH 2005, "DJ05"; thesis §2).
 //!
 //! Slab 0 ≤ z ≤ d (z downwards), relative index η0 at the top face and ηd at the bottom face.
 //! zb0 = 2A(η0)D, zbd = 2A(ηd)D, l = 1/σt′, L = d + zb0 + zbd; image pairs i = −n..n:
@@ -257,7 +257,7 @@ fn image_series(r_mm: f64, sigma: f64, big_l: f64, dipole: f64, terms: [(f64, f6
 }
 
 impl Slab {
-    /// Diffuse reflectance R(r) of the lit (top) face, mm⁻² (DJ05 eq. 12 / `specs/diffusion.md`).
+    /// Diffuse reflectance R(r) of the lit (top) face, mm⁻² (DJ05 eq. 12).
     pub fn reflectance_mm2(&self, r_mm: f64, series: Series) -> f64 {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let sigma = self.sigma_tr();
@@ -270,7 +270,7 @@ impl Slab {
         self.albedo_prime() / (4.0 * std::f64::consts::PI) * image_series(r_mm, sigma, big_l, dipole, terms, series)
     }
 
-    /// Diffuse transmittance T(r) through the bottom face, mm⁻² (DJ05 eq. 13 / `specs/diffusion.md`).
+    /// Diffuse transmittance T(r) through the bottom face, mm⁻² (DJ05 eq. 13).
     pub fn transmittance_mm2(&self, r_mm: f64, series: Series) -> f64 {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let sigma = self.sigma_tr();

@@ -1,4 +1,4 @@
-//! Profile tables (`specs/diffusion.md`, "Outputs"): radii on a grid, R(r) (and T(r)) per channel, totals R̂(0),
+//! Profile tables: radii on a grid, R(r) (and T(r)) per channel, totals R̂(0),
 //! T̂(0), and the model options, as CSV text or a JSON value. Pure: callers write the bytes.
 
 use super::RadialProfile;

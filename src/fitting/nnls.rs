@@ -1,6 +1,8 @@
 //! Exact non-negative least squares in normal-equation (Gram) form:
 //!
-//!     minimise ½ wᵀ G w − bᵀ w   subject to w ≥ 0        (G = AᵀA symmetric positive (semi)definite, b = Aᵀy)
+//! ```text
+//! minimise ½ wᵀ G w − bᵀ w   subject to w ≥ 0        (G = AᵀA symmetric positive (semi)definite, b = Aᵀy)
+//! ```
 //!
 //! which is min ‖A w − y‖² up to a constant. [`nnls`] is the active-set algorithm of C. L. Lawson and R. J. Hanson,
 //! *Solving Least Squares Problems* (Prentice-Hall, 1974), ch. 23, written against G and b so the fitter never forms

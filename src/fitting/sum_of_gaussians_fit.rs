@@ -1,8 +1,10 @@
 //! Sum-of-Gaussians fit of a radial diffusion profile (d'Eon, Luebke, Enderton, "Efficient Rendering of Human
 //! Skin", EGSR 2007; thesis eq. 2.2):
 //!
-//!     G(v, r) = exp(−r²/(2v)) / (2πv)
-//!     minimise  ∫₀^∞ r ( R(r) − Σᵢ wᵢ G(vᵢ, r) )² dr      over wᵢ ≥ 0, vᵢ > 0      // eq. 2.2
+//! ```text
+//! G(v, r) = exp(−r²/(2v)) / (2πv)
+//! minimise  ∫₀^∞ r ( R(r) − Σᵢ wᵢ G(vᵢ, r) )² dr      over wᵢ ≥ 0, vᵢ > 0      // eq. 2.2
+//! ```
 //!
 //! **Method (variable projection).** For fixed variances the weights solve a non-negative linear least-squares
 //! problem, solved exactly inside the objective ([`super::nnls::nnls`], Lawson–Hanson). The optimiser moves only the

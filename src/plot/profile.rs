@@ -1,4 +1,4 @@
-//! Plots of a [`ProfileTable`] (`specs/diffusion.md`, "Outputs"): two panels stacked in one image or SVG document,
+//! Plots of a [`ProfileTable`]: two panels stacked in one image or SVG document,
 //! both over a log₁₀ r axis (mm) and drawn at exactly the tabulated radii (radii ≤ 0 are skipped):
 //!
 //! 1. r·R(r) (mm⁻¹) on a linear y axis — the energy per unit log r, where the area under the curve in ln r is

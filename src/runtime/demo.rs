@@ -193,18 +193,19 @@ pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
     120 * w as u64 * h as u64 + (64 << 20)
 }
 
-/// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased.
-pub fn render(
-    gpu: Option<&Gpu>,
-    w: u32,
-    h: u32,
-    assets: &DemoAssets,
-    method: SssMethod,
-    aa: Option<&Antialiasing>,
-) -> Result<Image<u8>, RuntimeError> {
+/// The demo frame before SSS: geometry, skin albedo and transmittance, and the lit diffuse layer.
+struct Lit {
+    geo: Geometry,
+    albedo: Vec<f32>,
+    transmitted: Vec<f32>,
+    /// Diffuse irradiance · albedo, linear RGBA (alpha = SSS strength: 1 on skin, 0 elsewhere).
+    diffuse: Vec<f32>,
+}
+
+fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
     crate::error::check_size("--width/--height", w as u64, h as u64)?;
     let geo = geometry(w, h, assets.baked_rig.as_ref());
-    let (luts, rig, kernel, params) = (&assets.luts, &assets.rig, &assets.kernel, &assets.sss);
+    let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
     let key = normalise([-0.5, 0.6, 0.62]);
     let back = normalise([0.3, 0.2, -0.93]);
@@ -228,6 +229,37 @@ pub fn render(
         }
         diffuse[4 * i + 3] = 1.0;
     }
+    Ok(Lit { geo, albedo, transmitted, diffuse })
+}
+
+/// The inputs the demo hands its SSS pass, as `rtbake run sss` reads them: linear diffuse irradiance · albedo
+/// (RGBA, alpha = SSS strength, 1 on skin and 0 elsewhere) and linear view-space depth (one channel, > 0, in the
+/// world units of the kernel's `sss_width`: the skin spheres sit 3.5–5 units away, the background at 50).
+pub struct SssInputs {
+    pub width: u32,
+    pub height: u32,
+    pub irradiance_rgba: Vec<f32>,
+    pub depth: Vec<f32>,
+}
+
+/// The demo scene's SSS inputs (see [`SssInputs`]).
+pub fn sss_inputs(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<SssInputs, RuntimeError> {
+    let Lit { geo, diffuse, .. } = lit(gpu, w, h, assets)?;
+    Ok(SssInputs { width: w, height: h, irradiance_rgba: diffuse, depth: geo.depth })
+}
+
+/// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased.
+pub fn render(
+    gpu: Option<&Gpu>,
+    w: u32,
+    h: u32,
+    assets: &DemoAssets,
+    method: SssMethod,
+    aa: Option<&Antialiasing>,
+) -> Result<Image<u8>, RuntimeError> {
+    let Lit { geo, albedo, transmitted, diffuse } = lit(gpu, w, h, assets)?;
+    let n = (w * h) as usize;
+    let (kernel, params) = (&assets.kernel, &assets.sss);
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
         SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },

@@ -1,4 +1,4 @@
-//! The wgpu runtime: consumes `baked/` the way an engine would and renders headless (spec `runtime.md`).
+//! The wgpu runtime: consumes `baked/` the way an engine would and renders headless.
 //!
 //! Every pass has a CPU reference implementation of the same algorithm in [`cpu`] (rayon, no adapter needed)
 //! whose arithmetic mirrors the WGSL shaders; the tests compare the two on the same inputs.

@@ -1,7 +1,7 @@
 //! Separable subsurface scattering on the GPU (Jimenez et al., "Separable Subsurface Scattering", CGF 2015;
 //! thesis ch. 6): a horizontal and a vertical pass over a linear HDR irradiance image (`Rgba16Float`, alpha =
 //! per-pixel strength, 0 = not skin: passes through) with a linear depth image (`R32Float`), using an N-tap kernel
-//! (rgb weight, a offset; centre first) and the shader facts of `sss-fitting.md` §2 (sssWidth, FOVy,
+//! (rgb weight, a offset; centre first) and the published shader's conventions (sssWidth, FOVy,
 //! follow-surface). Resources created once in [`SeparableSss::new`]; CPU twin [`super::cpu::separable_sss`].
 
 use super::gpu::{self, GpuTimer};

@@ -48,7 +48,7 @@ impl SmaaTextures {
 
 /// Area-texture slice indices of one SMAA sample: (vertical orthogonal, horizontal orthogonal, diagonal 1,
 /// diagonal 2), as in the SMAA shader's `subsampleIndices`. Orthogonal slices 0..6, diagonal slices 0..4
-/// (`smaa-mlaa.md`).
+/// (thesis ch. 10).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubsampleIndices(pub [u32; 4]);
 

@@ -1,9 +1,9 @@
 //! Fitting the separable kernel's strength and falloff to the exact 2-D kernel of a diffusion profile
-//! (thesis eq. 6.1–6.3; `specs/sss-fitting.md` §2 "Fitting width / strength / falloff").
+//! (thesis eq. 6.1–6.3).
 //!
 //! # The objective (eq. 6.3), made explicit
 //!
-//! The thesis minimises Σ_{a ∈ A_s} Σ_c (S_c[a] − s_c[x]·s_c[y])² over a sample set A_s "denser near 0" but does
+//! The thesis minimises `Σ_{a ∈ A_s} Σ_c (S_c[a] − s_c[x]·s_c[y])²` over a sample set A_s "denser near 0" but does
 //! not publish A_s, the weighting, nor how the delta of eq. 6.1 is discretised. Here every choice is a field of
 //! [`ObjectiveSpec`] and is recorded in [`ObjectiveSpec::definition`]:
 //!

@@ -1,5 +1,5 @@
 //! The N-tap runtime kernel of separable SSS, generated exactly as the published `SeparableSSS` shader expects it
-//! (thesis ch. 6, eq. 6.1; `specs/sss-fitting.md` §2 "Kernel taps").
+//! (thesis ch. 6, eq. 6.1).
 //!
 //! Given strength t and falloff f per channel:
 //!

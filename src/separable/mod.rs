@@ -1,11 +1,13 @@
 //! Separable subsurface scattering (J. Jimenez, *Practical Real-Time Strategies for Photorealistic Skin Rendering
 //! and Antialiasing*, PhD thesis, 2012, ch. 6; J. Jimenez et al., "Separable Subsurface Scattering and Photorealistic
 //! Eyes Rendering", SIGGRAPH 2012 course *Advances in Real-Time Rendering in Games*, with the published
-//! `SeparableSSS` shader and demo; `specs/sss-fitting.md` §2).
+//! `SeparableSSS` shader and demo).
 //!
-//! The 2-D diffusion kernel S[x, y] of skin is replaced by the product s[x]·s[y] of one 1-D kernel (eq. 6.1)
+//! The 2-D diffusion kernel `S[x, y]` of skin is replaced by the product `s[x]·s[y]` of one 1-D kernel (eq. 6.1)
 //!
-//!     s(w, t, f)[x] = p[x·w/(0.001 + f)]·t + δ(x)·(1 − t)
+//! ```text
+//! s(w, t, f)[x] = p[x·w/(0.001 + f)]·t + δ(x)·(1 − t)
+//! ```
 //!
 //! with per-channel *strength* t and *falloff* f and a global *width* w; p is the red channel of d'Eon et al.'s
 //! 6-Gaussian skin profile without its narrowest Gaussian (which the delta term stands in for).

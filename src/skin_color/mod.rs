@@ -2,7 +2,8 @@
 //!
 //! Thesis (Jimenez 2012) §7.6, eq. 7.7, Table 7.1, Fig. 7.9; Jimenez et al., "A Practical Appearance Model for
 //! Dynamic Facial Color", SIGGRAPH Asia 2010; the model of Donner et al. 2008 / Donner & Jensen 2006.
-//! `specs/skin-color.md` fixes every constant.
+//! Every constant is stated where it is used (the defaults on [`SkinColorParams`], the layer forms in
+//! [`crate::spectral::skin_layers`], the colorimetry in [`crate::spectral::colorimetry`]).
 //!
 //! - [`two_layer`]: R(λ) of the epidermis-over-dermis stack (multipole totals + adding) and its linear sRGB colour.
 //! - [`lut`]: the cube-root-indexed melanin × hemoglobin table and its texel convention.

@@ -7,7 +7,7 @@
 //! 2. per layer the multipole totals R̂(0), T̂(0) with the exact infinite image series (Donner & Jensen,
 //!    SIGGRAPH 2005, `diffusion::multipole::Slab::totals(Series::Exact)`): epidermis with air above
 //!    (η0 = η_epi / 1) and the index-matched dermis below (ηd = η_epi / η_derm = 1); dermis with ηd = η_derm / η_below;
-//! 3. adding at k = 0 (DJ05 eq. as printed, `specs/diffusion.md`):
+//! 3. adding at k = 0 (DJ05 eq. as printed):
 //!    symmetric (default)  R = R1 + T1² R2 / (1 − R1 R2)
 //!    directional          R = R1↓ + T1↓ R2 T1↑ / (1 − R1↑ R2)   (R1↑, T1↑: the epidermis lit from below);
 //! 4. XYZ under D65 (or E) with the CIE 1931 2° observer, Y(white) = 1, then linear sRGB (`spectral::colorimetry`).
@@ -176,7 +176,7 @@ impl TwoLayerSkinModel {
     fn add_layers(&self, e: [f64; 4], r2: f64) -> f64 {
         let [r1, t1, r1_up, t1_up] = e;
         match self.options.adding {
-            // DJ05 adding as printed (specs/diffusion.md, "symmetric"), at k = 0.
+            // DJ05 adding as printed ("symmetric"), at k = 0.
             Adding::Symmetric => r1 + t1 * t1 * r2 / (1.0 - r1 * r2),
             // Kubelka 1954 directional adding, at k = 0.
             Adding::Directional => r1 + t1 * r2 * t1_up / (1.0 - r1_up * r2),

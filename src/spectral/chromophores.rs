@@ -2,9 +2,9 @@
 //!
 //! Donner & Jensen, "A Spectral BSSRDF for Shading Human Skin", EGSR 2006, and Donner, Weyrich, d'Eon,
 //! Ramamoorthi & Rusinkiewicz, "A Layered, Heterogeneous Reflectance Model for Acquiring and Rendering Human Skin",
-//! SIGGRAPH Asia 2008; as used for the skin-colour table of the thesis (Jimenez 2012, §7.6, Table 7.1) and pinned
-//! down in `specs/skin-color.md`. The forms here are the **mm⁻¹** ones (the cm⁻¹ forms printed elsewhere are
-//! 6.6e11, 2.9e15 and 0.244 + 85.3·exp(…)):
+//! SIGGRAPH Asia 2008; as used for the skin-colour table of the thesis (Jimenez 2012, §7.6, Table 7.1).
+//! The forms here are the **mm⁻¹** ones (the cm⁻¹ forms printed elsewhere are 6.6e11, 2.9e15 and
+//! 0.244 + 85.3·exp(…)):
 //!
 //! | chromophore | σa(λ) [mm⁻¹] |
 //! | --- | --- |

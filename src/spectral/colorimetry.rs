@@ -6,7 +6,7 @@
 //!   X = k Σλ R(λ) S(λ) x̄(λ) Δλ,  Y = k Σλ R(λ) S(λ) ȳ(λ) Δλ,  Z = k Σλ R(λ) S(λ) z̄(λ) Δλ,  k = 1 / Σλ S(λ) ȳ(λ) Δλ
 //!
 //! over 380–780 nm (the normalisation makes a perfect white reflector Y = 1), then linear sRGB with the
-//! IEC 61966-2-1:1999 matrix (`specs/skin-color.md`):
+//! IEC 61966-2-1:1999 matrix:
 //!
 //!   [R G B]ᵀ = [ 3.2406 −1.5372 −0.4986 ; −0.9689 1.8758 0.0415 ; 0.0557 −0.2040 1.0570 ] · [X Y Z]ᵀ
 //!

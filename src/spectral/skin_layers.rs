@@ -3,7 +3,7 @@
 //! Donner & Jensen, "A Spectral BSSRDF for Shading Human Skin", EGSR 2006 (§3, layer mixing), and Donner et al.,
 //! "A Layered, Heterogeneous Reflectance Model for Acquiring and Rendering Human Skin", SIGGRAPH Asia 2008; the
 //! parameters of the thesis (Jimenez 2012, §7.6, Table 7.1) with the defaults of its skin-colour table (Fig. 7.9).
-//! Exact forms: `specs/skin-color.md`.
+//! Each function states the form it computes (σa,epi, σa,derm, σs′ in mm⁻¹).
 //!
 //! | parameter | symbol | default | Table 7.1 range |
 //! | --- | --- | --- | --- |
@@ -187,14 +187,14 @@ pub fn epidermis_sigma_a_per_mm(s: &ChromophoreSpectra, cm: f64, che: f64, beta_
 /// The epidermal mixing rule with the melanin and blood mixes already formed (the LUT's inner loop).
 #[inline]
 pub fn epidermis_sigma_a_mixed(cm: f64, melanin: f64, che: f64, blood: f64, baseline: f64) -> f64 {
-    // Donner & Jensen 2006 §3 / Donner et al. 2008 epidermis mixing (specs/skin-color.md)
+    // Donner & Jensen 2006 §3 / Donner et al. 2008 epidermis mixing
     cm * melanin + che * blood + (1.0 - cm - che) * baseline
 }
 
 /// Dermal absorption σa,derm = Chd [γ σa,oxy + (1 − γ) σa,deoxy] + (1 − Chd) σa,base (mm⁻¹).
 #[inline]
 pub fn dermis_sigma_a_per_mm(s: &ChromophoreSpectra, chd: f64, gamma: f64) -> f64 {
-    // Donner & Jensen 2006 §3 / Donner et al. 2008 dermis mixing (specs/skin-color.md)
+    // Donner & Jensen 2006 §3 / Donner et al. 2008 dermis mixing
     chd * s.blood(gamma) + (1.0 - chd) * s.baseline
 }
 

@@ -22,7 +22,7 @@ fn committed(paths: &[&str]) -> Vec<BakedFile> {
 }
 
 fn write_bake(dir: &Path, files: &[BakedFile]) {
-    let mut m = Manifest::new("test".into());
+    let mut m = Manifest::new();
     m.set_asset("test", serde_json::json!({}), files);
     for f in files {
         let p = dir.join(&f.path);

@@ -36,7 +36,7 @@ fn bake_dir(dir: &Path, tweak: impl FnOnce(&mut BakedFile)) {
         meta: meta(PixelFormat::R8Unorm, 64, 16, "linear"),
     };
     tweak(&mut area);
-    let mut m = Manifest::new("test".into());
+    let mut m = Manifest::new();
     m.set_asset("smaa", serde_json::json!({}), &[area.clone(), search.clone()]);
     for f in [&area, &search] {
         let p = dir.join(&f.path);
@@ -140,7 +140,7 @@ fn float_lut_checks_sample_type() {
     };
     f.meta.sample_type = "f16".into();
     let write = |f: &BakedFile| {
-        let mut m = Manifest::new("test".into());
+        let mut m = Manifest::new();
         m.set_asset("skin", serde_json::json!({}), std::slice::from_ref(f));
         let p = t.path().join(&f.path);
         std::fs::create_dir_all(p.parent().unwrap()).unwrap();

@@ -29,7 +29,7 @@ fn committed(paths: &[&str]) -> Vec<BakedFile> {
 /// A bake directory holding `files` (after `tweak`) and a manifest describing them.
 fn bake_dir(dir: &Path, mut files: Vec<BakedFile>, tweak: impl FnOnce(&mut [BakedFile])) {
     tweak(&mut files);
-    let mut m = Manifest::new("test".into());
+    let mut m = Manifest::new();
     m.set_asset("test", serde_json::json!({}), &files);
     for f in &files {
         let p = dir.join(&f.path);

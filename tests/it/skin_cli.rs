@@ -98,17 +98,16 @@ fn out_bakes_the_table_with_the_given_parameters() {
         "skin_color_samples.csv",
         "skin_color_spectra.csv",
     ] {
-        assert!(out.join("skin").join(f).is_file(), "{f} missing");
+        assert!(out.join(f).is_file(), "{f} missing (--out DIR receives the files, no skin/ subdirectory)");
     }
     let side: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("skin/skin_color_lut.json")).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(out.join("skin_color_lut.json")).unwrap()).unwrap();
     assert_eq!(side["parameters"]["adding"], "directional");
     assert_eq!(side["parameters"]["spectral_step_nm"], 5);
     assert_eq!((side["width"].as_u64(), side["height"].as_u64()), (Some(8), Some(6)));
-    let names: Vec<String> = std::fs::read_dir(out.join("skin"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    assert!(!out.join("skin").exists());
+    let names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains("rtbake-tmp")), "temp files left: {names:?}");
 }
 
