@@ -5,7 +5,8 @@ use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use crate::profile_source::Named;
 use rtbake::diffusion::RadialProfile;
 use rtbake::fitting::screen_space::{ScreenSpaceParams, StretchParams, DEFAULT_ALPHA, DEFAULT_BETA, DEFAULT_GAMMA};
-use rtbake::fitting::{error_table, fit_sum_of_gaussians, profile_plot, FitSettings, GaussianFitError};
+use rtbake::fitting::{error_table, fit_sum_of_gaussians, FitSettings, GaussianFitError};
+use rtbake::plot::profile::fit_overlay_plot;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -134,7 +135,7 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
         } else {
             profile
         };
-        let plot = profile_plot(plotted.as_ref(), Some(&fit.sum), &format!("{stem}: {count}-Gaussian fit"));
+        let plot = fit_overlay_plot(plotted.as_ref(), Some(&fit.sum), &format!("{stem}: {count}-Gaussian fit"));
         let mut extra = obj.clone();
         for k in ScreenSpaceParams::new(&fit.sum, stretch)?.to_json().keys() {
             extra.remove(k);

@@ -10,8 +10,9 @@ use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
 use crate::error::InvalidInput;
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
-use crate::fitting::{fit_sum_of_gaussians, profile_plot, FitSettings, NormalizedProfile, RgbGaussians};
+use crate::fitting::{fit_sum_of_gaussians, FitSettings, NormalizedProfile, RgbGaussians};
 use crate::io::source::ShaderLang;
+use crate::plot::profile::fit_overlay_plot;
 use crate::plot::LinePlot;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -97,7 +98,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
                 "d'Eon, Luebke, Enderton, EGSR 2007; thesis Table 4.2",
             ),
         );
-        let plot = profile_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
+        let plot = fit_overlay_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
         files.extend(gaussian_files(&format!("{GAUSSIANS_DIR}/{name}"), &sum, p.stretch, extra, &plot)?);
     }
     Ok(files)
@@ -167,8 +168,11 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     } else {
         Box::new(profile)
     };
-    let plot =
-        profile_plot(plotted.as_ref(), Some(&fit.sum), &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count));
+    let plot = fit_overlay_plot(
+        plotted.as_ref(),
+        Some(&fit.sum),
+        &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count),
+    );
     gaussian_files(&stem, &fit.sum, p.stretch, extra, &plot)
 }
 

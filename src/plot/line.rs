@@ -14,7 +14,7 @@ use std::fmt::Write;
 
 /// One polyline.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Series {
+pub struct Curve {
     pub label: String,
     /// sRGB colour.
     pub color: [u8; 3],
@@ -34,7 +34,7 @@ pub struct LinePlot {
     /// log₁₀ y axis (points with y ≤ 0 are skipped, as are points more than [`LOG_Y_DECADES`] decades below the
     /// largest value).
     pub log_y: bool,
-    pub series: Vec<Series>,
+    pub series: Vec<Curve>,
 }
 
 const MARGIN_L: f64 = 70.0;
@@ -99,7 +99,7 @@ fn fmt_log_tick(e: i32) -> String {
 }
 
 impl LinePlot {
-    fn data_points(&self, s: &Series) -> Vec<(f64, f64)> {
+    fn data_points(&self, s: &Curve) -> Vec<(f64, f64)> {
         s.points
             .iter()
             .filter(|(x, y)| x.is_finite() && y.is_finite() && (!self.log_x || *x > 0.0) && (!self.log_y || *y > 0.0))
@@ -108,7 +108,7 @@ impl LinePlot {
     }
 
     /// Plot-space points of `s` that lie inside the frame's y range (only a log y axis cuts any off).
-    fn visible_points(&self, s: &Series, f: &Frame) -> Vec<(f64, f64)> {
+    fn visible_points(&self, s: &Curve, f: &Frame) -> Vec<(f64, f64)> {
         self.data_points(s).into_iter().filter(|&(_, y)| y >= f.y0).collect()
     }
 
@@ -554,7 +554,7 @@ mod tests {
             y_label: "r R(r)".into(),
             log_x: true,
             log_y: false,
-            series: vec![Series {
+            series: vec![Curve {
                 label: "a<b".into(),
                 color: [255, 0, 0],
                 dashed: false,

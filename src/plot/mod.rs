@@ -4,4 +4,4 @@
 pub mod line;
 pub mod profile;
 
-pub use line::{panels_to_image, panels_to_svg, LinePlot, Series, LOG_Y_DECADES};
+pub use line::{panels_to_image, panels_to_svg, Curve, LinePlot, LOG_Y_DECADES};

@@ -6,7 +6,7 @@
 //! 2. R(r) (mm⁻²) on a log₁₀ y axis (log–log), at most [`crate::plot::LOG_Y_DECADES`] decades deep, which shows the
 //!    near-field peak and the far exponential tail.
 //!
-//! Every channel is a solid line in [`crate::fitting::CHANNEL_COLORS`]; T(r) (slabs and layer stacks) is dashed in
+//! Every channel is a solid line in [`CHANNEL_COLORS`]; T(r) (slabs and layer stacks) is dashed in
 //! a lighter shade of the channel colour; an optional sum-of-Gaussians overlay is dashed in a darker shade. Pure:
 //! returns a [`LinePlot`] pair, text or PNG bytes; callers write the files.
 
@@ -14,8 +14,7 @@ use crate::diffusion::sum_of_gaussians::RgbGaussians;
 use crate::diffusion::table::ProfileTable;
 use crate::diffusion::RadialProfile;
 use crate::error::InvalidInput;
-use crate::fitting::CHANNEL_COLORS;
-use crate::plot::{panels_to_image, panels_to_svg, LinePlot, Series};
+use crate::plot::{panels_to_image, panels_to_svg, Curve, LinePlot};
 use serde_json::Value;
 use std::path::Path;
 
@@ -73,7 +72,7 @@ pub fn profile_panels(table: &ProfileTable, fit: Option<&RgbGaussians>, title: &
         };
         let mut series = Vec::new();
         for c in 0..3 {
-            series.push(Series {
+            series.push(Curve {
                 label: format!("R {}", CHANNEL_NAMES[c]),
                 color: CHANNEL_COLORS[c],
                 dashed: false,
@@ -82,7 +81,7 @@ pub fn profile_panels(table: &ProfileTable, fit: Option<&RgbGaussians>, title: &
         }
         if let Some(t) = &table.transmittance_mm2 {
             for c in 0..3 {
-                series.push(Series {
+                series.push(Curve {
                     label: format!("T {}", CHANNEL_NAMES[c]),
                     color: lighter(CHANNEL_COLORS[c]),
                     dashed: true,
@@ -92,7 +91,7 @@ pub fn profile_panels(table: &ProfileTable, fit: Option<&RgbGaussians>, title: &
         }
         if let (Some(f), Some(vals)) = (fit, &fit_values) {
             for c in 0..3 {
-                series.push(Series {
+                series.push(Curve {
                     label: format!("{}-Gaussian fit {}", f.count(), CHANNEL_NAMES[c]),
                     color: darker(CHANNEL_COLORS[c]),
                     dashed: true,
@@ -135,6 +134,51 @@ pub fn render(panels: &[LinePlot], format: PlotFormat, provenance: &Value) -> Re
             &panels_to_image(panels, PLOT_WIDTH, PANEL_HEIGHT),
             crate::io::png::PngColor::Srgb,
         ),
+    }
+}
+
+/// Plot colours of the R, G, B channels.
+pub const CHANNEL_COLORS: [[u8; 3]; 3] = [[200, 30, 30], [20, 140, 40], [30, 60, 210]];
+
+/// r·R(r) (mm⁻¹) on a log r axis per channel, with an optional fitted sum overlaid (dashed). The r range spans the
+/// profile's 0.1 %–99.9 % energy quantiles, widened by 3× on both sides; 240 log-spaced points.
+pub fn fit_overlay_plot(profile: &dyn RadialProfile, fit: Option<&RgbGaussians>, title: &str) -> LinePlot {
+    use crate::fitting::quadrature;
+    use crate::fitting::sum_of_gaussians_fit;
+    let grid = quadrature::RadialGrid::standard();
+    let samples: Vec<[f64; 3]> = grid.r_mm.iter().map(|&r| profile.reflectance_mm2(r)).collect();
+    let targets: Vec<Vec<f64>> = (0..3).map(|c| samples.iter().map(|s| s[c]).collect()).collect();
+    let lo = (sum_of_gaussians_fit::quantile_radius(&grid, &targets, 0.001) / 3.0).max(quadrature::R_MIN_MM);
+    let hi = (sum_of_gaussians_fit::quantile_radius(&grid, &targets, 0.999) * 3.0).min(quadrature::R_MAX_MM);
+    let n = 240;
+    let rs: Vec<f64> = (0..n).map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64)).collect();
+    let names = ["R", "G", "B"];
+    let mut series = Vec::new();
+    for c in 0..3 {
+        series.push(Curve {
+            label: format!("profile {}", names[c]),
+            color: CHANNEL_COLORS[c],
+            dashed: false,
+            points: rs.iter().map(|&r| (r, r * profile.reflectance_mm2(r)[c])).collect(),
+        });
+    }
+    if let Some(f) = fit {
+        for c in 0..3 {
+            series.push(Curve {
+                label: format!("fit {}", names[c]),
+                color: CHANNEL_COLORS[c].map(|v| v / 2),
+                dashed: true,
+                points: rs.iter().map(|&r| (r, r * f.reflectance_mm2(r)[c])).collect(),
+            });
+        }
+    }
+    LinePlot {
+        title: title.into(),
+        x_label: "r (mm)".into(),
+        y_label: "r R(r) (1/mm)".into(),
+        log_x: true,
+        log_y: false,
+        series,
     }
 }
 

@@ -1,7 +1,7 @@
 //! `rtbake profile --plot FILE [--overlay-fit K]`: the files it writes and its bad-input handling.
 
-use rtbake::fitting::CHANNEL_COLORS;
 use rtbake::io::png::{decode, DecodedPng};
+use rtbake::plot::profile::CHANNEL_COLORS;
 use std::path::Path;
 
 use crate::support::rtbake;
