@@ -77,7 +77,7 @@ pub mod schema {
     /// `baked/manifest.json`.
     pub const MANIFEST: &str = "rtbake-manifest/1";
     /// A separable-SSS kernel file ([`crate::separable::kernel::Kernel::to_json`]).
-    pub const SEPARABLE_KERNEL: &str = "rtbake-separable-kernel/1";
+    pub use crate::separable::kernel::JSON_SCHEMA as SEPARABLE_KERNEL;
     /// A hemoglobin rig description ([`super::RigDescription`]).
     pub const HEMOGLOBIN_RIG: &str = "rtbake-hemoglobin-rig/1";
     /// The wrinkle example's report.
@@ -236,54 +236,9 @@ pub struct RigMapFiles {
     pub source: RigSource,
 }
 
-/// A separable-SSS kernel file (schema [`schema::SEPARABLE_KERNEL`]). Numbers are already rounded to the kernel's
-/// arithmetic precision by the writer.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SeparableKernelFile {
-    pub schema: String,
-    pub source: String,
-    pub samples: usize,
-    pub range: f64,
-    pub exponent: f64,
-    /// The shader's fixed step divisor (3).
-    pub step_divisor: f64,
-    /// `f32` or `f64`.
-    pub precision: String,
-    pub strength: [f64; 3],
-    pub falloff: [f64; 3],
-    /// The width (world units) the parameters were made for, if known.
-    pub sss_width: Option<f64>,
-    pub layout: String,
-    /// `[r, g, b, offset]`, centre first.
-    pub kernel: Vec<[f64; 4]>,
-}
+/// The separable-SSS kernel file: defined with the kernel it serialises (so the model does not import the
+/// contract), re-exported here with the other files of the contract.
+pub use crate::separable::kernel::SeparableKernelFile;
 
-/// The keys of a sum-of-Gaussians / screen-space parameter file (`sss/gaussians/*.json`, `rtbake fit gaussians
-/// --json`) that the runtime reads. Shapes depend on `shared_variances` (shared: `variances` is one array and the
-/// weight-like keys are `[r, g, b]` per Gaussian; per channel: `[[r…], [g…], [b…]]`), so they stay JSON values
-/// here and are checked by the reader.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct GaussiansFile {
-    pub shared_variances: bool,
-    pub variances: Value,
-    pub weights: Value,
-    pub blend_weights: Value,
-    pub incremental_variances: Value,
-    pub std_devs: Value,
-    pub lod_thresholds: LodThresholds,
-    pub units: Value,
-    /// Provenance, error figures and the like added by the command that wrote the file.
-    #[serde(flatten)]
-    pub extra: serde_json::Map<String, Value>,
-}
-
-/// α, β, γ of the screen-space pass (eq. 4.5–4.6) and the per-Gaussian depth thresholds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct LodThresholds {
-    pub alpha: f64,
-    pub beta: f64,
-    pub gamma: f64,
-    pub two_sqrt_v_alpha: Value,
-    pub half_sqrt_v_alpha: Value,
-    pub convention: String,
-}
+/// The sum-of-Gaussians / screen-space parameter file, likewise defined with the parameters it serialises.
+pub use crate::fitting::screen_space::{GaussiansFile, LodThresholds};

@@ -11,9 +11,9 @@
 //!   2.0062 − 0.2719 = 1.7343) and the shader takes its standard deviation sqrt(vᵢ − vᵢ₋₁).
 
 use super::RgbGaussians;
-use crate::baked_layout::{GaussiansFile, LodThresholds};
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use crate::io::source::{ShaderInclude, ShaderLang};
+use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// Thesis defaults for eq. 4.1–4.4.
@@ -240,4 +240,34 @@ mod tests {
         let expect: f64 = w.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>() / w.iter().sum::<f64>();
         assert!((c - expect).abs() < 1e-12);
     }
+}
+
+/// The keys of a sum-of-Gaussians / screen-space parameter file (`sss/gaussians/*.json`, `rtbake fit gaussians
+/// --json`) that the runtime reads. Shapes depend on `shared_variances` (shared: `variances` is one array and the
+/// weight-like keys are `[r, g, b]` per Gaussian; per channel: `[[r…], [g…], [b…]]`), so they stay JSON values
+/// here and are checked by the reader.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GaussiansFile {
+    pub shared_variances: bool,
+    pub variances: Value,
+    pub weights: Value,
+    pub blend_weights: Value,
+    pub incremental_variances: Value,
+    pub std_devs: Value,
+    pub lod_thresholds: LodThresholds,
+    pub units: Value,
+    /// Provenance, error figures and the like added by the command that wrote the file.
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, Value>,
+}
+
+/// α, β, γ of the screen-space pass (eq. 4.5–4.6) and the per-Gaussian depth thresholds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LodThresholds {
+    pub alpha: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    pub two_sqrt_v_alpha: Value,
+    pub half_sqrt_v_alpha: Value,
+    pub convention: String,
 }

@@ -21,7 +21,6 @@
 //! [`Precision::F32`] evaluates every step in f32 in the shader's order of operations and reproduces the shipped
 //! header's digits (whose offsets are very slightly asymmetric); [`Precision::F64`] runs the same steps in f64.
 
-use crate::baked_layout::SeparableKernelFile;
 use crate::error::{check_range, InvalidInput};
 use crate::io::source::{ShaderInclude, ShaderLang};
 use serde::{Deserialize, Serialize};
@@ -317,7 +316,29 @@ fn rounded(v: f64, precision: Precision) -> f64 {
 }
 
 /// Kernel JSON schema identifier.
-pub use crate::baked_layout::schema::SEPARABLE_KERNEL as JSON_SCHEMA;
+pub const JSON_SCHEMA: &str = "rtbake-separable-kernel/1";
+
+/// A separable-SSS kernel file (schema [`JSON_SCHEMA`]). Numbers are already rounded to the kernel's
+/// arithmetic precision by the writer.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeparableKernelFile {
+    pub schema: String,
+    pub source: String,
+    pub samples: usize,
+    pub range: f64,
+    pub exponent: f64,
+    /// The shader's fixed step divisor (3).
+    pub step_divisor: f64,
+    /// `f32` or `f64`.
+    pub precision: String,
+    pub strength: [f64; 3],
+    pub falloff: [f64; 3],
+    /// The width (world units) the parameters were made for, if known.
+    pub sss_width: Option<f64>,
+    pub layout: String,
+    /// `[r, g, b, offset]`, centre first.
+    pub kernel: Vec<[f64; 4]>,
+}
 
 impl Kernel {
     /// The taps as `[[r, g, b, offset], …]`, centre first.
