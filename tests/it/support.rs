@@ -64,7 +64,8 @@ pub fn external_inputs_required() -> bool {
 /// was not checked. The message goes straight to the process' stderr (not through the test harness' capture), so
 /// a plain `cargo test` shows it.
 pub fn skip_missing(what: &str, path: &std::path::Path, env_var: &str) {
-    let msg = format!("SKIPPED: {what} — {} not found (set {env_var}; see README \"Tests and ../shared\")", path.display());
+    let msg =
+        format!("SKIPPED: {what} — {} not found (set {env_var}; see README \"Tests and ../shared\")", path.display());
     if external_inputs_required() {
         panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
     }
