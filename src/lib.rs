@@ -44,7 +44,7 @@
 //! # Cargo features
 //!
 //! - `runtime` (default): the wgpu runtime, module `runtime` (pulls in wgpu and pollster).
-//! - `cli` (default): the dependencies of the `rtbake` binary (clap, anyhow, indicatif, libc).
+//! - `cli` (default): the dependencies of the `rtbake` binary (clap, anyhow, indicatif).
 //!
 //! A `build.rs` or asset tool that only bakes tables depends on the bakers alone:
 //!

@@ -15,7 +15,7 @@
 use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
 use rtbake::aa::mlaa_area::MlaaVersion;
 use rtbake::aa::smaa_area::SmaaAreaParams;
-use rtbake::bake::aa::{mlaa_files, mlaa_stem, search_files, smaa_area_files, SearchKind};
+use rtbake::bake::aa::{mlaa_files_with_progress, mlaa_stem, search_files, smaa_area_files, SearchKind};
 use rtbake::bake::{BakeError, BakedFile};
 use sha2::{Digest, Sha256};
 use std::path::PathBuf;
@@ -308,7 +308,15 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let n = a.max_distance.unwrap_or(default_mlaa_n(v));
             let stem = a.stem.clone().unwrap_or_else(|| mlaa_stem(v, n));
             let from = format!("`rtbake aa {name} --max-distance {n}`");
-            mlaa_files(v, n, &stem, sources, &from).map_err(bake_err)?
+            let pb = ctx.progress(16 * n as u64, "MLAA area map rows");
+            pb.set_style(
+                indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} [{elapsed}]")
+                    .expect("valid template"),
+            );
+            let files = mlaa_files_with_progress(v, n, &stem, sources, &from, &|done, _| pb.set_position(done as u64))
+                .map_err(bake_err)?;
+            pb.finish_and_clear();
+            files
         }
     };
     let mut files = files;

@@ -244,6 +244,9 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         ctx.info(format!("wrote {}", path.display()));
     }
     // Totals are messages (stderr); stdout is pure CSV, and only when no file was asked for.
+    if let Some(note) = table.clamped_negative.describe() {
+        ctx.info(format!("note: {note}"));
+    }
     let t = &table.total_reflectance;
     ctx.info(format!("total R (r, g, b): {:.6} {:.6} {:.6}", t[0], t[1], t[2]));
     if let Some(t) = &table.total_transmittance {

@@ -230,10 +230,21 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => None,
     };
     let files = match &a.out {
-        Some(_) => Some(rtbake::bake::skin::skin_color_lut_files(&p).map_err(|e| match e {
-            rtbake::bake::BakeError::Invalid(i) => flag_error(SkinColorError::Invalid(i)),
-            other => anyhow::Error::new(other),
-        })?),
+        Some(_) => {
+            let pb = ctx.progress(p.layout().map_err(flag_error)?.height as u64, "skin LUT rows");
+            pb.set_style(
+                indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} rows [{elapsed}]")
+                    .expect("valid template"),
+            );
+            let files =
+                rtbake::bake::skin::skin_color_lut_files_with_progress(&p, &|done, _| pb.set_position(done as u64))
+                    .map_err(|e| match e {
+                        rtbake::bake::BakeError::Invalid(i) => flag_error(SkinColorError::Invalid(i)),
+                        other => anyhow::Error::new(other),
+                    })?;
+            pb.finish_and_clear();
+            Some(files)
+        }
         None => None,
     };
     // `--out DIR` receives the files themselves, like `transmittance`, `fit` and `kernel` (the bake's `skin/`

@@ -147,7 +147,18 @@ pub fn texel(version: MlaaVersion, e1: u8, e2: u8, left: u32, right: u32) -> (u8
 
 /// The `5N × 5N` RG8 area map with cell size `n` (CLI `--max-distance`).
 pub fn mlaa_area_map(version: MlaaVersion, n: u32) -> Result<Image<u8>, MlaaAreaError> {
+    mlaa_area_map_with_progress(version, n, &|_, _| {})
+}
+
+/// [`mlaa_area_map`], calling `progress(rows_done, rows)` after each of the 16·N cell rows (large N take tens of
+/// seconds); the texels do not depend on it.
+pub fn mlaa_area_map_with_progress(
+    version: MlaaVersion,
+    n: u32,
+    progress: &dyn Fn(u32, u32),
+) -> Result<Image<u8>, MlaaAreaError> {
     let edge = validate(version, n)?;
+    let mut rows_done = 0;
     let mut img = Image::<u8>::new(edge, edge, 2);
     let dist = |i: u32| if version == MlaaVersion::V2 { i * i } else { i };
     for e1 in [0u8, 1, 3, 4] {
@@ -159,6 +170,8 @@ pub fn mlaa_area_map(version: MlaaVersion, n: u32) -> Result<Image<u8>, MlaaArea
                     img.set(x, y, 0, r);
                     img.set(x, y, 1, g);
                 }
+                rows_done += 1;
+                progress(rows_done, 16 * n);
             }
         }
     }
@@ -168,6 +181,21 @@ pub fn mlaa_area_map(version: MlaaVersion, n: u32) -> Result<Image<u8>, MlaaArea
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn progress_reaches_every_cell_row_and_leaves_the_map_unchanged() {
+        let last = std::cell::Cell::new((0, 0));
+        let calls = std::cell::Cell::new(0);
+        let with = mlaa_area_map_with_progress(MlaaVersion::V1_4, 9, &|done, rows| {
+            assert_eq!(done, last.get().0 + 1, "rows are reported once each, in order");
+            last.set((done, rows));
+            calls.set(calls.get() + 1);
+        })
+        .unwrap();
+        assert_eq!(last.get(), (16 * 9, 16 * 9));
+        assert_eq!(calls.get(), 16 * 9);
+        assert_eq!(with, mlaa_area_map(MlaaVersion::V1_4, 9).unwrap());
+    }
 
     #[test]
     fn halves_sum_to_the_triangle_of_the_line() {

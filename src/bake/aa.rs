@@ -15,7 +15,7 @@
 //! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
 use super::{parse_params, text_file, unorm8_texture_files, Asset, BakeError, BakedFile};
-use crate::aa::mlaa_area::{mlaa_area_map, MlaaAreaError, MlaaVersion};
+use crate::aa::mlaa_area::{mlaa_area_map_with_progress, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
 use crate::aa::smaa_search;
 use crate::error::InvalidInput;
@@ -189,7 +189,19 @@ pub fn mlaa_files(
     sources: bool,
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let img = mlaa_area_map(version, n)?;
+    mlaa_files_with_progress(version, n, stem, sources, from, &|_, _| {})
+}
+
+/// [`mlaa_files`], reporting the map's rows as they are computed (`progress(rows_done, rows)`).
+pub fn mlaa_files_with_progress(
+    version: MlaaVersion,
+    n: u32,
+    stem: &str,
+    sources: bool,
+    from: &str,
+    progress: &dyn Fn(u32, u32),
+) -> Result<Vec<BakedFile>, BakeError> {
+    let img = mlaa_area_map_with_progress(version, n, progress)?;
     texture_with_sources(stem, &img, &mlaa_convention(version, n), sources.then_some(("AREAMAP", "areaMapBytes")), from)
 }
 
@@ -197,7 +209,7 @@ pub fn mlaa_files(
 pub const BEVY_AREA_LUT: &str = "SMAAAreaLUT.ktx2";
 pub const BEVY_SEARCH_LUT: &str = "SMAASearchLUT.ktx2";
 
-/// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`io::ktx2::BEVY_ZSTD_LEVEL`]).
+/// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`crate::io::ktx2::BEVY_ZSTD_LEVEL`]).
 pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<BakedFile, BakeError> {
     use crate::io::{self, ktx2::Supercompression, PixelFormat};
     let sc = Supercompression::Zstd(io::ktx2::BEVY_ZSTD_LEVEL);

@@ -1,7 +1,7 @@
 //! Skin-colour assets in `baked/skin/`: the melanin × hemoglobin lookup table (thesis §7.6, eq. 7.7, Fig. 7.9).
 
 use super::{float_texture_files, json_file, parse_params, text_file, Asset, BakeError, BakedFile};
-use crate::skin_color::lut::{bake_lut, IndexForm, LutLayout};
+use crate::skin_color::lut::{bake_lut_with_progress, IndexForm, LutLayout};
 use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
 use serde_json::Value;
@@ -62,9 +62,17 @@ fn sibling(path: &str) -> &str {
 }
 
 pub fn skin_color_lut_files(p: &SkinColorParams) -> Result<Vec<BakedFile>, BakeError> {
+    skin_color_lut_files_with_progress(p, &|_, _| {})
+}
+
+/// [`skin_color_lut_files`], reporting table rows as they complete (`progress(rows_done, rows)`).
+pub fn skin_color_lut_files_with_progress(
+    p: &SkinColorParams,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) -> Result<Vec<BakedFile>, BakeError> {
     let layout = p.layout().map_err(invalid)?;
     let model = p.model().map_err(invalid)?;
-    let img = bake_lut(&model, &layout, p.lut_evaluation).map_err(invalid)?;
+    let img = bake_lut_with_progress(&model, &layout, p.lut_evaluation, progress).map_err(invalid)?;
     let conv = convention(&layout);
     let mut files = float_texture_files(LUT_STEM, &img, "lut", &conv, LUT_TOLERANCE)?;
     files.push(json_file(SIDECAR_PATH, &sidecar(p, &layout, &img), "json", &conv));

@@ -59,13 +59,47 @@ pub struct ProfileTable {
     pub total_transmittance: Option<[f64; 3]>,
     /// Model options (a JSON object) recorded with the table.
     pub provenance: Value,
+    /// Negative R or T values set to 0: how many, and the largest magnitude (mm⁻²). A diffusion profile is
+    /// non-negative; where the layered model's numerical inverse Hankel transform (absolute error ≈ 1e-12–1e-9 of
+    /// the peak) falls below zero at large r, the table holds 0 and says so here (and in its JSON and CSV).
+    pub clamped_negative: ClampReport,
+}
+
+/// What [`ProfileTable::compute`] clamped (see [`ProfileTable::clamped_negative`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClampReport {
+    pub count: usize,
+    pub max_abs_mm2: f64,
+}
+
+impl ClampReport {
+    fn clamp(&mut self, col: &mut [[f64; 3]]) {
+        for v in col.iter_mut().flatten() {
+            if *v < 0.0 {
+                self.count += 1;
+                self.max_abs_mm2 = self.max_abs_mm2.max(-*v);
+                *v = 0.0;
+            }
+        }
+    }
+
+    /// One sentence for people (CSV comment, stderr), or `None` when nothing was clamped.
+    pub fn describe(&self) -> Option<String> {
+        (self.count > 0).then(|| {
+            format!(
+                "{} negative R/T values (largest magnitude {:e} mm^-2, the numerical inverse Hankel transform's error \
+                 floor) were set to 0",
+                self.count, self.max_abs_mm2
+            )
+        })
+    }
 }
 
 impl ProfileTable {
     /// Evaluates `profile` at `radii_mm` (checked with [`check_radii`], errors name `radii`).
     pub fn compute(profile: &dyn RadialProfile, radii_mm: &[f64], provenance: Value) -> Result<Self, InvalidInput> {
         check_radii("radii", radii_mm)?;
-        let (reflectance_mm2, transmittance_mm2) = profile.profile_many(radii_mm);
+        let (mut reflectance_mm2, mut transmittance_mm2) = profile.profile_many(radii_mm);
         let (total_reflectance, total_transmittance) = (profile.total_reflectance(), profile.total_transmittance());
         // Nothing non-finite is ever written: huge but finite coefficients or thicknesses can overflow the model.
         let columns = [("R", Some(&reflectance_mm2)), ("T", transmittance_mm2.as_ref())];
@@ -93,6 +127,11 @@ impl ProfileTable {
                 ));
             }
         }
+        let mut clamped_negative = ClampReport::default();
+        clamped_negative.clamp(&mut reflectance_mm2);
+        if let Some(t) = transmittance_mm2.as_mut() {
+            clamped_negative.clamp(t);
+        }
         Ok(Self {
             r_mm: radii_mm.to_vec(),
             reflectance_mm2,
@@ -100,6 +139,7 @@ impl ProfileTable {
             total_reflectance,
             total_transmittance,
             provenance,
+            clamped_negative,
         })
     }
 
@@ -115,6 +155,14 @@ impl ProfileTable {
         }
         if let Some(t) = &self.total_transmittance {
             v["total_T"] = json!(t);
+        }
+        if self.clamped_negative.count > 0 {
+            v["clamped_negative"] = json!({
+                "count": self.clamped_negative.count,
+                "max_abs_mm2": self.clamped_negative.max_abs_mm2,
+                "reason": "a diffusion profile is non-negative; values below 0 are the numerical inverse Hankel \
+                           transform's error floor and were set to 0",
+            });
         }
         if let Value::Object(p) = &self.provenance {
             for (k, val) in p {
@@ -134,6 +182,9 @@ impl ProfileTable {
         s.push_str(&format!("# total_R (r,g,b): {}\n", t3(&self.total_reflectance)));
         if let Some(t) = &self.total_transmittance {
             s.push_str(&format!("# total_T (r,g,b): {}\n", t3(t)));
+        }
+        if let Some(note) = self.clamped_negative.describe() {
+            s.push_str(&format!("# {note}\n"));
         }
         s.push_str("r_mm,R_r,R_g,R_b");
         if self.transmittance_mm2.is_some() {

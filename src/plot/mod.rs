@@ -1,4 +1,4 @@
-//! Plots, in one place: [`line`] draws line plots as SVG and as raster images (for PNG) with a built-in font;
+//! Plots, in one place: [`line`](mod@line) draws line plots as SVG and as raster images (for PNG) with a built-in font;
 //! [`profile`] turns a diffusion-profile table into its two-panel plot. Pure: text or pixels; callers write files.
 
 pub mod line;

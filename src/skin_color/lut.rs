@@ -115,6 +115,17 @@ pub fn bake_lut(
     layout: &LutLayout,
     evaluation: LutEvaluation,
 ) -> Result<Image<f32>, SkinColorError> {
+    bake_lut_with_progress(model, layout, evaluation, &|_, _| {})
+}
+
+/// [`bake_lut`], calling `progress(rows_done, rows)` as rows complete (from the worker threads, in completion
+/// order; the table itself does not depend on it), so a caller can show progress on large tables.
+pub fn bake_lut_with_progress(
+    model: &TwoLayerSkinModel,
+    layout: &LutLayout,
+    evaluation: LutEvaluation,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) -> Result<Image<f32>, SkinColorError> {
     let (cm_max, chd_max) = (layout.index_form.melanin_max(), layout.index_form.hemoglobin_max());
     model.check_validity(cm_max, chd_max)?;
     let tables = match evaluation {
@@ -125,9 +136,36 @@ pub fn bake_lut(
     let hemoglobin: Vec<f64> = (0..layout.height).map(|j| layout.hemoglobin_at_row(j)).collect();
     let row_len = 3 * layout.width as usize;
     let mut img = Image::new(layout.width, layout.height, 3);
-    img.data
-        .par_chunks_mut(row_len * ROWS_PER_TASK)
-        .zip(hemoglobin.par_chunks(ROWS_PER_TASK))
-        .for_each(|(out, chd)| model.linear_rgb_grid(&melanin, chd, &tables, out));
+    let rows_done = std::sync::atomic::AtomicU32::new(0);
+    img.data.par_chunks_mut(row_len * ROWS_PER_TASK).zip(hemoglobin.par_chunks(ROWS_PER_TASK)).for_each(
+        |(out, chd)| {
+            model.linear_rgb_grid(&melanin, chd, &tables, out);
+            let done = rows_done.fetch_add(chd.len() as u32, std::sync::atomic::Ordering::Relaxed) + chd.len() as u32;
+            progress(done, layout.height);
+        },
+    );
     Ok(img)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Progress reaches every row exactly once in total, and reporting it does not change the table.
+    #[test]
+    fn progress_counts_every_row_and_leaves_the_table_unchanged() {
+        let p = crate::skin_color::SkinColorParams { width: 6, height: 40, ..Default::default() };
+        let (model, layout) = (p.model().unwrap(), p.layout().unwrap());
+        let max = std::sync::atomic::AtomicU32::new(0);
+        let calls = std::sync::atomic::AtomicU32::new(0);
+        let with = bake_lut_with_progress(&model, &layout, p.lut_evaluation, &|done, rows| {
+            assert_eq!(rows, 40);
+            max.fetch_max(done, std::sync::atomic::Ordering::Relaxed);
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
+        .unwrap();
+        assert_eq!(max.into_inner(), 40);
+        assert!(calls.into_inner() >= 40 / ROWS_PER_TASK as u32);
+        assert_eq!(with, bake_lut(&model, &layout, p.lut_evaluation).unwrap());
+    }
 }

@@ -31,6 +31,7 @@ mod fitting_cli;
 mod fitting_determinism;
 mod fitting_published;
 mod newcomer_cli;
+mod newcomer_profile_floor;
 mod newcomer_provenance;
 mod newcomer_readme;
 mod profiles_bake;
