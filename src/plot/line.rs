@@ -55,6 +55,19 @@ struct Frame {
     y_ticks: Vec<(f64, String)>,
 }
 
+/// A linear axis from `lo` to `hi` widened to whole "nice" steps (about `target` of them), its ticks appended to
+/// `ticks`; returns the widened range.
+fn linear_ticks(lo: f64, hi: f64, target: usize, ticks: &mut Vec<(f64, String)>) -> (f64, f64) {
+    let step = nice_step(hi - lo, target);
+    let (lo, hi) = ((lo / step).floor() * step, (hi / step).ceil() * step);
+    let mut t = lo;
+    while t <= hi + 0.5 * step {
+        ticks.push((t, fmt_tick(t, step)));
+        t += step;
+    }
+    (lo, hi)
+}
+
 fn nice_step(range: f64, target: usize) -> f64 {
     let raw = range / target as f64;
     let mag = 10f64.powf(raw.log10().floor());
@@ -145,14 +158,7 @@ impl LinePlot {
                 y_ticks.push((e as f64, fmt_log_tick(e)));
             }
         } else {
-            let ystep = nice_step(y1 - y0, 5);
-            y1 = (y1 / ystep).ceil() * ystep;
-            y0 = (y0 / ystep).floor() * ystep;
-            let mut t = y0;
-            while t <= y1 + 0.5 * ystep {
-                y_ticks.push((t, fmt_tick(t, ystep)));
-                t += ystep;
-            }
+            (y0, y1) = linear_ticks(y0, y1, 5, &mut y_ticks);
         }
         let mut x_ticks = Vec::new();
         if self.log_x {
@@ -162,14 +168,7 @@ impl LinePlot {
                 x_ticks.push((e as f64, fmt_decade(e)));
             }
         } else {
-            let xstep = nice_step(x1 - x0, 6);
-            x0 = (x0 / xstep).floor() * xstep;
-            x1 = (x1 / xstep).ceil() * xstep;
-            let mut t = x0;
-            while t <= x1 + 0.5 * xstep {
-                x_ticks.push((t, fmt_tick(t, xstep)));
-                t += xstep;
-            }
+            (x0, x1) = linear_ticks(x0, x1, 6, &mut x_ticks);
         }
         Frame { x0, x1, y0, y1, x_ticks, y_ticks }
     }
