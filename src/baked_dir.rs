@@ -128,7 +128,7 @@ pub fn bake_into_with(
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
     for (k, (asset, params)) in jobs.iter().enumerate() {
         progress(k, asset.name);
-        let files = (asset.bake)(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
+        let files = asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
         produced.push((asset, params, files));
     }
     progress(jobs.len(), "writing");
@@ -386,7 +386,7 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
         if !recomputed.insert(record.name.as_str()) {
             continue;
         }
-        let files = match (asset.bake)(&record.params) {
+        let files = match asset.run(&record.params) {
             Ok(f) => f,
             Err(err) => {
                 for e in manifest.files.iter().filter(|e| e.asset == record.name) {

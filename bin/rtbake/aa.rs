@@ -122,9 +122,8 @@ pub struct AaArgs {
     /// File name stem (default: the upstream name, e.g. AreaTex, SearchTex, AreaMap33_v1.4).
     #[arg(long, value_name = "NAME")]
     pub stem: Option<String>,
-    /// Zstandard-supercompress the KTX2 output at this level (1..=22; Bevy ships its SMAA LUTs at 15).
-    #[arg(long, value_name = "LEVEL")]
-    pub zstd: Option<i32>,
+    #[command(flatten)]
+    pub zstd: crate::cli::ZstdArg,
 }
 
 fn is_smaa_area(t: AaTexture) -> bool {
@@ -320,10 +319,7 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     };
     let mut files = files;
-    if let Some(level) = a.zstd {
-        rtbake::error::check_range("--zstd", level, 1, 22, "(Zstandard level)").map_err(usage)?;
-        rtbake::bake::supercompress_ktx2(&mut files, level).map_err(bake_err)?;
-    }
+    a.zstd.apply(&mut files)?;
     let all = a.format.contains(&AaFormat::All);
     let wanted: Vec<&BakedFile> = files
         .iter()

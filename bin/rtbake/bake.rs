@@ -15,6 +15,9 @@ pub struct BakeArgs {
     /// JSON object {"ASSET": {parameters…}} merged over each asset's embedded defaults.
     #[arg(long, value_name = "FILE")]
     pub asset_params: Option<PathBuf>,
+    /// Sets the `ktx2_zstd` parameter of every asset baked (recorded in the manifest, so `verify` recomputes it).
+    #[command(flatten)]
+    pub zstd: crate::cli::ZstdArg,
 }
 
 #[derive(clap::Args)]
@@ -47,6 +50,7 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
             return Err(usage_msg(format!("unknown asset {n:?}; known assets: {}", names.join(", "))));
         }
     }
+    let zstd = a.zstd.level()?;
     let overrides: Value = match &a.asset_params {
         None => Value::Object(Default::default()),
         Some(p) => {
@@ -73,6 +77,9 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let mut p = (asset.default_params)();
             if let Some(o) = overrides.get(asset.name) {
                 merge(&mut p, o);
+            }
+            if let (Some(level), Some(obj)) = (zstd, p.as_object_mut()) {
+                obj.insert(rtbake::bake::KTX2_ZSTD_PARAM.into(), level.into());
             }
             (*asset, p)
         })

@@ -319,6 +319,34 @@ pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
 /// directory's lock, all or nothing (a kill is rolled forward by the next command), an output that is one of
 /// `inputs` refused (exit 2, both paths named), a lock held elsewhere under --no-wait exit 3.
 #[allow(dead_code)]
+/// `--zstd LEVEL`, shared by every command that writes KTX2 files (`aa`, `bake`, `transmittance`, `skin-color`,
+/// `maps hemoglobin|wrinkles|masks`).
+#[derive(clap::Args, Debug, Clone, Copy, Default)]
+pub struct ZstdArg {
+    /// Zstandard-supercompress every KTX2 file written (KTX2 supercompression scheme 2) at this level (1..=22;
+    /// Bevy ships its SMAA LUTs at 15). Other formats are unchanged.
+    #[arg(long, value_name = "LEVEL", allow_negative_numbers = true)]
+    pub zstd: Option<i32>,
+}
+
+impl ZstdArg {
+    /// The level, validated (exit 2 naming `--zstd` and the range).
+    pub fn level(&self) -> anyhow::Result<Option<i32>> {
+        if let Some(level) = self.zstd {
+            rtbake::error::check_range("--zstd", level, 1, 22, "(Zstandard level)").map_err(usage)?;
+        }
+        Ok(self.zstd)
+    }
+
+    /// Supercompresses the uncompressed KTX2 files of `files` (recorded in their metadata) when `--zstd` is given.
+    pub fn apply(&self, files: &mut [rtbake::bake::BakedFile]) -> anyhow::Result<()> {
+        if let Some(level) = self.level()? {
+            rtbake::bake::supercompress_ktx2(files, level).map_err(|e| anyhow::anyhow!("--zstd {level}: {e}"))?;
+        }
+        Ok(())
+    }
+}
+
 pub fn write_set(
     ctx: &Ctx,
     flag: &str,

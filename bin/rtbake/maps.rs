@@ -65,6 +65,8 @@ pub struct HemoglobinArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    #[command(flatten)]
+    zstd: crate::cli::ZstdArg,
 }
 
 #[derive(clap::Args)]
@@ -113,6 +115,8 @@ pub struct WrinklesArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    #[command(flatten)]
+    zstd: crate::cli::ZstdArg,
 }
 
 #[derive(clap::Args)]
@@ -127,6 +131,8 @@ pub struct WrinkleMasksArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+    #[command(flatten)]
+    zstd: crate::cli::ZstdArg,
 }
 
 #[derive(clap::Args)]
@@ -174,13 +180,23 @@ fn parse_border(s: &str) -> Border {
 }
 
 /// Writes files below `dir` (paths relative to it) as one set: locked, all or nothing, never over an input.
-fn write_files(ctx: &Ctx, flag: &str, dir: &Path, files: &[BakedFile], inputs: &[&Path]) -> Result<()> {
+/// `--zstd` supercompresses the set's KTX2 files first.
+fn write_files(
+    ctx: &Ctx,
+    flag: &str,
+    dir: &Path,
+    mut files: Vec<BakedFile>,
+    inputs: &[&Path],
+    zstd: &crate::cli::ZstdArg,
+) -> Result<Vec<BakedFile>> {
+    zstd.apply(&mut files)?;
     prepare_out_dir(flag, dir)?;
-    crate::cli::write_set(ctx, flag, dir, files, inputs)?;
-    Ok(())
+    crate::cli::write_set(ctx, flag, dir, &files, inputs)?;
+    Ok(files)
 }
 
 fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
+    a.zstd.level()?;
     let range = match &a.value_range {
         None => None,
         Some(s) => {
@@ -259,7 +275,7 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     )?;
     let mut input_paths: Vec<&Path> = vec![a.neutral.as_path()];
     input_paths.extend(pairs.iter().map(|(_, p)| p.as_path()));
-    write_files(ctx, "--out", &a.out, &files, &input_paths)?;
+    let files = write_files(ctx, "--out", &a.out, files, &input_paths, &a.zstd)?;
     let pct = 100.0 * rig.sigma_floored_texels as f64 / (w as f64 * h as f64);
     ctx.info(format!(
         "wrote {} files to {} (rig {}x{}); sigma_neutral floored at {} in {} texels ({pct:.3} %)",
@@ -345,6 +361,7 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
 }
 
 fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
+    a.zstd.level()?;
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
     let green =
         if a.green == "opengl" { wrinkles::GreenConvention::OpenGl } else { wrinkles::GreenConvention::DirectX };
@@ -411,7 +428,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
     report["composition"] = json!("n = normalize(base.xy + sum_z mask_z * weight_z * wrinkle.xy, 1), texel.rg -> 2*rg - 1 (thesis Listing 8.1; read .rg, not .gr)");
     files.push(rtbake::bake::json_file("wrinkles.json", &report, "json", "wrinkle conversion report"));
     let inputs_read: Vec<&Path> = std::iter::once(a.normal.as_path()).chain(a.base.as_deref()).collect();
-    write_files(ctx, "--out", &a.out, &files, &inputs_read)?;
+    write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
     if ctx.json {
         ctx.emit_json(&report);
     }
@@ -419,6 +436,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
 }
 
 fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
+    a.zstd.level()?;
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
     let mut masks: [Option<Vec<f64>>; 8] = Default::default();
     let mut dims: Option<(u32, u32, String)> = None;
@@ -470,7 +488,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         .flat_map(|z| z.split(','))
         .filter_map(|z| z.split_once('=').map(|(_, f)| Path::new(f)))
         .collect();
-    write_files(ctx, "--out", &a.out, &files, &inputs_read)?;
+    write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
     ctx.info(format!(
         "packed {} zone masks into 2 RGBA8 textures {}x{}",
         given.len(),
@@ -492,7 +510,7 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
         let bytes = io::png::encode_u16(img)?;
         files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text("input", "png", "") });
     }
-    write_files(ctx, "--out", &a.out, &files, &[])?;
+    let files = write_files(ctx, "--out", &a.out, files, &[], &Default::default())?;
     ctx.info(format!(
         "wrote {} synthetic maps ({}x{}, concentration = sample/65535) to {}",
         set.len(),

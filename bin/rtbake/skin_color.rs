@@ -29,6 +29,8 @@ pub struct SkinColorArgs {
     /// Model and table parameters (boxed: keeps the subcommand enum small).
     #[command(flatten)]
     pub model: Box<ModelFlags>,
+    #[command(flatten)]
+    pub zstd: crate::cli::ZstdArg,
 }
 
 /// Every model/table parameter; each flag is the JSON field of `SkinColorParams` in kebab case.
@@ -224,6 +226,7 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
     }
     // Everything is validated and computed before anything is written.
     p.layout().map_err(flag_error)?;
+    a.zstd.level()?;
     let model = p.model().map_err(flag_error)?;
     let sample = match point {
         Some((cm, chd)) => Some(model.evaluate(cm, chd, p.allow_unphysiological).map_err(flag_error)?),
@@ -243,6 +246,8 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
                         other => anyhow::Error::new(other),
                     })?;
             pb.finish_and_clear();
+            let mut files = files;
+            a.zstd.apply(&mut files)?;
             Some(files)
         }
         None => None,

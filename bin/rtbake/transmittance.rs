@@ -43,6 +43,8 @@ pub struct TransmittanceArgs {
     /// Table domain end s_max in mm (> 0); texel i holds s = s_max*i/(n-1).
     #[arg(long = "s-max", default_value_t = DEFAULT_S_MAX_MM, allow_hyphen_values = true)]
     pub s_max: f64,
+    #[command(flatten)]
+    pub zstd: crate::cli::ZstdArg,
 }
 
 fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
@@ -80,6 +82,7 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     };
     let table = TableSettings { samples: a.samples, height: a.height, s_max_mm: a.s_max, form };
     table.validate().map_err(usage)?;
+    a.zstd.level()?;
     if a.out.is_some() {
         ctx.check_memory(&format!("--samples {} --height {}", a.samples, a.height), table.memory_estimate_bytes())?;
     }
@@ -101,8 +104,9 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     if let Some(dir) = &a.out {
-        let files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
+        let mut files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
             .map_err(|e| anyhow::anyhow!(e))?;
+        a.zstd.apply(&mut files)?;
         prepare_out_dir("--out", dir)?;
         crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         result["files"] = json!(files.iter().map(|f| dir.join(&f.path).display().to_string()).collect::<Vec<_>>());

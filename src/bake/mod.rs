@@ -35,6 +35,45 @@ pub struct Asset {
     pub bake: fn(&Value) -> Result<Vec<BakedFile>, BakeError>,
 }
 
+/// The parameter key every asset accepts beside its own: `"ktx2_zstd": LEVEL` (1..=22) rewrites the asset's
+/// uncompressed KTX2 files with Zstandard supercompression at that level ([`supercompress_ktx2`]). It is recorded
+/// in the manifest with the other parameters, so `verify` recomputes the compressed bytes. `rtbake bake --zstd`
+/// sets it for every asset it bakes.
+pub const KTX2_ZSTD_PARAM: &str = "ktx2_zstd";
+
+impl Asset {
+    /// Runs the asset on `params`: strips and applies the common [`KTX2_ZSTD_PARAM`] key, then calls the asset's
+    /// own [`Asset::bake`] with the rest. The bake directory and `verify` call this, never `bake` directly.
+    pub fn run(&self, params: &Value) -> Result<Vec<BakedFile>, BakeError> {
+        let (level, own) = split_zstd_param(self.name, params)?;
+        let mut files = (self.bake)(&own)?;
+        if let Some(level) = level {
+            supercompress_ktx2(&mut files, level)?;
+        }
+        Ok(files)
+    }
+}
+
+/// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).
+fn split_zstd_param(asset: &str, params: &Value) -> Result<(Option<i32>, Value), BakeError> {
+    let Some(obj) = params.as_object() else { return Ok((None, params.clone())) };
+    let Some(v) = obj.get(KTX2_ZSTD_PARAM) else { return Ok((None, params.clone())) };
+    let param = format!("{asset} parameter {KTX2_ZSTD_PARAM}");
+    let level = match v.as_i64() {
+        Some(l) if (1..=22).contains(&l) => l as i32,
+        _ => {
+            return Err(crate::error::InvalidInput::new(
+                param,
+                format!("expected an integer Zstandard level in 1..=22, got {v}"),
+            )
+            .into())
+        }
+    };
+    let mut own = obj.clone();
+    own.remove(KTX2_ZSTD_PARAM);
+    Ok((Some(level), Value::Object(own)))
+}
+
 /// Every registered asset, in bake order.
 pub fn registry() -> Vec<Asset> {
     let mut v = Vec::new();

@@ -1,11 +1,11 @@
-//! Minimal line plots as SVG text and as raster images (for PNG), without system fonts or plotting dependencies.
+//! Minimal line plots as SVG text and as raster images (for PNG), without system fonts or a plotting crate.
 //!
 //! Why not `plotters`: its text needs system fonts or the `ab_glyph` feature plus a bundled TrueType font (and the
 //! crate's compile time) for plots that are a few polylines on a linear or log₁₀ x axis. The SVG is written
 //! directly (title, ticks, tick labels, axis labels with units, legend). The raster version draws the same axes,
-//! ticks, grid, polylines, title, axis labels (the y label rotated) and legend names into an `Image<u8>` with a
-//! built-in 3×5 pixel capital font scaled ×2 (lower case is drawn as capitals; `²`, `⁻`, `μ`, `·` map to `2`,
-//! `-`, `U`, `*`), so both formats carry the same text. The y axis may be log₁₀ too
+//! ticks, grid, polylines, title, axis labels (the y label rotated) and legend names into an `Image<u8>` with the
+//! public-domain X11 6×10 bitmap font that `embedded-graphics` embeds (ISO 8859-1: both cases, `µ`, `²`, `·`), so
+//! both formats carry the same text and nothing depends on system fonts. The y axis may be log₁₀ too
 //! (decade ticks; at most [`LOG_Y_DECADES`] decades below the largest value are shown). Several plots can be stacked
 //! vertically into one document ([`panels_to_svg`], [`panels_to_image`]). Pure: returns text / pixels.
 
@@ -366,91 +366,67 @@ pub fn panels_to_image(panels: &[LinePlot], width: u32, panel_height: u32) -> Im
     Image::from_vec(width, panel_height * panels.len() as u32, 3, data)
 }
 
-/// The glyph drawn for `ch`: lower case as capitals, a few symbols folded to ASCII, unknown as `?`.
+/// The character drawn for `ch`: the font's ISO 8859-1 repertoire as it is, the few other symbols plot labels use
+/// folded onto it (Greek μ → micro sign µ, superscript/typographic minus → `-`, subscript digits → digits).
 fn normalize(ch: char) -> char {
     match ch {
-        '²' => '2',
-        '³' => '3',
-        '¹' => '1',
+        'μ' => 'µ',
         '⁻' | '−' | '–' => '-',
-        '₀' => '0',
-        '₁' => '1',
-        'μ' | 'µ' => 'U',
-        '·' | '×' => '*',
+        '₀'..='₉' => char::from(b'0' + (ch as u32 - '₀' as u32) as u8),
         '′' => '\'',
-        c => c.to_ascii_uppercase(),
+        c => c,
     }
 }
 
-/// 3×5 font: each glyph is 5 rows of 3 bits (MSB = left column).
-fn glyph(ch: char) -> Option<[u8; 5]> {
-    Some(match normalize(ch) {
-        '0' => [7, 5, 5, 5, 7],
-        '1' => [2, 6, 2, 2, 7],
-        '2' => [7, 1, 7, 4, 7],
-        '3' => [7, 1, 7, 1, 7],
-        '4' => [5, 5, 7, 1, 1],
-        '5' => [7, 4, 7, 1, 7],
-        '6' => [7, 4, 7, 5, 7],
-        '7' => [7, 1, 1, 1, 1],
-        '8' => [7, 5, 7, 5, 7],
-        '9' => [7, 5, 7, 1, 7],
-        'A' => [2, 5, 7, 5, 5],
-        'B' => [6, 5, 6, 5, 6],
-        'C' => [3, 4, 4, 4, 3],
-        'D' => [6, 5, 5, 5, 6],
-        'E' => [7, 4, 6, 4, 7],
-        'F' => [7, 4, 6, 4, 4],
-        'G' => [3, 4, 5, 5, 3],
-        'H' => [5, 5, 7, 5, 5],
-        'I' => [7, 2, 2, 2, 7],
-        'J' => [1, 1, 1, 5, 2],
-        'K' => [5, 5, 6, 5, 5],
-        'L' => [4, 4, 4, 4, 7],
-        'M' => [5, 7, 7, 5, 5],
-        'N' => [6, 5, 5, 5, 5],
-        'O' => [2, 5, 5, 5, 2],
-        'P' => [6, 5, 6, 4, 4],
-        'Q' => [2, 5, 5, 6, 3],
-        'R' => [6, 5, 6, 5, 5],
-        'S' => [3, 4, 2, 1, 6],
-        'T' => [7, 2, 2, 2, 2],
-        'U' => [5, 5, 5, 5, 7],
-        'V' => [5, 5, 5, 5, 2],
-        'W' => [5, 5, 7, 7, 5],
-        'X' => [5, 5, 2, 5, 5],
-        'Y' => [5, 5, 2, 2, 2],
-        'Z' => [7, 1, 2, 4, 7],
-        '.' => [0, 0, 0, 0, 2],
-        ',' => [0, 0, 0, 2, 4],
-        ':' => [0, 2, 0, 2, 0],
-        ';' => [0, 2, 0, 2, 4],
-        '-' => [0, 0, 7, 0, 0],
-        '+' => [0, 2, 7, 2, 0],
-        '=' => [0, 7, 0, 7, 0],
-        '*' => [0, 5, 2, 5, 0],
-        '/' => [1, 1, 2, 4, 4],
-        '(' => [1, 2, 2, 2, 1],
-        ')' => [4, 2, 2, 2, 4],
-        '[' => [3, 2, 2, 2, 3],
-        ']' => [6, 2, 2, 2, 6],
-        '^' => [2, 5, 0, 0, 0],
-        '_' => [0, 0, 0, 0, 7],
-        '\'' => [2, 2, 0, 0, 0],
-        '%' => [5, 1, 2, 4, 5],
-        '<' => [1, 2, 4, 2, 1],
-        '>' => [4, 2, 1, 2, 4],
-        '|' => [2, 2, 2, 2, 2],
-        ' ' => [0, 0, 0, 0, 0],
-        _ => [6, 1, 2, 0, 2],
-    })
+/// The raster font: X11's 6×10 "fixed" (public domain) as embedded in `embedded-graphics`, ISO 8859-1 (upper and
+/// lower case, `µ`, `²`, `³`, `·`, `×`); unknown characters draw as `?`.
+const FONT: embedded_graphics::mono_font::MonoFont<'static> = embedded_graphics::mono_font::iso_8859_1::FONT_6X10;
+
+/// Advance of one character in pixels.
+fn char_advance() -> f64 {
+    (FONT.character_size.width + FONT.character_spacing) as f64
 }
 
-/// Pixel scale of the font.
-const FONT_SCALE: f64 = 2.0;
-
 fn text_width(s: &str) -> f64 {
-    s.chars().count() as f64 * 4.0 * FONT_SCALE - FONT_SCALE
+    s.chars().count() as f64 * char_advance() - FONT.character_spacing as f64
+}
+
+/// Receives the font's lit pixels (in text coordinates: x along the text, y down, origin at the top-left of the
+/// first glyph cell) and puts them on the canvas, horizontally or rotated 90° counter-clockwise.
+struct GlyphSink<'a> {
+    canvas: &'a mut Canvas,
+    origin: (i64, i64),
+    vertical: bool,
+    color: [u8; 3],
+}
+
+impl embedded_graphics::geometry::OriginDimensions for GlyphSink<'_> {
+    fn size(&self) -> embedded_graphics::geometry::Size {
+        embedded_graphics::geometry::Size::new(u32::MAX / 2, u32::MAX / 2)
+    }
+}
+
+impl embedded_graphics::draw_target::DrawTarget for GlyphSink<'_> {
+    type Color = embedded_graphics::pixelcolor::BinaryColor;
+    type Error = std::convert::Infallible;
+
+    fn draw_iter<I>(&mut self, pixels: I) -> Result<(), Self::Error>
+    where
+        I: IntoIterator<Item = embedded_graphics::Pixel<Self::Color>>,
+    {
+        for embedded_graphics::Pixel(p, c) in pixels {
+            if c == embedded_graphics::pixelcolor::BinaryColor::On {
+                let (tx, ty) = (p.x as i64, p.y as i64);
+                let (x, y) = if self.vertical {
+                    (self.origin.0 + ty, self.origin.1 - tx)
+                } else {
+                    (self.origin.0 + tx, self.origin.1 + ty)
+                };
+                self.canvas.put(x, y, self.color);
+            }
+        }
+        Ok(())
+    }
 }
 
 struct Canvas {
@@ -494,51 +470,22 @@ impl Canvas {
 
     /// Draws `s` rotated 90° counter-clockwise (reading bottom to top), centred vertically on `y`, left edge at `x`.
     fn text_vertical(&mut self, s: &str, x: f64, y: f64, color: [u8; 3]) {
-        let y0 = y + text_width(s) / 2.0;
-        for (i, ch) in s.chars().enumerate() {
-            let Some(rows) = glyph(ch) else { continue };
-            let gy = y0 - i as f64 * 4.0 * FONT_SCALE;
-            for (ry, bits) in rows.iter().enumerate() {
-                for cx in 0..3 {
-                    if bits & (4 >> cx) != 0 {
-                        for sy in 0..FONT_SCALE as i64 {
-                            for sx in 0..FONT_SCALE as i64 {
-                                // Glyph column → up the page, glyph row → right.
-                                self.put(
-                                    (x + ry as f64 * FONT_SCALE).round() as i64 + sx,
-                                    (gy - cx as f64 * FONT_SCALE).round() as i64 - sy,
-                                    color,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let origin = (x.round() as i64, (y + text_width(s) / 2.0).round() as i64);
+        self.glyphs(s, origin, true, color);
     }
 
-    /// Draws `s` with the built-in font; (x, y) is the top-left corner, or the top-centre when `centered`.
+    /// Draws `s` with the raster font; (x, y) is the top-left corner, or the top-centre when `centered`.
     fn text(&mut self, s: &str, x: f64, y: f64, centered: bool, color: [u8; 3]) {
         let x = if centered { x - text_width(s) / 2.0 } else { x };
-        for (i, ch) in s.chars().enumerate() {
-            let Some(rows) = glyph(ch) else { continue };
-            let gx = x + i as f64 * 4.0 * FONT_SCALE;
-            for (ry, bits) in rows.iter().enumerate() {
-                for cx in 0..3 {
-                    if bits & (4 >> cx) != 0 {
-                        for sy in 0..FONT_SCALE as i64 {
-                            for sx in 0..FONT_SCALE as i64 {
-                                self.put(
-                                    (gx + cx as f64 * FONT_SCALE).round() as i64 + sx,
-                                    (y + ry as f64 * FONT_SCALE).round() as i64 + sy,
-                                    color,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        self.glyphs(s, (x.round() as i64, y.round() as i64), false, color);
+    }
+
+    fn glyphs(&mut self, s: &str, origin: (i64, i64), vertical: bool, color: [u8; 3]) {
+        use embedded_graphics::{mono_font::MonoTextStyle, pixelcolor::BinaryColor, prelude::*, text};
+        let folded: String = s.chars().map(normalize).collect();
+        let style = MonoTextStyle::new(&FONT, BinaryColor::On);
+        let mut sink = GlyphSink { canvas: self, origin, vertical, color };
+        let _ = text::Text::with_baseline(&folded, Point::zero(), style, text::Baseline::Top).draw(&mut sink);
     }
 }
 
@@ -646,7 +593,6 @@ mod tests {
             assert!(dark(&with, x0, x1, y0, y1) > 10, "{what} not drawn");
             assert_eq!(dark(&without, x0, x1, y0, y1), 0, "{what} band not empty without text");
         }
-        assert!(glyph('a') == glyph('A') && glyph('μ') == glyph('U') && glyph('²') == glyph('2'));
     }
 
     #[test]

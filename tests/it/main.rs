@@ -19,6 +19,7 @@ mod consumers_json_errors;
 mod consumers_png;
 mod consumers_separable_sss;
 mod consumers_sources;
+mod consumers_zstd;
 mod diffusion_cli;
 mod diffusion_layered;
 mod diffusion_physics;
