@@ -5,7 +5,7 @@
 //!   [`crate::io::file_set`]) exclusively from reading the old manifest to the swap; `verify` holds it shared. A
 //!   second bake or verify waits (or fails with `Busy` under `--no-wait`) instead of racing: no lost update.
 //! - A bake is all-or-nothing. Every file and the manifest are first written into a hidden staging directory
-//!   beside the target (`.NAME.rtbake-stage-PID`), fsynced, then exchanged with the target in one
+//!   beside the target (`.NAME.rtbake-stage-PID`), flushed once (`syncfs`), then exchanged with the target in one
 //!   `renameat2(RENAME_EXCHANGE)` (Linux; a rolled-forward two-rename fallback elsewhere). The path always names
 //!   the old or the new directory. Leftover staging directories are removed only under the exclusive lock, so a
 //!   live one is never touched.
@@ -79,14 +79,12 @@ fn list_files(dir: &Path) -> Result<BTreeSet<String>, BakeDirError> {
     Ok(out)
 }
 
-fn write_synced(path: &Path, bytes: &[u8]) -> Result<(), BakeDirError> {
-    use std::io::Write;
+/// Writes a file of the stage; the stage is made durable as a whole afterwards ([`io::atomic::sync_batch`]).
+fn write_unsynced(path: &Path, bytes: &[u8]) -> Result<(), BakeDirError> {
     if let Some(p) = path.parent() {
         fs::create_dir_all(p).map_err(|e| io_err(p, e))?;
     }
-    let mut f = fs::File::create(path).map_err(|e| io_err(path, e))?;
-    f.write_all(bytes).map_err(|e| io_err(path, e))?;
-    f.sync_all().map_err(|e| io_err(path, e))
+    fs::write(path, bytes).map_err(|e| io_err(path, e))
 }
 
 /// Summary of a bake.
@@ -182,17 +180,19 @@ pub fn bake_into_with(
                 fs::copy(&src, &dst).map_err(|e| io_err(&src, e))?;
             }
         }
+        let mut written = Vec::new();
         for (_, _, files) in &produced {
             for f in files {
-                write_synced(&stage.join(&f.path), &f.bytes)?;
+                written.push(stage.join(&f.path));
+                write_unsynced(written.last().expect("just pushed"), &f.bytes)?;
                 bytes += f.bytes.len() as u64;
                 count += 1;
             }
         }
-        write_synced(&stage.join(MANIFEST_NAME), manifest.to_text().as_bytes())?;
-        if let Ok(d) = fs::File::open(&stage) {
-            let _ = d.sync_all();
-        }
+        written.push(stage.join(MANIFEST_NAME));
+        write_unsynced(&stage.join(MANIFEST_NAME), manifest.to_text().as_bytes())?;
+        // One flush for every file and directory of the stage (not one fsync per file) before the swap.
+        io::atomic::sync_batch(&stage, &written)?;
         Ok((bytes, count))
     })();
     let (bytes_written, files_written) = match result {

@@ -16,6 +16,7 @@ use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
 use rtbake::aa::mlaa_area::MlaaVersion;
 use rtbake::aa::smaa_area::SmaaAreaParams;
 use rtbake::bake::aa::{mlaa_files_with_progress, mlaa_stem, search_files, smaa_area_files, SearchKind};
+use rtbake::bake::TextureFormats;
 use rtbake::bake::{BakeError, BakedFile};
 use sha2::{Digest, Sha256};
 use std::path::PathBuf;
@@ -68,18 +69,21 @@ pub enum AaFormat {
     All,
 }
 
-impl AaFormat {
-    fn extension(self) -> &'static str {
-        match self {
-            Self::Bin => "bin",
-            Self::Dds => "dds",
-            Self::Ktx2 => "ktx2",
-            Self::Png => "png",
-            Self::H => "h",
-            Self::Rs => "rs",
-            Self::All => "",
+/// The files `--format` asks for (only these are encoded).
+fn texture_formats(list: &[AaFormat]) -> TextureFormats {
+    let mut f = TextureFormats::NONE;
+    for fmt in list {
+        match fmt {
+            AaFormat::Bin => f.bin = true,
+            AaFormat::Dds => f.dds = true,
+            AaFormat::Ktx2 => f.ktx2 = true,
+            AaFormat::Png => f.png = true,
+            AaFormat::H => f.c_header = true,
+            AaFormat::Rs => f.rust_source = true,
+            AaFormat::All => f = TextureFormats::ALL,
         }
     }
+    f
 }
 
 #[derive(clap::Args)]
@@ -276,7 +280,8 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             vec![AaFormat::Bin, AaFormat::Dds, AaFormat::Ktx2, AaFormat::Png]
         };
     }
-    let sources = a.format.iter().any(|f| matches!(f, AaFormat::All | AaFormat::H | AaFormat::Rs));
+    let formats = texture_formats(&a.format);
+    let sources = formats.c_header || formats.rust_source;
     if sources && 6 * payload > LARGE_SOURCE_WARN_BYTES {
         eprintln!(
             "warning: writing C/Rust sources of ~{} MiB each (payload {} bytes); --format bin,dds,ktx2,png skips them",
@@ -291,7 +296,7 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let p = smaa_params(&a)?;
             let default_stem = if a.texture == AaTexture::SmaaArea { "AreaTex" } else { "AreaTex_v2.8" };
             let from = format!("`{}`", smaa_command(&name, &p));
-            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, sources, &from).map_err(bake_err)?
+            smaa_area_files(a.stem.as_deref().unwrap_or(default_stem), &p, formats, &from).map_err(bake_err)?
         }
         AaTexture::SmaaSearch | AaTexture::SmaaSearchV28 | AaTexture::SmaaSearchPrecrop => {
             let (kind, stem) = match a.texture {
@@ -299,7 +304,7 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 AaTexture::SmaaSearchV28 => (SearchKind::V2_8, "SearchTex_v2.8"),
                 _ => (SearchKind::LogicalPrecrop, "SearchTex_logical_precrop"),
             };
-            search_files(kind, a.stem.as_deref().unwrap_or(stem), sources, &format!("`rtbake aa {name}`"))
+            search_files(kind, a.stem.as_deref().unwrap_or(stem), formats, &format!("`rtbake aa {name}`"))
                 .map_err(bake_err)?
         }
         AaTexture::MlaaV14 | AaTexture::MlaaV13 | AaTexture::MlaaV2 => {
@@ -307,30 +312,24 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
             let n = a.max_distance.unwrap_or(default_mlaa_n(v));
             let stem = a.stem.clone().unwrap_or_else(|| mlaa_stem(v, n));
             let from = format!("`rtbake aa {name} --max-distance {n}`");
-            let pb = ctx.progress(16 * n as u64, "MLAA area map rows");
+            let pb = ctx.progress(5 * n as u64, "MLAA area map rows");
             pb.set_style(
                 indicatif::ProgressStyle::with_template("{msg} {bar:30} {pos}/{len} [{elapsed}]")
                     .expect("valid template"),
             );
-            let files = mlaa_files_with_progress(v, n, &stem, sources, &from, &|done, _| pb.set_position(done as u64))
+            let files = mlaa_files_with_progress(v, n, &stem, formats, &from, &|done, _| pb.set_position(done as u64))
                 .map_err(bake_err)?;
             pb.finish_and_clear();
             files
         }
     };
+    // Only the requested formats were encoded.
     let mut files = files;
     a.zstd.apply(&mut files)?;
-    let all = a.format.contains(&AaFormat::All);
-    let wanted: Vec<&BakedFile> = files
-        .iter()
-        .filter(|f| all || a.format.iter().any(|fmt| f.path.ends_with(&format!(".{}", fmt.extension()))))
-        .collect();
-
     prepare_out_dir("--out", &a.out)?;
-    let set: Vec<BakedFile> = wanted.iter().map(|f| (*f).clone()).collect();
-    crate::cli::write_set(ctx, "--out", &a.out, &set, &[])?;
+    crate::cli::write_set(ctx, "--out", &a.out, &files, &[])?;
     let mut written = Vec::new();
-    for f in wanted {
+    for f in &files {
         let path = a.out.join(&f.path);
         let sha: String = Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect();
         ctx.info(format!("wrote {} ({} bytes, sha256 {sha})", path.display(), f.bytes.len()));

@@ -247,7 +247,7 @@ fn antialias_file(ctx: &Ctx, a: &AaArgs, img: Image<u8>, aa: &Antialiasing, name
     let t = Instant::now();
     let out = chain::antialias(gpu.as_ref(), &img, aa)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
-    write_atomic(&a.output, &io::png::encode_u8(&out)?)?;
+    write_atomic(&a.output, &io::png::encode_u8_frame(&out)?)?;
     report(ctx, name, &a.output, &out, gpu.as_ref(), ms);
     Ok(())
 }
@@ -380,7 +380,7 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         Some(dir) => Some((dir, demo::sss_inputs(gpu.as_ref(), d.width, d.height, &assets)?)),
         None => None,
     };
-    write_atomic(&d.output, &io::png::encode_u8(&out)?)?;
+    write_atomic(&d.output, &io::png::encode_u8_frame(&out)?)?;
     if let Some((dir, i)) = inputs {
         crate::cli::prepare_out_dir("--sss-inputs", dir)?;
         let color = Image::from_vec(i.width, i.height, 4, i.irradiance_rgba);

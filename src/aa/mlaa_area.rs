@@ -150,30 +150,39 @@ pub fn mlaa_area_map(version: MlaaVersion, n: u32) -> Result<Image<u8>, MlaaArea
     mlaa_area_map_with_progress(version, n, &|_, _| {})
 }
 
-/// [`mlaa_area_map`], calling `progress(rows_done, rows)` after each of the 16·N cell rows (large N take tens of
-/// seconds); the texels do not depend on it.
+/// [`mlaa_area_map`], calling `progress(rows_done, rows)` from the calling thread after each band of image rows
+/// (`rows` = 5·N; large N take seconds). Rows are computed in parallel (rayon), each texel by [`texel`] alone, so
+/// the map is the same bytes for any thread count and does not depend on the callback.
 pub fn mlaa_area_map_with_progress(
     version: MlaaVersion,
     n: u32,
     progress: &dyn Fn(u32, u32),
 ) -> Result<Image<u8>, MlaaAreaError> {
+    use rayon::prelude::*;
+    const BAND_ROWS: usize = 64;
     let edge = validate(version, n)?;
-    let mut rows_done = 0;
     let mut img = Image::<u8>::new(edge, edge, 2);
     let dist = |i: u32| if version == MlaaVersion::V2 { i * i } else { i };
-    for e1 in [0u8, 1, 3, 4] {
-        for e2 in [0u8, 1, 3, 4] {
+    // Image row y holds the cells (e1, e2 = y / N) at right distance j = y % N; cell row and column 2 stay zero.
+    let fill_row = |y: u32, row: &mut [u8]| {
+        let (e2, j) = ((y / n) as u8, y % n);
+        if e2 == 2 {
+            return;
+        }
+        for e1 in [0u8, 1, 3, 4] {
             for i in 0..n {
-                for j in 0..n {
-                    let (r, g) = texel(version, e1, e2, dist(i), dist(j));
-                    let (x, y) = (n * e1 as u32 + i, n * e2 as u32 + j);
-                    img.set(x, y, 0, r);
-                    img.set(x, y, 1, g);
-                }
-                rows_done += 1;
-                progress(rows_done, 16 * n);
+                let (r, g) = texel(version, e1, e2, dist(i), dist(j));
+                let x = (n * e1 as u32 + i) as usize;
+                row[2 * x] = r;
+                row[2 * x + 1] = g;
             }
         }
+    };
+    let row_bytes = 2 * edge as usize;
+    for (b, band) in img.data.chunks_mut(row_bytes * BAND_ROWS).enumerate() {
+        let y0 = b * BAND_ROWS;
+        band.par_chunks_mut(row_bytes).enumerate().for_each(|(r, row)| fill_row((y0 + r) as u32, row));
+        progress(((y0 + BAND_ROWS) as u32).min(edge), edge);
     }
     Ok(img)
 }
@@ -183,18 +192,34 @@ mod tests {
     use super::*;
 
     #[test]
-    fn progress_reaches_every_cell_row_and_leaves_the_map_unchanged() {
-        let last = std::cell::Cell::new((0, 0));
-        let calls = std::cell::Cell::new(0);
-        let with = mlaa_area_map_with_progress(MlaaVersion::V1_4, 9, &|done, rows| {
-            assert_eq!(done, last.get().0 + 1, "rows are reported once each, in order");
-            last.set((done, rows));
-            calls.set(calls.get() + 1);
+    fn progress_reaches_every_row_and_the_map_is_the_serial_definition_for_any_thread_count() {
+        let n = 65; // 325 rows: several bands, the last one partial
+        let last = std::cell::Cell::new(0);
+        let with = mlaa_area_map_with_progress(MlaaVersion::V1_4, n, &|done, rows| {
+            assert!(done > last.get(), "progress only grows");
+            assert_eq!(rows, 5 * n);
+            last.set(done);
         })
         .unwrap();
-        assert_eq!(last.get(), (16 * 9, 16 * 9));
-        assert_eq!(calls.get(), 16 * 9);
-        assert_eq!(with, mlaa_area_map(MlaaVersion::V1_4, 9).unwrap());
+        assert_eq!(last.get(), 5 * n);
+        // The definition, texel by texel in cell order.
+        let mut serial = Image::<u8>::new(5 * n, 5 * n, 2);
+        for e1 in [0u8, 1, 3, 4] {
+            for e2 in [0u8, 1, 3, 4] {
+                for i in 0..n {
+                    for j in 0..n {
+                        let (r, g) = texel(MlaaVersion::V1_4, e1, e2, i, j);
+                        serial.set(n * e1 as u32 + i, n * e2 as u32 + j, 0, r);
+                        serial.set(n * e1 as u32 + i, n * e2 as u32 + j, 1, g);
+                    }
+                }
+            }
+        }
+        assert!(with == serial, "parallel rows differ from the serial definition");
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            assert!(pool.install(|| mlaa_area_map(MlaaVersion::V1_4, n).unwrap()) == serial, "{threads} threads");
+        }
     }
 
     #[test]

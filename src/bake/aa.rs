@@ -14,7 +14,7 @@
 //! RG textures are RGB with B = 0. `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2` are the same payloads named and stored
 //! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
-use super::{parse_params, text_file, unorm8_texture_files, Asset, BakeError, BakedFile};
+use super::{parse_params, text_file, unorm8_texture_files_in, Asset, BakeError, BakedFile, TextureFormats};
 use crate::aa::mlaa_area::{mlaa_area_map_with_progress, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
 use crate::aa::smaa_search;
@@ -105,17 +105,17 @@ pub fn smaa_area_convention(p: &SmaaAreaParams, width: u32, height: u32) -> Stri
     )
 }
 
-/// Files of an SMAA area texture under `stem` (`stem.bin`, …); with `sources`, also the upstream-compatible C header
-/// `stem.h` (`AREATEX_*`, `areaTexBytes`) and Rust source `stem.rs` (`AREATEX_*`, `AREATEX_BYTES`).
+/// Files of an SMAA area texture under `stem` (`stem.bin`, …) in `formats`; the upstream-compatible C header is
+/// `stem.h` (`AREATEX_*`, `areaTexBytes`), the Rust source `stem.rs` (`AREATEX_*`, `AREATEX_BYTES`).
 pub fn smaa_area_files(
     stem: &str,
     params: &SmaaAreaParams,
-    sources: bool,
+    formats: TextureFormats,
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
     let img = smaa_area_texture(params)?;
     let convention = smaa_area_convention(params, img.width, img.height);
-    texture_with_sources(stem, &img, &convention, sources.then_some(("AREATEX", "areaTexBytes")), from)
+    texture_with_sources(stem, &img, &convention, formats, ("AREATEX", "areaTexBytes"), from)
 }
 
 /// Convention string of a search table.
@@ -140,15 +140,20 @@ pub fn search_convention(kind: SearchKind) -> String {
     }
 }
 
-/// Files of a search table under `stem`; with `sources`, also `stem.h` (`SEARCHTEX_*`, `searchTexBytes`) and
-/// `stem.rs` (`SEARCHTEX_*`, `SEARCHTEX_BYTES`).
-pub fn search_files(kind: SearchKind, stem: &str, sources: bool, from: &str) -> Result<Vec<BakedFile>, BakeError> {
+/// Files of a search table under `stem` in `formats`; the sources are `stem.h` (`SEARCHTEX_*`, `searchTexBytes`)
+/// and `stem.rs` (`SEARCHTEX_*`, `SEARCHTEX_BYTES`).
+pub fn search_files(
+    kind: SearchKind,
+    stem: &str,
+    formats: TextureFormats,
+    from: &str,
+) -> Result<Vec<BakedFile>, BakeError> {
     let img = match kind {
         SearchKind::Current => smaa_search::search_texture(),
         SearchKind::V2_8 => smaa_search::search_texture_v2_8(),
         SearchKind::LogicalPrecrop => smaa_search::search_texture_logical_precrop(),
     };
-    texture_with_sources(stem, &img, &search_convention(kind), sources.then_some(("SEARCHTEX", "searchTexBytes")), from)
+    texture_with_sources(stem, &img, &search_convention(kind), formats, ("SEARCHTEX", "searchTexBytes"), from)
 }
 
 /// Convention string of an MLAA area map.
@@ -180,16 +185,16 @@ pub fn mlaa_stem(version: MlaaVersion, n: u32) -> String {
     }
 }
 
-/// Files of an MLAA area map under `stem`; with `sources`, also `stem.h` (`AREAMAP_*`, `areaMapBytes`) and
-/// `stem.rs` (`AREAMAP_*`, `AREAMAP_BYTES`).
+/// Files of an MLAA area map under `stem` in `formats`; the sources are `stem.h` (`AREAMAP_*`, `areaMapBytes`)
+/// and `stem.rs` (`AREAMAP_*`, `AREAMAP_BYTES`).
 pub fn mlaa_files(
     version: MlaaVersion,
     n: u32,
     stem: &str,
-    sources: bool,
+    formats: TextureFormats,
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    mlaa_files_with_progress(version, n, stem, sources, from, &|_, _| {})
+    mlaa_files_with_progress(version, n, stem, formats, from, &|_, _| {})
 }
 
 /// [`mlaa_files`], reporting the map's rows as they are computed (`progress(rows_done, rows)`).
@@ -197,12 +202,12 @@ pub fn mlaa_files_with_progress(
     version: MlaaVersion,
     n: u32,
     stem: &str,
-    sources: bool,
+    formats: TextureFormats,
     from: &str,
     progress: &dyn Fn(u32, u32),
 ) -> Result<Vec<BakedFile>, BakeError> {
     let img = mlaa_area_map_with_progress(version, n, progress)?;
-    texture_with_sources(stem, &img, &mlaa_convention(version, n), sources.then_some(("AREAMAP", "areaMapBytes")), from)
+    texture_with_sources(stem, &img, &mlaa_convention(version, n), formats, ("AREAMAP", "areaMapBytes"), from)
 }
 
 /// Bevy's file names for the SMAA LUTs (`bevy_anti_alias/src/smaa/`).
@@ -233,15 +238,18 @@ fn texture_with_sources(
     stem: &str,
     img: &Image<u8>,
     convention: &str,
-    sources: Option<(&str, &str)>,
+    formats: TextureFormats,
+    (prefix, array): (&str, &str),
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let mut files = unorm8_texture_files(stem, img, "lut", convention)?;
-    if let Some((prefix, array)) = sources {
-        let note = format!("{convention}; generated source, bytes identical to {stem}.bin");
-        let notice = if prefix == "AREAMAP" { DataNotice::Mlaa } else { DataNotice::Smaa };
+    let mut files = unorm8_texture_files_in(stem, img, "lut", convention, formats)?;
+    let note = format!("{convention}; generated source, bytes identical to {stem}.bin");
+    let notice = if prefix == "AREAMAP" { DataNotice::Mlaa } else { DataNotice::Smaa };
+    if formats.c_header {
         let header = c_header_u8(prefix, array, img, from, notice);
         files.push(text_file(&format!("{stem}.h"), header, "c-header", "c", &note));
+    }
+    if formats.rust_source {
         let rust = rust_source_u8(prefix, img, from, notice);
         files.push(text_file(&format!("{stem}.rs"), rust, "rust-source", "rust", &note));
     }
@@ -271,7 +279,7 @@ fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<Ba
     let mut files = Vec::new();
     for &n in &p.max_distances {
         let stem = format!("{MLAA_DIR}/{}", mlaa_stem(version, n));
-        files.extend(mlaa_files(version, n, &stem, false, &from_line(asset))?);
+        files.extend(mlaa_files(version, n, &stem, TextureFormats::BINARY, &from_line(asset))?);
     }
     Ok(files)
 }
@@ -287,8 +295,9 @@ pub fn assets() -> Vec<Asset> {
                 let img = smaa_area_texture(&p)?;
                 let convention = smaa_area_convention(&p, img.width, img.height);
                 let stem = format!("{SMAA_DIR}/AreaTex");
-                let sources = Some(("AREATEX", "areaTexBytes"));
-                let mut files = texture_with_sources(&stem, &img, &convention, sources, &from_line("smaa-area"))?;
+                let names = ("AREATEX", "areaTexBytes");
+                let from = from_line("smaa-area");
+                let mut files = texture_with_sources(&stem, &img, &convention, TextureFormats::ALL, names, &from)?;
                 files.push(bevy_zstd_file(&format!("{SMAA_DIR}/{BEVY_AREA_LUT}"), &img, &convention)?);
                 Ok(files)
             },
@@ -299,7 +308,12 @@ pub fn assets() -> Vec<Asset> {
             default_params: || json(SmaaAreaParams::v2_8()),
             bake: |v| {
                 let p: SmaaAreaParams = parse_params("smaa-area-v2.8", v)?;
-                smaa_area_files(&format!("{SMAA_DIR}/AreaTex_v2.8"), &p, false, &from_line("smaa-area-v2.8"))
+                smaa_area_files(
+                    &format!("{SMAA_DIR}/AreaTex_v2.8"),
+                    &p,
+                    TextureFormats::BINARY,
+                    &from_line("smaa-area-v2.8"),
+                )
             },
         },
         Asset {
@@ -311,7 +325,7 @@ pub fn assets() -> Vec<Asset> {
                 let mut files = search_files(
                     SearchKind::Current,
                     &format!("{SMAA_DIR}/SearchTex"),
-                    true,
+                    TextureFormats::ALL,
                     &from_line("smaa-search"),
                 )?;
                 let convention = search_convention(SearchKind::Current);
@@ -327,11 +341,16 @@ pub fn assets() -> Vec<Asset> {
             bake: |v| {
                 let _: NoParams = parse_params("smaa-search-v2.8", v)?;
                 let from = from_line("smaa-search-v2.8");
-                let mut f = search_files(SearchKind::V2_8, &format!("{SMAA_DIR}/SearchTex_v2.8"), false, &from)?;
+                let mut f = search_files(
+                    SearchKind::V2_8,
+                    &format!("{SMAA_DIR}/SearchTex_v2.8"),
+                    TextureFormats::BINARY,
+                    &from,
+                )?;
                 f.extend(search_files(
                     SearchKind::LogicalPrecrop,
                     &format!("{SMAA_DIR}/SearchTex_logical_precrop"),
-                    false,
+                    TextureFormats::BINARY,
                     &from,
                 )?);
                 Ok(f)
@@ -395,7 +414,7 @@ mod tests {
 
     #[test]
     fn smaa_headers_use_upstream_names() {
-        let f = search_files(SearchKind::Current, "SearchTex", true, "test").unwrap();
+        let f = search_files(SearchKind::Current, "SearchTex", TextureFormats::ALL, "test").unwrap();
         let h = std::str::from_utf8(&f.iter().find(|f| f.path == "SearchTex.h").unwrap().bytes).unwrap().to_string();
         assert!(h.contains("#define SEARCHTEX_WIDTH 64") && h.contains("#define SEARCHTEX_HEIGHT 16"));
         assert!(h.contains("static const unsigned char searchTexBytes[]"));
@@ -409,8 +428,8 @@ mod tests {
     #[test]
     fn containers_hold_the_raw_bytes_as_linear_unorm() {
         use crate::io::{self, PixelFormat};
-        let mut files = search_files(SearchKind::Current, "s", false, "test").unwrap();
-        files.extend(mlaa_files(MlaaVersion::V1_4, 9, "m", false, "test").unwrap());
+        let mut files = search_files(SearchKind::Current, "s", TextureFormats::BINARY, "test").unwrap();
+        files.extend(mlaa_files(MlaaVersion::V1_4, 9, "m", TextureFormats::BINARY, "test").unwrap());
         for stem in ["s", "m"] {
             let get = |ext: &str| files.iter().find(|f| f.path == format!("{stem}.{ext}")).unwrap();
             let raw = &get("bin").bytes;

@@ -103,6 +103,43 @@ pub fn unorm8_texture_files(
     kind: &str,
     convention: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
+    unorm8_texture_files_in(stem, img, kind, convention, TextureFormats::BINARY)
+}
+
+/// Which files of a texture to encode: the bake writes them all, `rtbake aa --format` only those asked for
+/// (encoding dominates the cost of large tables: the hex sources are ~6 bytes per texel byte, PNG compression
+/// the rest).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureFormats {
+    pub bin: bool,
+    pub dds: bool,
+    pub ktx2: bool,
+    pub png: bool,
+    /// C header (`stem.h`), for textures that have one.
+    pub c_header: bool,
+    /// Rust source (`stem.rs`), for textures that have one.
+    pub rust_source: bool,
+}
+
+impl TextureFormats {
+    /// The four binary containers (bin, DDS, KTX2, PNG).
+    pub const BINARY: Self = Self { bin: true, dds: true, ktx2: true, png: true, c_header: false, rust_source: false };
+    /// The binary containers and the C/Rust sources.
+    pub const ALL: Self = Self { c_header: true, rust_source: true, ..Self::BINARY };
+    /// Nothing (start of a selection).
+    pub const NONE: Self =
+        Self { bin: false, dds: false, ktx2: false, png: false, c_header: false, rust_source: false };
+}
+
+/// [`unorm8_texture_files`] restricted to the binary containers selected in `formats` (the sources are the
+/// caller's).
+pub fn unorm8_texture_files_in(
+    stem: &str,
+    img: &Image<u8>,
+    kind: &str,
+    convention: &str,
+    formats: TextureFormats,
+) -> Result<Vec<BakedFile>, BakeError> {
     let pf = PixelFormat::unorm8_for(img.channels);
     let meta = |format: &str| FileMeta {
         kind: kind.into(),
@@ -123,12 +160,20 @@ pub fn unorm8_texture_files(
         png_meta.channels = 3;
         png_meta.pixel_format = None;
     }
-    Ok(vec![
-        BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") },
-        BakedFile { path: format!("{stem}.dds"), bytes: io::dds::encode_u8(img)?, meta: meta("dds") },
-        BakedFile { path: format!("{stem}.ktx2"), bytes: io::ktx2::encode_u8(img)?, meta: meta("ktx2") },
-        BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: png_meta },
-    ])
+    let mut files = Vec::new();
+    if formats.bin {
+        files.push(BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") });
+    }
+    if formats.dds {
+        files.push(BakedFile { path: format!("{stem}.dds"), bytes: io::dds::encode_u8(img)?, meta: meta("dds") });
+    }
+    if formats.ktx2 {
+        files.push(BakedFile { path: format!("{stem}.ktx2"), bytes: io::ktx2::encode_u8(img)?, meta: meta("ktx2") });
+    }
+    if formats.png {
+        files.push(BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: png_meta });
+    }
+    Ok(files)
 }
 
 /// Writes a linear float texture as EXR f32 (`{stem}.exr`), EXR f16 (`{stem}_f16.exr`), KTX2 half floats

@@ -12,7 +12,8 @@
 //! - A whole directory is installed with one `renameat2(RENAME_EXCHANGE)` on Linux (the path always names either
 //!   the old or the new directory); elsewhere (or where the file system refuses the exchange) with two renames
 //!   whose interrupted state is rolled forward to the new directory by the next locked command.
-//! - A file set inside a directory shared with other files ([`write_file_set`]) is staged as fsynced temp files,
+//! - A file set inside a directory shared with other files ([`write_file_set`]) is staged as temp files made durable
+//!   together (one `syncfs`, [`super::atomic::sync_batch`]),
 //!   committed by atomically writing a journal that lists the renames, then renamed; a kill after the journal is
 //!   rolled forward by the next rtbake command that locks or reads the directory ([`settle`]), a kill before it
 //!   leaves the old set. No output may be one of the command's inputs.
@@ -517,10 +518,13 @@ pub fn write_file_set(
                     detail: "is a directory; cannot write a file there".into(),
                 });
             }
-            let tmp = super::atomic::stage(&dst, bytes)?;
+            let tmp = super::atomic::stage_unsynced(&dst, bytes)?;
             let tmp_rel = tmp.strip_prefix(&root).expect("temp beside its file").to_string_lossy().into_owned();
             renames.push((tmp_rel, rel.to_string()));
         }
+        // One flush for the whole set before the journal makes it the committed state.
+        let temps: Vec<PathBuf> = renames.iter().map(|(tmp, _)| root.join(tmp)).collect();
+        super::atomic::sync_batch(&root, &temps)?;
         Ok(())
     })();
     if let Err(e) = staged {

@@ -38,6 +38,18 @@ fn rg_to_rgb<T: Copy>(data: &[T], zero: T) -> Vec<T> {
 }
 
 fn encode(bytes: &[u8], w: u32, h: u32, channels: u32, sixteen: bool, color: PngColor) -> Result<Vec<u8>, IoError> {
+    encode_with(bytes, w, h, channels, sixteen, color, png::Compression::High)
+}
+
+fn encode_with(
+    bytes: &[u8],
+    w: u32,
+    h: u32,
+    channels: u32,
+    sixteen: bool,
+    color: PngColor,
+    compression: png::Compression,
+) -> Result<Vec<u8>, IoError> {
     let err = |e: png::EncodingError| IoError::Unsupported { what: "png", detail: e.to_string() };
     let mut info = png::Info::with_size(w, h);
     info.color_type = color_type(channels)?;
@@ -58,7 +70,7 @@ fn encode(bytes: &[u8], w: u32, h: u32, channels: u32, sixteen: bool, color: Png
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::with_info(&mut out, info).map_err(err)?;
-        enc.set_compression(png::Compression::High);
+        enc.set_compression(compression);
         let mut writer = enc.write_header().map_err(err)?;
         // cICP (PNG Third Edition §11.3.2.6): BT.709 primaries, transfer, RGB (matrix 0), full range. The
         // encoder does not write `Info::coding_independent_code_points`, so the chunk is written here, before IDAT.
@@ -80,6 +92,15 @@ pub fn encode_u8_as(img: &Image<u8>, color: PngColor) -> Result<Vec<u8>, IoError
         return encode(&rg_to_rgb(&img.data, 0), img.width, img.height, 3, false, color);
     }
     encode(&img.data, img.width, img.height, img.channels, false, color)
+}
+
+/// A rendered 8-bit **sRGB-encoded** frame (`rtbake run` outputs) tagged sRGB, with fast compression: frames are
+/// looked at, not archived, and at 1080p the default compression cost more than the pass itself.
+pub fn encode_u8_frame(img: &Image<u8>) -> Result<Vec<u8>, IoError> {
+    if img.channels == 2 {
+        return Err(IoError::Unsupported { what: "png", detail: "a frame has 1, 3 or 4 channels".into() });
+    }
+    encode_with(&img.data, img.width, img.height, img.channels, false, PngColor::Srgb, png::Compression::Fast)
 }
 
 /// 16-bit PNG of linear data: the samples of `img` unchanged (RG widened to RGB with B = 0), tagged linear.

@@ -119,6 +119,14 @@ fn default_run_matches_the_library_and_writes_headers() {
     assert_eq!(o.status.code(), Some(0));
     let h = std::fs::read_to_string(tmp.path().join("SearchTex.h")).unwrap();
     assert!(h.contains("#define SEARCHTEX_WIDTH 64") && h.contains("searchTexBytes"));
+    // Exactly the requested formats are written (and only they are encoded): --format bin,png → two files.
+    let only = tmp.path().join("only");
+    let o = rtbake(&["aa", "mlaa-v2", "--format", "bin,png", "--out", only.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&only).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["AreaTex_MLAAv2.bin", "AreaTex_MLAAv2.png"]);
 }
 
 #[test]

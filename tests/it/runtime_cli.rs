@@ -94,6 +94,10 @@ fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
             let o = rtbake(&args);
             assert!(o.status.success(), "{pass} cpu={cpu}: {}", String::from_utf8_lossy(&o.stderr));
         }
+        for out in [&gpu_out, &cpu_out] {
+            let chunks = rtbake::io::png::chunk_types(&std::fs::read(out).unwrap());
+            assert!(chunks.contains(b"sRGB") && chunks.contains(b"cICP"), "{pass}: frame not tagged sRGB {chunks:?}");
+        }
         let (g, c) = (read_rgba(&gpu_out), read_rgba(&cpu_out));
         assert_ne!(g, input.data, "{pass} changed nothing");
         let (frac, _) = within(&g, &c, 1);
@@ -120,6 +124,9 @@ fn demo_writes_a_png() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(read_rgba(&out).len(), 320 * 180 * 4);
+    // The frame is sRGB-encoded and says so (a colour-managed viewer would otherwise decode it as linear).
+    let chunks = rtbake::io::png::chunk_types(&std::fs::read(&out).unwrap());
+    assert!(chunks.contains(b"sRGB") && chunks.contains(b"cICP"), "{chunks:?}");
 }
 
 #[test]
