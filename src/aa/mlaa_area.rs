@@ -114,8 +114,17 @@ fn q(a: f64) -> u8 {
 
 /// `(R, G)` bytes of cell `(e1, e2)` at distances `(left, right)` (pixels).
 pub fn texel(version: MlaaVersion, e1: u8, e2: u8, left: u32, right: u32) -> (u8, u8) {
-    let lh = q(left_half_area(left, right));
-    let rh = q(left_half_area(right, left));
+    texel_from_halves(version, e1, e2, half_bytes(left, right))
+}
+
+/// The two stored halves `(floor(255·left half), floor(255·right half))` at distances `(left, right)`: they do not
+/// depend on the crossing edges, so a map computes them once per distance pair, not once per cell.
+fn half_bytes(left: u32, right: u32) -> (u8, u8) {
+    (q(left_half_area(left, right)), q(left_half_area(right, left)))
+}
+
+/// [`texel`] from the halves of [`half_bytes`].
+fn texel_from_halves(version: MlaaVersion, e1: u8, e2: u8, (lh, rh): (u8, u8)) -> (u8, u8) {
     let (mut r, mut g) = (0u8, 0u8);
     let mut put = |kind: u8, h: u8| match kind {
         1 => g += h,
@@ -163,15 +172,19 @@ pub fn mlaa_area_map_with_progress(
     let edge = validate(version, n)?;
     let mut img = Image::<u8>::new(edge, edge, 2);
     let dist = |i: u32| if version == MlaaVersion::V2 { i * i } else { i };
+    // The halves of every distance pair (i, j), row j = right distance: N² area evaluations instead of 16 N².
+    let halves: Vec<(u8, u8)> = (0..n * n).into_par_iter().map(|k| half_bytes(dist(k % n), dist(k / n))).collect();
     // Image row y holds the cells (e1, e2 = y / N) at right distance j = y % N; cell row and column 2 stay zero.
     let fill_row = |y: u32, row: &mut [u8]| {
         let (e2, j) = ((y / n) as u8, y % n);
         if e2 == 2 {
             return;
         }
+        let halves_j = &halves[(j * n) as usize..((j + 1) * n) as usize];
         for e1 in [0u8, 1, 3, 4] {
-            for i in 0..n {
-                let (r, g) = texel(version, e1, e2, dist(i), dist(j));
+            for (i, &h) in halves_j.iter().enumerate() {
+                let i = i as u32;
+                let (r, g) = texel_from_halves(version, e1, e2, h);
                 let x = (n * e1 as u32 + i) as usize;
                 row[2 * x] = r;
                 row[2 * x + 1] = g;

@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""CLI-level benchmarks of issue 17, side by side with an anchor binary.
+
+usage: scripts/bench_cli.py [--anchor OLD_RTBAKE] [--runs N] [RTBAKE]
+
+Times whole commands (process start to exit, output written to a scratch directory) as a user's pipeline runs
+them: MLAA AreaMap513 with `--format bin` and with every format, the MLAA generator with 1 and 2 rayon threads,
+the full default bake and its verify. Every job runs RUNS times (default 7, at least 3) alternating between the
+binary under test and the anchor, so both see the same machine load; it prints the median with min-max and the
+anchor/new ratio of wall and of CPU time (user + sys; the wall time of large outputs is bound by the disk
+flush). RTBAKE defaults to target/release/rtbake. Nothing here is a test: figures are for the README
+and the issue notes.
+"""
+import argparse
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+JOBS = [
+    # (name, argv after the binary, env overrides)
+    ("aa mlaa-v1.4 N=513 --format bin", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin"], {}),
+    ("aa mlaa-v1.4 N=513 all formats", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin,dds,ktx2,png"], {}),
+    ("aa mlaa-v1.4 N=1023 bin, 1 thread", ["aa", "mlaa-v1.4", "--max-distance", "1023", "--format", "bin"],
+     {"RAYON_NUM_THREADS": "1"}),
+    ("aa mlaa-v1.4 N=1023 bin, 2 threads", ["aa", "mlaa-v1.4", "--max-distance", "1023", "--format", "bin"],
+     {"RAYON_NUM_THREADS": "2"}),
+    ("bake (all assets), 1 thread", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "1"}),
+    ("bake (all assets), 2 threads", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "2"}),
+    ("verify", ["verify"], {}),
+]
+
+
+def run_once(binary, argv, env, scratch):
+    out = os.path.join(scratch, "out")
+    if argv[0] == "verify":
+        argv = ["verify", "--dir", os.path.join(scratch, "baked")]
+    elif argv[0] == "bake":
+        shutil.rmtree(os.path.join(scratch, "bakeout"), ignore_errors=True)
+        argv = argv + ["--out", os.path.join(scratch, "bakeout")]
+    else:
+        shutil.rmtree(out, ignore_errors=True)
+        argv = argv + ["--out", out]
+    e = dict(os.environ, **env)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    r = subprocess.run([binary] + argv, env=e, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    dt = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if r.returncode != 0:
+        sys.exit(f"{binary} {' '.join(argv)} failed: {r.stderr.decode()[-500:]}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return dt, cpu
+
+
+def fmt(ts):
+    walls = [w for w, _ in ts]
+    cpu = statistics.median(c for _, c in ts)
+    return f"{statistics.median(walls):7.3f} s ({min(walls):.3f}-{max(walls):.3f}) cpu {cpu:6.3f} s"
+
+
+def med(ts, k=0):
+    return statistics.median(t[k] for t in ts)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("binary", nargs="?", default="target/release/rtbake")
+    ap.add_argument("--anchor", help="rtbake binary to compare with (e.g. a build of the previous commit)")
+    ap.add_argument("--runs", type=int, default=7)
+    args = ap.parse_args()
+    runs = max(3, args.runs)
+    bins = [("new", args.binary)] + ([("anchor", args.anchor)] if args.anchor else [])
+    print(f"rtbake bench_cli: median (min-max) of {runs} runs, {os.cpu_count()} logical CPUs; binaries: "
+          + ", ".join(f"{n}={b}" for n, b in bins))
+    with tempfile.TemporaryDirectory(dir=os.environ.get("BENCH_DIR")) as scratch:
+        # verify needs a bake of the same binary: each binary verifies its own.
+        results = {}
+        for name, argv, env in JOBS:
+            times = {n: [] for n, _ in bins}
+            for _ in range(runs):
+                for n, b in bins:
+                    s = os.path.join(scratch, n)
+                    os.makedirs(s, exist_ok=True)
+                    if argv[0] == "verify" and not os.path.exists(os.path.join(s, "baked")):
+                        subprocess.run([b, "bake", "--quiet", "--out", os.path.join(s, "baked")], check=True)
+                    times[n].append(run_once(b, argv, env, s))
+            results[name] = times
+            line = f"{name:<38} new {fmt(times['new'])}"
+            if args.anchor:
+                ratio = med(times["anchor"]) / med(times["new"])
+                cpu_ratio = med(times["anchor"], 1) / max(med(times["new"], 1), 1e-9)
+                line += f" | anchor {fmt(times['anchor'])} | anchor/new wall {ratio:5.2f}x cpu {cpu_ratio:5.2f}x"
+            print(line, flush=True)
+        for n, _ in bins:
+            one = med(results["aa mlaa-v1.4 N=1023 bin, 1 thread"][n])
+            two = med(results["aa mlaa-v1.4 N=1023 bin, 2 threads"][n])
+            b1 = med(results["bake (all assets), 1 thread"][n])
+            b2 = med(results["bake (all assets), 2 threads"][n])
+            print(f"{n}: 1 -> 2 threads: MLAA N=1023 {one / two:.2f}x, full bake {b1 / b2:.2f}x")
+
+
+if __name__ == "__main__":
+    main()
