@@ -335,21 +335,38 @@ impl TwoLayerSkinModel {
             let wt = self.weights.linear_srgb[b];
             for (r, acc_row) in acc.chunks_exact_mut(w).enumerate() {
                 let (r2, che) = (dermis[r].0[b], ches[r]);
-                for (a, &cm) in acc_row.iter_mut().zip(melanin) {
-                    let sigma_a = self.epidermis_sigma_a(band, cm, che);
-                    let e = match table {
-                        Some(t) => t.eval(sigma_a),
-                        None => self.epidermis_totals(band, sigma_a),
-                    };
-                    let refl = self.add_layers(e, r2);
-                    a[0] += wt[0] * refl;
-                    a[1] += wt[1] * refl;
-                    a[2] += wt[2] * refl;
+                // The table/direct choice is made once per band and row, not per texel (monomorphised loops).
+                match table {
+                    Some(t) => self.accumulate_row(acc_row, melanin, band, che, r2, wt, |sa| t.eval(sa)),
+                    None => {
+                        self.accumulate_row(acc_row, melanin, band, che, r2, wt, |sa| self.epidermis_totals(band, sa))
+                    }
                 }
             }
         }
         for (o, a) in out.chunks_exact_mut(3).zip(&acc) {
             o.copy_from_slice(&a.map(|c| c as f32));
+        }
+    }
+
+    /// Adds band `band`'s weighted stack reflectance of every texel of one row to `acc_row`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn accumulate_row(
+        &self,
+        acc_row: &mut [[f64; 3]],
+        melanin: &[f64],
+        band: &Band,
+        che: f64,
+        r2: f64,
+        wt: [f64; 3],
+        totals: impl Fn(f64) -> [f64; 4],
+    ) {
+        for (a, &cm) in acc_row.iter_mut().zip(melanin) {
+            let refl = self.add_layers(totals(self.epidermis_sigma_a(band, cm, che)), r2);
+            a[0] += wt[0] * refl;
+            a[1] += wt[1] * refl;
+            a[2] += wt[2] * refl;
         }
     }
 
@@ -398,12 +415,17 @@ impl EpidermisTable {
     #[inline]
     pub fn eval(&self, sigma_a_per_mm: f64) -> [f64; 4] {
         let x = (sigma_a_per_mm.sqrt() - self.y_lo) * self.inv_h;
-        let k = (x.floor().max(0.0) as usize).min(TABLE_INTERVALS - 1);
+        // floor(x) clamped to ≥ 0, as a truncating cast of max(x, 0) (the same integer, without the out-of-line
+        // libm `floor` of baseline x86-64).
+        let k = (x.max(0.0) as usize).min(TABLE_INTERVALS - 1);
         let t = x - k as f64;
-        // Lagrange weights for nodes at −1, 0, 1, 2 (relative to interval k's left node).
+        // Lagrange weights for nodes at −1, 0, 1, 2 (relative to interval k's left node); halving is exact, so
+        // `* 0.5` gives the bits of `/ 2`.
         let (tm1, tm2, tp1) = (t - 1.0, t - 2.0, t + 1.0);
-        let w = [-t * tm1 * tm2 / 6.0, tp1 * tm1 * tm2 / 2.0, -tp1 * t * tm2 / 2.0, tp1 * t * tm1 / 6.0];
+        let w = [-t * tm1 * tm2 / 6.0, tp1 * tm1 * tm2 * 0.5, -tp1 * t * tm2 * 0.5, tp1 * t * tm1 / 6.0];
         let lerp4 = |v: &[[f64; 2]]| -> [f64; 2] {
+            // A fixed-size view: k ≤ TABLE_INTERVALS − 1 then bounds the stencil statically (no per-texel check).
+            let v: &[[f64; 2]; TABLE_INTERVALS + 3] = v.try_into().expect("one node per grid point");
             let n = &v[k..k + 4];
             [
                 w[0] * n[0][0] + w[1] * n[1][0] + w[2] * n[2][0] + w[3] * n[3][0],
