@@ -11,7 +11,12 @@ pub struct Ctx {
     pub no_wait: bool,
     /// `--max-memory` in bytes (None: half of physical memory).
     pub max_memory: Option<u64>,
+    /// `--max-seconds` (None: [`DEFAULT_MAX_SECONDS`]).
+    pub max_seconds: Option<f64>,
 }
+
+/// The default time budget of one command (`--max-seconds`).
+pub const DEFAULT_MAX_SECONDS: f64 = 600.0;
 
 impl Ctx {
     /// Human message on stderr (suppressed by --quiet).
@@ -64,6 +69,31 @@ impl Ctx {
             )));
         }
         Ok(())
+    }
+
+    /// Refuses, before any work, a job whose time estimate exceeds `--max-seconds` (exit 2, estimate, budget and
+    /// flags named). The estimates come from the models (`time_estimate_seconds`), calibrated with the release
+    /// build on the project's 2-core machine and scaled by the rayon thread count.
+    pub fn check_time(&self, flags: &str, estimate_seconds: f64) -> anyhow::Result<()> {
+        let (budget, source) = match self.max_seconds {
+            Some(s) => (s, format!("--max-seconds {s}")),
+            None => (DEFAULT_MAX_SECONDS, format!("default --max-seconds {DEFAULT_MAX_SECONDS}")),
+        };
+        if estimate_seconds > budget {
+            return Err(usage_msg(format!(
+                "{flags}: this is estimated to take about {} on {} thread(s), more than the time budget of {budget} s \
+                 ({source}); choose smaller sizes or raise --max-seconds",
+                fmt_seconds(estimate_seconds),
+                rayon::current_num_threads()
+            )));
+        }
+        Ok(())
+    }
+
+    /// [`Self::check_memory`] and [`Self::check_time`] of one job.
+    pub fn check_budget(&self, flags: &str, estimate_bytes: u64, estimate_seconds: f64) -> anyhow::Result<()> {
+        self.check_memory(flags, estimate_bytes)?;
+        self.check_time(flags, estimate_seconds)
     }
 
     /// A progress bar on stderr, hidden when stderr is not a terminal or with --quiet.
@@ -357,6 +387,25 @@ pub fn write_set(
     let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
     ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
+}
+
+/// `42 s`, `7.5 min` or `3.2 h`.
+pub fn fmt_seconds(s: f64) -> String {
+    if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
+/// Parses `--max-seconds`: a positive, finite number of seconds.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 => Ok(s),
+        _ => Err(format!("expected a positive number of seconds, got '{text}'")),
+    }
 }
 
 /// `1.5 GiB`-style size.

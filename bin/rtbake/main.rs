@@ -42,6 +42,10 @@ struct Cli {
     /// before anything is allocated. Default: half of physical memory.
     #[arg(long, global = true, value_name = "SIZE", value_parser = cli::parse_bytes)]
     max_memory: Option<u64>,
+    /// Time budget for one command in seconds: sizes whose estimated run time on this kind of machine exceeds it
+    /// are refused up front, with the estimate. Default: 600.
+    #[arg(long, global = true, value_name = "SECONDS", value_parser = cli::parse_seconds)]
+    max_seconds: Option<f64>,
     /// Read parameters from a JSON object {"flag-name": value, ...}; flags given on the command line override it.
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<std::path::PathBuf>,
@@ -106,7 +110,13 @@ fn main() {
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
         Err(e) => cli::exit_clap(e, json),
     };
-    let ctx = Ctx { json: parsed.json, quiet: parsed.quiet, no_wait: parsed.no_wait, max_memory: parsed.max_memory };
+    let ctx = Ctx {
+        json: parsed.json,
+        quiet: parsed.quiet,
+        no_wait: parsed.no_wait,
+        max_memory: parsed.max_memory,
+        max_seconds: parsed.max_seconds,
+    };
     let result = match parsed.command {
         Command::Bake(a) => bake::run_bake(a, &ctx),
         Command::Verify(a) => bake::run_verify(a, &ctx),

@@ -229,6 +229,14 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         channel,
     )?;
     let (w, h) = (neutral.image.width, neutral.image.height);
+    let settings = RigSettings { radius_texels: a.radius, border, sigma_floor: a.sigma_floor, rig_size: a.rig_size };
+    hemoglobin_rig::check_settings(&settings, w, h)?;
+    let n_maps = pairs.len() + 1;
+    ctx.check_budget(
+        &format!("--radius {} on {n_maps} maps of {w}x{h}", a.radius),
+        hemoglobin_rig::memory_estimate_bytes(w, h, n_maps),
+        hemoglobin_rig::time_estimate_seconds(w, h, n_maps, a.radius, rayon::current_num_threads()),
+    )?;
     let mut sources = vec![RigSource {
         name: "neutral".into(),
         source: file_name(&a.neutral),
@@ -257,8 +265,6 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
         });
         maps.push((name.clone(), m.image.data));
     }
-    let settings = RigSettings { radius_texels: a.radius, border, sigma_floor: a.sigma_floor, rig_size: a.rig_size };
-    hemoglobin_rig::check_settings(&settings, w, h)?;
     ctx.info(format!("hemoglobin rig: {w}x{h}, {} targets, r = {} texels", maps.len(), a.radius));
     let refs: Vec<(String, &[f32])> = maps.iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
     let bar = ctx.progress(1 + refs.len() as u64, "local statistics");

@@ -205,6 +205,21 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         s.validate().map_err(|e| flag_error(e, None))?;
     }
 
+    if let ProfileSource::Layers { stack, series, .. } = &source {
+        let layers = stack.layers().len();
+        let estimate = rtbake::diffusion::layered::profile_time_estimate_seconds(
+            layers,
+            radii.len(),
+            *series,
+            rayon::current_num_threads(),
+        );
+        let pairs = match series {
+            Series::Exact => "exact series".to_string(),
+            Series::Truncated { pairs } => format!("--dipole-pairs {pairs}"),
+        };
+        let grid = if args.radii.is_some() { "--radii" } else { "--count" };
+        ctx.check_time(&format!("{grid} ({} radii), {layers} layers, {pairs}", radii.len()), estimate)?;
+    }
     let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
     let table =
         ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| non_finite_error(e, &args))?;

@@ -348,9 +348,10 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
 fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     check_output(&d.output, &[])?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
-    ctx.check_memory(
+    ctx.check_budget(
         &format!("--width {} --height {}", d.width, d.height),
         demo::memory_estimate_bytes(d.width, d.height),
+        demo::time_estimate_seconds(d.width, d.height, d.common.cpu),
     )?;
     let aa = match d.aa {
         DemoAa::Smaa => Some(Antialiasing::Smaa(loader::load_smaa_textures(&d.common.baked).map_err(usage)?)),

@@ -228,6 +228,24 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
     p.layout().map_err(flag_error)?;
     a.zstd.level()?;
     let model = p.model().map_err(flag_error)?;
+    if a.out.is_some() {
+        use rtbake::skin_color::lut;
+        let layout = p.layout().map_err(flag_error)?;
+        let evaluation = match p.lut_evaluation {
+            lut::LutEvaluation::Tabulated => "tabulated",
+            lut::LutEvaluation::Direct => "direct",
+        };
+        ctx.check_budget(
+            &format!("--resolution {}x{} --lut-evaluation {evaluation}", layout.width, layout.height),
+            lut::memory_estimate_bytes(&layout),
+            lut::time_estimate_seconds(
+                &layout,
+                p.lut_evaluation,
+                model.wavelengths_nm().len(),
+                rayon::current_num_threads(),
+            ),
+        )?;
+    }
     let sample = match point {
         Some((cm, chd)) => Some(model.evaluate(cm, chd, p.allow_unphysiological).map_err(flag_error)?),
         None => None,

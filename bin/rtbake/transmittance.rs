@@ -84,7 +84,11 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     table.validate().map_err(usage)?;
     a.zstd.level()?;
     if a.out.is_some() {
-        ctx.check_memory(&format!("--samples {} --height {}", a.samples, a.height), table.memory_estimate_bytes())?;
+        ctx.check_budget(
+            &format!("--samples {} --height {}", a.samples, a.height),
+            table.memory_estimate_bytes(),
+            table.time_estimate_seconds(),
+        )?;
     }
     if s_mm.is_none() && a.out.is_none() {
         return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));

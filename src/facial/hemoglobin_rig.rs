@@ -271,3 +271,18 @@ pub fn evaluate(rig: &HemoglobinRig, weights: &[f64], global_scale: f64) -> Vec<
     });
     out
 }
+/// Wall time of [`build_rig`] on `maps` maps (neutral + targets) of `width`×`height` at disk radius `radius`
+/// (issue 15's budget check): 1.5 ns per texel, map and chord row (2r + 1 rows per disk) on one thread, divided by
+/// `threads`. Measured with the release build on the project's 2-core machine (4096², 9 maps, r = 32: 6.4 s on 2
+/// threads, i.e. 1.3 ns); the estimate rounds up.
+pub fn time_estimate_seconds(width: u32, height: u32, maps: usize, radius: u32, threads: usize) -> f64 {
+    1.5e-9 * width as f64 * height as f64 * maps as f64 * (2 * radius as u64 + 1) as f64 / threads.max(1) as f64
+}
+
+/// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32), the disk statistics of the
+/// neutral and of one target at a time (mean and σ, f64), the full-size scale and bias, and the encoded outputs —
+/// counted from the buffers as 4 bytes per texel per map plus 72 bytes per texel, plus 32 MiB.
+pub fn memory_estimate_bytes(width: u32, height: u32, maps: usize) -> u64 {
+    let texels = width as u64 * height as u64;
+    texels * (4 * maps as u64 + 72) + (32 << 20)
+}

@@ -147,6 +147,24 @@ pub fn bake_lut_with_progress(
     Ok(img)
 }
 
+/// Wall time of [`bake_lut`] (issue 15's budget check, before any work): per texel and wavelength band 30 ns
+/// tabulated, 250 ns direct, on one thread, divided by `threads`, plus 1 s of model set-up (the epidermis tables).
+/// Measured with the release build on the project's 2-core machine (256² at 401 bands: 0.6–0.7 s tabulated,
+/// 4.5–5.9 s direct on one thread); the estimate rounds up.
+pub fn time_estimate_seconds(layout: &LutLayout, evaluation: LutEvaluation, bands: usize, threads: usize) -> f64 {
+    let per_eval = match evaluation {
+        LutEvaluation::Tabulated => 30e-9,
+        LutEvaluation::Direct => 250e-9,
+    };
+    1.0 + per_eval * layout.width as f64 * layout.height as f64 * bands as f64 / threads.max(1) as f64
+}
+
+/// Peak memory of a table bake with its files, in bytes: the f32 table, its f16/EXR/KTX2/PNG encodings and the
+/// per-task accumulators, about 64 bytes per texel, plus 64 MiB of model and spectra.
+pub fn memory_estimate_bytes(layout: &LutLayout) -> u64 {
+    64 * layout.width as u64 * layout.height as u64 + (64 << 20)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

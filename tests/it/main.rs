@@ -37,6 +37,7 @@ mod newcomer_provenance;
 mod newcomer_readme;
 mod profiles_bake;
 mod profiles_cli;
+mod reliability_budget;
 mod reliability_cli;
 mod reliability_dir;
 mod reliability_files;
