@@ -154,6 +154,7 @@ pub mod separable;
 pub mod skin_color;
 pub mod spectral;
 pub mod transmittance;
+pub mod transport;
 
 pub use bake::{registry, Asset, BakeError, BakedFile, FileMeta};
 pub use baked_dir::{bake_into, verify, BakeDirError, BakeSummary, VerifyReport};
