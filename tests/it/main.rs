@@ -58,3 +58,4 @@ mod skin_color;
 mod skin_layers;
 mod skin_spectral_data;
 mod transmittance_table;
+mod transport_physics;
