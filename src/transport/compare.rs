@@ -92,3 +92,48 @@ pub fn compare(mc: &McResult, profile: &dyn RadialProfile, r_window_mm: [f64; 2]
     });
     Comparison { r_window_mm, channels }
 }
+
+/// The diffusion model rtbake has for `stack` (σs′ = σs(1 − g) per channel, DJ05 Fdr, exact image series):
+/// a single semi-infinite layer is the dipole (η = n_layer/n_above; Jensen et al. 2001), finite stacks are the
+/// multipole / layered adding (Donner & Jensen 2005). Returns the profile and its name, or why there is none
+/// (a semi-infinite layer under others; a layer thinner than 1/σt′, where the multipole is not defined).
+pub fn diffusion_counterpart(
+    stack: &super::McStack,
+) -> Result<(Box<dyn RadialProfile + Send>, &'static str), crate::error::InvalidInput> {
+    use crate::diffusion::dipole::{Dipole, DipoleRgb};
+    use crate::diffusion::layered::{Adding, Layer, LayerStack, LayeredProfile};
+    use crate::diffusion::multipole::Series;
+    use crate::diffusion::FdrForm;
+    let layers = stack.layers();
+    let reduced = |l: &super::McLayer| [0, 1, 2].map(|c| l.sigma_s_per_mm[c] * (1.0 - l.g[c]));
+    if layers.len() == 1 && layers[0].thickness_mm.is_infinite() {
+        let l = &layers[0];
+        let sp = reduced(l);
+        let mut d = Vec::with_capacity(3);
+        for c in 0..3 {
+            d.push(Dipole::new(l.sigma_a_per_mm[c], sp[c], l.eta / stack.eta_above(), FdrForm::Dj05)?);
+        }
+        return Ok((Box::new(DipoleRgb([d[0], d[1], d[2]])), "dipole"));
+    }
+    if layers.iter().any(|l| l.thickness_mm.is_infinite()) {
+        return Err(crate::error::InvalidInput::new(
+            "layers",
+            "a semi-infinite layer under other layers has no diffusion counterpart in rtbake",
+        ));
+    }
+    let ls = LayerStack::new(
+        stack.eta_above(),
+        stack.eta_below(),
+        layers
+            .iter()
+            .map(|l| Layer {
+                thickness_mm: l.thickness_mm,
+                eta: l.eta,
+                sigma_a: l.sigma_a_per_mm,
+                sigma_s_prime: reduced(l),
+            })
+            .collect(),
+    )?;
+    let name = if layers.len() == 1 { "multipole" } else { "layered multipole" };
+    Ok((Box::new(LayeredProfile::new(&ls, Adding::Symmetric, Series::Exact, FdrForm::Dj05)?), name))
+}

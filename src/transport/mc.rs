@@ -101,6 +101,13 @@ impl McSettings {
         self.photons.div_ceil(u64::from(self.batches))
     }
 
+    /// Peak memory of [`simulate`] beyond the stack, bytes: ([`WAVE_CHUNKS`] + 3·batches + 1) tallies of 2·bins
+    /// f64 plus the result's 4·3·bins estimates.
+    pub fn memory_estimate_bytes(&self, layers: usize) -> u64 {
+        let tally = (2 * self.bins as u64 + layers as u64 + 4) * 8;
+        (WAVE_CHUNKS as u64 + 3 * u64::from(self.batches) + 1) * tally + 12 * 16 * self.bins as u64
+    }
+
     /// Bin centres (i + ½)Δr, mm.
     pub fn radii_mm(&self) -> Vec<f64> {
         (0..self.bins).map(|i| (i as f64 + 0.5) * self.bin_mm).collect()

@@ -7,10 +7,12 @@
 //!   independent batches), deterministic for any thread count.
 //! - [`rng`]: Philox4x32-10, counter-based random numbers keyed by (seed, photon index).
 //! - [`compare`]: Monte Carlo against a diffusion [`RadialProfile`](crate::diffusion::RadialProfile) (total R,
-//!   r·R(r) error).
+//!   r·R(r) error) and [`compare::diffusion_counterpart`], the diffusion model of a stack.
+//! - [`report`]: a result as CSV (the `rtbake profile --csv` layout) and JSON (with standard errors).
 
 pub mod compare;
 pub mod mc;
+pub mod report;
 pub mod rng;
 pub mod stack;
 
