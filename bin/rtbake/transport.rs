@@ -227,8 +227,10 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
         if let Some(cmp) = &comparison {
             let k = &cmp.channels[c];
             line += &format!(
-                "; {name} total R {:.5} ({:+.2} %), r R(r) error {:.1} %",
-                k.total_r_diffusion, k.total_r_difference_percent, k.rr_error_percent
+                "; {name} total R {:.5} ({:+.2} %), r R(r) error {}",
+                k.total_r_diffusion,
+                k.total_r_difference_percent,
+                k.rr_error_percent.map(|e| format!("{e:.1} %")).unwrap_or("n/a".into())
             );
         }
         ctx.info(line);

@@ -22,8 +22,8 @@ pub struct ChannelComparison {
     pub total_r_diffusion: f64,
     /// (diffusion − Monte Carlo) / Monte Carlo, %.
     pub total_r_difference_percent: f64,
-    /// Relative L2 error of r·R(r) over the window, %.
-    pub rr_error_percent: f64,
+    /// Relative L2 error of r·R(r) over the window, % (`None` when no Monte Carlo photon left in the window).
+    pub rr_error_percent: Option<f64>,
     /// Largest |R̄ − R| / SE over the window's bins with a non-zero SE (how many standard errors apart).
     pub max_z: f64,
 }
@@ -86,7 +86,7 @@ pub fn compare(mc: &McResult, profile: &dyn RadialProfile, r_window_mm: [f64; 2]
             total_r_mc: mc_total,
             total_r_diffusion: totals[c],
             total_r_difference_percent: 100.0 * (totals[c] - mc_total.mean) / mc_total.mean,
-            rr_error_percent: if den > 0.0 { 100.0 * (num / den).sqrt() } else { 0.0 },
+            rr_error_percent: (den > 0.0).then(|| 100.0 * (num / den).sqrt()),
             max_z,
         }
     });

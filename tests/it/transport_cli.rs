@@ -192,3 +192,30 @@ fn bad_input_exits_2_naming_the_flag_and_writes_nothing() {
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["error"].as_str().unwrap().contains("--photons"), "{v}");
 }
+
+/// The committed `transport-report`: every case and channel, and the dipole's totals within a few per cent of
+/// Monte Carlo wherever the reduced albedo exceeds 0.99 (diffusion's regime), further off at low albedo.
+#[test]
+fn baked_transport_report_shows_where_diffusion_holds() {
+    let path = crate::support::baked_dir().join(rtbake::baked_layout::path::TRANSPORT_REPORT_CSV);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let rows: Vec<Vec<&str>> =
+        text.lines().filter(|l| !l.starts_with('#')).skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), (11 + 3) * 3);
+    let (mut high, mut low) = (0, 0);
+    for r in &rows {
+        let albedo: f64 = r[2].parse().unwrap();
+        let (mc, se, diff): (f64, f64, f64) = (r[3].parse().unwrap(), r[4].parse().unwrap(), r[7].parse().unwrap());
+        assert!(mc > 0.0 && se > 0.0 && se < 0.1 * mc, "{r:?}");
+        if r[0].starts_with("dipole/") && albedo > 0.99 {
+            high += 1;
+            // 2 % plus three standard errors of the 2000-photon run.
+            assert!(diff.abs() < 2.0 + 300.0 * se / mc, "{r:?}");
+        }
+        if r[0].starts_with("dipole/") && albedo < 0.8 {
+            low += 1;
+            assert!(diff > 5.0, "the dipole overestimates total R at low albedo: {r:?}");
+        }
+    }
+    assert!(high >= 15 && low >= 5, "{high} high-albedo rows, {low} low-albedo rows");
+}
