@@ -36,7 +36,7 @@ fn assert_energy(r: &McResult, what: &str) {
 
 /// MCML paper (Wang, Jacques & Zheng 1995), Table 2: van de Hulst's (1980) adding-doubling values for a slab with
 /// μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0.75, n = 1 (matched), d = 0.02 cm: total diffuse reflectance 0.09739, total
-/// transmittance 0.66096.
+/// transmittance 0.66096 (MCML 2.0's sample1a output, 10⁶ photons: Rd 0.0972139 ± 0.00023, Tt 0.660967).
 #[test]
 fn van_de_hulst_slab_as_in_the_mcml_paper() {
     let stack = one_layer(0.2, 1.0, 1.0, 9.0, 0.75);
@@ -100,6 +100,28 @@ fn giovanelli_semi_infinite_isotropic() {
     assert!(se < 0.003, "SE {se}");
     assert_eq!(r.channels[0].transmittance.mean, 0.0);
     assert_energy(&r, "semi-infinite");
+}
+
+/// MCML 2.0's own sample (`samples/sample1/sample1b.mco` in Wang's MCML distribution, github.com/lhvwang/MCML):
+/// a semi-infinite medium, μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0, n = 1.5 under air, 100 000 photons:
+/// Rsp = 0.04, Rd = 0.220348 ± 0.000916 — a check of the Fresnel faces (total internal reflection included).
+#[test]
+fn mcml_sample_with_a_mismatched_boundary() {
+    let layer = McLayer {
+        thickness_mm: f64::INFINITY,
+        eta: 1.5,
+        sigma_a_per_mm: [1.0; 3],
+        sigma_s_per_mm: [9.0; 3],
+        g: [0.0; 3],
+    };
+    let r = simulate(&McStack::new(1.0, 1.5, vec![layer]).unwrap(), &McSettings::new(20_000, 4, 10, 0.1, 10).unwrap());
+    let (rd, se) = pooled(&r, |c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
+    eprintln!("MCML sample1b: Rd = {rd:.5} ± {se:.5} (MCML 0.220348 ± 0.000916)");
+    assert!((r.channels[0].specular_reflectance - 0.04).abs() < 1e-15);
+    let both = (se * se + 0.000916f64 * 0.000916).sqrt();
+    assert!((rd - 0.220348).abs() < 4.0 * both, "Rd {rd} ± {se}");
+    assert!(se < 0.003, "SE {se}");
+    assert_energy(&r, "MCML sample1b");
 }
 
 /// Without absorption nothing is lost: Rsp + Rd + T = 1 to rounding, through mismatched faces, a clear layer and
