@@ -110,8 +110,8 @@ pub fn diffusion_counterpart(
         let l = &layers[0];
         let sp = reduced(l);
         let mut d = Vec::with_capacity(3);
-        for c in 0..3 {
-            d.push(Dipole::new(l.sigma_a_per_mm[c], sp[c], l.eta / stack.eta_above(), FdrForm::Dj05)?);
+        for (c, &s) in sp.iter().enumerate() {
+            d.push(Dipole::new(l.sigma_a_per_mm[c], s, l.eta / stack.eta_above(), FdrForm::Dj05)?);
         }
         return Ok((Box::new(DipoleRgb([d[0], d[1], d[2]])), "dipole"));
     }

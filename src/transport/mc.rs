@@ -236,18 +236,19 @@ fn spin(u: [f64; 3], cos_t: f64, phi: f64) -> [f64; 3] {
     }
 }
 
-/// Traces photons `first..first + count` of `channel` into `tally`.
-fn trace_chunk(
-    media: &[Medium],
+/// What every photon of one channel shares.
+struct Channel<'a> {
+    media: &'a [Medium],
     eta_above: f64,
     eta_below: f64,
+    /// 1 − Rsp.
     start_weight: f64,
-    settings: &McSettings,
-    channel: u32,
-    first: u64,
-    count: u64,
-    tally: &mut Tally,
-) {
+    index: u32,
+}
+
+/// Traces photons `first..first + count` of channel `ch` into `tally`.
+fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
+    let Channel { media, eta_above, eta_below, start_weight, index: channel } = *ch;
     let inv_bin = 1.0 / settings.bin_mm;
     let bins = settings.bins;
     let last = media.len() - 1;
@@ -407,17 +408,14 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                 let count = CHUNK_PHOTONS.min(per_batch - first_in_batch);
                 let first = batch * per_batch + first_in_batch;
                 let mut t = Tally::new(settings.bins, n_layers);
-                trace_chunk(
-                    &media[channel as usize],
-                    stack.eta_above(),
-                    stack.eta_below(),
-                    1.0 - rsp,
-                    settings,
-                    channel as u32,
-                    first,
-                    count,
-                    &mut t,
-                );
+                let ch = Channel {
+                    media: &media[channel as usize],
+                    eta_above: stack.eta_above(),
+                    eta_below: stack.eta_below(),
+                    start_weight: 1.0 - rsp,
+                    index: channel as u32,
+                };
+                trace_chunk(&ch, settings, first, count, &mut t);
                 ((channel as usize) * batches + batch as usize, t)
             })
             .collect();

@@ -14,8 +14,9 @@ fn one_layer(thickness_mm: f64, eta: f64, sigma_a: f64, sigma_s: f64, g: f64) ->
     McStack::new(1.0, 1.0, vec![layer]).unwrap()
 }
 
-/// Pools the three (identical, independently seeded) channels: mean and standard error of the mean.
-fn pooled(r: &McResult, f: impl Fn(usize) -> (f64, f64)) -> (f64, f64) {
+/// Pools the three (identical, independently seeded) channels of a result: `f(channel)` gives (mean, SE); returns
+/// the mean and standard error of the pooled mean.
+fn pooled(f: impl Fn(usize) -> (f64, f64)) -> (f64, f64) {
     let v: Vec<(f64, f64)> = (0..3).map(f).collect();
     let mean = v.iter().map(|x| x.0).sum::<f64>() / 3.0;
     let se = (v.iter().map(|x| x.1 * x.1).sum::<f64>()).sqrt() / 3.0;
@@ -41,8 +42,8 @@ fn assert_energy(r: &McResult, what: &str) {
 fn van_de_hulst_slab_as_in_the_mcml_paper() {
     let stack = one_layer(0.2, 1.0, 1.0, 9.0, 0.75);
     let r = simulate(&stack, &McSettings::new(300_000, 1, 10, 0.01, 50).unwrap());
-    let (rd, rd_se) = pooled(&r, |c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
-    let (tt, tt_se) = pooled(&r, |c| (r.channels[c].transmittance.mean, r.channels[c].transmittance.se));
+    let (rd, rd_se) = pooled(|c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
+    let (tt, tt_se) = pooled(|c| (r.channels[c].transmittance.mean, r.channels[c].transmittance.se));
     eprintln!("van de Hulst slab: Rd = {rd:.5} ± {rd_se:.5} (0.09739), Tt = {tt:.5} ± {tt_se:.5} (0.66096)");
     assert!((rd - 0.09739).abs() < 4.0 * rd_se, "Rd {rd} ± {rd_se}");
     assert!((tt - 0.66096).abs() < 4.0 * tt_se, "Tt {tt} ± {tt_se}");
@@ -94,7 +95,7 @@ fn giovanelli_semi_infinite_isotropic() {
     )
     .unwrap();
     let r = simulate(&stack, &McSettings::new(20_000, 2, 10, 0.1, 50).unwrap());
-    let (rd, se) = pooled(&r, |c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
+    let (rd, se) = pooled(|c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
     eprintln!("Giovanelli: Rd = {rd:.5} ± {se:.5} (exact {exact:.5})");
     assert!((rd - exact).abs() < 4.0 * se, "Rd {rd} ± {se} vs {exact}");
     assert!(se < 0.003, "SE {se}");
@@ -115,7 +116,7 @@ fn mcml_sample_with_a_mismatched_boundary() {
         g: [0.0; 3],
     };
     let r = simulate(&McStack::new(1.0, 1.5, vec![layer]).unwrap(), &McSettings::new(20_000, 4, 10, 0.1, 10).unwrap());
-    let (rd, se) = pooled(&r, |c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
+    let (rd, se) = pooled(|c| (r.channels[c].diffuse_reflectance.mean, r.channels[c].diffuse_reflectance.se));
     eprintln!("MCML sample1b: Rd = {rd:.5} ± {se:.5} (MCML 0.220348 ± 0.000916)");
     assert!((r.channels[0].specular_reflectance - 0.04).abs() < 1e-15);
     let both = (se * se + 0.000916f64 * 0.000916).sqrt();
@@ -187,12 +188,12 @@ fn converges_to_the_dipole_where_diffusion_holds() {
     let dip = DipoleRgb([0, 1, 2].map(|c| Dipole::new(sa[c], 1.0 - sa[c], 1.0, FdrForm::Dj05).unwrap()));
     let far = compare(&r, &dip, [8.0, 15.0]);
     let near = compare(&r, &dip, [1.0, 4.0]);
-    for c in 0..3 {
+    for (c, a) in sa.iter().enumerate() {
         let (f, n) = (&far.channels[c], &near.channels[c]);
         eprintln!(
             "albedo' {:.2}: Rd MC {:.4} ± {:.4}, dipole {:.4} ({:+.1} %); r R(r) error 1..4 mm {:.1} %, 8..15 mm {:.1} % \
              (max {:.1} SE)",
-            1.0 - sa[c],
+            1.0 - a,
             f.total_r_mc.mean,
             f.total_r_mc.se,
             f.total_r_diffusion,
