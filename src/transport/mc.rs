@@ -222,7 +222,9 @@ fn hg_cos_theta(g: f64, xi: f64) -> f64 {
 #[inline]
 fn spin(u: [f64; 3], cos_t: f64, phi: f64) -> [f64; 3] {
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let (sin_p, cos_p) = phi.sin_cos();
+    // One cosine and a square root instead of sin and cos (MCML's `Spin` does the same).
+    let cos_p = phi.cos();
+    let sin_p = (1.0 - cos_p * cos_p).max(0.0).sqrt().copysign(PI - phi);
     let [ux, uy, uz] = u;
     if uz.abs() > 0.99999 {
         [sin_t * cos_p, sin_t * sin_p, cos_t * uz.signum()]

@@ -184,7 +184,7 @@ fn converges_to_the_dipole_where_diffusion_holds() {
     // Channels: reduced albedo 0.99, 0.9, 0.5 at σt′ = 1 mm⁻¹, g = 0.
     let sa = [0.01, 0.1, 0.5];
     let stack = McStack::semi_infinite(sa, sa.map(|a| 1.0 - a), 0.0, 1.0).unwrap();
-    let r = simulate(&stack, &McSettings::new(40_000, 5, 10, 0.5, 30).unwrap());
+    let r = simulate(&stack, &McSettings::new(80_000, 5, 10, 0.5, 30).unwrap());
     let dip = DipoleRgb([0, 1, 2].map(|c| Dipole::new(sa[c], 1.0 - sa[c], 1.0, FdrForm::Dj05).unwrap()));
     let far = compare(&r, &dip, [8.0, 15.0]);
     let near = compare(&r, &dip, [1.0, 4.0]);
@@ -204,12 +204,12 @@ fn converges_to_the_dipole_where_diffusion_holds() {
         );
     }
     let (hi, mid, lo) = (&far.channels[0], &far.channels[1], &far.channels[2]);
-    // High albedo: totals within 2 %, and the far field within 12 % (statistical noise included) …
+    // High albedo: totals within 2 %, and the far field within 15 % (statistical noise included) …
     assert!(hi.total_r_difference_percent.abs() < 2.0, "{hi:?}");
-    assert!(hi.rr_error_percent.unwrap() < 12.0, "{hi:?}");
+    assert!(hi.rr_error_percent.unwrap() < 15.0, "{hi:?}");
     // … while within 4 mean free paths of the source the dipole is off by more than 15 % (its point source at one
-    // mean free path misses the single-scattering peak), and lower albedo makes every difference grow.
-    assert!(near.channels[0].rr_error_percent.unwrap() > 15.0, "{:?}", near.channels[0]);
+    // mean free path misses the single-scattering peak; off by more than 20 %), and lower albedo makes every difference grow.
+    assert!(near.channels[0].rr_error_percent.unwrap() > 20.0, "{:?}", near.channels[0]);
     assert!(hi.total_r_difference_percent.abs() < mid.total_r_difference_percent.abs(), "{mid:?}");
     assert!(mid.total_r_difference_percent.abs() + 10.0 < lo.total_r_difference_percent.abs(), "{lo:?}");
     assert!(lo.rr_error_percent.unwrap() > 2.0 * hi.rr_error_percent.unwrap(), "{lo:?}");
