@@ -29,6 +29,11 @@ pub mod path {
         format!("{MLAA_DIR}/AreaMap{n}_v1.4.bin")
     }
 
+    /// Folder of the Monte Carlo vs diffusion report (`transport-report`).
+    pub const TRANSPORT_DIR: &str = "transport";
+    /// The report table, one row per case and channel (CSV; `report.json` beside it).
+    pub const TRANSPORT_REPORT_CSV: &str = "transport/report.csv";
+
     /// Folder of the sum-of-Gaussians fits and their screen-space parameters.
     pub const GAUSSIANS_DIR: &str = "sss/gaussians";
     /// Default sum-of-Gaussians fit of the screen-space SSS (d'Eon's 6 Gaussians).

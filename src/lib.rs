@@ -13,6 +13,7 @@
 //! | bake registered assets into a directory with a manifest | [`bake::registry`], [`baked_dir::bake_into`], [`baked_dir::verify`] | files + `manifest.json` (sha256, parameters, conventions) |
 //! | SMAA / MLAA lookup textures | [`aa::smaa_area::smaa_area_texture`], [`aa::smaa_search::search_texture`], [`aa::mlaa_area::mlaa_area_map`] | [`Image<u8>`], byte-identical to the published textures |
 //! | diffusion profiles R(r), T(r) | [`diffusion::dipole`], [`diffusion::multipole`], [`diffusion::layered`], [`diffusion::sum_of_gaussians`], all [`RadialProfile`] | mm⁻² per channel |
+//! | Monte Carlo ground truth for layer stacks (MCML) | [`transport::simulate`], [`transport::compare`] | R(r), T(r) in mm⁻² with standard errors; diffusion vs transport |
 //! | sum-of-Gaussians fit (thesis eq. 2.2) | [`fit_sum_of_gaussians`] | variances (mm²) and weights |
 //! | separable-SSS kernel (thesis eq. 6.1) | [`separable::kernel::generate`] | taps `[r, g, b, offset]` |
 //! | transmittance T(s) (thesis eq. 5.12) | [`transmittance`] | table over thickness s in mm |
@@ -154,6 +155,7 @@ pub mod separable;
 pub mod skin_color;
 pub mod spectral;
 pub mod transmittance;
+pub mod transport;
 
 pub use bake::{registry, Asset, BakeError, BakedFile, FileMeta};
 pub use baked_dir::{bake_into, verify, BakeDirError, BakeSummary, VerifyReport};

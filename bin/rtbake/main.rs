@@ -15,6 +15,7 @@ mod profile_source;
 mod run;
 mod skin_color;
 mod transmittance;
+mod transport;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use cli::Ctx;
@@ -72,6 +73,8 @@ enum Command {
     Kernel(kernel::KernelArgs),
     /// Evaluate or bake the transmittance table T(s) (thesis eq. 5.12).
     Transmittance(transmittance::TransmittanceArgs),
+    /// Monte Carlo photon transport in a layer stack (MCML-style): R(r), T(r) with standard errors, against diffusion.
+    Transport(transport::TransportArgs),
     /// Evaluate the spectral two-layer skin model (melanin × hemoglobin → RGB albedo).
     SkinColor(skin_color::SkinColorArgs),
     /// Facial appearance maps: hemoglobin scale/bias rig, wrinkle maps.
@@ -126,6 +129,7 @@ fn main() {
         Command::Fit(c) => fit::run(c, &ctx),
         Command::Kernel(a) => kernel::run(a, &ctx),
         Command::Transmittance(a) => transmittance::run(a, &ctx),
+        Command::Transport(a) => transport::run(a, &ctx),
         Command::SkinColor(a) => skin_color::run(a, &ctx),
         Command::Maps(c) => maps::run(c, &ctx),
         Command::Run(c) => run::run(c, &ctx),

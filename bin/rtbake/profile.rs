@@ -288,7 +288,7 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
 }
 
 /// Before any work: `path` must not be a directory, and its directory must exist and accept a new file.
-fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
+pub(crate) fn check_output_file(flag: &str, path: &Path) -> anyhow::Result<()> {
     if path.is_dir() {
         return Err(usage_msg(format!("{flag} {}: is a directory, expected a file path", path.display())));
     }

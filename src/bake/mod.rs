@@ -84,6 +84,7 @@ pub fn registry() -> Vec<Asset> {
     v.extend(skin::assets());
     v.extend(facial::assets());
     v.extend(profiles::assets());
+    v.extend(transport::assets());
     v
 }
 
@@ -94,6 +95,7 @@ pub mod profiles;
 pub mod separable;
 pub mod skin;
 pub mod transmittance;
+pub mod transport;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is RGB with B = 0 (what engines and browsers load as R, G), tagged linear.

@@ -15,6 +15,7 @@ use std::fmt::Write;
 /// One polyline.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
+    /// Legend name; an empty label draws the curve without a legend entry (e.g. error bars).
     pub label: String,
     /// sRGB colour.
     pub color: [u8; 3],
@@ -246,7 +247,7 @@ impl LinePlot {
                 pts.join(" ")
             );
         }
-        for (i, series) in self.series.iter().enumerate() {
+        for (i, series) in self.series.iter().filter(|s| !s.label.is_empty()).enumerate() {
             let [r, g, b] = series.color;
             let y = MARGIN_T + 12.0 + 14.0 * i as f64;
             let x = w - MARGIN_R - 150.0;
@@ -322,7 +323,7 @@ impl LinePlot {
         }
         // Legend: swatch and name, right-aligned inside the frame's top-right corner.
         let widest = self.series.iter().map(|s| text_width(&s.label)).fold(0.0, f64::max);
-        for (i, series) in self.series.iter().enumerate() {
+        for (i, series) in self.series.iter().filter(|s| !s.label.is_empty()).enumerate() {
             let y = MARGIN_T + 8.0 + 14.0 * i as f64;
             let x = w - MARGIN_R - 40.0 - widest;
             c.line(x, y, x + 24.0, y, series.color, series.dashed);

@@ -1,7 +1,9 @@
 //! Plots, in one place: [`line`](mod@line) draws line plots as SVG and as raster images (for PNG) with a built-in font;
-//! [`profile`] turns a diffusion-profile table into its two-panel plot. Pure: text or pixels; callers write files.
+//! [`profile`] turns a diffusion-profile table into its two-panel plot; [`transport`] a Monte Carlo result against
+//! a diffusion profile. Pure: text or pixels; callers write files.
 
 pub mod line;
 pub mod profile;
+pub mod transport;
 
 pub use line::{panels_to_image, panels_to_svg, Curve, LinePlot, LOG_Y_DECADES};

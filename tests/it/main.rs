@@ -60,3 +60,5 @@ mod skin_color;
 mod skin_layers;
 mod skin_spectral_data;
 mod transmittance_table;
+mod transport_cli;
+mod transport_physics;

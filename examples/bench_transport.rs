@@ -1,0 +1,106 @@
+//! Benchmark: Monte Carlo photon transport (`rtbake::transport`), photon histories per second, on the two cases of
+//! MCML 2.0's `samples/sample1/sample1.mci` (Wang, Jacques & Zheng 1995):
+//! (a) van de Hulst's slab: μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0.75, n = 1, d = 0.02 cm, air both sides;
+//! (b) a semi-infinite medium: μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0, n = 1.5 under air.
+//! The issue's goal is ≥ 2× MCML per core.
+//!
+//! `cargo run --release --example bench_transport` prints, per case, the median wall time of 5 runs on the default
+//! rayon pool and on 1 thread, photon histories per second (3 channels × photons), the totals (which must not change
+//! with the thread count) and, when `RTBAKE_MCML` names an MCML 2.0 binary, MCML's median time on the same input
+//! (one channel, its own tallies at the sample's grid) and the per-core ratio.
+
+use rtbake::transport::{simulate, McLayer, McSettings, McStack};
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// MCML input for one run (lengths in cm).
+fn mci(thickness_cm: &str, n: f64, g: f64, photons: u64) -> String {
+    format!(
+        "mcmli2.0\n  air 1.0 0 0 0\n  medium {n} 10 90 {g}\nend\nout.mco A\n  air\n  medium {thickness_cm}\n  air\nend\n\
+         pencil\n0\n0.01 0.01 0.1\n10 100 1 1\nRd_r\n{photons} 10:00\n1E-4\n1\nend\n"
+    )
+}
+
+fn main() {
+    let layer = |t: f64, eta: f64, g: f64| McLayer {
+        thickness_mm: t,
+        eta,
+        sigma_a_per_mm: [1.0; 3],
+        sigma_s_per_mm: [9.0; 3],
+        g: [g; 3],
+    };
+    let cases = [
+        (
+            "(a) van de Hulst slab, 0.2 mm, g 0.75, n 1",
+            McStack::new(1.0, 1.0, vec![layer(0.2, 1.0, 0.75)]).unwrap(),
+            1_000_000u64,
+            "0.02",
+            1.0,
+            0.75,
+        ),
+        (
+            "(b) semi-infinite, g 0, n 1.5",
+            McStack::new(1.0, 1.5, vec![layer(f64::INFINITY, 1.5, 0.0)]).unwrap(),
+            200_000,
+            "1E8",
+            1.5,
+            0.0,
+        ),
+    ];
+    let threads = rayon::current_num_threads();
+    let mcml = std::env::var_os("RTBAKE_MCML");
+    for (name, stack, photons, thickness_cm, n, g) in cases {
+        let settings = McSettings::new(photons, 1, 10, 0.1, 100).unwrap();
+        let histories = 3.0 * photons as f64;
+        let mut per_pool = Vec::new();
+        for pool_threads in [threads, 1] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(pool_threads).build().unwrap();
+            let mut times = Vec::new();
+            let mut result = None;
+            for _ in 0..5 {
+                let t0 = Instant::now();
+                result = Some(pool.install(|| simulate(&stack, &settings)));
+                times.push(t0.elapsed().as_secs_f64());
+            }
+            let r = result.unwrap();
+            let t = median(times);
+            let interactions: u64 = r.channels.iter().map(|c| c.interactions).sum();
+            println!(
+                "{name}: {pool_threads} thread(s): median {:.3} s for {histories:.0} histories = {:.3e} photons/s, \
+                 {:.3e} interactions/s; Rd {:.5}, T {:.5}",
+                t,
+                histories / t,
+                interactions as f64 / t,
+                r.channels[0].diffuse_reflectance.mean,
+                r.channels[0].transmittance.mean
+            );
+            per_pool.push((pool_threads, histories / t));
+        }
+        if let Some(bin) = &mcml {
+            let dir = std::env::temp_dir().join(format!("rtbake_bench_mcml_{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join("in.mci"), mci(thickness_cm, n, g, photons)).unwrap();
+            let mut times = Vec::new();
+            for _ in 0..5 {
+                let t0 = Instant::now();
+                let out = std::process::Command::new(bin).arg("in.mci").current_dir(&dir).output().unwrap();
+                assert!(out.status.success(), "MCML failed: {}", String::from_utf8_lossy(&out.stderr));
+                times.push(t0.elapsed().as_secs_f64());
+            }
+            let t = median(times);
+            let rate = photons as f64 / t;
+            let one = per_pool.iter().find(|p| p.0 == 1).unwrap().1;
+            println!(
+                "{name}: MCML 2.0 (1 thread): median {t:.3} s for {photons} photons = {rate:.3e} photons/s; \
+                 rtbake per core / MCML = {:.2}; rtbake on {threads} threads / MCML = {:.2}",
+                one / rate,
+                per_pool[0].1 / rate
+            );
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+    }
+}

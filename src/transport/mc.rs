@@ -1,0 +1,491 @@
+//! MCML-style photon transport (L. Wang, S. L. Jacques, L. Zheng, "MCML — Monte Carlo modeling of light transport in
+//! multi-layered tissues", Comput. Methods Programs Biomed. 47:131–146, 1995; section numbers below are theirs).
+//!
+//! Per channel, each photon packet starts at the origin heading straight down with weight 1 − Rsp, where
+//! Rsp = ((n₀ − n₁)/(n₀ + n₁))² is the specular reflection of the top surface (§3.1; MCML's special case of a
+//! clear first layer is not made: a clear layer is simply traced). Then, repeatedly (§3.2–3.8):
+//!
+//! * **Step**: a dimensionless optical depth s = −ln ξ is drawn; in a layer of σt = σa + σs the packet moves s/σt
+//!   unless it reaches the layer's face first, in which case it stops there and keeps the rest of s for the next
+//!   layer (§3.3.2, with σt = 0 in a clear layer).
+//! * **Face**: unpolarised Fresnel reflectance R(θi) = ½(rs² + rp²) between the layer's index and the neighbour's
+//!   (the next layer or the ambient medium; total internal reflection past the critical angle); the packet is
+//!   reflected if ξ ≤ R, else refracted by Snell's law (§3.5, all-or-none). Leaving through the top face scores
+//!   its weight in R(r), through the bottom face in T(r), at r = √(x² + y²).
+//! * **Interaction**: implicit capture — the weight w·σa/σt is scored as absorbed in the layer and w keeps the rest
+//!   (§3.4); the direction is scattered by the Henyey–Greenstein phase function
+//!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ = 2πξ (§3.5, eq. 3.28–3.30).
+//! * **Russian roulette** below w = [`ROULETTE_THRESHOLD`]: the packet survives with chance 1/[`ROULETTE_CHANCE`]
+//!   with weight w·`ROULETTE_CHANCE`, else ends (§3.6; energy is conserved in expectation).
+//!
+//! Tallies (§4): R(r) and T(r) in annuli of width Δr, divided by the photon count N and the annulus area
+//! π(2i + 1)Δr² (mm⁻², the value at the bin centre (i + ½)Δr is the annulus mean); total diffuse R and T (all exits,
+//! including those beyond the last bin); absorbed fraction per layer. Rsp + Rd + T + ΣA = 1 up to roulette noise.
+//! Standard errors come from [`McSettings::batches`] independent batches of equal size:
+//! SE = √(Σ_b (x_b − x̄)²/(B(B − 1))).
+//!
+//! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, block)
+//! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
+//! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
+//! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
+
+use super::rng::PhotonRng;
+use super::stack::McStack;
+use crate::error::InvalidInput;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Weight below which Russian roulette is played (MCML's default, §3.6).
+pub const ROULETTE_THRESHOLD: f64 = 1e-4;
+/// A packet survives roulette with chance 1/m and weight ×m, m = 10 (MCML §3.6).
+pub const ROULETTE_CHANCE: f64 = 10.0;
+/// Most photons per channel accepted (refused before any work).
+pub const MAX_PHOTONS: u64 = 10_000_000_000;
+/// Most radial bins accepted.
+pub const MAX_BINS: usize = 100_000;
+/// Finest radial bin accepted, mm (1 nm; bins finer than this are below what the f64 positions resolve across
+/// a stack that is millimetres wide).
+pub const MIN_BIN_MM: f64 = 1e-6;
+/// Largest tallied radius (bins × Δr), mm.
+pub const MAX_RADIUS_MM: f64 = 1e4;
+/// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling).
+pub const CHUNK_PHOTONS: u64 = 256;
+/// Chunks traced in parallel before their tallies are summed in order.
+pub const WAVE_CHUNKS: usize = 64;
+
+/// Run settings, validated by [`McSettings::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct McSettings {
+    /// Photons per channel (rounded up to a multiple of `batches`; [`McResult::photons`] is the count traced).
+    pub photons: u64,
+    pub seed: u64,
+    /// Independent batches for the standard errors, 2..=1000.
+    pub batches: u32,
+    /// Radial bin width Δr, mm.
+    pub bin_mm: f64,
+    /// Number of radial bins (R and T each).
+    pub bins: usize,
+}
+
+impl McSettings {
+    /// Checks `photons` in 1..=[`MAX_PHOTONS`] (`photons`), `batches` in 2..=1000 (`batches`), `bin_mm` in
+    /// [`MIN_BIN_MM`]..=[`MAX_RADIUS_MM`] (`bin_mm`), `bins` in 1..=[`MAX_BINS`] with bins × Δr ≤ [`MAX_RADIUS_MM`]
+    /// (`bins`) — before anything is allocated.
+    pub fn new(photons: u64, seed: u64, batches: u32, bin_mm: f64, bins: usize) -> Result<Self, InvalidInput> {
+        if photons == 0 || photons > MAX_PHOTONS {
+            return Err(InvalidInput::new(
+                "photons",
+                format!("must be in 1..={MAX_PHOTONS} per channel, got {photons}"),
+            ));
+        }
+        crate::error::check_range("batches", batches, 2, 1000, "")?;
+        if !(bin_mm.is_finite() && (MIN_BIN_MM..=MAX_RADIUS_MM).contains(&bin_mm)) {
+            return Err(InvalidInput::new(
+                "bin_mm",
+                format!(
+                    "must be in {MIN_BIN_MM:e}..={MAX_RADIUS_MM} mm (finer bins are not representable), got {bin_mm}"
+                ),
+            ));
+        }
+        if bins == 0 || bins > MAX_BINS || bins as f64 * bin_mm > MAX_RADIUS_MM * (1.0 + 1e-12) {
+            return Err(InvalidInput::new(
+                "bins",
+                format!("must be in 1..={MAX_BINS} with bins x bin_mm <= {MAX_RADIUS_MM} mm, got {bins} x {bin_mm} mm"),
+            ));
+        }
+        Ok(Self { photons, seed, batches, bin_mm, bins })
+    }
+
+    /// Photons per batch (⌈N/B⌉).
+    pub fn photons_per_batch(&self) -> u64 {
+        self.photons.div_ceil(u64::from(self.batches))
+    }
+
+    /// Peak memory of [`simulate`] beyond the stack, bytes: ([`WAVE_CHUNKS`] + 3·batches + 1) tallies of 2·bins
+    /// f64 plus the result's 4·3·bins estimates.
+    pub fn memory_estimate_bytes(&self, layers: usize) -> u64 {
+        let tally = (2 * self.bins as u64 + layers as u64 + 4) * 8;
+        (WAVE_CHUNKS as u64 + 3 * u64::from(self.batches) + 1) * tally + 12 * 16 * self.bins as u64
+    }
+
+    /// Bin centres (i + ½)Δr, mm.
+    pub fn radii_mm(&self) -> Vec<f64> {
+        (0..self.bins).map(|i| (i as f64 + 0.5) * self.bin_mm).collect()
+    }
+}
+
+/// A Monte Carlo estimate and its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    pub mean: f64,
+    pub se: f64,
+}
+
+/// One channel's tallies.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelResult {
+    /// R(r) per bin, mm⁻², and its standard error.
+    pub reflectance_mm2: Vec<Estimate>,
+    /// T(r) per bin, mm⁻² (all zero for a semi-infinite stack).
+    pub transmittance_mm2: Vec<Estimate>,
+    /// Total diffuse reflectance (every exit through the top, also beyond the last bin).
+    pub diffuse_reflectance: Estimate,
+    /// Total transmittance (unscattered included).
+    pub transmittance: Estimate,
+    /// Specular reflectance Rsp (exact).
+    pub specular_reflectance: f64,
+    /// Absorbed fraction per layer.
+    pub absorbed: Vec<Estimate>,
+    /// Interactions (absorption + scattering events) traced, for photons-per-second figures.
+    pub interactions: u64,
+}
+
+/// Tallies of all three channels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct McResult {
+    pub settings: McSettings,
+    /// Photons traced per channel (batches × photons per batch).
+    pub photons: u64,
+    pub channels: [ChannelResult; 3],
+}
+
+/// Raw weight sums of a chunk or batch.
+#[derive(Clone, Debug)]
+struct Tally {
+    r: Vec<f64>,
+    t: Vec<f64>,
+    rd: f64,
+    td: f64,
+    absorbed: Vec<f64>,
+    interactions: u64,
+}
+
+impl Tally {
+    fn new(bins: usize, layers: usize) -> Self {
+        Self { r: vec![0.0; bins], t: vec![0.0; bins], rd: 0.0, td: 0.0, absorbed: vec![0.0; layers], interactions: 0 }
+    }
+    fn add(&mut self, o: &Tally) {
+        for (a, b) in self.r.iter_mut().zip(&o.r) {
+            *a += b;
+        }
+        for (a, b) in self.t.iter_mut().zip(&o.t) {
+            *a += b;
+        }
+        self.rd += o.rd;
+        self.td += o.td;
+        for (a, b) in self.absorbed.iter_mut().zip(&o.absorbed) {
+            *a += b;
+        }
+        self.interactions += o.interactions;
+    }
+}
+
+/// Per-layer constants of one channel.
+#[derive(Clone, Copy, Debug)]
+struct Medium {
+    z_top_mm: f64,
+    z_bottom_mm: f64,
+    sigma_t: f64,
+    /// σa/σt (0 in a clear layer).
+    absorb_fraction: f64,
+    g: f64,
+    eta: f64,
+}
+
+/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ [0, 1], and the cosine of
+/// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
+fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
+    if n_i == n_t {
+        return (0.0, cos_i);
+    }
+    let sin_t2 = (n_i / n_t).powi(2) * (1.0 - cos_i * cos_i).max(0.0);
+    if sin_t2 >= 1.0 {
+        return (1.0, 0.0);
+    }
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let rs = (n_i * cos_i - n_t * cos_t) / (n_i * cos_i + n_t * cos_t);
+    let rp = (n_i * cos_t - n_t * cos_i) / (n_i * cos_t + n_t * cos_i);
+    (0.5 * (rs * rs + rp * rp), cos_t)
+}
+
+/// HG cos θ from a uniform ξ (MCML eq. 3.28).
+#[inline]
+fn hg_cos_theta(g: f64, xi: f64) -> f64 {
+    if g.abs() < 1e-6 {
+        return 2.0 * xi - 1.0;
+    }
+    let f = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+    ((1.0 + g * g - f * f) / (2.0 * g)).clamp(-1.0, 1.0)
+}
+
+/// Rotates direction `u` by polar cos θ and azimuth φ (MCML eq. 3.30–3.31).
+#[inline]
+fn spin(u: [f64; 3], cos_t: f64, phi: f64) -> [f64; 3] {
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    // One cosine and a square root instead of sin and cos (MCML's `Spin` does the same).
+    let cos_p = phi.cos();
+    let sin_p = (1.0 - cos_p * cos_p).max(0.0).sqrt().copysign(PI - phi);
+    let [ux, uy, uz] = u;
+    if uz.abs() > 0.99999 {
+        [sin_t * cos_p, sin_t * sin_p, cos_t * uz.signum()]
+    } else {
+        let tmp = (1.0 - uz * uz).sqrt();
+        [
+            sin_t * (ux * uz * cos_p - uy * sin_p) / tmp + ux * cos_t,
+            sin_t * (uy * uz * cos_p + ux * sin_p) / tmp + uy * cos_t,
+            -sin_t * cos_p * tmp + uz * cos_t,
+        ]
+    }
+}
+
+/// What every photon of one channel shares.
+struct Channel<'a> {
+    media: &'a [Medium],
+    eta_above: f64,
+    eta_below: f64,
+    /// 1 − Rsp.
+    start_weight: f64,
+    index: u32,
+}
+
+/// Traces photons `first..first + count` of channel `ch` into `tally`.
+fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
+    let Channel { media, eta_above, eta_below, start_weight, index: channel } = *ch;
+    let inv_bin = 1.0 / settings.bin_mm;
+    let bins = settings.bins;
+    let last = media.len() - 1;
+    for k in first..first + count {
+        let mut rng = PhotonRng::new(settings.seed, k, channel);
+        let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
+        let mut u = [0.0f64, 0.0, 1.0];
+        let mut w = start_weight;
+        let mut layer = 0usize;
+        let mut s_left = 0.0f64;
+        loop {
+            let m = &media[layer];
+            if s_left == 0.0 {
+                s_left = -rng.uniform().ln();
+            }
+            let d_face = if u[2] > 0.0 {
+                (m.z_bottom_mm - z) / u[2]
+            } else if u[2] < 0.0 {
+                (m.z_top_mm - z) / u[2]
+            } else {
+                f64::INFINITY
+            };
+            let d_step = if m.sigma_t > 0.0 { s_left / m.sigma_t } else { f64::INFINITY };
+            if d_step.is_infinite() && d_face.is_infinite() {
+                // Gliding parallel to the faces of a clear layer: it never leaves; score it as absorbed there.
+                tally.absorbed[layer] += w;
+                break;
+            }
+            if d_face <= d_step {
+                // Move to the face, keep the rest of the optical depth.
+                x += u[0] * d_face;
+                y += u[1] * d_face;
+                z = if u[2] > 0.0 { m.z_bottom_mm } else { m.z_top_mm };
+                if m.sigma_t > 0.0 {
+                    s_left = (s_left - d_face * m.sigma_t).max(0.0);
+                }
+                let down = u[2] > 0.0;
+                let n_t = match (down, layer) {
+                    (false, 0) => eta_above,
+                    (false, j) => media[j - 1].eta,
+                    (true, j) if j == last => eta_below,
+                    (true, j) => media[j + 1].eta,
+                };
+                let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
+                if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
+                    u[2] = -u[2];
+                    continue;
+                }
+                let ratio = m.eta / n_t;
+                u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
+                match (down, layer) {
+                    (false, 0) => {
+                        tally.rd += w;
+                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
+                        if bin < bins {
+                            tally.r[bin] += w;
+                        }
+                        break;
+                    }
+                    (true, j) if j == last => {
+                        tally.td += w;
+                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
+                        if bin < bins {
+                            tally.t[bin] += w;
+                        }
+                        break;
+                    }
+                    (false, _) => layer -= 1,
+                    (true, _) => layer += 1,
+                }
+                continue;
+            }
+            // Interaction inside the layer.
+            x += u[0] * d_step;
+            y += u[1] * d_step;
+            z += u[2] * d_step;
+            s_left = 0.0;
+            tally.interactions += 1;
+            let dw = w * m.absorb_fraction;
+            tally.absorbed[layer] += dw;
+            w -= dw;
+            let cos_t = hg_cos_theta(m.g, rng.uniform());
+            u = spin(u, cos_t, 2.0 * PI * rng.uniform());
+            if w < ROULETTE_THRESHOLD {
+                if w == 0.0 {
+                    break;
+                }
+                if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
+                    w *= ROULETTE_CHANCE;
+                } else {
+                    break;
+                }
+            }
+        }
+    }
+}
+
+fn estimate(batch_values: impl Iterator<Item = f64> + Clone, total: f64, batches: usize) -> Estimate {
+    let b = batches as f64;
+    let mean = batch_values.clone().sum::<f64>() / b;
+    let var: f64 = batch_values.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (b * (b - 1.0));
+    Estimate { mean: total, se: var.sqrt() }
+}
+
+/// Runs the transport in every channel. Deterministic for a given (stack, settings), whatever the thread count.
+pub fn simulate(stack: &McStack, settings: &McSettings) -> McResult {
+    simulate_with_progress(stack, settings, &|_| {})
+}
+
+/// [`simulate`], calling `progress(fraction done)` after every wave of chunks (from the calling thread).
+pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: &dyn Fn(f64)) -> McResult {
+    let layers = stack.layers();
+    let n_layers = layers.len();
+    let batches = settings.batches as usize;
+    let per_batch = settings.photons_per_batch();
+    let chunks_per_batch = per_batch.div_ceil(CHUNK_PHOTONS);
+    let photons = per_batch * u64::from(settings.batches);
+    let n1 = layers[0].eta;
+    let rsp = ((stack.eta_above() - n1) / (stack.eta_above() + n1)).powi(2);
+
+    // Media per channel.
+    let media: Vec<Vec<Medium>> = (0..3)
+        .map(|c| {
+            let mut z = 0.0;
+            layers
+                .iter()
+                .map(|l| {
+                    let sigma_t = l.sigma_a_per_mm[c] + l.sigma_s_per_mm[c];
+                    let m = Medium {
+                        z_top_mm: z,
+                        z_bottom_mm: z + l.thickness_mm,
+                        sigma_t,
+                        absorb_fraction: if sigma_t > 0.0 { l.sigma_a_per_mm[c] / sigma_t } else { 0.0 },
+                        g: l.g[c],
+                        eta: l.eta,
+                    };
+                    z += l.thickness_mm;
+                    m
+                })
+                .collect()
+        })
+        .collect();
+
+    // Work list: (channel, batch, chunk) in a fixed order; every batch tally sums its chunks in chunk order.
+    let total_chunks = 3 * batches as u64 * chunks_per_batch;
+    let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
+    let mut next = 0u64;
+    while next < total_chunks {
+        let end = (next + WAVE_CHUNKS as u64).min(total_chunks);
+        let wave: Vec<(usize, Tally)> = (next..end)
+            .into_par_iter()
+            .map(|g| {
+                let channel = g / (batches as u64 * chunks_per_batch);
+                let rest = g % (batches as u64 * chunks_per_batch);
+                let (batch, chunk) = (rest / chunks_per_batch, rest % chunks_per_batch);
+                let first_in_batch = chunk * CHUNK_PHOTONS;
+                let count = CHUNK_PHOTONS.min(per_batch - first_in_batch);
+                let first = batch * per_batch + first_in_batch;
+                let mut t = Tally::new(settings.bins, n_layers);
+                let ch = Channel {
+                    media: &media[channel as usize],
+                    eta_above: stack.eta_above(),
+                    eta_below: stack.eta_below(),
+                    start_weight: 1.0 - rsp,
+                    index: channel as u32,
+                };
+                trace_chunk(&ch, settings, first, count, &mut t);
+                ((channel as usize) * batches + batch as usize, t)
+            })
+            .collect();
+        for (slot, t) in &wave {
+            batch_tallies[*slot].add(t);
+        }
+        next = end;
+        progress(next as f64 / total_chunks as f64);
+    }
+
+    let area = |i: usize| PI * (2 * i + 1) as f64 * settings.bin_mm * settings.bin_mm;
+    let channels = [0, 1, 2].map(|c| {
+        let bt = &batch_tallies[c * batches..(c + 1) * batches];
+        let mut sum = Tally::new(settings.bins, n_layers);
+        for t in bt {
+            sum.add(t);
+        }
+        let (n, nb) = (photons as f64, per_batch as f64);
+        let est = |f: &dyn Fn(&Tally) -> f64, scale: f64| {
+            estimate(bt.iter().map(|t| f(t) / (nb * scale)), f(&sum) / (n * scale), batches)
+        };
+        ChannelResult {
+            reflectance_mm2: (0..settings.bins).map(|i| est(&|t: &Tally| t.r[i], area(i))).collect(),
+            transmittance_mm2: (0..settings.bins).map(|i| est(&|t: &Tally| t.t[i], area(i))).collect(),
+            diffuse_reflectance: est(&|t: &Tally| t.rd, 1.0),
+            transmittance: est(&|t: &Tally| t.td, 1.0),
+            specular_reflectance: rsp,
+            absorbed: (0..n_layers).map(|j| est(&|t: &Tally| t.absorbed[j], 1.0)).collect(),
+            interactions: sum.interactions,
+        }
+    });
+    McResult { settings: *settings, photons, channels }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_limits() {
+        // Normal incidence: ((n1 - n2)/(n1 + n2))^2.
+        let (r, c) = fresnel(1.0, 1.5, 1.0);
+        assert!((r - 0.04).abs() < 1e-12 && (c - 1.0).abs() < 1e-12);
+        // Matched: no reflection. Past the critical angle from glass: total reflection.
+        assert_eq!(fresnel(1.4, 1.4, 0.3).0, 0.0);
+        assert_eq!(fresnel(1.5, 1.0, 0.5).0, 1.0);
+        // Grazing incidence reflects everything.
+        assert!(fresnel(1.0, 1.5, 1e-9).0 > 0.999);
+    }
+
+    #[test]
+    fn hg_mean_cosine_is_g() {
+        for g in [-0.5, 0.0, 0.75, 0.9] {
+            let n = 4000;
+            let mean: f64 = (0..n).map(|i| hg_cos_theta(g, (i as f64 + 0.5) / n as f64)).sum::<f64>() / n as f64;
+            assert!((mean - g).abs() < 2e-3, "g {g}: <cos> {mean}");
+        }
+    }
+
+    #[test]
+    fn settings_refuse_out_of_range() {
+        assert_eq!(McSettings::new(0, 1, 10, 0.01, 10).unwrap_err().param, "photons");
+        assert_eq!(McSettings::new(MAX_PHOTONS + 1, 1, 10, 0.01, 10).unwrap_err().param, "photons");
+        assert_eq!(McSettings::new(10, 1, 1, 0.01, 10).unwrap_err().param, "batches");
+        assert_eq!(McSettings::new(10, 1, 10, 1e-9, 10).unwrap_err().param, "bin_mm");
+        assert_eq!(McSettings::new(10, 1, 10, f64::NAN, 10).unwrap_err().param, "bin_mm");
+        assert_eq!(McSettings::new(10, 1, 10, 0.01, MAX_BINS + 1).unwrap_err().param, "bins");
+        assert_eq!(McSettings::new(10, 1, 10, 1.0, 20_000).unwrap_err().param, "bins");
+        assert_eq!(McSettings::new(10, 1, 10, 0.01, 100).unwrap().photons_per_batch(), 1);
+    }
+}

@@ -1,0 +1,20 @@
+//! Monte Carlo photon transport in plane-parallel layer stacks — the ground truth the diffusion profiles of
+//! [`crate::diffusion`] approximate (MCML: L. Wang, S. L. Jacques, L. Zheng, Comput. Methods Programs Biomed. 47,
+//! 1995). Pure computation: no files, no GPU.
+//!
+//! - [`stack`]: [`stack::McStack`], layers with σa, σs, HG g and η per channel (JSON, validated).
+//! - [`mc`]: the transport and its tallies (R(r), T(r) in mm⁻², totals, absorbed per layer, standard errors from
+//!   independent batches), deterministic for any thread count.
+//! - [`rng`]: Philox4x32-10, counter-based random numbers keyed by (seed, photon index).
+//! - [`compare`]: Monte Carlo against a diffusion [`RadialProfile`](crate::diffusion::RadialProfile) (total R,
+//!   r·R(r) error) and [`compare::diffusion_counterpart`], the diffusion model of a stack.
+//! - [`report`]: a result as CSV (the `rtbake profile --csv` layout) and JSON (with standard errors).
+
+pub mod compare;
+pub mod mc;
+pub mod report;
+pub mod rng;
+pub mod stack;
+
+pub use mc::{simulate, ChannelResult, Estimate, McResult, McSettings};
+pub use stack::{McLayer, McStack};
