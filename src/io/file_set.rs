@@ -245,7 +245,12 @@ pub fn probe_writable(dir: &Path) -> Result<(), FileSetError> {
     }
     fs::create_dir(&probe).map_err(|e| io_err(parent, e))?;
     fault_point("probe");
-    fs::remove_dir(&probe).map_err(|e| io_err(&probe, e))
+    match fs::remove_dir(&probe) {
+        // The probe is made without the lock: a concurrent writer's recovery, which owns every staging name under
+        // its lock, may already have removed it. Creating it was the proof of writability.
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        other => other.map_err(|e| io_err(&probe, e)),
+    }
 }
 
 /// Whether a killed writer left `dir` inside a fallback swap (missing, or a finished "ready" directory beside it):

@@ -181,6 +181,27 @@ fn a_probe_left_by_an_older_rtbake_is_not_carried_over() {
     assert!(rtbake(&["verify", "--dir", s(&d)]).status.success());
 }
 
+/// Found by `scripts/trial_reliability.sh` (1 of 24 concurrent rounds): a bake's writability probe, made before
+/// it takes the lock, was removed by a concurrent bake's recovery, and the first bake then failed "not writable".
+#[test]
+fn a_probe_removed_by_a_concurrent_recovery_does_not_fail_the_bake() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path().join("d");
+    let (mut first, mut err) = spawn(&["bake", A, "--out", s(&d)], "hold@probe");
+    wait_for(&mut err, "holding at probe");
+    // The second bake takes the lock, treats the probe as a stale staging directory and removes it.
+    assert!(rtbake(&["bake", B, "--out", s(&d), "-q"]).status.success());
+    release(&mut first);
+    let o = first.wait_with_output().unwrap();
+    assert!(o.status.success(), "first bake failed after its probe was removed: {}", stderr(&o));
+    let mut assets = assets_in(&d);
+    assets.sort();
+    let mut want = vec![A.to_string(), B.to_string()];
+    want.sort();
+    assert_eq!(assets, want);
+    assert!(rtbake(&["verify", "--dir", s(&d)]).status.success());
+}
+
 #[cfg(unix)]
 #[test]
 fn bake_through_a_symlink_updates_its_target_and_keeps_the_link() {
