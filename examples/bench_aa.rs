@@ -54,6 +54,10 @@ fn main() {
         let name = format!("MLAA AreaMap{n} v1.3 {0}x{0}", 5 * n);
         report(&name, median_of(runs, || mlaa_area_map(MlaaVersion::V1_3, n).unwrap().data.len()));
     }
+    report(
+        "MLAA AreaMap1023 v1.4 5115x5115",
+        median_of(runs, || mlaa_area_map(MlaaVersion::V1_4, 1023).unwrap().data.len()),
+    );
     report("MLAA 2.0 AreaTex 75x75", median_of(runs, || mlaa_area_map(MlaaVersion::V2, 15).unwrap().data.len()));
 
     let s = smaa.as_secs_f64();
