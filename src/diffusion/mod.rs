@@ -16,6 +16,7 @@
 //! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
 pub mod bessel;
+pub mod burley;
 pub mod dipole;
 pub mod hankel;
 pub mod layered;
