@@ -2,6 +2,7 @@
 //! or a user layer stack. One resolution path for every command that consumes profiles (`profile`, `fit`,
 //! `kernel`, `transmittance`), so they all accept the same inputs and record the same provenance.
 
+use super::burley::{RgbBurley, ShapeFit};
 use super::dipole::Dipole;
 use super::layered::{Adding, LayerStack, LayeredProfile};
 use super::materials::{self, JENSEN_2001_ETA};
@@ -28,6 +29,17 @@ pub enum ProfileSource {
     Preset(String),
     /// A user layer stack.
     Layers { stack: LayerStack, adding: Adding, series: Series, fdr: FdrForm },
+    /// Burley's normalized diffusion from per-channel surface albedo and mean free path (mm) with one shape fit.
+    Burley { albedo: [f64; 3], mean_free_path_mm: [f64; 3], fit: ShapeFit },
+}
+
+fn rgb(v: &Value, key: &str) -> Result<[f64; 3], InvalidInput> {
+    let a = v.get(key).and_then(Value::as_array).filter(|a| a.len() == 3);
+    let vals: Option<Vec<f64>> = a.and_then(|a| a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>());
+    match vals {
+        Some(x) => Ok([x[0], x[1], x[2]]),
+        None => Err(InvalidInput::new(key, "is required for model burley: three numbers [R, G, B]")),
+    }
 }
 
 fn series_json(series: Series) -> Value {
@@ -99,6 +111,12 @@ impl ProfileSource {
                 series: parse_series(v)?,
             }),
             "sum-of-gaussians" => Ok(ProfileSource::Preset(string("profile_preset")?)),
+            "burley" => Ok(ProfileSource::Burley {
+                albedo: rgb(v, "albedo")?,
+                mean_free_path_mm: rgb(v, "mean_free_path_mm")?,
+                fit: serde_json::from_value(v.get("shape_fit").cloned().unwrap_or(json!("diffuse-transmission")))
+                    .map_err(|e| InvalidInput::new("shape_fit", e.to_string()))?,
+            }),
             "layered" => {
                 let layers =
                     v.get("layers").ok_or_else(|| InvalidInput::new("layers", "is required for model layered"))?;
@@ -115,7 +133,7 @@ impl ProfileSource {
             }
             other => Err(InvalidInput::new(
                 "model",
-                format!("must be one of dipole, multipole, sum-of-gaussians, layered, got '{other}'"),
+                format!("must be one of dipole, multipole, sum-of-gaussians, layered, burley, got '{other}'"),
             )),
         }
     }
@@ -168,6 +186,9 @@ impl ProfileSource {
             ProfileSource::Layers { stack, adding, series, fdr } => {
                 Ok(Box::new(LayeredProfile::new(stack, *adding, *series, *fdr)?))
             }
+            ProfileSource::Burley { albedo, mean_free_path_mm, fit } => {
+                Ok(Box::new(RgbBurley::from_mean_free_path(*albedo, *mean_free_path_mm, *fit)?))
+            }
         }
     }
 
@@ -205,6 +226,14 @@ impl ProfileSource {
                 "fdr": fdr_name(*fdr),
                 "layers": stack.to_json(),
                 "units": "r in mm, R and T in mm^-2",
+            }),
+            ProfileSource::Burley { albedo, mean_free_path_mm, fit } => json!({
+                "model": "burley",
+                "albedo": albedo,
+                "mean_free_path_mm": mean_free_path_mm,
+                "shape_fit": fit.name(),
+                "reference": "Christensen & Burley 2015, normalized diffusion",
+                "units": "r in mm, R in mm^-2",
             }),
         }
     }
