@@ -15,6 +15,7 @@
 //!   `crate::plot::profile`: a table as a two-panel plot (r·R(r) over log r, R(r) log–log) in PNG or SVG.
 //! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
+pub mod albedo_inversion;
 pub mod bessel;
 pub mod burley;
 pub mod dipole;
