@@ -143,7 +143,8 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let files = rtbake::bake::gaussians::gaussian_files(&file_stem, &fit.sum, stretch, extra, &plot)
             .map_err(|e| anyhow::anyhow!(e))?;
         prepare_out_dir("--out", dir)?;
-        let inputs: Vec<&std::path::Path> = a.layered.layers.iter().map(|p| p.as_path()).collect();
+        let inputs: Vec<&std::path::Path> =
+            a.layered.layers.iter().chain(&a.layered.profile_csv).map(|p| p.as_path()).collect();
         crate::cli::write_set(ctx, "--out", dir, &files, &inputs)?;
         obj.insert(
             "files".into(),

@@ -34,11 +34,16 @@ pub struct LayeredArgs {
     /// Truncate the multipole image series to i = -N..N (default: exact infinite series)
     #[arg(long, value_name = "N")]
     pub dipole_pairs: Option<u32>,
+    /// Target: your own profile as CSV, the layout `rtbake profile --csv` and `rtbake transport --csv` write (`#`
+    /// comments, header r_mm,R_r,R_g,R_b or r_mm,R, rows of r in mm strictly increasing and R in mm^-2 >= 0, any
+    /// spacing, >= 2 rows); interpolated linearly in log r, 0 beyond the last radius
+    #[arg(long, value_name = "FILE")]
+    pub profile_csv: Option<PathBuf>,
 }
 
 impl LayeredArgs {
     pub fn is_set(&self) -> bool {
-        self.layers.is_some() || self.skin_melanin.is_some()
+        self.layers.is_some() || self.skin_melanin.is_some() || self.profile_csv.is_some()
     }
 
     /// Resolves the layered source, if one was given: (profile, provenance, file stem).
@@ -46,8 +51,24 @@ impl LayeredArgs {
         if !self.is_set() {
             return Ok(None);
         }
-        if self.layers.is_some() && self.skin_melanin.is_some() {
-            return Err(usage_msg("--layers and --skin-melanin/--skin-hemoglobin are exclusive"));
+        let given = [self.layers.is_some(), self.skin_melanin.is_some(), self.profile_csv.is_some()];
+        if given.iter().filter(|&&g| g).count() > 1 {
+            return Err(usage_msg("--layers, --skin-melanin/--skin-hemoglobin and --profile-csv are exclusive"));
+        }
+        if let Some(path) = &self.profile_csv {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| usage(anyhow::anyhow!("--profile-csv {}: cannot read: {e}", path.display())))?;
+            let profile =
+                rtbake::diffusion::tabulated::TabulatedProfile::from_csv_str(&text, &path.display().to_string())
+                    .map_err(|e| usage(anyhow::anyhow!("--profile-csv {e}")))?;
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "profile".into());
+            let provenance = json!({
+                "model": "tabulated",
+                "file": path.display().to_string(),
+                "rows": profile.r_mm.len(),
+                "interpolation": "linear in log r; held below the first radius, 0 above the last",
+            });
+            return Ok(Some((Box::new(profile), provenance, stem)));
         }
         let adding = Adding::from(self.adding);
         if let Some(n) = self.dipole_pairs {

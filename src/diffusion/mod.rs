@@ -27,6 +27,7 @@ pub mod quadrature;
 pub mod source;
 pub mod sum_of_gaussians;
 pub mod table;
+pub mod tabulated;
 
 /// An RGB radial diffusion profile R(r) in mm⁻² (r in mm), with its total ∫₀^∞ 2πr R(r) dr.
 ///

@@ -1,6 +1,8 @@
-//! `rtbake profile --burley-albedo … --burley-mfp-mm …` (issue 11, part): Burley's normalized diffusion as a
-//! profile source — the values are the library's closed form, the totals are the albedos, the provenance rebuilds
-//! the same profile, and bad input exits 2 naming the flag and the channel.
+//! Issue 11 (part), user-facing profile inputs. `rtbake profile --burley-albedo … --burley-mfp-mm …`: Burley's
+//! normalized diffusion as a profile source (the values are the library's closed form, the totals are the albedos,
+//! the provenance rebuilds the same profile, bad input exits 2 naming the flag and the channel). `--profile-csv`:
+//! a tabulated profile in the `rtbake profile --csv` layout for the fits (rtbake's own output reproduces the
+//! built-in fit; bad CSVs exit 2 naming the file and the row).
 
 use crate::support::rtbake;
 use rtbake::diffusion::burley::{Burley, ShapeFit};
@@ -61,4 +63,63 @@ fn bad_burley_input_exits_2_naming_the_flag() {
     }
     let o = rtbake(&["profile", "--burley-albedo", "0.5,0.5,0.5", "--csv", c]);
     assert_eq!(o.status.code(), Some(2), "--burley-albedo needs --burley-mfp-mm");
+}
+
+/// `--profile-csv` (issue 11): rtbake's own `profile --csv` output fed back reproduces the fit of the built-in
+/// profile (variances within 0.5 %, every weight above 1 % of the largest within 1 %, error within 0.05 points).
+#[test]
+fn profile_csv_of_a_built_in_profile_reproduces_its_gaussian_fit() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("skin1.csv");
+    let o = rtbake(&["profile", "--material", "skin1", "--csv", csv.to_str().unwrap(), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let fit = |args: &[&str]| -> serde_json::Value {
+        let mut a = vec!["--json", "fit", "gaussians"];
+        a.extend(args);
+        let o = rtbake(&a);
+        assert_eq!(o.status.code(), Some(0), "{a:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let (built_in, from_csv) = (fit(&["--material", "skin1"]), fit(&["--profile-csv", csv.to_str().unwrap()]));
+    fn nums(v: &serde_json::Value) -> Vec<f64> {
+        match v {
+            serde_json::Value::Array(a) => a.iter().flat_map(nums).collect(),
+            x => vec![x.as_f64().unwrap()],
+        }
+    }
+    for (a, b) in nums(&built_in["variances"]).iter().zip(nums(&from_csv["variances"])) {
+        assert!((a - b).abs() <= 5e-3 * a, "variance {a} vs {b}");
+    }
+    let (wa, wb) = (nums(&built_in["weights"]), nums(&from_csv["weights"]));
+    let wmax = wa.iter().cloned().fold(0.0, f64::max);
+    for (a, b) in wa.iter().zip(&wb) {
+        if *a > 0.01 * wmax {
+            assert!((a - b).abs() <= 1e-2 * a, "weight {a} vs {b}");
+        }
+    }
+    for (a, b) in nums(&built_in["error_percent"]).iter().zip(nums(&from_csv["error_percent"])) {
+        assert!((a - b).abs() <= 0.05, "error {a} vs {b}");
+    }
+    assert_eq!(from_csv["source"]["model"], "tabulated", "{}", from_csv["source"]);
+}
+
+#[test]
+fn bad_profile_csvs_exit_2_naming_the_row() {
+    let t = tempfile::tempdir().unwrap();
+    for (name, text, needle) in [
+        ("empty.csv", "", "is empty"),
+        ("nan.csv", "r_mm,R\n0.1,1\n0.2,NaN\n", "row 3"),
+        ("decreasing.csv", "r_mm,R\n0.2,1\n0.1,1\n", "row 3"),
+        ("negative.csv", "r_mm,R_r,R_g,R_b\n0.1,1,1,1\n0.2,1,-1,1\n", "row 3"),
+        ("one_row.csv", "r_mm,R\n0.1,1\n", "at least 2 rows"),
+    ] {
+        let path = t.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = t.path().join("out");
+        let o = rtbake(&["fit", "separable", "--profile-csv", path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("--profile-csv") && err.contains(name) && err.contains(needle), "{name}: {err}");
+        assert!(!out.exists());
+    }
 }
