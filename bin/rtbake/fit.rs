@@ -1,7 +1,9 @@
-//! `rtbake fit gaussians|separable`.
+//! `rtbake fit gaussians|separable|burley`.
 
 use crate::cli::Ctx;
 
+#[path = "fit_burley.rs"]
+mod fit_burley;
 #[path = "fit_gaussians.rs"]
 mod fit_gaussians;
 #[path = "fit_separable.rs"]
@@ -13,6 +15,8 @@ pub enum FitCommand {
     Gaussians(fit_gaussians::FitGaussiansArgs),
     /// Fit the separable-SSS kernel's strength and falloff (thesis eq. 6.1–6.3).
     Separable(fit_separable::FitSeparableArgs),
+    /// Fit Burley's normalized diffusion (albedo A and shape parameter d per channel, Christensen & Burley 2015).
+    Burley(fit_burley::FitBurleyArgs),
 }
 
 pub use fit_gaussians::fit_error;
@@ -21,5 +25,6 @@ pub fn run(cmd: FitCommand, ctx: &Ctx) -> anyhow::Result<()> {
     match cmd {
         FitCommand::Gaussians(a) => fit_gaussians::run(a, ctx),
         FitCommand::Separable(a) => fit_separable::run(a, ctx),
+        FitCommand::Burley(a) => fit_burley::run(a, ctx),
     }
 }

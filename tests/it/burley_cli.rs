@@ -123,3 +123,26 @@ fn bad_profile_csvs_exit_2_naming_the_row() {
         assert!(!out.exists());
     }
 }
+
+/// `rtbake fit burley` recovers the parameters of a Burley profile written by `rtbake profile --csv` (through the
+/// CSV's interpolation: within 1 %), and names what is missing.
+#[test]
+fn fit_burley_recovers_a_burley_profile_from_its_csv() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("b.csv");
+    let c = csv.to_str().unwrap();
+    let o = rtbake(&["profile", "--burley-albedo", "0.8,0.5,0.2", "--burley-mfp-mm", "3,1.5,0.8", "--csv", c, "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rtbake(&["--json", "fit", "burley", "--profile-csv", c]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for (ch, (a, mfp)) in [(0.8, 3.0), (0.5, 1.5), (0.2, 0.8)].iter().enumerate() {
+        let want = Burley::from_mean_free_path(*a, *mfp, ShapeFit::DiffuseTransmission).unwrap();
+        let (ga, gd) = (v["albedo"][ch].as_f64().unwrap(), v["d_mm"][ch].as_f64().unwrap());
+        assert!((ga - want.albedo).abs() < 0.01 * want.albedo, "channel {ch}: A {ga} vs {}", want.albedo);
+        assert!((gd - want.d_mm).abs() < 0.01 * want.d_mm, "channel {ch}: d {gd} vs {}", want.d_mm);
+    }
+    let o = rtbake(&["fit", "burley"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--profile-csv"));
+}
