@@ -245,6 +245,8 @@ fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
 fn antialias_file(ctx: &Ctx, a: &AaArgs, img: Image<u8>, aa: &Antialiasing, name: &str) -> anyhow::Result<()> {
     let gpu = device(ctx, a.common.cpu)?;
     let t = Instant::now();
+    let (bytes, seconds) = chain::antialias_estimate(img.width, img.height, aa, gpu.is_some());
+    ctx.check_budget(&format!("--input {} ({}x{})", a.input.display(), img.width, img.height), bytes, seconds)?;
     let out = chain::antialias(gpu.as_ref(), &img, aa)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &io::png::encode_u8_frame(&out)?)?;
@@ -332,6 +334,8 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
         (None, Some(f)) => Subsurface::Gaussians { blurs: &f.blurs, params: f.params },
         (None, None) => unreachable!("one SSS method is selected"),
     };
+    let (bytes, seconds) = rtbake::runtime::chain::subsurface_estimate(w, h, &method, gpu.is_some());
+    ctx.check_budget(&format!("--color {} ({w}x{h})", a.color.display()), bytes, seconds)?;
     let out = rtbake::runtime::chain::subsurface(gpu.as_ref(), &rgba, &d, (w, h), &method)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     let img = Image::from_vec(w, h, 4, out);

@@ -153,6 +153,10 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
         .map_err(|e| flag_error(e, None))?;
     let (stack, mut provenance, title) = resolve(&args)?;
     ctx.check_memory("--bins/--batches", settings.memory_estimate_bytes(stack.layers().len()))?;
+    ctx.check_time(
+        &format!("--photons {}", args.photons),
+        settings.time_estimate_seconds(rayon::current_num_threads()),
+    )?;
     for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
         if let Some(p) = path {
             check_output_file(flag, p)?;

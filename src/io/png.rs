@@ -153,8 +153,25 @@ pub enum DecodedPng {
 
 /// Decodes a PNG keeping its channel count and bit depth.
 pub fn decode(bytes: &[u8], path: &str) -> Result<DecodedPng, IoError> {
-    let err = |e: image::ImageError| IoError::Decode { path: path.to_string(), detail: e.to_string() };
-    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(err)?;
+    let edge = crate::error::MAX_TEXTURE_EDGE;
+    let err = |e: image::ImageError| {
+        let detail = match &e {
+            image::ImageError::Limits(_) => {
+                format!("{e} (accepted: width and height up to {edge} texels, 8 or 16 bits, 1 to 4 channels)")
+            }
+            _ => e.to_string(),
+        };
+        IoError::Decode { path: path.to_string(), detail }
+    };
+    // rtbake's own size range, not the decoder's default 512 MiB allocation cap (which refused 16384² RGBA8 inputs
+    // that --help allows); the commands then check their memory budget against the decoded size.
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(edge);
+    limits.max_image_height = Some(edge);
+    limits.max_alloc = Some(edge as u64 * edge as u64 * 8 + (64 << 20));
+    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Png);
+    reader.limits(limits);
+    let img = reader.decode().map_err(err)?;
     let (w, h) = (img.width(), img.height());
     use image::DynamicImage as D;
     Ok(match img {
@@ -192,6 +209,19 @@ impl DecodedPng {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn decode_accepts_rtbakes_size_range_and_names_it_beyond() {
+        // 16385 × 1 is beyond the edge range: refused by the decoder's limits, with the accepted range named.
+        let wide = Image::from_vec(16385, 1, 1, vec![7u8; 16385]);
+        let Err(e) = decode(&encode_u8(&wide).unwrap(), "wide.png") else { panic!("16385 wide decoded") };
+        let e = e.to_string();
+        assert!(e.contains("wide.png") && e.contains("up to 16384"), "{e}");
+        let ok = Image::from_vec(16384, 2, 4, vec![9u8; 16384 * 2 * 4]);
+        let decoded = decode(&encode_u8(&ok).unwrap(), "ok.png");
+        assert!(matches!(decoded, Ok(DecodedPng::U8(ref i)) if i.width == 16384));
+    }
+
     use super::*;
 
     #[test]

@@ -108,6 +108,14 @@ impl McSettings {
         (WAVE_CHUNKS as u64 + 3 * u64::from(self.batches) + 1) * tally + 12 * 16 * self.bins as u64
     }
 
+    /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
+    /// 250 000 photons/s per thread, the slowest case measured with the release build on the project's 2-core
+    /// machine (semi-infinite, albedo 0.9, mismatched boundary: 0.28–0.32 M/s on one thread); thin or absorbing
+    /// stacks run up to ten times faster, so this is an upper estimate.
+    pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
+        3.0 * self.photons as f64 / (250_000.0 * threads.max(1) as f64)
+    }
+
     /// Bin centres (i + ½)Δr, mm.
     pub fn radii_mm(&self) -> Vec<f64> {
         (0..self.bins).map(|i| (i as f64 + 0.5) * self.bin_mm).collect()

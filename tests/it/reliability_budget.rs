@@ -75,6 +75,14 @@ fn the_largest_sizes_help_allows_are_refused_up_front_when_they_exceed_the_time_
         &["--samples 16384 --height 16384", "--max-seconds 60"],
         "time budget of 60 s",
     );
+    // Monte Carlo transport at the largest photon count.
+    refused(
+        &["transport", "--material", "skin1", "--photons", "10000000000"],
+        "--csv",
+        &out,
+        &["--photons 10000000000", "default --max-seconds 600"],
+        "time budget of 600 s",
+    );
     // The demo at its largest frame on the CPU.
     refused(
         &[
@@ -155,4 +163,55 @@ fn estimates_scale_with_the_work() {
         rtbake::diffusion::layered::profile_time_estimate_seconds(2, 1_000_000, Series::Truncated { pairs: 10_000 }, 2);
     assert!(exact > 10.0 && exact < 600.0, "the default 10⁶-radius skin profile is served: {exact}");
     assert!(pairs > 600.0, "10⁶ radii at 10 000 pairs is refused by default: {pairs}");
+}
+
+/// `run smaa|mlaa|sss` estimate their pass from the decoded input's size before running it.
+#[test]
+fn run_passes_estimate_from_the_input_size() {
+    let t = tempfile::tempdir().unwrap();
+    let baked = crate::support::baked_dir();
+    let b = s(&baked);
+    let frame = t.path().join("f.png");
+    let inputs = t.path().join("si");
+    let o = rtbake(&[
+        "run",
+        "demo",
+        "--cpu",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--output",
+        s(&frame),
+        "--sss-inputs",
+        s(&inputs),
+        "--baked-dir",
+        b,
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = t.path().join("o.png");
+    for pass in ["smaa", "mlaa"] {
+        let args = ["run", pass, "--cpu", "--input", s(&frame), "--baked-dir", b, "--max-seconds", "0.00001"];
+        refused(&args, "--output", &out, &["--input", "(64x48)", "--max-seconds"], "time budget");
+        let args = ["run", pass, "--cpu", "--input", s(&frame), "--baked-dir", b, "--max-memory", "1M"];
+        refused(&args, "--output", &out, &["--input", "(64x48)", "--max-memory"], "MiB");
+    }
+    let (color, depth) = (inputs.join("irradiance.exr"), inputs.join("depth.exr"));
+    let out = t.path().join("o.exr");
+    let args =
+        ["run", "sss", "--cpu", "--color", s(&color), "--depth", s(&depth), "--baked-dir", b, "--max-memory", "1M"];
+    refused(&args, "--output", &out, &["--color", "(64x48)", "--max-memory"], "MiB");
+    // Within the default budgets the same passes run.
+    let o = rtbake(&[
+        "run",
+        "smaa",
+        "--cpu",
+        "--input",
+        s(&frame),
+        "--baked-dir",
+        b,
+        "--output",
+        s(&t.path().join("ok.png")),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
 }
