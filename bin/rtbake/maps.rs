@@ -374,6 +374,8 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
     let cone = if a.cone == "reject" { wrinkles::ConeMode::Reject } else { wrinkles::ConeMode::Clamp };
     let np = a.normal.display().to_string();
     let normal = inputs::decode_normal_map("--normal", &np, &read_input("--normal", &a.normal)?)?;
+    let (bytes, seconds) = wrinkles::wrinkle_estimate(normal.width, normal.height, a.base.is_some());
+    ctx.check_budget(&format!("--normal {np} ({}x{})", normal.width, normal.height), bytes, seconds)?;
     let base = match &a.base {
         None => None,
         Some(b) => {
@@ -462,7 +464,16 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
                     img.width, img.height
                 )));
             }
-            None => dims = Some((img.width, img.height, file.to_string())),
+            None => {
+                let zones = a.zones.iter().flat_map(|z| z.split(',')).count();
+                let (bytes, seconds) = wrinkles::mask_estimate(img.width, img.height, zones);
+                ctx.check_budget(
+                    &format!("--zone x{zones} ({}x{} from {file})", img.width, img.height),
+                    bytes,
+                    seconds,
+                )?;
+                dims = Some((img.width, img.height, file.to_string()))
+            }
             _ => {}
         }
         masks[i] = Some(img.data.iter().map(|&v| v as f64).collect());

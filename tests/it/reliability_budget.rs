@@ -215,3 +215,26 @@ fn run_passes_estimate_from_the_input_size() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// `maps wrinkles` and `maps wrinkle-masks` estimate from the decoded input before the conversion.
+#[test]
+fn wrinkle_conversions_estimate_from_the_input_size() {
+    let t = tempfile::tempdir().unwrap();
+    let normal = t.path().join("n.png");
+    let px: Vec<u8> = (0..64 * 64).flat_map(|_| [140u8, 120, 240]).collect();
+    std::fs::write(&normal, rtbake::io::png::encode_u8(&rtbake::Image::from_vec(64, 64, 3, px)).unwrap()).unwrap();
+    let zone = t.path().join("z.png");
+    std::fs::write(
+        &zone,
+        rtbake::io::png::encode_u8(&rtbake::Image::from_vec(64, 64, 1, vec![90u8; 64 * 64])).unwrap(),
+    )
+    .unwrap();
+    let out = t.path().join("o");
+    let args = ["maps", "wrinkles", "--normal", s(&normal), "--max-memory", "1M"];
+    refused(&args, "--out", &out, &["--normal", "(64x64)", "--max-memory"], "MiB");
+    let zone_arg = format!("red={}", s(&zone));
+    let args = ["maps", "wrinkle-masks", "--zone", &zone_arg, "--max-seconds", "0.001"];
+    refused(&args, "--out", &out, &["--zone x1", "(64x64", "--max-seconds"], "time budget");
+    let o = rtbake(&["maps", "wrinkles", "--normal", s(&normal), "--size", "16", "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+}
