@@ -7,6 +7,7 @@
 mod aa;
 mod bake;
 mod cli;
+mod evaluate;
 mod fit;
 mod kernel;
 mod maps;
@@ -69,6 +70,9 @@ enum Command {
     /// Fit diffusion profiles: sums of Gaussians, or the separable-SSS kernel.
     #[command(subcommand)]
     Fit(fit::FitCommand),
+    /// Report the error of given parameters (Gaussians, separable strength/falloff, Burley) against a target
+    /// profile; --max-error gates a pipeline (exit 1 above it).
+    Evaluate(evaluate::EvaluateArgs),
     /// Generate separable-SSS kernel taps from strength and falloff.
     Kernel(kernel::KernelArgs),
     /// Evaluate or bake the transmittance table T(s) (thesis eq. 5.12).
@@ -127,6 +131,7 @@ fn main() {
         Command::Aa(a) => aa::run(a, &ctx),
         Command::Profile(a) => profile::run(a, &ctx),
         Command::Fit(c) => fit::run(c, &ctx),
+        Command::Evaluate(a) => evaluate::run(a, &ctx),
         Command::Kernel(a) => kernel::run(a, &ctx),
         Command::Transmittance(a) => transmittance::run(a, &ctx),
         Command::Transport(a) => transport::run(a, &ctx),

@@ -10,6 +10,7 @@
 //! Everything here is pure computation over a `&dyn RadialProfile`; nothing touches files.
 
 pub mod burley_fit;
+pub mod evaluate;
 pub mod nnls;
 pub mod quadrature;
 pub mod screen_space;

@@ -261,6 +261,44 @@ pub struct GaussiansFile {
     pub extra: serde_json::Map<String, Value>,
 }
 
+impl GaussiansFile {
+    /// The sum of Gaussians the file describes (`rtbake evaluate --gaussians`): shared → `variances` [v…] and
+    /// `weights` [[r,g,b] per Gaussian]; per channel → both [[r…],[g…],[b…]]. Checks shapes, finiteness, v > 0 and
+    /// w ≥ 0, naming the field.
+    pub fn sum(&self) -> Result<RgbGaussians, InvalidInput> {
+        fn parse<T: serde::de::DeserializeOwned>(v: &Value, key: &str, shape: &str) -> Result<T, InvalidInput> {
+            serde_json::from_value(v.clone()).map_err(|e| InvalidInput::new(key, format!("must be {shape}: {e}")))
+        }
+        let sum = if self.shared_variances {
+            let v: Vec<f64> = parse(&self.variances, "variances", "an array of numbers (shared_variances)")?;
+            let w: Vec<[f64; 3]> = parse(&self.weights, "weights", "an array of [r, g, b] (shared_variances)")?;
+            if v.len() != w.len() {
+                return Err(InvalidInput::new("weights", format!("has {} entries for {} variances", w.len(), v.len())));
+            }
+            RgbGaussians::from(&crate::diffusion::sum_of_gaussians::SumOfGaussians { variances_mm2: v, weights: w })
+        } else {
+            let v: [Vec<f64>; 3] = parse(&self.variances, "variances", "[[r…], [g…], [b…]] (per channel)")?;
+            let w: [Vec<f64>; 3] = parse(&self.weights, "weights", "[[r…], [g…], [b…]] (per channel)")?;
+            if (0..3).any(|c| v[c].len() != w[c].len()) {
+                return Err(InvalidInput::new("weights", "needs one weight per variance in every channel"));
+            }
+            RgbGaussians { variances_mm2: v, weights: w }
+        };
+        for c in 0..3 {
+            if sum.variances_mm2[c].is_empty() {
+                return Err(InvalidInput::new("variances", "must hold at least one Gaussian"));
+            }
+            if sum.variances_mm2[c].iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(InvalidInput::new("variances", "must be finite and > 0 (mm^2)"));
+            }
+            if sum.weights[c].iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
+                return Err(InvalidInput::new("weights", "must be finite and >= 0"));
+            }
+        }
+        Ok(sum)
+    }
+}
+
 /// α, β, γ of the screen-space pass (eq. 4.5–4.6) and the per-Gaussian depth thresholds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LodThresholds {

@@ -143,6 +143,17 @@ pub const CHANNEL_COLORS: [[u8; 3]; 3] = [[200, 30, 30], [20, 140, 40], [30, 60,
 /// r·R(r) (mm⁻¹) on a log r axis per channel, with an optional fitted sum overlaid (dashed). The r range spans the
 /// profile's 0.1 %–99.9 % energy quantiles, widened by 3× on both sides; 240 log-spaced points.
 pub fn fit_overlay_plot(profile: &dyn RadialProfile, fit: Option<&RgbGaussians>, title: &str) -> LinePlot {
+    overlay_plot(profile, "profile", fit.map(|f| (f as &dyn RadialProfile, "fit")), title)
+}
+
+/// r·R(r) (mm⁻¹) of `profile` (solid, legend `name R/G/B`) with any other profile overlaid (dashed, legend
+/// `label R/G/B`), over the range of [`fit_overlay_plot`] (`rtbake evaluate` plots a candidate on its target).
+pub fn overlay_plot(
+    profile: &dyn RadialProfile,
+    name: &str,
+    overlay: Option<(&dyn RadialProfile, &str)>,
+    title: &str,
+) -> LinePlot {
     use crate::fitting::quadrature;
     use crate::fitting::sum_of_gaussians_fit;
     let grid = quadrature::RadialGrid::standard();
@@ -156,16 +167,16 @@ pub fn fit_overlay_plot(profile: &dyn RadialProfile, fit: Option<&RgbGaussians>,
     let mut series = Vec::new();
     for c in 0..3 {
         series.push(Curve {
-            label: format!("profile {}", names[c]),
+            label: format!("{name} {}", names[c]),
             color: CHANNEL_COLORS[c],
             dashed: false,
             points: rs.iter().map(|&r| (r, r * profile.reflectance_mm2(r)[c])).collect(),
         });
     }
-    if let Some(f) = fit {
+    if let Some((f, label)) = overlay {
         for c in 0..3 {
             series.push(Curve {
-                label: format!("fit {}", names[c]),
+                label: format!("{label} {}", names[c]),
                 color: CHANNEL_COLORS[c].map(|v| v / 2),
                 dashed: true,
                 points: rs.iter().map(|&r| (r, r * f.reflectance_mm2(r)[c])).collect(),

@@ -471,6 +471,39 @@ pub fn objective_at_width(target: &TargetKernel, params: &SeparableParams, width
     })
 }
 
+/// Relative errors of the separable model s̃⊗s̃ with `params` against the pixel-filtered target kernel S̃ on the
+/// fit's tensor grid, per channel, percent (`rtbake evaluate --separable`): the relative L2
+/// √(Σ (S̃ − s̃⊗s̃)² / Σ S̃²) over the grid (the plain sum of eq. 6.3 as [`objective`] uses it, relative to the
+/// target) and the max |S̃ − s̃⊗s̃| / max S̃. Both kernels have unit total by construction (module docs).
+pub fn kernel_errors(target: &TargetKernel, params: &SeparableParams) -> ([f64; 3], [f64; 3]) {
+    let model = Model::new(&target.spec);
+    let n = target.nodes_mm.len();
+    let mut l2 = [0.0; 3];
+    let mut max = [0.0; 3];
+    for c in 0..3 {
+        let s = model.filtered(&target.nodes_mm, params.strength[c], params.falloff[c]);
+        let (mut num, mut den, mut worst, mut peak) = (0.0, 0.0, 0.0f64, 0.0f64);
+        for i in 0..n {
+            for j in 0..n {
+                let t = target.values[c][i * n + j];
+                let d = t - s[i] * s[j];
+                num += d * d;
+                den += t * t;
+                worst = worst.max(d.abs());
+                peak = peak.max(t.abs());
+            }
+        }
+        l2[c] = 100.0 * (num / den).sqrt();
+        max[c] = 100.0 * worst / peak;
+    }
+    (l2, max)
+}
+
+/// The separable model's pixel-filtered 1-D kernel s̃(x) at `nodes_mm` (for plots next to the target's row).
+pub fn model_row(spec: &ObjectiveSpec, params: &SeparableParams, channel: usize, nodes_mm: &[f64]) -> Vec<f64> {
+    Model::new(spec).filtered(nodes_mm, params.strength[channel], params.falloff[channel])
+}
+
 /// One channel's problem in the reparameterised variables (θ, φ): t = sin²θ, f = φ².
 struct ChannelProblem<'a> {
     model: &'a Model,

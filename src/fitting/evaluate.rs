@@ -1,0 +1,141 @@
+//! Evaluating given profile parameters against a target profile (issue 11: `rtbake evaluate`).
+//!
+//! A candidate radial profile (a sum of Gaussians, Burley's normalized diffusion, any [`RadialProfile`]) is compared
+//! with a target on the fixed radial grid of the fits ([`RadialGrid::standard`], 1e-5..1e3 mm, 16 nodes per decade)
+//! with the metrics the fits report:
+//!
+//! - **relative L2 of r·R(r)** (the curve the papers plot), √(∫ (r (R_cand − R_target))² dr / ∫ (r R_target)² dr),
+//!   percent — the metric of [`super::burley_fit`];
+//! - **max**: max_r |r ΔR(r)| / max_r |r R_target(r)|, percent (the largest deviation of the plotted curve, relative
+//!   to its peak);
+//! - **totals**: ∫ 2πr R dr of both and their difference (candidate − target), the colour a renderer would shift.
+//!
+//! With `normalize`, both profiles are divided by their own totals first (shape only; the separable kernel and a
+//! normalised fit conserve energy and take colour from the albedo). The separable kernel is not radial; its errors
+//! are [`crate::separable::fit::kernel_errors`] on the fit's 2-D grid.
+
+use super::quadrature::RadialGrid;
+use crate::diffusion::RadialProfile;
+use crate::error::InvalidInput;
+
+/// Errors of a candidate profile against a target, per channel.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ProfileErrors {
+    /// Relative L2 of r·R(r), percent.
+    pub relative_l2_percent: [f64; 3],
+    /// max |r ΔR| / max |r R_target|, percent.
+    pub max_percent: [f64; 3],
+    /// ∫ 2πr R dr of the candidate (1 with `normalize`).
+    pub candidate_totals: [f64; 3],
+    /// ∫ 2πr R dr of the target (1 with `normalize`).
+    pub target_totals: [f64; 3],
+    /// candidate − target totals.
+    pub total_difference: [f64; 3],
+    /// Whether both were normalised to unit totals first.
+    pub normalized: bool,
+}
+
+impl ProfileErrors {
+    /// The largest relative L2 over the channels (what `--max-error` gates on).
+    pub fn worst_relative_l2_percent(&self) -> f64 {
+        self.relative_l2_percent.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+/// Compares `candidate` with `target` (module docs); both must be finite and non-negative on the grid, with
+/// positive totals when `normalize` is set.
+pub fn compare_profiles(
+    candidate: &dyn RadialProfile,
+    target: &dyn RadialProfile,
+    normalize: bool,
+) -> Result<ProfileErrors, InvalidInput> {
+    let grid = RadialGrid::standard();
+    let cand = candidate.reflectance_many(&grid.r_mm);
+    let targ = target.reflectance_many(&grid.r_mm);
+    for (name, values) in [("candidate", &cand), ("target", &targ)] {
+        for (k, v) in values.iter().enumerate() {
+            if let Some(c) = (0..3).find(|&c| !(v[c].is_finite() && v[c] >= 0.0)) {
+                return Err(InvalidInput::new(
+                    name,
+                    format!("R at r = {} mm (channel {c}) is {}; expected finite and >= 0", grid.r_mm[k], v[c]),
+                ));
+            }
+        }
+    }
+    let (mut ct, mut tt) = (candidate.total_reflectance(), target.total_reflectance());
+    let mut scale = ([1.0; 3], [1.0; 3]);
+    if normalize {
+        for c in 0..3 {
+            for (name, t) in [("candidate", ct[c]), ("target", tt[c])] {
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(InvalidInput::new(
+                        name,
+                        format!("total reflectance (channel {c}) is {t}; --normalize needs it finite and > 0"),
+                    ));
+                }
+            }
+            scale.0[c] = 1.0 / ct[c];
+            scale.1[c] = 1.0 / tt[c];
+        }
+        (ct, tt) = ([1.0; 3], [1.0; 3]);
+    }
+    let mut out = ProfileErrors {
+        relative_l2_percent: [0.0; 3],
+        max_percent: [0.0; 3],
+        candidate_totals: ct,
+        target_totals: tt,
+        total_difference: [0, 1, 2].map(|c| ct[c] - tt[c]),
+        normalized: normalize,
+    };
+    for c in 0..3 {
+        // ∫ (r f)² dr = ∫ r·(r f²) dr: the grid integrates r·g.
+        let rr =
+            |f: &dyn Fn(usize) -> f64| -> Vec<f64> { (0..grid.len()).map(|j| grid.r_mm[j] * f(j).powi(2)).collect() };
+        let diff = |j: usize| cand[j][c] * scale.0[c] - targ[j][c] * scale.1[c];
+        let norm = grid.integrate_r(&rr(&|j| targ[j][c] * scale.1[c]));
+        if norm.is_nan() || norm <= 0.0 {
+            return Err(InvalidInput::new("target", format!("channel {c} is zero on the grid; nothing to compare")));
+        }
+        out.relative_l2_percent[c] = 100.0 * (grid.integrate_r(&rr(&diff)) / norm).sqrt();
+        let peak = (0..grid.len()).map(|j| grid.r_mm[j] * targ[j][c] * scale.1[c]).fold(0.0, f64::max);
+        let worst = (0..grid.len()).map(|j| (grid.r_mm[j] * diff(j)).abs()).fold(0.0, f64::max);
+        out.max_percent[c] = 100.0 * worst / peak;
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diffusion::burley::{Burley, RgbBurley};
+    use crate::diffusion::sum_of_gaussians::deon6;
+
+    #[test]
+    fn a_profile_against_itself_has_no_error_and_a_scaled_one_has_its_scale() {
+        let p = deon6();
+        let e = compare_profiles(&p, &p, false).unwrap();
+        assert_eq!(e.relative_l2_percent, [0.0; 3]);
+        assert_eq!(e.total_difference, [0.0; 3]);
+        let b =
+            RgbBurley([Burley::new(0.5, 1.0).unwrap(), Burley::new(0.4, 0.5).unwrap(), Burley::new(0.2, 0.2).unwrap()]);
+        let b2 = RgbBurley(b.0.map(|x| Burley::new(x.albedo * 1.1, x.d_mm).unwrap()));
+        let e = compare_profiles(&b2, &b, false).unwrap();
+        for c in 0..3 {
+            assert!((e.relative_l2_percent[c] - 10.0).abs() < 1e-9, "{e:?}");
+            assert!((e.max_percent[c] - 10.0).abs() < 1e-9, "{e:?}");
+            assert!((e.total_difference[c] - 0.1 * b.0[c].albedo).abs() < 1e-12);
+        }
+        // Normalised: the scale disappears.
+        let e = compare_profiles(&b2, &b, true).unwrap();
+        assert!(e.worst_relative_l2_percent() < 1e-12 && e.total_difference == [0.0; 3], "{e:?}");
+    }
+
+    #[test]
+    fn a_different_shape_is_measured() {
+        let wide = RgbBurley([Burley::new(0.5, 1.0).unwrap(); 3]);
+        let narrow = RgbBurley([Burley::new(0.5, 0.5).unwrap(); 3]);
+        let e = compare_profiles(&wide, &narrow, false).unwrap();
+        assert!(e.relative_l2_percent[0] > 30.0 && e.max_percent[0] > 10.0, "{e:?}");
+        assert_eq!(e.total_difference, [0.0; 3]);
+    }
+}
