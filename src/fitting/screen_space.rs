@@ -263,7 +263,7 @@ pub struct GaussiansFile {
 
 impl GaussiansFile {
     /// The sum of Gaussians the file describes (`rtbake evaluate --gaussians`): shared → `variances` [v…] and
-    /// `weights` [[r,g,b] per Gaussian]; per channel → both [[r…],[g…],[b…]]. Checks shapes, finiteness, v > 0 and
+    /// `weights` `[[r,g,b] per Gaussian]`; per channel → both `[[r…],[g…],[b…]]`. Checks shapes, finiteness, v > 0 and
     /// w ≥ 0, naming the field.
     pub fn sum(&self) -> Result<RgbGaussians, InvalidInput> {
         fn parse<T: serde::de::DeserializeOwned>(v: &Value, key: &str, shape: &str) -> Result<T, InvalidInput> {
