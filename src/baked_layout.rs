@@ -106,10 +106,34 @@ pub struct TransmittanceSidecar {
     /// `node-inclusive: …` ([`TransmittanceSidecar::TEXEL_CONVENTION`]).
     pub texel_convention: String,
     pub shader_lookup: String,
-    /// The profile's Gaussians: variances (mm²) per channel.
+    /// The profile's Gaussians: variances (mm²) per channel (empty for a Burley table).
+    #[serde(default, skip_serializing_if = "no_gaussians")]
     pub variances_mm2: [Vec<f64>; 3],
-    /// Weights per channel.
+    /// Weights per channel (empty for a Burley table).
+    #[serde(default, skip_serializing_if = "no_gaussians")]
     pub weights: [Vec<f64>; 3],
+    /// Burley's parameters, for a table of [`crate::transmittance::BURLEY_FORMULA`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub burley: Option<BurleyParams>,
+}
+
+fn no_gaussians(v: &[Vec<f64>; 3]) -> bool {
+    v.iter().all(Vec::is_empty)
+}
+
+/// Burley's normalized diffusion per channel, as files record it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BurleyParams {
+    /// Surface albedo A per channel.
+    pub albedo: [f64; 3],
+    /// Shape parameter d per channel, mm.
+    pub d_mm: [f64; 3],
+}
+
+impl From<&crate::diffusion::burley::RgbBurley> for BurleyParams {
+    fn from(b: &crate::diffusion::burley::RgbBurley) -> Self {
+        Self { albedo: b.0.map(|c| c.albedo), d_mm: b.0.map(|c| c.d_mm) }
+    }
 }
 
 impl TransmittanceSidecar {

@@ -9,9 +9,15 @@
 //! ([`TransmittanceForm::Physical`], `--physical`). The weights and variances come from any preset or fitted sum of
 //! Gaussians ([`crate::diffusion::sum_of_gaussians::RgbGaussians`]), per channel. T(0) = Σ w (= 1 for normalised profiles).
 //!
+//! Burley's normalized diffusion (Christensen & Burley 2015) has the plane integral in closed form,
+//! T_c(s) = A_c (e^(−s/d_c) + 3e^(−s/(3d_c)))/4 ([`crate::diffusion::burley::Burley::plane_transmittance`]): the
+//! "transmission profile" engine bakers (Unreal's Subsurface Profile, Unity HDRP) derive from a Burley profile.
+//! [`TransmittanceModel`] is either source; Burley has only the plane-integral ("physical") form.
+//!
 //! **Table convention** (node-inclusive): texel i of n holds s = s_max·i/(n − 1); a shader samples with linear
 //! filtering at u = s/s_max·(n − 1)/n + 0.5/n (clamp to edge). The optional 2-D variant repeats the row h times.
 
+use crate::diffusion::burley::RgbBurley;
 use crate::diffusion::sum_of_gaussians::RgbGaussians;
 use crate::error::{check_positive, check_range, InvalidInput};
 use crate::image_buf::ImageF32;
@@ -65,6 +71,70 @@ pub fn transmittance(sum: &RgbGaussians, s_mm: f64, form: TransmittanceForm) -> 
             })
             .sum()
     })
+}
+
+/// What a transmittance table is computed from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TransmittanceModel {
+    /// A sum of Gaussians (a preset or a fit): eq. 5.12 or its plane-integral form.
+    Gaussians(RgbGaussians),
+    /// Burley's normalized diffusion per channel: the closed-form plane integral.
+    Burley(RgbBurley),
+}
+
+/// The formula string of Burley's transmission (recorded in sidecars and conventions).
+pub const BURLEY_FORMULA: &str =
+    "T(s) = A (exp(-s/d) + 3 exp(-s/(3 d))) / 4 (plane integral of Burley's normalized diffusion)";
+
+impl TransmittanceModel {
+    /// Checks that `form` applies: Burley has only the plane integral (`physical`).
+    pub fn check_form(&self, form: TransmittanceForm) -> Result<(), InvalidInput> {
+        match (self, form) {
+            (Self::Burley(_), TransmittanceForm::Published) => Err(InvalidInput::new(
+                "form",
+                "a Burley profile has only the plane-integral ('physical') transmittance; the published \
+                 exp(-s^2/v) form applies to sums of Gaussians",
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// T(s) per channel (s ≥ 0 mm); `form` is checked by [`Self::check_form`].
+    pub fn at(&self, s_mm: f64, form: TransmittanceForm) -> [f64; 3] {
+        match self {
+            Self::Gaussians(sum) => transmittance(sum, s_mm, form),
+            Self::Burley(b) => b.0.map(|c| c.plane_transmittance(s_mm)),
+        }
+    }
+
+    /// The formula of the table in `form`.
+    pub fn formula(&self, form: TransmittanceForm) -> &'static str {
+        match self {
+            Self::Gaussians(_) => form.formula(),
+            Self::Burley(_) => BURLEY_FORMULA,
+        }
+    }
+
+    /// Evaluates T at each distance (any order).
+    pub fn evaluate(&self, s_mm: &[f64], form: TransmittanceForm) -> Result<Vec<[f64; 3]>, InvalidInput> {
+        check_distances(s_mm)?;
+        self.check_form(form)?;
+        Ok(s_mm.iter().map(|&s| self.at(s, form)).collect())
+    }
+
+    /// Bakes the n×h RGB float table.
+    pub fn table(&self, settings: &TableSettings) -> Result<ImageF32, TransmittanceError> {
+        settings.validate()?;
+        self.check_form(settings.form)?;
+        let n = settings.samples;
+        let row: Vec<f32> =
+            (0..n).flat_map(|i| self.at(settings.s_of_texel(i), settings.form).map(|t| t as f32)).collect();
+        let mut data = Vec::with_capacity(row.len() * settings.height as usize);
+        for _ in 0..settings.height {
+            data.extend_from_slice(&row);
+        }
+        Ok(ImageF32::from_vec(n, settings.height, 3, data))
+    }
 }
 
 /// Validates distances (finite, ≥ 0, `--s`).
@@ -132,10 +202,15 @@ impl TableSettings {
 
     /// The convention string recorded in the manifest.
     pub fn convention(&self) -> String {
+        self.convention_for(self.form.formula())
+    }
+
+    /// The convention string of a table of `formula` (a [`TransmittanceModel::formula`]).
+    pub fn convention_for(&self, formula: &str) -> String {
         format!(
             "RGB = T(s) per channel, {}; x = texel i of n = {} holds s = s_max*i/(n-1) mm with s_max = {} mm \
              (node-inclusive); sample with linear filtering and clamp at u = s/s_max*(n-1)/n + 0.5/n; {} identical rows",
-            self.form.formula(),
+            formula,
             self.samples,
             self.s_max_mm,
             self.height
@@ -143,17 +218,9 @@ impl TableSettings {
     }
 }
 
-/// Bakes the n×h RGB float table.
+/// Bakes the n×h RGB float table of a sum of Gaussians ([`TransmittanceModel::table`]).
 pub fn table(sum: &RgbGaussians, settings: &TableSettings) -> Result<ImageF32, TransmittanceError> {
-    settings.validate()?;
-    let n = settings.samples;
-    let row: Vec<f32> =
-        (0..n).flat_map(|i| transmittance(sum, settings.s_of_texel(i), settings.form).map(|t| t as f32)).collect();
-    let mut data = Vec::with_capacity(row.len() * settings.height as usize);
-    for _ in 0..settings.height {
-        data.extend_from_slice(&row);
-    }
-    Ok(ImageF32::from_vec(n, settings.height, 3, data))
+    TransmittanceModel::Gaussians(sum.clone()).table(settings)
 }
 
 impl TableSettings {
@@ -180,5 +247,29 @@ mod tests {
         for c in 0..3 {
             assert!((p[c] - q[c]).abs() < 1e-15);
         }
+    }
+
+    /// The model's Gaussian table is the Gaussian function's table; a Burley table holds the closed-form plane
+    /// integral at every texel and refuses the published exp(−s²/v) form.
+    #[test]
+    fn model_tables() {
+        use crate::diffusion::burley::{Burley, RgbBurley};
+        let sum = RgbGaussians::from(&deon6());
+        let settings = TableSettings { samples: 16, ..TableSettings::default() };
+        let g = TransmittanceModel::Gaussians(sum.clone()).table(&settings).unwrap();
+        assert_eq!(g.data, table(&sum, &settings).unwrap().data);
+        let b =
+            RgbBurley([Burley::new(0.8, 0.5).unwrap(), Burley::new(0.5, 0.2).unwrap(), Burley::new(0.3, 0.1).unwrap()]);
+        let m = TransmittanceModel::Burley(b);
+        assert!(m.table(&settings).is_err(), "published form refused");
+        let physical = TableSettings { form: TransmittanceForm::Physical, ..settings };
+        let img = m.table(&physical).unwrap();
+        for i in 0..16u32 {
+            for c in 0..3 {
+                let want = b.0[c].plane_transmittance(physical.s_of_texel(i)) as f32;
+                assert_eq!(img.data[3 * i as usize + c], want);
+            }
+        }
+        assert_eq!(img.data[..3], [0.8, 0.5, 0.3]);
     }
 }

@@ -3,7 +3,7 @@
 //! `rtbake::separable::fit::kernel_errors`); `--max-error` turns it into a pipeline gate (exit 1 above it).
 
 use crate::cli::{parse_f64_list, parse_rgb, usage, usage_msg, Ctx};
-use crate::profile_source::{named, physiological_skin, Named};
+use crate::profile_source::{named, physiological_skin, BurleyFitArg, Named};
 use rtbake::diffusion::burley::{Burley, RgbBurley, ShapeFit};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
@@ -65,23 +65,6 @@ pub struct EvaluateArgs {
     /// --separable: pixel footprint, mm.
     #[arg(long, default_value_t = ObjectiveSpec::default().pixel_mm, allow_hyphen_values = true)]
     pixel_mm: f64,
-}
-
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum BurleyFitArg {
-    Searchlight,
-    DiffuseTransmission,
-    MeanFreePath,
-}
-
-impl From<BurleyFitArg> for ShapeFit {
-    fn from(a: BurleyFitArg) -> Self {
-        match a {
-            BurleyFitArg::Searchlight => ShapeFit::Searchlight,
-            BurleyFitArg::DiffuseTransmission => ShapeFit::DiffuseTransmission,
-            BurleyFitArg::MeanFreePath => ShapeFit::MeanFreePath,
-        }
-    }
 }
 
 const TARGET_FORMS: &str =

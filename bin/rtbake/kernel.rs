@@ -2,6 +2,7 @@
 //! `rtbake::separable::kernel`).
 
 use crate::cli::{parse_rgb, prepare_out_dir, usage, usage_msg, Ctx};
+use rtbake::separable::fit::{self, ObjectiveSpec};
 use rtbake::separable::kernel::{self, KernelSpec, Precision};
 use rtbake::separable::{SeparableParams, PUBLISHED};
 use std::path::PathBuf;
@@ -35,6 +36,10 @@ pub struct KernelArgs {
     /// File stem for --out (default: kernel_n<N>).
     #[arg(long, value_name = "NAME")]
     name: Option<String>,
+    /// Instead of --strength/--falloff: fit them to a profile first (as `rtbake fit separable` does, width
+    /// --sss-width or 0.014) — your own --profile-csv, a --layers stack or the physiological --skin-*.
+    #[command(flatten)]
+    layered: crate::profile_source::LayeredArgs,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -53,13 +58,19 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
             args.samples
         ))
     })?;
-    let strength = match &args.strength {
-        Some(s) => parse_rgb("--strength", s)?,
-        None => PUBLISHED.strength,
-    };
-    let falloff = match &args.falloff {
-        Some(s) => parse_rgb("--falloff", s)?,
-        None => PUBLISHED.falloff,
+    let fitted = fitted_params(&args)?;
+    let (strength, falloff) = match &fitted {
+        Some((p, _)) => (p.strength, p.falloff),
+        None => (
+            match &args.strength {
+                Some(s) => parse_rgb("--strength", s)?,
+                None => PUBLISHED.strength,
+            },
+            match &args.falloff {
+                Some(s) => parse_rgb("--falloff", s)?,
+                None => PUBLISHED.falloff,
+            },
+        ),
     };
     let precision = match args.precision {
         PrecisionArg::F32 => Precision::F32,
@@ -72,9 +83,6 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
         exponent: args.exponent,
         precision,
     };
-    if let Some(w) = args.sss_width {
-        rtbake::error::check_positive("--sss-width", w, "world units").map_err(usage)?;
-    }
     let stem = args.name.clone().unwrap_or_else(|| format!("kernel_n{samples}"));
     if !stem.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') || stem.is_empty() {
         return Err(usage_msg(format!("--name must be 1 or more characters of [A-Za-z0-9_-], got {stem:?}")));
@@ -83,19 +91,27 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
 
     if let Some(dir) = &args.out {
         prepare_out_dir("--out", dir)?;
-        let source = format!(
+        let mut source = format!(
             "rtbake kernel --samples {samples} --strength {} --falloff {} --precision {}",
             join(&strength),
             join(&falloff),
             precision.as_str()
         );
-        let files = rtbake::bake::separable::kernel_files("", &stem, &k, args.sss_width, &source);
+        if let Some((_, from)) = &fitted {
+            source.push_str(&format!(" (strength and falloff fitted to {from})"));
+        }
+        let width = args.sss_width.or(fitted.as_ref().map(|_| ObjectiveSpec::default().width));
+        let files = rtbake::bake::separable::kernel_files("", &stem, &k, width, &source);
         crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));
     }
 
     if ctx.json {
-        ctx.emit_json(&serde_json::json!({ "kernel": k.taps_json() }));
+        let mut v = serde_json::json!({ "kernel": k.taps_json(), "strength": strength, "falloff": falloff });
+        if let Some((_, from)) = &fitted {
+            v["fitted_to"] = serde_json::json!(from);
+        }
+        ctx.emit_json(&v);
     } else if args.out.is_none() {
         println!(
             "# {samples} taps, RANGE {}, EXPONENT {}, {} (r, g, b, offset), centre first",
@@ -112,6 +128,28 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Strength and falloff fitted to the layered / CSV profile, if one was given (width: --sss-width or the fit's
+/// default), with a description of the target.
+fn fitted_params(args: &KernelArgs) -> anyhow::Result<Option<(SeparableParams, String)>> {
+    if let Some(w) = args.sss_width {
+        rtbake::error::check_positive("--sss-width", w, "world units").map_err(usage)?;
+    }
+    if !args.layered.is_set() {
+        return Ok(None);
+    }
+    if args.strength.is_some() || args.falloff.is_some() {
+        return Err(usage_msg(
+            "--strength/--falloff and a profile (--profile-csv, --layers, --skin-*) are exclusive: the profile's are fitted",
+        ));
+    }
+    let (profile, provenance, stem) = args.layered.resolve()?.expect("is_set");
+    let spec = ObjectiveSpec { width: args.sss_width.unwrap_or(ObjectiveSpec::default().width), ..Default::default() };
+    let target = fit::TargetKernel::from_profile(profile.as_ref(), &spec, &stem).map_err(usage)?;
+    let result = fit::fit(&target)?;
+    let from = provenance.get("file").and_then(|f| f.as_str()).map(str::to_string).unwrap_or(stem);
+    Ok(Some((result.params, from)))
 }
 
 fn join(v: &[f64; 3]) -> String {

@@ -30,17 +30,6 @@ pub enum FdrArg {
     Jensen01,
 }
 
-/// Christensen & Burley 2015's shape-parameter fits.
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum BurleyFitArg {
-    /// Searchlight illumination, diffuse mean free path: s = 1.85 - A + 7|A - 0.8|^3.
-    Searchlight,
-    /// Diffuse surface transmission, diffuse mean free path: s = 1.9 - A + 3.5(A - 0.8)^2.
-    DiffuseTransmission,
-    /// Searchlight illumination, volume mean free path 1/sigma_t: s = 3.5 + 100(A - 0.33)^4.
-    MeanFreePath,
-}
-
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["material", "profile_preset", "layers", "skin_melanin", "burley_albedo"])))]
 pub struct ProfileArgs {
@@ -69,16 +58,8 @@ pub struct ProfileArgs {
     /// Dermal hemoglobin volume fraction Chd in 0..=0.32 for --skin-melanin.
     #[arg(long, value_name = "CHD", requires = "skin_melanin")]
     skin_hemoglobin: Option<f64>,
-    /// Burley's normalized diffusion (Christensen & Burley 2015) with this surface albedo per channel, each in
-    /// 0..=1 (needs --burley-mfp-mm).
-    #[arg(long, value_name = "R,G,B", requires = "burley_mfp_mm")]
-    burley_albedo: Option<String>,
-    /// Mean free path per channel for --burley-albedo, mm (> 0); the shape parameter is d = mfp / s(A).
-    #[arg(long, value_name = "R,G,B", requires = "burley_albedo")]
-    burley_mfp_mm: Option<String>,
-    /// Which of the paper's fits s(A) relates d to the mean free path (--burley-albedo only).
-    #[arg(long, value_enum, default_value = "diffuse-transmission")]
-    burley_fit: BurleyFitArg,
+    #[command(flatten)]
+    burley: crate::profile_source::BurleyArgs,
     /// How layers are combined (--layers and --skin-* only).
     #[arg(long, value_enum, default_value = "symmetric")]
     adding: AddingArg,
@@ -193,24 +174,8 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
             .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
         let stack = LayerStack::from_json_str(&text).map_err(|e| flag_error(e, Some(path)))?;
         ProfileSource::Layers { stack, adding: args.adding.into(), series, fdr }
-    } else if let (Some(albedo), Some(mfp)) = (&args.burley_albedo, &args.burley_mfp_mm) {
-        use rtbake::diffusion::burley::{RgbBurley, ShapeFit};
-        let three = |flag: &str, text: &str| -> anyhow::Result<[f64; 3]> {
-            let v = parse_f64_list(flag, text)?;
-            <[f64; 3]>::try_from(v.as_slice())
-                .map_err(|_| usage_msg(format!("{flag}: expected three values R,G,B, got '{text}'")))
-        };
-        let (albedo, mean_free_path_mm) = (three("--burley-albedo", albedo)?, three("--burley-mfp-mm", mfp)?);
-        let fit = match args.burley_fit {
-            BurleyFitArg::Searchlight => ShapeFit::Searchlight,
-            BurleyFitArg::DiffuseTransmission => ShapeFit::DiffuseTransmission,
-            BurleyFitArg::MeanFreePath => ShapeFit::MeanFreePath,
-        };
-        RgbBurley::from_mean_free_path(albedo, mean_free_path_mm, fit).map_err(|e| {
-            let flag = if e.param.starts_with("albedo") { "--burley-albedo" } else { "--burley-mfp-mm" };
-            usage(InvalidInput::new(flag, format!("{}: {}", e.param, e.message)))
-        })?;
-        ProfileSource::Burley { albedo, mean_free_path_mm, fit }
+    } else if let Some((_, src)) = args.burley.resolve()? {
+        src
     } else if let (Some(cm), Some(chd)) = (args.skin_melanin, args.skin_hemoglobin) {
         crate::profile_source::physiological_skin(cm, chd, args.adding.into(), series, fdr)?.0
     } else {

@@ -1,11 +1,13 @@
 //! Profile inputs shared by `fit gaussians` and `fit separable` beyond the named materials and presets:
 //! a user layer stack (`--layers FILE`) or the physiological two-layer skin (`--skin-melanin`, `--skin-hemoglobin`).
 
-use crate::cli::{usage, usage_msg, AddingArg};
+use crate::cli::{parse_f64_list, usage, usage_msg, AddingArg};
+use rtbake::diffusion::burley::{RgbBurley, ShapeFit};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::source::{MaterialModel, ProfileSource};
 use rtbake::diffusion::{FdrForm, RadialProfile};
+use rtbake::error::InvalidInput;
 use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -144,4 +146,70 @@ pub fn named(kind: Named<'_>) -> anyhow::Result<(ProfileSource, Box<dyn RadialPr
 pub enum Named<'a> {
     Material { flag: &'a str, name: &'a str },
     Preset { flag: &'a str, name: &'a str },
+}
+
+/// Burley normalized diffusion from the artist's parameters (Christensen & Burley 2015): flattened into every
+/// command that takes a Burley profile; `rtbake::diffusion::burley` does the maths.
+#[derive(clap::Args, Debug, Default)]
+pub struct BurleyArgs {
+    /// Burley's normalized diffusion (Christensen & Burley 2015) with this surface albedo per channel, each in
+    /// 0..=1 (needs --burley-mfp-mm).
+    #[arg(long, value_name = "R,G,B", requires = "burley_mfp_mm", allow_hyphen_values = true)]
+    pub burley_albedo: Option<String>,
+    /// Mean free path per channel for --burley-albedo, mm (> 0); the shape parameter is d = mfp / s(A).
+    #[arg(long, value_name = "R,G,B", requires = "burley_albedo", allow_hyphen_values = true)]
+    pub burley_mfp_mm: Option<String>,
+    /// Which of the paper's fits s(A) relates d to the mean free path (--burley-albedo only).
+    #[arg(long, value_enum, default_value = "diffuse-transmission")]
+    pub burley_fit: BurleyFitArg,
+}
+
+/// `--burley-fit`: Christensen & Burley's s(A) fits.
+#[derive(Clone, Copy, Debug, Default, clap::ValueEnum)]
+pub enum BurleyFitArg {
+    /// Searchlight illumination, diffuse mean free path: s = 1.85 - A + 7|A - 0.8|^3.
+    Searchlight,
+    /// Diffuse surface transmission, diffuse mean free path: s = 1.9 - A + 3.5(A - 0.8)^2.
+    #[default]
+    DiffuseTransmission,
+    /// Searchlight illumination, volume mean free path 1/sigma_t: s = 3.5 + 100(A - 0.33)^4.
+    MeanFreePath,
+}
+
+impl From<BurleyFitArg> for ShapeFit {
+    fn from(a: BurleyFitArg) -> Self {
+        match a {
+            BurleyFitArg::Searchlight => ShapeFit::Searchlight,
+            BurleyFitArg::DiffuseTransmission => ShapeFit::DiffuseTransmission,
+            BurleyFitArg::MeanFreePath => ShapeFit::MeanFreePath,
+        }
+    }
+}
+
+/// Three comma-separated numbers R,G,B for `flag`.
+pub fn three(flag: &str, text: &str) -> anyhow::Result<[f64; 3]> {
+    let v = parse_f64_list(flag, text)?;
+    <[f64; 3]>::try_from(v.as_slice())
+        .map_err(|_| usage_msg(format!("{flag}: expected three values R,G,B, got '{text}'")))
+}
+
+impl BurleyArgs {
+    pub fn is_set(&self) -> bool {
+        self.burley_albedo.is_some()
+    }
+
+    /// The validated profile and its [`ProfileSource`] (provenance), if --burley-albedo was given; errors name
+    /// the flag and the channel.
+    pub fn resolve(&self) -> anyhow::Result<Option<(RgbBurley, ProfileSource)>> {
+        let (Some(albedo), Some(mfp)) = (&self.burley_albedo, &self.burley_mfp_mm) else {
+            return Ok(None);
+        };
+        let (albedo, mean_free_path_mm) = (three("--burley-albedo", albedo)?, three("--burley-mfp-mm", mfp)?);
+        let fit = ShapeFit::from(self.burley_fit);
+        let profile = RgbBurley::from_mean_free_path(albedo, mean_free_path_mm, fit).map_err(|e| {
+            let flag = if e.param.starts_with("albedo") { "--burley-albedo" } else { "--burley-mfp-mm" };
+            usage(InvalidInput::new(flag, format!("{}: {}", e.param, e.message)))
+        })?;
+        Ok(Some((profile, ProfileSource::Burley { albedo, mean_free_path_mm, fit })))
+    }
 }

@@ -3,8 +3,9 @@
 use crate::cli::{parse_f64_list, prepare_out_dir, usage, usage_msg, Ctx};
 use crate::profile_source::{named, Named};
 use rtbake::diffusion::sum_of_gaussians::preset;
+use rtbake::diffusion::RadialProfile;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings, RgbGaussians};
-use rtbake::transmittance::{evaluate, TableSettings, TransmittanceForm, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
+use rtbake::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel, DEFAULT_SAMPLES, DEFAULT_S_MAX_MM};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -16,15 +17,23 @@ pub struct TransmittanceArgs {
     /// Fit a Jensen 2001 material (dipole, η = 1.3) with --count Gaussians first and use that sum.
     #[arg(long, value_name = "NAME")]
     pub material: Option<String>,
-    /// Gaussians for --material (2..=8).
-    #[arg(long, default_value_t = 6, requires = "material")]
+    /// Gaussians of the fit for --material, --layers, --skin-* or --profile-csv (2..=8).
+    #[arg(long, default_value_t = 6)]
     pub count: usize,
-    /// With --material: divide each channel by its total first (T(0) = 1).
-    #[arg(long, requires = "material")]
+    /// With a fitted profile: divide each channel by its total first (T(0) = 1).
+    #[arg(long)]
     pub normalize: bool,
-    /// With --material: per-channel variances instead of shared ones.
-    #[arg(long, requires = "material")]
+    /// With a fitted profile: per-channel variances instead of shared ones.
+    #[arg(long)]
     pub per_channel: bool,
+    /// A profile to fit --count Gaussians to first, as for --material: your --profile-csv, a --layers stack or the
+    /// physiological --skin-*.
+    #[command(flatten)]
+    pub layered: crate::profile_source::LayeredArgs,
+    /// Burley's normalized diffusion: the closed-form plane integral T(s) = A (e^(-s/d) + 3 e^(-s/(3d)))/4 (the
+    /// transmission profile engine bakers derive; implies --physical).
+    #[command(flatten)]
+    pub burley: crate::profile_source::BurleyArgs,
     /// Distances s in mm to evaluate, comma-separated (any order, each finite and >= 0).
     #[arg(long = "s", value_name = "MM,...", allow_hyphen_values = true)]
     pub s: Option<String>,
@@ -47,9 +56,32 @@ pub struct TransmittanceArgs {
     pub zstd: crate::cli::ZstdArg,
 }
 
-fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, String)> {
-    if let Some(name) = &a.material {
-        let (src, profile, _) = named(Named::Material { flag: "--material", name })?;
+fn source_model(a: &TransmittanceArgs) -> anyhow::Result<(TransmittanceModel, Value, String)> {
+    let sources = [a.profile_preset.is_some(), a.material.is_some(), a.layered.is_set(), a.burley.is_set()];
+    if sources.iter().filter(|&&s| s).count() > 1 {
+        return Err(usage_msg(
+            "give one profile: --profile-preset, --material, --layers, --skin-*, --profile-csv or --burley-albedo",
+        ));
+    }
+    let fitted = a.material.is_some() || a.layered.is_set();
+    if !fitted && (a.count != 6 || a.normalize || a.per_channel) {
+        return Err(usage_msg(
+            "--count, --normalize and --per-channel apply to a fitted profile (--material, --layers, --skin-*, \
+             --profile-csv)",
+        ));
+    }
+    if let Some((burley, src)) = a.burley.resolve()? {
+        let stem = "burley".to_string();
+        return Ok((TransmittanceModel::Burley(burley), src.provenance(), stem));
+    }
+    let target = match &a.material {
+        Some(name) => {
+            let (src, profile, _) = named(Named::Material { flag: "--material", name })?;
+            Some((profile as Box<dyn RadialProfile>, src.provenance(), name.to_ascii_lowercase()))
+        }
+        None => a.layered.resolve()?,
+    };
+    if let Some((profile, provenance, stem)) = target {
         let settings = FitSettings {
             count: a.count,
             shared_variances: !a.per_channel,
@@ -58,19 +90,20 @@ fn source_sum(a: &TransmittanceArgs) -> anyhow::Result<(RgbGaussians, Value, Str
         };
         settings.validate().map_err(usage)?;
         let fit = fit_sum_of_gaussians(profile.as_ref(), &settings).map_err(crate::fit::fit_error)?;
-        let provenance = json!({"kind": "fit", "profile": src.provenance(), "count": a.count,
+        let provenance = json!({"kind": "fit", "profile": provenance, "count": a.count,
                          "shared_variances": !a.per_channel, "normalize": a.normalize,
                          "error_percent": fit.error_percent});
-        return Ok((fit.sum, provenance, format!("{}_k{}", name.to_ascii_lowercase(), a.count)));
+        return Ok((TransmittanceModel::Gaussians(fit.sum), provenance, format!("{stem}_k{}", a.count)));
     }
     let name = a.profile_preset.clone().unwrap_or_else(|| "deon6".into());
     let (src, _, stem) = named(Named::Preset { flag: "--profile-preset", name: &name })?;
     let sog = preset(&name).expect("resolved by ProfileSource");
-    Ok((RgbGaussians::from(&sog), src.provenance(), stem))
+    Ok((TransmittanceModel::Gaussians(RgbGaussians::from(&sog)), src.provenance(), stem))
 }
 
 pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
-    let form = if a.physical { TransmittanceForm::Physical } else { TransmittanceForm::Published };
+    // Burley has only the plane integral.
+    let form = if a.physical || a.burley.is_set() { TransmittanceForm::Physical } else { TransmittanceForm::Published };
     // Validate every input before any work or output.
     let s_mm = match &a.s {
         Some(text) => {
@@ -93,28 +126,30 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if s_mm.is_none() && a.out.is_none() {
         return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));
     }
-    let (sum, source, stem) = source_sum(&a)?;
-    let form_name = if a.physical { "physical" } else { "published" };
-    let mut result = json!({"form": form_name, "formula": form.formula(), "source": source});
+    let (model, source, stem) = source_model(&a)?;
+    let form_name = if form == TransmittanceForm::Physical { "physical" } else { "published" };
+    let formula = model.formula(form);
+    let mut result = json!({"form": form_name, "formula": formula, "source": source});
     if let Some(s) = &s_mm {
-        let t = evaluate(&sum, s, form)?;
+        let t = model.evaluate(s, form).map_err(usage)?;
         result["s_mm"] = json!(s);
         result["T"] = json!(t);
         if !ctx.json {
-            ctx.info(form.formula());
+            ctx.info(formula);
             for (s, t) in s.iter().zip(&t) {
                 println!("s = {s:>8.4} mm   T = {:.6} {:.6} {:.6}", t[0], t[1], t[2]);
             }
         }
     }
     if let Some(dir) = &a.out {
-        let mut files = rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &sum, &table, source)
-            .map_err(|e| anyhow::anyhow!(e))?;
+        let mut files =
+            rtbake::bake::transmittance::table_files(&format!("{stem}_{form_name}"), &model, &table, source)
+                .map_err(|e| anyhow::anyhow!(e))?;
         a.zstd.apply(&mut files)?;
         prepare_out_dir("--out", dir)?;
         crate::cli::write_set(ctx, "--out", dir, &files, &[])?;
         result["files"] = json!(files.iter().map(|f| dir.join(&f.path).display().to_string()).collect::<Vec<_>>());
-        result["convention"] = json!(table.convention());
+        result["convention"] = json!(table.convention_for(formula));
         ctx.info(format!("wrote {} files to {}", files.len(), dir.display()));
     }
     if ctx.json {

@@ -5,7 +5,7 @@ use crate::baked_layout::{self, TransmittanceSidecar};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
-use crate::transmittance::{table, TableSettings, TransmittanceForm};
+use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -16,14 +16,15 @@ pub const VERIFY_TOLERANCE: f64 = 1e-6;
 /// the provenance (`source`, `form`, convention, lookup formula). Paths `{stem}.*`.
 pub fn table_files(
     stem: &str,
-    sum: &RgbGaussians,
+    model: &TransmittanceModel,
     settings: &TableSettings,
     source: Value,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let img = table(sum, settings).map_err(|e| match e {
+    let img = model.table(settings).map_err(|e| match e {
         crate::transmittance::TransmittanceError::Invalid(i) => BakeError::Invalid(i),
     })?;
-    let convention = settings.convention();
+    let formula = model.formula(settings.form);
+    let convention = settings.convention_for(formula);
     let mut files = float_texture_files(stem, &img, "lut", &convention, VERIFY_TOLERANCE)?;
     let mut meta = FileMeta::text("lut", "png", &format!("{convention}; 16-bit linear: value = sample/65535"));
     meta.width = img.width;
@@ -40,14 +41,24 @@ pub fn table_files(
     let sidecar = TransmittanceSidecar {
         source,
         form: form.into(),
-        formula: settings.form.formula().into(),
+        formula: formula.into(),
         samples: settings.samples,
         height: settings.height,
         s_max_mm: settings.s_max_mm,
         texel_convention: TransmittanceSidecar::TEXEL_CONVENTION.into(),
         shader_lookup: TransmittanceSidecar::SHADER_LOOKUP.into(),
-        variances_mm2: sum.variances_mm2.clone(),
-        weights: sum.weights.clone(),
+        variances_mm2: match model {
+            TransmittanceModel::Gaussians(sum) => sum.variances_mm2.clone(),
+            TransmittanceModel::Burley(_) => Default::default(),
+        },
+        weights: match model {
+            TransmittanceModel::Gaussians(sum) => sum.weights.clone(),
+            TransmittanceModel::Burley(_) => Default::default(),
+        },
+        burley: match model {
+            TransmittanceModel::Gaussians(_) => None,
+            TransmittanceModel::Burley(b) => Some(b.into()),
+        },
     };
     files.push(json_file(
         &baked_layout::path::sidecar(&format!("{stem}.exr")),
@@ -80,7 +91,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     );
     table_files(
         &format!("{}/{}_{form}", baked_layout::path::TRANSMITTANCE_DIR, p.preset),
-        &RgbGaussians::from(&sog),
+        &TransmittanceModel::Gaussians(RgbGaussians::from(&sog)),
         &p.table,
         source,
     )

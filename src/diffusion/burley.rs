@@ -97,6 +97,17 @@ impl Burley {
         ((-r_mm / d).exp() + (-r_mm / (3.0 * d)).exp()) / (4.0 * d)
     }
 
+    /// Transmittance through a thickness s (mm): the profile integrated over the plane at depth s, the light a
+    /// point source reaching the other side of a slab of thickness s spreads over it. With ρ² = r² + s²,
+    ///
+    ///   T(s) = ∫₀^∞ R(√(r² + s²)) 2πr dr = ∫ₛ^∞ R(ρ) 2πρ dρ = A (1 − F(s)) = A (e^(−s/d) + 3e^(−s/(3d))) / 4,
+    ///
+    /// the form engine bakers use for thin-object transmission with Burley profiles; T(0) = A.
+    pub fn plane_transmittance(&self, s_mm: f64) -> f64 {
+        let x = s_mm.max(0.0) / self.d_mm;
+        self.albedo * 0.25 * ((-x).exp() + 3.0 * (-x / 3.0).exp())
+    }
+
     /// The radius (mm) at which F(r) = u, for u in [0, 1) (importance sampling of the profile).
     pub fn sample_radius_mm(&self, u: f64) -> Result<f64, InvalidInput> {
         if !(0.0..1.0).contains(&u) {
@@ -181,6 +192,26 @@ impl RadialProfile for RgbBurley {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// T(s) is the plane integral of R: compared with a direct quadrature of ∫ R(√(r² + s²)) 2πr dr.
+    #[test]
+    fn plane_transmittance_is_the_plane_integral_of_the_profile() {
+        let b = Burley::new(0.7, 0.4).unwrap();
+        assert_eq!(b.plane_transmittance(0.0), 0.7);
+        for s in [0.05, 0.3, 1.0, 4.0] {
+            // Substitute r = e^t over t in [ln 1e-9, ln 200] mm, trapezoid with 200k nodes.
+            let (t0, t1, n) = ((1e-9f64).ln(), 200f64.ln(), 200_000);
+            let h = (t1 - t0) / n as f64;
+            let f = |t: f64| {
+                let r = t.exp();
+                b.reflectance_mm2((r * r + s * s).sqrt()) * 2.0 * PI * r * r
+            };
+            let sum: f64 = (0..=n).map(|i| f(t0 + i as f64 * h) * if i == 0 || i == n { 0.5 } else { 1.0 }).sum();
+            let quad = sum * h;
+            let t = b.plane_transmittance(s);
+            assert!((quad - t).abs() <= 1e-6 * t, "s = {s}: {quad} vs {t}");
+        }
+    }
 
     /// ∫₀^∞ 2πr R(r) dr by Gauss–Legendre on r = d·t/(1 − t) pieces; the integrand 2πr R is finite at 0.
     fn numeric_total(b: &Burley) -> f64 {

@@ -146,3 +146,136 @@ fn fit_burley_recovers_a_burley_profile_from_its_csv() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--profile-csv"));
 }
+
+/// `rtbake kernel --profile-csv` (issue 11) fits strength and falloff to the user's profile exactly as
+/// `rtbake fit separable --profile-csv` does, then builds the same taps as `kernel --strength S --falloff F`; given
+/// together with --strength the two sources are refused (exit 2, both named) and nothing is written.
+#[test]
+fn kernel_from_a_profile_csv_is_the_fit_separable_kernel() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("skin1.csv");
+    let c = csv.to_str().unwrap();
+    let o = rtbake(&["profile", "--material", "skin1", "--csv", c, "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = rtbake(args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let fit = json(&["--json", "fit", "separable", "--profile-csv", c]);
+    let kernel = json(&["--json", "kernel", "--samples", "9", "--profile-csv", c]);
+    assert_eq!(kernel["strength"], fit["strength"]);
+    assert_eq!(kernel["falloff"], fit["falloff"]);
+    assert_eq!(kernel["fitted_to"].as_str(), Some(c));
+    let rgb = |v: &serde_json::Value| -> String {
+        (0..3).map(|i| format!("{:?}", v[i].as_f64().unwrap())).collect::<Vec<_>>().join(",")
+    };
+    let by_hand = json(&[
+        "--json",
+        "kernel",
+        "--samples",
+        "9",
+        "--strength",
+        &rgb(&fit["strength"]),
+        "--falloff",
+        &rgb(&fit["falloff"]),
+    ]);
+    assert_eq!(kernel["kernel"], by_hand["kernel"]);
+    // The fitted falloff is not the published default: the profile was used.
+    assert_ne!(kernel["falloff"][0].as_f64().unwrap(), 1.0);
+
+    let out = t.path().join("k");
+    let o = rtbake(&["kernel", "--profile-csv", c, "--strength", "0.5", "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--strength") && err.contains("--profile-csv"), "{err}");
+    assert!(!out.exists());
+}
+
+/// `rtbake transmittance --burley-*` (issue 11: the transmission profile engine bakers derive from Burley): T(s) is
+/// the closed-form plane integral A (e^(−s/d) + 3e^(−s/(3d)))/4 at every texel of the baked table, T(0) = A, the
+/// sidecar records A and d instead of Gaussians, and the form is the plane integral whatever --physical says.
+#[test]
+fn transmittance_from_burley_is_the_plane_integral() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("t");
+    let args = ["--burley-albedo", "0.8,0.5,0.3", "--burley-mfp-mm", "1,0.5,0.25", "--burley-fit", "searchlight"];
+    let mut a = vec!["--json", "transmittance", "--s", "0,0.5,2", "--samples", "64", "--s-max", "4"];
+    a.extend(args);
+    a.extend(["--out", out.to_str().unwrap()]);
+    let o = rtbake(&a);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["form"], "physical");
+    let want = |c: usize, s: f64| {
+        Burley::from_mean_free_path([0.8, 0.5, 0.3][c], [1.0, 0.5, 0.25][c], ShapeFit::Searchlight)
+            .unwrap()
+            .plane_transmittance(s)
+    };
+    for (i, s) in [0.0, 0.5, 2.0].iter().enumerate() {
+        for c in 0..3 {
+            let got = v["T"][i][c].as_f64().unwrap();
+            assert!((got - want(c, *s)).abs() <= 1e-15, "s = {s}, channel {c}: {got}");
+        }
+    }
+    assert_eq!(v["T"][0][2].as_f64().unwrap(), 0.3);
+    let side: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("burley_physical.json")).unwrap()).unwrap();
+    assert!(side.get("variances_mm2").is_none(), "{side}");
+    assert_eq!(side["burley"]["albedo"][0].as_f64(), Some(0.8));
+    assert!(side["formula"].as_str().unwrap().contains("Burley"));
+    // The f32 EXR texels, read as the `image` crate reads them: texel i holds s = 4·i/63.
+    let img = image::open(out.join("burley_physical.exr")).unwrap().to_rgb32f();
+    assert_eq!(img.dimensions(), (64, 1));
+    for i in [0u32, 1, 20, 63] {
+        let s = 4.0 * i as f64 / 63.0;
+        for c in 0..3 {
+            let got = img.get_pixel(i, 0)[c] as f64;
+            assert!((got - want(c, s)).abs() <= 1e-7, "texel {i}, channel {c}: {got} vs {}", want(c, s));
+        }
+    }
+}
+
+/// `rtbake transmittance --profile-csv` (issue 11) fits --count Gaussians to the user's profile as --material does
+/// to the built-in one: rtbake's own skin1 CSV gives T(s) within 1 % (of T(0)) of `--material skin1`. Two profile
+/// sources, or fit flags without a fitted profile, exit 2 and write nothing.
+#[test]
+fn transmittance_from_a_profile_csv_matches_the_built_in_material() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("skin1.csv");
+    let c = csv.to_str().unwrap();
+    let o = rtbake(&["profile", "--material", "skin1", "--csv", c, "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let run = |src: &[&str]| -> serde_json::Value {
+        let mut a = vec!["--json", "transmittance", "--s", "0,0.25,1,3", "--count", "4"];
+        a.extend(src);
+        let o = rtbake(&a);
+        assert_eq!(o.status.code(), Some(0), "{a:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let (built_in, from_csv) = (run(&["--material", "skin1"]), run(&["--profile-csv", c]));
+    assert_eq!(from_csv["source"]["profile"]["model"], "tabulated");
+    for i in 0..4 {
+        for ch in 0..3 {
+            let (a, b) = (built_in["T"][i][ch].as_f64().unwrap(), from_csv["T"][i][ch].as_f64().unwrap());
+            let t0 = built_in["T"][0][ch].as_f64().unwrap();
+            assert!((a - b).abs() <= 0.01 * t0, "s index {i}, channel {ch}: {a} vs {b}");
+        }
+    }
+    let out = t.path().join("t");
+    let o_ = out.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["--profile-csv", c, "--material", "skin1"], "give one profile"),
+        (vec!["--profile-csv", c, "--burley-albedo", "0.5,0.5,0.5", "--burley-mfp-mm", "1,1,1"], "give one profile"),
+        (vec!["--profile-preset", "deon4", "--count", "3"], "--count"),
+        (vec!["--burley-albedo", "0.5,0.5,0.5", "--burley-mfp-mm", "1,0,1"], "--burley-mfp-mm"),
+    ] {
+        let mut a = vec!["transmittance", "--out", o_];
+        a.extend(&args);
+        let o = rtbake(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!out.exists());
+    }
+}

@@ -21,7 +21,8 @@ fn kernel_json_contract_matches_the_published_17_tap_kernel() {
         rtbake(&["kernel", "--samples", "17", "--strength", "0.48,0.41,0.28", "--falloff", "1.0,0.37,0.3", "--json"]);
     let v = json(&out);
     let obj = v.as_object().unwrap();
-    assert_eq!(obj.keys().collect::<Vec<_>>(), vec!["kernel"]);
+    assert_eq!(obj.keys().collect::<Vec<_>>(), vec!["kernel", "strength", "falloff"]);
+    assert_eq!(v["strength"][1].as_f64().unwrap(), 0.41);
     let k = v["kernel"].as_array().unwrap();
     assert_eq!(k.len(), 17);
     let centre: Vec<f64> = k[0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
