@@ -236,11 +236,13 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
             "target": target_provenance,
             "relative_l2_percent": e.relative_l2_percent,
             "max_percent": e.max_percent,
+            "eq_2_2_rms_percent": e.eq_2_2_rms_percent,
+            "compared_range_mm": e.compared_range_mm,
             "candidate_totals": e.candidate_totals,
             "target_totals": e.target_totals,
             "total_difference": e.total_difference,
             "normalized": e.normalized,
-            "metric": "relative L2 of r*R(r): sqrt(int (r (R_c - R_t))^2 dr / int (r R_t)^2 dr); max |r dR| / max |r R_t|; percent, on the fits' radial grid 1e-5..1e3 mm",
+            "metric": "relative L2 of r*R(r): sqrt(int (r (R_c - R_t))^2 dr / int (r R_t)^2 dr); max |r dR| / max |r R_t|; eq. 2.2 RMS (the Gaussian fit's error_percent): sqrt(int r (R_c - R_t)^2 dr / int r R_t^2 dr); percent, on the fits' radial grid 1e-5..1e3 mm within compared_range_mm",
         });
         (report, plot, e.worst_relative_l2_percent())
     };
@@ -259,13 +261,15 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
     } else {
         println!("candidate: {}", report["candidate"]);
         println!("target:    {target_label}");
-        println!("channel   rel. L2 %     max %   total difference");
+        println!("channel   rel. L2 %     max %   eq2.2 RMS %   total difference");
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            let num = |key: &str| report[key][c].as_f64().unwrap_or(f64::NAN);
             println!(
-                "{name:<7} {:>9.3} {:>9.3} {:>+18.6}",
-                report["relative_l2_percent"][c].as_f64().unwrap_or(f64::NAN),
-                report["max_percent"][c].as_f64().unwrap_or(f64::NAN),
-                report["total_difference"][c].as_f64().unwrap_or(f64::NAN)
+                "{name:<7} {:>9.3} {:>9.3} {:>13} {:>+18.6}",
+                num("relative_l2_percent"),
+                num("max_percent"),
+                report.get("eq_2_2_rms_percent").map_or("-".into(), |_| format!("{:.3}", num("eq_2_2_rms_percent"))),
+                num("total_difference")
             );
         }
     }

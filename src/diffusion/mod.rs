@@ -47,6 +47,11 @@ pub trait RadialProfile: Sync {
     fn total_transmittance(&self) -> Option<[f64; 3]> {
         None
     }
+    /// The radii (mm) over which the profile is known, where it is not defined everywhere (a tabulated profile:
+    /// its first and last rows); comparisons are restricted to it. `None`: all r ≥ 0.
+    fn support_mm(&self) -> Option<(f64, f64)> {
+        None
+    }
     /// R at many radii (implementations may parallelise; results must not depend on the thread count).
     fn reflectance_many(&self, radii_mm: &[f64]) -> Vec<[f64; 3]> {
         radii_mm.iter().map(|&r| self.reflectance_mm2(r)).collect()

@@ -124,6 +124,10 @@ impl RadialProfile for TabulatedProfile {
     fn total_reflectance(&self) -> [f64; 3] {
         self.totals
     }
+
+    fn support_mm(&self) -> Option<(f64, f64)> {
+        Some((self.r_mm[0], *self.r_mm.last().expect(">= 2 rows")))
+    }
 }
 
 #[cfg(test)]

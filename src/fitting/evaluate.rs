@@ -8,7 +8,14 @@
 //!   percent — the metric of [`super::burley_fit`];
 //! - **max**: max_r |r ΔR(r)| / max_r |r R_target(r)|, percent (the largest deviation of the plotted curve, relative
 //!   to its peak);
+//! - **eq. 2.2 RMS**: √(∫ r (R_cand − R_target)² dr / ∫ r R_target² dr), percent — the error
+//!   [`super::fit_sum_of_gaussians`] reports (d'Eon et al.'s weighting), so a sum of Gaussians evaluated against the
+//!   profile it was fitted to reproduces `rtbake fit gaussians`' `error_percent`;
 //! - **totals**: ∫ 2πr R dr of both and their difference (candidate − target), the colour a renderer would shift.
+//!
+//! Where either profile is known only over a range ([`RadialProfile::support_mm`]: a tabulated `--profile-csv`),
+//! the errors are measured over the grid nodes inside it (the CSV's extrapolation is no measurement); the totals are
+//! each profile's own.
 //!
 //! With `normalize`, both profiles are divided by their own totals first (shape only; the separable kernel and a
 //! normalised fit conserve energy and take colour from the albedo). The separable kernel is not radial; its errors
@@ -25,6 +32,10 @@ pub struct ProfileErrors {
     pub relative_l2_percent: [f64; 3],
     /// max |r ΔR| / max |r R_target|, percent.
     pub max_percent: [f64; 3],
+    /// √(∫ r ΔR² dr / ∫ r R_target² dr), percent (thesis eq. 2.2's weighting: the Gaussian fit's error).
+    pub eq_2_2_rms_percent: [f64; 3],
+    /// The radii compared, mm (first and last grid node used).
+    pub compared_range_mm: [f64; 2],
     /// ∫ 2πr R dr of the candidate (1 with `normalize`).
     pub candidate_totals: [f64; 3],
     /// ∫ 2πr R dr of the target (1 with `normalize`).
@@ -49,7 +60,21 @@ pub fn compare_profiles(
     target: &dyn RadialProfile,
     normalize: bool,
 ) -> Result<ProfileErrors, InvalidInput> {
-    let grid = RadialGrid::standard();
+    let mut grid = RadialGrid::standard();
+    let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
+    for (a, b) in [candidate.support_mm(), target.support_mm()].into_iter().flatten() {
+        (lo, hi) = (lo.max(a), hi.min(b));
+    }
+    // Keep the nodes inside the support (a small relative slack keeps a node that equals a CSV row).
+    let keep: Vec<bool> = grid.r_mm.iter().map(|&r| r >= lo * (1.0 - 1e-12) && r <= hi * (1.0 + 1e-12)).collect();
+    if keep.iter().filter(|&&k| k).count() < 2 {
+        return Err(InvalidInput::new(
+            "target",
+            format!("the profiles overlap on [{lo}, {hi}] mm, fewer than 2 nodes of the comparison grid"),
+        ));
+    }
+    grid.r_mm = grid.r_mm.iter().zip(&keep).filter(|(_, &k)| k).map(|(r, _)| *r).collect();
+    grid.weights = grid.weights.iter().zip(&keep).filter(|(_, &k)| k).map(|(w, _)| *w).collect();
     let cand = candidate.reflectance_many(&grid.r_mm);
     let targ = target.reflectance_many(&grid.r_mm);
     for (name, values) in [("candidate", &cand), ("target", &targ)] {
@@ -82,6 +107,8 @@ pub fn compare_profiles(
     let mut out = ProfileErrors {
         relative_l2_percent: [0.0; 3],
         max_percent: [0.0; 3],
+        eq_2_2_rms_percent: [0.0; 3],
+        compared_range_mm: [grid.r_mm[0], *grid.r_mm.last().expect("checked")],
         candidate_totals: ct,
         target_totals: tt,
         total_difference: [0, 1, 2].map(|c| ct[c] - tt[c]),
@@ -97,6 +124,9 @@ pub fn compare_profiles(
             return Err(InvalidInput::new("target", format!("channel {c} is zero on the grid; nothing to compare")));
         }
         out.relative_l2_percent[c] = 100.0 * (grid.integrate_r(&rr(&diff)) / norm).sqrt();
+        let sq = |f: &dyn Fn(usize) -> f64| -> Vec<f64> { (0..grid.len()).map(|j| f(j).powi(2)).collect() };
+        let norm_2_2 = grid.integrate_r(&sq(&|j| targ[j][c] * scale.1[c]));
+        out.eq_2_2_rms_percent[c] = 100.0 * (grid.integrate_r(&sq(&diff)) / norm_2_2).sqrt();
         let peak = (0..grid.len()).map(|j| grid.r_mm[j] * targ[j][c] * scale.1[c]).fold(0.0, f64::max);
         let worst = (0..grid.len()).map(|j| (grid.r_mm[j] * diff(j)).abs()).fold(0.0, f64::max);
         out.max_percent[c] = 100.0 * worst / peak;

@@ -24,6 +24,7 @@ mod consumers_zstd;
 mod diffusion_cli;
 mod diffusion_layered;
 mod diffusion_physics;
+mod evaluate_cli;
 mod facial_cli;
 mod facial_rig;
 mod facial_wrinkles;
