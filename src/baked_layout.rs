@@ -45,6 +45,8 @@ pub mod path {
 
     /// Folder of the transmittance tables T(s).
     pub const TRANSMITTANCE_DIR: &str = "transmittance";
+    /// Burley fits, their plots and transmission profiles (asset `burley-profiles`).
+    pub const BURLEY_DIR: &str = "burley";
     /// Default transmittance table (EXR f32, RGB, node-inclusive); sidecar [`sidecar`] of it.
     pub const TRANSMITTANCE_DEFAULT: &str = "transmittance/deon6_published.exr";
 

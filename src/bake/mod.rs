@@ -85,10 +85,12 @@ pub fn registry() -> Vec<Asset> {
     v.extend(facial::assets());
     v.extend(profiles::assets());
     v.extend(transport::assets());
+    v.extend(burley::assets());
     v
 }
 
 pub mod aa;
+pub mod burley;
 pub mod facial;
 pub mod gaussians;
 pub mod profiles;

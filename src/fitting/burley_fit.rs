@@ -43,20 +43,16 @@ fn best_albedo(grid: &RadialGrid, target: &[f64], d: f64) -> (f64, f64) {
     (a, int(&|j| (rt[j] - a * rb[j]).powi(2)))
 }
 
-/// Fits A and d per channel to `profile` (whose values on the grid must be finite and non-negative).
+/// Fits A and d per channel to `profile` (whose values on the grid must be finite and non-negative, up to
+/// [`super::quadrature::NEGATIVE_FLOOR`]).
 pub fn fit_burley(profile: &dyn RadialProfile) -> Result<BurleyFit, InvalidInput> {
     let grid = RadialGrid::standard();
-    let values = profile.reflectance_many(&grid.r_mm);
+    let mut values = profile.reflectance_many(&grid.r_mm);
+    super::quadrature::checked_samples("profile", &grid.r_mm, &mut values)?;
     let mut channels = [Burley { albedo: 0.0, d_mm: 1.0 }; 3];
     let mut error_percent = [0.0; 3];
     for c in 0..3 {
         let target: Vec<f64> = values.iter().map(|v| v[c]).collect();
-        if let Some(k) = target.iter().position(|t| !t.is_finite() || *t < 0.0) {
-            return Err(InvalidInput::new(
-                "profile",
-                format!("R at r = {} mm (channel {c}) is {}; expected finite and >= 0", grid.r_mm[k], target[k]),
-            ));
-        }
         // ∫ (r R)² dr.
         let t2: Vec<f64> = grid.r_mm.iter().zip(&target).map(|(r, t)| r * t * t).collect();
         let norm = grid.integrate_r(&t2);

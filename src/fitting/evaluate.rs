@@ -21,7 +21,7 @@
 //! normalised fit conserve energy and take colour from the albedo). The separable kernel is not radial; its errors
 //! are [`crate::separable::fit::kernel_errors`] on the fit's 2-D grid.
 
-use super::quadrature::RadialGrid;
+use super::quadrature::{checked_samples, RadialGrid};
 use crate::diffusion::RadialProfile;
 use crate::error::InvalidInput;
 
@@ -75,18 +75,10 @@ pub fn compare_profiles(
     }
     grid.r_mm = grid.r_mm.iter().zip(&keep).filter(|(_, &k)| k).map(|(r, _)| *r).collect();
     grid.weights = grid.weights.iter().zip(&keep).filter(|(_, &k)| k).map(|(w, _)| *w).collect();
-    let cand = candidate.reflectance_many(&grid.r_mm);
-    let targ = target.reflectance_many(&grid.r_mm);
-    for (name, values) in [("candidate", &cand), ("target", &targ)] {
-        for (k, v) in values.iter().enumerate() {
-            if let Some(c) = (0..3).find(|&c| !(v[c].is_finite() && v[c] >= 0.0)) {
-                return Err(InvalidInput::new(
-                    name,
-                    format!("R at r = {} mm (channel {c}) is {}; expected finite and >= 0", grid.r_mm[k], v[c]),
-                ));
-            }
-        }
-    }
+    let mut cand = candidate.reflectance_many(&grid.r_mm);
+    let mut targ = target.reflectance_many(&grid.r_mm);
+    checked_samples("candidate", &grid.r_mm, &mut cand)?;
+    checked_samples("target", &grid.r_mm, &mut targ)?;
     let (mut ct, mut tt) = (candidate.total_reflectance(), target.total_reflectance());
     let mut scale = ([1.0; 3], [1.0; 3]);
     if normalize {

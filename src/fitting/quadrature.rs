@@ -72,6 +72,29 @@ impl RadialGrid {
     }
 }
 
+/// Relative size (to the channel's largest |R|) below which a negative sample is the numerical floor of a profile's
+/// transform (the layered multipole's inverse Hankel transform returns values of order −1e−19 mm⁻² far from the
+/// source) and reads as 0.
+pub const NEGATIVE_FLOOR: f64 = 1e-12;
+
+/// Checks profile samples `values[j]` at `r_mm[j]` for a fit or a comparison: every value finite, negatives only
+/// within [`NEGATIVE_FLOOR`] of the channel's peak (set to 0); `name` names the profile in the error.
+pub fn checked_samples(name: &str, r_mm: &[f64], values: &mut [[f64; 3]]) -> Result<(), crate::error::InvalidInput> {
+    for c in 0..3 {
+        let peak = values.iter().map(|v| v[c].abs()).filter(|v| v.is_finite()).fold(0.0, f64::max);
+        for (k, v) in values.iter_mut().enumerate() {
+            if !v[c].is_finite() || v[c] < -NEGATIVE_FLOOR * peak {
+                return Err(crate::error::InvalidInput::new(
+                    name,
+                    format!("R at r = {} mm (channel {c}) is {}; expected finite and >= 0", r_mm[k], v[c]),
+                ));
+            }
+            v[c] = v[c].max(0.0);
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
@@ -106,5 +129,18 @@ mod tests {
                 assert!(((total - exact[c]) / exact[c]).abs() < 1e-11, "{} {c}: {total} vs {}", m.name, exact[c]);
             }
         }
+    }
+
+    #[test]
+    fn samples_at_the_transform_floor_read_as_zero_and_real_negatives_are_refused() {
+        let r = [0.1, 1.0, 10.0];
+        let mut v = [[1.0, 2.0, 3.0], [0.5, 1.0, 1.0], [-6e-20, 0.0, 1e-3]];
+        checked_samples("profile", &r, &mut v).unwrap();
+        assert_eq!(v[2], [0.0, 0.0, 1e-3]);
+        let mut bad = [[1.0, 2.0, 3.0], [0.5, -1e-6, 1.0], [0.0, 0.0, 0.0]];
+        let e = checked_samples("profile", &r, &mut bad).unwrap_err();
+        assert!(e.message.contains("r = 1 mm (channel 1)"), "{e}");
+        let mut nan = [[f64::NAN, 1.0, 1.0]];
+        assert!(checked_samples("profile", &r[..1], &mut nan).is_err());
     }
 }

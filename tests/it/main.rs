@@ -12,6 +12,7 @@ mod aa_cli;
 mod aa_golden;
 mod bake_cli;
 mod baked_conformance;
+mod burley_bake;
 mod burley_cli;
 mod consumers_bevy;
 mod consumers_dds;
