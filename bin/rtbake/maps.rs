@@ -333,6 +333,13 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         .map_err(|e| usage(anyhow::anyhow!("--rig {}: not a valid rig description: {e}", a.rig.display())))?;
     let names: Vec<String> = desc.maps.iter().map(|m| m.name.clone()).collect();
     let weights = hemoglobin_rig::rig_weights(&names, &pairs, a.normalize_weights)?;
+    // The output is full size: estimate before the maps are read or anything is allocated.
+    let ([fw, fh], [rw, rh]) = (desc.full_size, desc.rig_size);
+    ctx.check_budget(
+        &format!("--rig {} (full size {fw}x{fh})", a.rig.display()),
+        hemoglobin_rig::evaluate_memory_estimate_bytes(fw, fh, rw, rh, names.len()),
+        hemoglobin_rig::evaluate_time_estimate_seconds(fw, fh),
+    )?;
     let dir = a.rig.parent().unwrap_or(Path::new(".")).to_path_buf();
     let param = format!("--rig {}", a.rig.display());
     let rig = bf::rig_from_description(&param, &desc, &mut |file| {
@@ -521,6 +528,8 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
 fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
     rtbake::error::check_range("--size", a.size, 3, 8192, "texels")?;
     let names: Vec<String> = a.targets.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect();
+    let (bytes, seconds) = synthetic::hemoglobin_set_estimate(a.size, names.len() + 1);
+    ctx.check_budget(&format!("--size {} with {} maps (--targets)", a.size, names.len() + 1), bytes, seconds)?;
     let set = synthetic::hemoglobin_set("--targets", a.size, a.seed, &names)?;
     let mut files = Vec::new();
     for (name, img) in &set {

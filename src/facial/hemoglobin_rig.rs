@@ -279,6 +279,20 @@ pub fn time_estimate_seconds(width: u32, height: u32, maps: usize, radius: u32, 
     1.5e-9 * width as f64 * height as f64 * maps as f64 * (2 * radius as u64 + 1) as f64 / threads.max(1) as f64
 }
 
+/// Wall time of [`evaluate`] at full resolution `width`×`height` with its EXR encoding (`maps rig-eval`; issue 15's
+/// budget check): 0.25 µs per output texel + 0.5 s. Measured with the release build on the project's 2-core machine:
+/// 4096², 5 maps, f32 output: 2.0 s (0.12 µs per texel); the estimate doubles it.
+pub fn evaluate_time_estimate_seconds(width: u32, height: u32) -> f64 {
+    0.5 + 0.25e-6 * width as f64 * height as f64
+}
+
+/// Peak memory of [`evaluate`] with its EXR encoding, in bytes: the f32 output, the encoder's copy and the encoded
+/// bytes (16 bytes per texel measured at 4096²: 267 MB), rounded up to 24, plus the stored rig maps (scale and
+/// bias, f32, of `rig_width`×`rig_height`, `maps` of them) and 32 MiB.
+pub fn evaluate_memory_estimate_bytes(width: u32, height: u32, rig_width: u32, rig_height: u32, maps: usize) -> u64 {
+    24 * width as u64 * height as u64 + 8 * maps as u64 * rig_width as u64 * rig_height as u64 + (32 << 20)
+}
+
 /// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32), the disk statistics of the
 /// neutral and of one target at a time (mean and σ, f64), the full-size scale and bias, and the encoded outputs —
 /// counted from the buffers as 4 bytes per texel per map plus 72 bytes per texel, plus 32 MiB.

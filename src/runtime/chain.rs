@@ -57,9 +57,11 @@ pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Resul
 }
 
 /// Peak memory (bytes) and wall time (s) of `rtbake run smaa|mlaa` on a `w`×`h` image, decoding and encoding
-/// included (issue 15's budget check, before the pass): measured with the release build on the project's 2-core
-/// machine at 1024² on the CPU path (SMAA 0.41 s, MLAA 0.78 s, 24 MB), doubled; the GPU path takes a tenth of the
-/// CPU time plus 1 s of device set-up and the same host buffers.
+/// included (issue 15's budget check, before the pass): times measured with the release build on the project's 2-core
+/// machine at 1024² on the CPU path (SMAA 0.41 s, MLAA 0.78 s), doubled; the GPU path takes a tenth of the CPU time
+/// plus 1 s of device set-up and the same host buffers. Memory: 24 bytes per pixel + 32 MiB, from peak RSS measured
+/// on the CPU path (4096²: SMAA 11 B/px, MLAA 14 B/px; SMAA at 16384²: 4.1 GB, 15.3 B/px), so the largest input
+/// `--help` allows (16384², 6 GiB) is served under the default budget.
 pub fn antialias_estimate(w: u32, h: u32, aa: &Antialiasing, gpu: bool) -> (u64, f64) {
     let px = w as f64 * h as f64;
     let cpu_s_per_px = match aa {
@@ -67,7 +69,7 @@ pub fn antialias_estimate(w: u32, h: u32, aa: &Antialiasing, gpu: bool) -> (u64,
         Antialiasing::Mlaa(_) => 1.6e-6,
     };
     let seconds = if gpu { 1.0 + 0.1 * cpu_s_per_px * px } else { 0.2 + cpu_s_per_px * px };
-    (48 * w as u64 * h as u64 + (32 << 20), seconds)
+    (24 * w as u64 * h as u64 + (32 << 20), seconds)
 }
 
 /// Peak memory (bytes) and wall time (s) of `rtbake run sss` on a `w`×`h` frame, EXR decoding and encoding included:

@@ -238,3 +238,59 @@ fn wrinkle_conversions_estimate_from_the_input_size() {
     let o = rtbake(&["maps", "wrinkles", "--normal", s(&normal), "--size", "16", "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// `maps synthetic` and `maps rig-eval` (whose output is the rig's full size, up to 16384²) estimate before any
+/// work: refused under small budgets with the flags named; at the sizes `--help` allows the estimates are served by
+/// the default budgets (measured at 4096² with the release build: synthetic 40.8 s / 300 MB for 5 maps, rig-eval
+/// 2.0 s / 267 MB).
+#[test]
+fn synthetic_maps_and_rig_evaluation_estimate_before_any_work() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("o");
+    let all = "joy,anger,fear,disgust,sadness,surprise,exercise,alcohol";
+    let args = ["maps", "synthetic", "--size", "8192", "--targets", all, "--max-seconds", "60"];
+    refused(&args, "--out", &out, &["--size 8192 with 9 maps", "--targets", "--max-seconds"], "time budget of 60 s");
+    let args = ["maps", "synthetic", "--size", "512", "--max-memory", "20M"];
+    refused(&args, "--out", &out, &["--size 512", "--max-memory"], "MiB");
+    let (bytes, seconds) = rtbake::facial::synthetic::hemoglobin_set_estimate(8192, 9);
+    assert!(
+        bytes < 6 << 30 && seconds < 600.0,
+        "the largest synthetic set is served by default: {bytes} B, {seconds} s"
+    );
+
+    // A small rig, then its evaluation under a budget too small for its full size.
+    let syn = t.path().join("syn");
+    let o = rtbake(&["maps", "synthetic", "--size", "32", "--targets", "joy", "--out", s(&syn), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let rig = t.path().join("rig");
+    let target = format!("joy={}", s(&syn.join("joy.png")));
+    let o = rtbake(&[
+        "maps",
+        "hemoglobin",
+        "--neutral",
+        s(&syn.join("neutral.png")),
+        "--target",
+        &target,
+        "--radius",
+        "4",
+        "--rig-size",
+        "8",
+        "--out",
+        s(&rig),
+        "-q",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let rig_json = rig.join("rig.json");
+    let eval_out = t.path().join("h.exr");
+    let args = ["maps", "rig-eval", "--rig", s(&rig_json), "--weights", "joy=1", "--max-memory", "1M"];
+    refused(&args, "--out", &eval_out, &["--rig", "(full size 32x32)", "--max-memory"], "MiB");
+    let o = rtbake(&["maps", "rig-eval", "--rig", s(&rig_json), "--weights", "joy=1", "--out", s(&eval_out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    use rtbake::facial::hemoglobin_rig::{evaluate_memory_estimate_bytes, evaluate_time_estimate_seconds};
+    // The thesis' 256² storage at the largest full size is served; 9 full-size 16384² scale/bias pairs (18 GiB
+    // of stored maps) are not.
+    let bytes = evaluate_memory_estimate_bytes(16384, 16384, 256, 256, 9);
+    assert!(bytes > 6 << 30 && bytes < 7 << 30, "16384² from 256² maps: {bytes} B");
+    assert!(evaluate_memory_estimate_bytes(16384, 16384, 16384, 16384, 9) > 24 << 30);
+    assert!(evaluate_time_estimate_seconds(16384, 16384) < 600.0);
+}
