@@ -46,6 +46,7 @@ mod reliability_limits;
 mod runtime_cli;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
+mod runtime_importance_sss;
 mod runtime_loader;
 mod runtime_loader_tables;
 mod runtime_mlaa;
