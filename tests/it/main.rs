@@ -32,6 +32,7 @@ mod fitting_bake;
 mod fitting_cli;
 mod fitting_determinism;
 mod fitting_published;
+mod importance_cli;
 mod newcomer_cli;
 mod newcomer_profile_floor;
 mod newcomer_provenance;
