@@ -23,7 +23,7 @@ pub enum RunCommand {
     Mlaa(MlaaArgs),
     /// Subsurface scattering on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR: separable SSS
     /// with a baked kernel (default), or the screen-space sum of Gaussians with the baked fit.
-    Sss(SssArgs),
+    Sss(Box<SssArgs>),
     /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
     /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
     Demo(DemoArgs),
@@ -180,7 +180,7 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
         }
-        RunCommand::Sss(a) => sss(ctx, a),
+        RunCommand::Sss(a) => sss(ctx, *a),
         RunCommand::Demo(d) => run_demo(ctx, d),
     }
 }

@@ -26,7 +26,7 @@ pub fn assets() -> Vec<Asset> {
     vec![Asset {
         name: "sss-importance-kernels",
         summary: "Importance-sampled SSS disk kernels (skin1 dipole, deon6, Burley skin; N=20/40/80): JSON + HLSL/GLSL/WGSL + f32 table",
-        default_params: default_params,
+        default_params,
         bake,
     }]
 }

@@ -19,6 +19,9 @@
 //! radii agree with the closed-form inverse to 1e−6 relative (the spacing Δu = ln 10/256 ≈ 0.009 makes the
 //! Hermite error O(Δu⁴)).
 
+// Index loops over channels mirror the equations.
+#![allow(clippy::needless_range_loop)]
+
 use crate::diffusion::quadrature::gauss_legendre;
 use crate::diffusion::RadialProfile;
 use crate::error::InvalidInput;

@@ -31,6 +31,9 @@
 //! ‖a − E‖₂ / ‖E − I‖₂ (the error relative to the blur's own effect on the edge) and the max absolute error
 //! max |a − E| (irradiance 1 on the lit side).
 
+// Index loops over channels mirror the equations.
+#![allow(clippy::needless_range_loop)]
+
 use super::cdf::RadialCdf;
 use super::disk::{ImportanceKernel, SampledProfile};
 use crate::diffusion::quadrature::gauss_legendre;
@@ -145,7 +148,7 @@ fn fetch(values: &[f64], x0_mm: f64, h: f64, x: f64) -> f64 {
 /// The separable runtime's taps per pass for a budget of N fetches.
 pub fn separable_taps(n: usize) -> usize {
     let t = (n / 2).max(3);
-    if t % 2 == 0 {
+    if t.is_multiple_of(2) {
         t - 1
     } else {
         t
@@ -325,6 +328,34 @@ pub fn markdown_table(rows: &[(String, usize, [MethodErrors; 3])]) -> String {
     s
 }
 
+/// The comparison of the three profiles (skin1 dipole, d'Eon 6-Gaussian skin, a Burley skin) at
+/// N = 20, 40, 80 with the default pixel (125/720 mm): the rows of [`markdown_table`].
+pub fn default_comparison() -> Result<Vec<(String, usize, [MethodErrors; 3])>, CompareError> {
+    use crate::diffusion::burley::{RgbBurley, ShapeFit};
+    let skin1 = crate::diffusion::materials::find("skin1").expect("built-in").dipole(crate::diffusion::FdrForm::Dj05);
+    let deon6 = crate::diffusion::sum_of_gaussians::deon6();
+    let burley = RgbBurley::from_mean_free_path(BURLEY_SKIN_ALBEDO, BURLEY_SKIN_MFP_MM, ShapeFit::DiffuseTransmission)?;
+    let pixel_mm = ObjectiveSpec::default().pixel_mm;
+    let profiles: [(&str, SampledProfile<'_>, &dyn RadialProfile); 3] = [
+        ("skin1 (Jensen dipole)", SampledProfile::Tabulated(&skin1), &skin1),
+        ("deon6 (d'Eon 6 Gaussians)", SampledProfile::Tabulated(&deon6), &deon6),
+        ("Burley skin", SampledProfile::Burley(&burley), &burley),
+    ];
+    let mut rows = Vec::new();
+    for (label, sampled, dynp) in profiles {
+        let test = EdgeTest::new(dynp, pixel_mm)?;
+        for n in super::disk::UNITY_SAMPLE_PRESETS {
+            rows.push((label.to_string(), n, test.compare(sampled, n)?));
+        }
+    }
+    Ok(rows)
+}
+
+/// The Burley skin of the comparison and the default bake: surface albedo per channel.
+pub const BURLEY_SKIN_ALBEDO: [f64; 3] = [0.8, 0.5, 0.3];
+/// The Burley skin's diffuse mean free path per channel, mm (diffuse-transmission fit).
+pub const BURLEY_SKIN_MFP_MM: [f64; 3] = [1.0, 0.5, 0.25];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -384,31 +415,3 @@ mod tests {
         }
     }
 }
-
-/// The comparison of the three profiles (skin1 dipole, d'Eon 6-Gaussian skin, a Burley skin) at
-/// N = 20, 40, 80 with the default pixel (125/720 mm): the rows of [`markdown_table`].
-pub fn default_comparison() -> Result<Vec<(String, usize, [MethodErrors; 3])>, CompareError> {
-    use crate::diffusion::burley::{RgbBurley, ShapeFit};
-    let skin1 = crate::diffusion::materials::find("skin1").expect("built-in").dipole(crate::diffusion::FdrForm::Dj05);
-    let deon6 = crate::diffusion::sum_of_gaussians::deon6();
-    let burley = RgbBurley::from_mean_free_path(BURLEY_SKIN_ALBEDO, BURLEY_SKIN_MFP_MM, ShapeFit::DiffuseTransmission)?;
-    let pixel_mm = ObjectiveSpec::default().pixel_mm;
-    let profiles: [(&str, SampledProfile<'_>, &dyn RadialProfile); 3] = [
-        ("skin1 (Jensen dipole)", SampledProfile::Tabulated(&skin1), &skin1),
-        ("deon6 (d'Eon 6 Gaussians)", SampledProfile::Tabulated(&deon6), &deon6),
-        ("Burley skin", SampledProfile::Burley(&burley), &burley),
-    ];
-    let mut rows = Vec::new();
-    for (label, sampled, dynp) in profiles {
-        let test = EdgeTest::new(dynp, pixel_mm)?;
-        for n in super::disk::UNITY_SAMPLE_PRESETS {
-            rows.push((label.to_string(), n, test.compare(sampled, n)?));
-        }
-    }
-    Ok(rows)
-}
-
-/// The Burley skin of the comparison and the default bake: surface albedo per channel.
-pub const BURLEY_SKIN_ALBEDO: [f64; 3] = [0.8, 0.5, 0.3];
-/// The Burley skin's diffuse mean free path per channel, mm (diffuse-transmission fit).
-pub const BURLEY_SKIN_MFP_MM: [f64; 3] = [1.0, 0.5, 0.25];

@@ -24,6 +24,9 @@
 //! **Cut-off:** [`ImportanceKernel::cutoff_mm`] = F⁻¹([`CUTOFF_QUANTILE`] = 0.999) of the sampled channel, the
 //! radius within which 99.9 % of its reflected light lands (a screen-space filter radius).
 
+// Index loops over channels mirror the equations.
+#![allow(clippy::needless_range_loop)]
+
 use super::cdf::RadialCdf;
 use crate::diffusion::burley::RgbBurley;
 use crate::diffusion::RadialProfile;
@@ -123,7 +126,7 @@ impl ImportanceKernel {
     fn burley(b: &RgbBurley, n: usize) -> Result<Self, InvalidInput> {
         let totals = b.total_reflectance();
         for (c, a) in totals.iter().enumerate() {
-            if !(*a > 0.0) {
+            if a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return Err(InvalidInput::new(
                     format!("albedo[{c}]"),
                     "must be > 0 for an importance kernel (a channel with no reflectance has nothing to sample)",
@@ -158,7 +161,7 @@ impl ImportanceKernel {
                 return Err(InvalidInput::new("profile", format!("R({r} mm) is not finite")));
             }
             let pdf = rc[s] / totals[s];
-            if !(pdf > 0.0) {
+            if pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return Err(InvalidInput::new(
                     "profile",
                     format!("has zero density at the sampled radius {r} mm of channel {s}"),
