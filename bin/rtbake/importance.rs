@@ -133,6 +133,7 @@ impl ResolvedProfile {
             let flag = match e.param.as_str() {
                 "samples" => "--samples".to_string(),
                 p if p.starts_with("albedo") => format!("--burley-albedo {p}"),
+                "profile" => "profile".to_string(),
                 p => format!("profile ({p})"),
             };
             usage(anyhow::anyhow!("{flag} {}", e.message))
