@@ -43,6 +43,15 @@ pub mod path {
     /// Default separable-SSS kernel (17 taps, published parameters).
     pub const SEPARABLE_KERNEL_DEFAULT: &str = "sss/separable/published_n17.json";
 
+    /// Folder of the importance-sampled disk kernels (`sss-importance-kernels`).
+    pub const IMPORTANCE_DIR: &str = "sss/importance";
+
+    /// Stem of an importance kernel's files in [`IMPORTANCE_DIR`]: `{name}_n{samples}` (`.json`, `.hlsl`, `.glsl`,
+    /// `.wgsl`, `_f32x8.bin`).
+    pub fn importance_kernel_stem(name: &str, samples: usize) -> String {
+        format!("{name}_n{samples}")
+    }
+
     /// Folder of the transmittance tables T(s).
     pub const TRANSMITTANCE_DIR: &str = "transmittance";
     /// Burley fits, their plots and transmission profiles (asset `burley-profiles`).
@@ -85,6 +94,8 @@ pub mod schema {
     pub const MANIFEST: &str = "rtbake-manifest/1";
     /// A separable-SSS kernel file ([`crate::separable::kernel::Kernel::to_json`]).
     pub use crate::separable::kernel::JSON_SCHEMA as SEPARABLE_KERNEL;
+    /// An importance-sampled disk kernel (`crate::bake::importance::kernel_json`).
+    pub const IMPORTANCE_KERNEL: &str = "rtbake-importance-kernel/1";
     /// A hemoglobin rig description ([`super::RigDescription`]).
     pub const HEMOGLOBIN_RIG: &str = "rtbake-hemoglobin-rig/1";
     /// The wrinkle example's report.

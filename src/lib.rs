@@ -154,6 +154,7 @@ pub mod runtime;
 pub mod separable;
 pub mod skin_color;
 pub mod spectral;
+pub mod sss_sampling;
 pub mod transmittance;
 pub mod transport;
 

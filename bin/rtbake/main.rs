@@ -9,6 +9,7 @@ mod bake;
 mod cli;
 mod evaluate;
 mod fit;
+mod importance;
 mod kernel;
 mod maps;
 mod profile;
@@ -75,6 +76,9 @@ enum Command {
     Evaluate(evaluate::EvaluateArgs),
     /// Generate separable-SSS kernel taps from strength and falloff.
     Kernel(kernel::KernelArgs),
+    /// An importance-sampled SSS disk kernel of a profile (N samples of its radial CDF, golden-angle spiral):
+    /// JSON, HLSL/GLSL/WGSL includes and an f32 table.
+    ImportanceKernel(importance::ImportanceKernelArgs),
     /// Evaluate or bake the transmittance table T(s) (thesis eq. 5.12).
     Transmittance(transmittance::TransmittanceArgs),
     /// Monte Carlo photon transport in a layer stack (MCML-style): R(r), T(r) with standard errors, against diffusion.
@@ -133,6 +137,7 @@ fn main() {
         Command::Fit(c) => fit::run(c, &ctx),
         Command::Evaluate(a) => evaluate::run(a, &ctx),
         Command::Kernel(a) => kernel::run(a, &ctx),
+        Command::ImportanceKernel(a) => importance::run(a, &ctx),
         Command::Transmittance(a) => transmittance::run(a, &ctx),
         Command::Transport(a) => transport::run(a, &ctx),
         Command::SkinColor(a) => skin_color::run(a, &ctx),

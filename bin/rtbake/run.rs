@@ -8,6 +8,7 @@ use rtbake::runtime::chain::Subsurface;
 use rtbake::runtime::chain::{self, Antialiasing};
 use rtbake::runtime::demo::{self, DemoAssets, SssMethod};
 use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use rtbake::runtime::loader;
 use rtbake::runtime::mlaa::MlaaAreaMap;
 use rtbake::runtime::separable_sss::SssParams;
@@ -22,7 +23,7 @@ pub enum RunCommand {
     Mlaa(MlaaArgs),
     /// Subsurface scattering on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR: separable SSS
     /// with a baked kernel (default), or the screen-space sum of Gaussians with the baked fit.
-    Sss(SssArgs),
+    Sss(Box<SssArgs>),
     /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
     /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
     Demo(DemoArgs),
@@ -88,9 +89,18 @@ pub struct SssArgs {
     /// (checked against it), or a kernel file elsewhere (content checks only).
     #[arg(long, value_name = "JSON", default_value = path::SEPARABLE_KERNEL_DEFAULT)]
     kernel: String,
-    /// SSS method: separable (--kernel) or gaussians (--gaussians).
+    /// SSS method: separable (--kernel), gaussians (--gaussians) or importance (--samples and a profile flag).
     #[arg(long, value_enum, default_value = "separable")]
-    method: Method,
+    method: SssMethodArg,
+    /// Sample budget of --method importance, 1..=1024 (default 40).
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    samples: Option<i64>,
+    /// The profile --method importance samples.
+    #[command(flatten)]
+    profile: crate::importance::ImportanceProfileArgs,
+    /// mm per world unit of --depth for --method importance (default 125: a head 1 unit tall).
+    #[arg(long, default_value_t = ImportanceSssParams::default().mm_per_world_unit, allow_negative_numbers = true)]
+    mm_per_world_unit: f32,
     /// Sum-of-Gaussians fit for --method gaussians, a path listed in the manifest of --baked-dir.
     #[arg(long, value_name = "JSON", default_value = path::GAUSSIANS_DEFAULT)]
     gaussians: String,
@@ -105,6 +115,17 @@ pub struct SssArgs {
     no_follow_surface: bool,
     #[command(flatten)]
     common: Common,
+}
+
+/// `run sss --method`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SssMethodArg {
+    /// Separable SSS (thesis ch. 6), two passes.
+    Separable,
+    /// Screen-space sum of Gaussians (thesis ch. 4), α scaled from its 720-pixel viewport to the image height.
+    Gaussians,
+    /// Importance-sampled disk kernel of a profile (Unity HDRP's sampling), one pass of --samples fetches.
+    Importance,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -159,7 +180,7 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
         }
-        RunCommand::Sss(a) => sss(ctx, a),
+        RunCommand::Sss(a) => sss(ctx, *a),
         RunCommand::Demo(d) => run_demo(ctx, d),
     }
 }
@@ -298,9 +319,31 @@ fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     check_output(&a.output, &[&a.color, &a.depth])?;
     let baked = &a.common.baked;
+    if a.method != SssMethodArg::Importance && (a.samples.is_some() || a.profile.is_set()) {
+        return Err(usage_msg(
+            "--samples and the profile flags (--material, --profile-preset, …) need --method importance",
+        ));
+    }
+    let importance = match a.method {
+        SssMethodArg::Importance => {
+            let n = crate::importance::parse_samples(a.samples.unwrap_or(40))?;
+            let resolved = a.profile.resolve()?;
+            let k = resolved.kernel(n)?;
+            ctx.info(format!("importance kernel: {} samples of {} (cut-off {:.4} mm)", n, resolved.stem, k.cutoff_mm));
+            let p = ImportanceSssParams {
+                mm_per_world_unit: a.mm_per_world_unit,
+                fovy_deg: a.fovy,
+                follow_surface: !a.no_follow_surface,
+            };
+            p.validate()?;
+            Some((ImportanceSamples::from_kernel(&k), p))
+        }
+        _ => None,
+    };
     let (kernel, gaussians) = match a.method {
-        Method::Separable => (Some(read_kernel(ctx, baked, &a.kernel)?), None),
-        Method::Gaussians => (None, Some(loader::load_gaussians(baked, &a.gaussians).map_err(usage)?)),
+        SssMethodArg::Separable => (Some(read_kernel(ctx, baked, &a.kernel)?), None),
+        SssMethodArg::Gaussians => (None, Some(loader::load_gaussians(baked, &a.gaussians).map_err(usage)?)),
+        SssMethodArg::Importance => (None, None),
     };
     let default_width = kernel.as_ref().and_then(|k| k.sss_width).unwrap_or(SssParams::default().sss_width);
     let params = SssParams {
@@ -329,10 +372,11 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     let gpu = device(ctx, a.common.cpu)?;
     let (w, h) = (color.width, color.height);
     let t = Instant::now();
-    let method = match (&kernel, &gaussians) {
-        (Some(k), _) => Subsurface::Separable { kernel: &k.kernel, params: &params },
-        (None, Some(f)) => Subsurface::Gaussians { blurs: &f.blurs, params: f.params },
-        (None, None) => unreachable!("one SSS method is selected"),
+    let method = match (&kernel, &gaussians, &importance) {
+        (Some(k), _, _) => Subsurface::Separable { kernel: &k.kernel, params: &params },
+        (None, Some(f), _) => Subsurface::Gaussians { blurs: &f.blurs, params: f.params },
+        (None, None, Some((samples, p))) => Subsurface::Importance { samples, params: p },
+        (None, None, None) => unreachable!("one SSS method is selected"),
     };
     let (bytes, seconds) = rtbake::runtime::chain::subsurface_estimate(w, h, &method, gpu.is_some());
     ctx.check_budget(&format!("--color {} ({w}x{h})", a.color.display()), bytes, seconds)?;

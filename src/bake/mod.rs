@@ -81,6 +81,7 @@ pub fn registry() -> Vec<Asset> {
     v.extend(gaussians::assets());
     v.extend(transmittance::assets());
     v.extend(separable::assets());
+    v.extend(importance::assets());
     v.extend(skin::assets());
     v.extend(facial::assets());
     v.extend(profiles::assets());
@@ -93,6 +94,7 @@ pub mod aa;
 pub mod burley;
 pub mod facial;
 pub mod gaussians;
+pub mod importance;
 pub mod profiles;
 pub mod separable;
 pub mod skin;

@@ -4,6 +4,7 @@
 use super::cpu::{self, FilterPrecision};
 use super::device::Gpu;
 use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use super::importance_sss::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
 use super::mlaa::{Mlaa, MlaaAreaMap};
 use super::separable_sss::{SeparableSss, SssKernel, SssParams};
 use super::smaa::{Smaa, SmaaTextures};
@@ -74,12 +75,14 @@ pub fn antialias_estimate(w: u32, h: u32, aa: &Antialiasing, gpu: bool) -> (u64,
 
 /// Peak memory (bytes) and wall time (s) of `rtbake run sss` on a `w`×`h` frame, EXR decoding and encoding included:
 /// measured with the release build on the project's 2-core machine at 1024² on the CPU path (separable 0.49 s and
-/// 103 MB, sum of Gaussians 0.84 s and 136 MB), doubled; the GPU path as for [`antialias_estimate`].
+/// 103 MB, sum of Gaussians 0.84 s and 136 MB), doubled; the GPU path as for [`antialias_estimate`]. The importance
+/// pass is not measured: the separable figure scaled by its fetches (N samples against the separable's 2 × 17).
 pub fn subsurface_estimate(w: u32, h: u32, method: &Subsurface, gpu: bool) -> (u64, f64) {
     let px = w as f64 * h as f64;
     let (cpu_s_per_px, bytes_per_px) = match method {
         Subsurface::Separable { .. } => (1.0e-6, 200),
         Subsurface::Gaussians { .. } => (1.7e-6, 260),
+        Subsurface::Importance { samples, .. } => (1.0e-6 * (samples.offsets_mm.len() as f64 / 34.0).max(1.0), 200),
     };
     let seconds = if gpu { 1.0 + 0.1 * cpu_s_per_px * px } else { 0.2 + cpu_s_per_px * px };
     (bytes_per_px * w as u64 * h as u64 + (32 << 20), seconds)
@@ -92,6 +95,8 @@ pub enum Subsurface<'a> {
     /// Sum-of-Gaussians screen-space SSS (thesis ch. 4); `params.alpha` as stated for the 720-pixel viewport of
     /// eq. 4.1 — [`subsurface`] scales it to the image height.
     Gaussians { blurs: &'a GaussianBlurs, params: GaussianSssParams },
+    /// Importance-sampled disk kernel (`crate::sss_sampling`), one pass.
+    Importance { samples: &'a ImportanceSamples, params: &'a ImportanceSssParams },
 }
 
 /// Blurs linear RGBA f32 `rgba` (alpha = SSS strength) with linear depth `depth_linear` (one value per pixel, the
@@ -117,6 +122,14 @@ pub fn subsurface(
         }
         (None, Subsurface::Gaussians { blurs, params }) => {
             cpu::gaussian_sss::gaussian_sss(rgba, depth_linear, w, h, blurs, &params.for_viewport_height(h))
+        }
+        (Some(g), Subsurface::Importance { samples, params }) => {
+            ImportanceSss::new(&g.device, w, h, samples, params)?.run(&g.device, &g.queue, rgba, depth_linear)?
+        }
+        (None, Subsurface::Importance { samples, params }) => {
+            samples.validate()?;
+            params.validate()?;
+            cpu::importance_sss::importance_sss(rgba, depth_linear, w, h, samples, params)
         }
     })
 }

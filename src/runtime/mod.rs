@@ -16,6 +16,7 @@ pub mod demo;
 pub mod device;
 pub mod gaussian_sss;
 pub mod gpu;
+pub mod importance_sss;
 pub mod loader;
 pub mod mlaa;
 pub mod scene;

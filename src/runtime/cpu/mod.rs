@@ -7,6 +7,7 @@
 //! textures with 8-bit weights and return 8-bit results.
 
 pub mod gaussian_sss;
+pub mod importance_sss;
 pub mod mlaa;
 pub mod separable_sss;
 pub mod skin_inputs;

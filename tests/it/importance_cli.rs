@@ -1,0 +1,186 @@
+//! Issue 11 (part): `rtbake importance-kernel` (an importance-sampled disk kernel of any profile; files and their
+//! consumers) and `rtbake run sss --method importance`; bad input exits 2 naming the flag and writes nothing.
+
+use crate::support::rtbake;
+use rtbake::image_buf::Image;
+use rtbake::io::exr::{encode, ExrPrecision};
+use serde_json::Value;
+use wgpu::naga;
+
+/// The WGSL include followed by an entry point that reads every constant (arrays with a run-time index).
+fn naga_check(src: &str) {
+    let mut body = String::new();
+    for l in src.lines().filter_map(|l| l.strip_prefix("const ")) {
+        let (name, ty) = l.split_once(':').unwrap();
+        let ty = ty.split('=').next().unwrap().trim();
+        match ty.strip_prefix("array<") {
+            Some(a) => {
+                let n: u32 = a.trim_end_matches('>').rsplit(',').next().unwrap().trim().parse().unwrap();
+                body.push_str(&format!("    var a_{0} = {0};\n    _ = a_{0}[id.x % {n}u];\n", name.trim()));
+            }
+            None => body.push_str(&format!("    _ = {};\n", name.trim())),
+        }
+    }
+    let text = format!(
+        "{src}\n@compute @workgroup_size(1)\nfn check(@builtin(global_invocation_id) id: vec3<u32>) {{\n{body}}}\n"
+    );
+    let module = naga::front::wgsl::parse_str(&text).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&text)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&text)));
+}
+
+#[test]
+fn importance_kernel_writes_json_includes_and_table() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("k");
+    let o = rtbake(&[
+        "--json",
+        "importance-kernel",
+        "--samples",
+        "40",
+        "--burley-albedo",
+        "0.8,0.5,0.3",
+        "--burley-mfp-mm",
+        "1,0.5,0.25",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let printed: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(printed["files"].as_array().unwrap().len(), 5);
+    let v: Value = serde_json::from_slice(&std::fs::read(out.join("burley_n40.json")).unwrap()).unwrap();
+    assert_eq!(v["schema"], rtbake::baked_layout::schema::IMPORTANCE_KERNEL);
+    assert_eq!(v["samples"], 40);
+    assert_eq!(v["inversion"], "burley-closed-form");
+    assert_eq!(v["sampled_channel"], "red");
+    assert_eq!(v["profile"]["model"], "burley");
+    let samples = v["kernel"].as_array().unwrap();
+    assert_eq!(samples.len(), 40);
+    for c in 0..3 {
+        let s: f64 = samples.iter().map(|s| s["weight"][c].as_f64().unwrap()).sum();
+        assert!((s - 1.0).abs() < 1e-6, "channel {c}: {s}");
+    }
+    // The binary table: 40 records of 8 little-endian f32, as the JSON's layout says.
+    assert!(v["binary_layout"].as_str().unwrap().contains("[x_mm, y_mm, r_mm, theta_rad, pdf_per_mm2, w_r, w_g, w_b]"));
+    let bin = std::fs::read(out.join("burley_n40_f32x8.bin")).unwrap();
+    assert_eq!(bin.len(), 40 * 8 * 4);
+    let f = |i: usize| f32::from_le_bytes(bin[4 * i..4 * i + 4].try_into().unwrap()) as f64;
+    for (i, s) in samples.iter().enumerate() {
+        assert!((f(8 * i + 2) - s["r_mm"].as_f64().unwrap()).abs() <= 1e-6 * f(8 * i + 2).max(1e-3));
+        assert!((f(8 * i + 6) - s["weight"][1].as_f64().unwrap()).abs() <= 1e-7);
+    }
+    // The includes: WGSL through naga; HLSL/GLSL declare the same arrays.
+    let wgsl = std::fs::read_to_string(out.join("burley_n40.wgsl")).unwrap();
+    assert!(wgsl.contains("const SSS_IMPORTANCE_OFFSETS: array<vec4<f32>, 40>"), "{wgsl}");
+    naga_check(&wgsl);
+    let hlsl = std::fs::read_to_string(out.join("burley_n40.hlsl")).unwrap();
+    assert!(hlsl.contains("static const float3 SSS_IMPORTANCE_WEIGHTS[40] = {"));
+    let glsl = std::fs::read_to_string(out.join("burley_n40.glsl")).unwrap();
+    assert!(glsl.contains("const int SSS_IMPORTANCE_N_SAMPLES = 40;"));
+}
+
+#[test]
+fn importance_kernel_accepts_every_profile_flag() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("p.csv");
+    let o = rtbake(&["profile", "--material", "skin1", "--csv", csv.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    for args in [
+        vec!["--material", "skin1"],
+        vec!["--profile-preset", "deon6"],
+        vec!["--profile-csv", csv.to_str().unwrap()],
+        vec!["--skin-melanin", "0.1", "--skin-hemoglobin", "0.05"],
+    ] {
+        let mut a = vec!["--json", "importance-kernel", "--samples", "20"];
+        a.extend(&args);
+        let o = rtbake(&a);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["inversion"], "tabulated-cdf", "{args:?}");
+        assert!(v["cutoff_mm"].as_f64().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn importance_kernel_bad_input_exits_2_naming_the_flag_and_writes_nothing() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("k");
+    let o_s = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--samples", "0", "--material", "skin1"], "--samples"),
+        (vec!["--samples", "1025", "--material", "skin1"], "1..=1024"),
+        (vec!["--samples", "-3", "--material", "skin1"], "--samples"),
+        (vec!["--samples", "20"], "give exactly one profile"),
+        (vec!["--samples", "20", "--material", "skin1", "--profile-preset", "deon6"], "give exactly one profile"),
+        (vec!["--samples", "20", "--material", "unobtainium"], "--material"),
+        (vec!["--samples", "20", "--profile-preset", "deon9"], "--profile-preset"),
+        (vec!["--samples", "20", "--burley-albedo", "0.8,0,0.3", "--burley-mfp-mm", "1,1,1"], "--burley-albedo"),
+        (vec!["--samples", "20", "--burley-albedo", "0.8,0.5,0.3", "--burley-mfp-mm", "1,-1,1"], "--burley-mfp-mm"),
+        (vec!["--samples", "20", "--profile-csv", "/nonexistent/p.csv"], "--profile-csv"),
+    ];
+    for (args, needle) in cases {
+        let mut a = vec!["importance-kernel", "--out", o_s];
+        a.extend(&args);
+        let o = rtbake(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        let written = std::fs::read_dir(&out).map(|d| d.count()).unwrap_or(0);
+        assert_eq!(written, 0, "{args:?} wrote files");
+    }
+}
+
+fn write_exr(path: &std::path::Path, img: &Image<f32>) {
+    std::fs::write(path, encode(img, ExrPrecision::F32).unwrap()).unwrap();
+}
+
+#[test]
+fn importance_run_sss_matches_the_library_and_refuses_mixed_flags() {
+    let t = tempfile::tempdir().unwrap();
+    let (w, h) = (48u32, 32u32);
+    let mut rgba = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let lit = if (x / 4 + y / 4) % 2 == 0 { 1.0 } else { 0.1 };
+            rgba.extend_from_slice(&[0.9 * lit, 0.6 * lit, 0.4 * lit, if x < 40 { 1.0 } else { 0.0 }]);
+        }
+    }
+    let depth = vec![0.5f32; (w * h) as usize];
+    let (c, d, out) = (t.path().join("c.exr"), t.path().join("d.exr"), t.path().join("o.exr"));
+    write_exr(&c, &Image::from_vec(w, h, 4, rgba.clone()));
+    write_exr(&d, &Image::from_vec(w, h, 1, depth.clone()));
+    let (cs, ds, os) = (c.to_str().unwrap(), d.to_str().unwrap(), out.to_str().unwrap());
+    let base = ["run", "sss", "--cpu", "--color", cs, "--depth", ds, "--output", os];
+    let mut a = base.to_vec();
+    a.extend(["--method", "importance", "--samples", "20", "--profile-preset", "deon6"]);
+    let o = rtbake(&a);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let (got, _) = rtbake::io::exr::decode(&std::fs::read(&out).unwrap(), "o.exr").unwrap();
+    let g = rtbake::diffusion::sum_of_gaussians::deon6();
+    let k =
+        rtbake::sss_sampling::ImportanceKernel::new(rtbake::sss_sampling::SampledProfile::Tabulated(&g), 20).unwrap();
+    let samples = rtbake::runtime::importance_sss::ImportanceSamples::from_kernel(&k);
+    let params = rtbake::runtime::importance_sss::ImportanceSssParams::default();
+    let method = rtbake::runtime::chain::Subsurface::Importance { samples: &samples, params: &params };
+    let want = rtbake::runtime::chain::subsurface(None, &rgba, &depth, (w, h), &method).unwrap();
+    assert_eq!(got.data.len(), want.len());
+    let max = got.data.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(max < 1e-3, "max difference {max}");
+    assert!(got.data.iter().zip(&rgba).any(|(a, b)| (a - b).abs() > 0.05), "the blur did something");
+    std::fs::remove_file(&out).unwrap();
+    for (extra, needle) in [
+        (vec!["--method", "separable", "--samples", "20"], "--method importance"),
+        (vec!["--method", "importance"], "give exactly one profile"),
+        (vec!["--method", "importance", "--material", "skin1", "--samples", "0"], "--samples"),
+        (vec!["--method", "importance", "--material", "skin1", "--mm-per-world-unit", "0"], "--mm-per-world-unit"),
+    ] {
+        let mut a = base.to_vec();
+        a.extend(&extra);
+        let o = rtbake(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(needle), "{extra:?}: {err}");
+        assert!(!out.exists(), "{extra:?} wrote the output");
+    }
+}
