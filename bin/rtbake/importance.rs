@@ -38,10 +38,7 @@ pub struct ResolvedProfile {
 impl ImportanceProfileArgs {
     /// True when any profile flag was given.
     pub fn is_set(&self) -> bool {
-        self.material.is_some()
-            || self.profile_preset.is_some()
-            || self.layered.is_set()
-            || self.burley.is_set()
+        self.material.is_some() || self.profile_preset.is_some() || self.layered.is_set() || self.burley.is_set()
     }
 
     /// The files the profile flags read (outputs must not replace them).
@@ -51,12 +48,8 @@ impl ImportanceProfileArgs {
 
     /// Resolves exactly one profile source (exit 2 naming the flags otherwise).
     pub fn resolve(&self) -> anyhow::Result<ResolvedProfile> {
-        let given = [
-            self.material.is_some(),
-            self.profile_preset.is_some(),
-            self.layered.is_set(),
-            self.burley.is_set(),
-        ];
+        let given =
+            [self.material.is_some(), self.profile_preset.is_some(), self.layered.is_set(), self.burley.is_set()];
         let count = given.iter().filter(|g| **g).count();
         const FLAGS: &str = "--material, --profile-preset, --layers, --skin-melanin/--skin-hemoglobin, --profile-csv \
                              or --burley-albedo/--burley-mfp-mm";

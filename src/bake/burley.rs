@@ -15,7 +15,10 @@
 //! plane integral, [`crate::transmittance::TransmittanceModel::Burley`]) and from a sum of Gaussians fitted to the
 //! same profile (plane-integral form exp(−s²/(2v))), as the tables of `rtbake transmittance --out`
 //! (`burley/transmission/<case>_{burley,gaussians<k>}_physical.*`) and one plot comparing them with the target
-//! profile's own plane integral 2π∫ₛ^∞ ρ R(ρ) dρ (`burley/transmission/<case>.{svg,png}`).
+//! profile's own plane integral 2π∫ₛ^∞ ρ R(ρ) dρ (`burley/transmission/<case>.{svg,png}`). Every fit also gets
+//! importance-sampled screen-space kernels ([`crate::sss_sampling`], Burley's closed-form CDF) for the sample
+//! budgets in `kernel_samples` (default 40), as `rtbake importance-kernel --out` writes them
+//! (`burley/kernels/<case>_n<N>.{json,hlsl,glsl,wgsl}` and `_f32x8.bin`).
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::BURLEY_DIR;
@@ -30,6 +33,7 @@ use crate::fitting::{fit_sum_of_gaussians, FitSettings};
 use crate::plot::profile::{overlay_plot, render, PlotFormat, CHANNEL_COLORS, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::plot::{Curve, LinePlot};
 use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use crate::sss_sampling::disk::{ImportanceKernel, SampledProfile};
 use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -66,6 +70,8 @@ struct Params {
     /// Cases that also get a PNG of their plot.
     png_plots: Vec<String>,
     transmission: Transmission,
+    /// Sample budgets of the importance-sampled kernels baked from every case's Burley fit (each 1..=1024).
+    kernel_samples: Vec<usize>,
 }
 
 fn default_params() -> Params {
@@ -81,6 +87,7 @@ fn default_params() -> Params {
             gaussians: 4,
             table: TableSettings { samples: 64, height: 1, s_max_mm: 8.0, form: TransmittanceForm::Physical },
         },
+        kernel_samples: vec![40],
     }
 }
 
@@ -389,6 +396,20 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         }
         if p.transmission.cases.contains(&case.name) {
             files.extend(transmission_files(case, &r.fit, &p.transmission, &reference)?);
+        }
+        for (i, &n) in p.kernel_samples.iter().enumerate() {
+            let k = ImportanceKernel::new(SampledProfile::Burley(&r.fit), n).map_err(|e| {
+                InvalidInput::new(format!("kernel_samples[{i}]"), format!("{}: {}", e.param, e.message))
+            })?;
+            let provenance = json!({"kind": "burley-fit", "profile": case.source.provenance(),
+                                    "burley": burley_json(&r.fit)});
+            files.extend(super::importance::kernel_files(
+                &format!("{BURLEY_DIR}/kernels"),
+                &format!("{}_n{n}", case.name.replace('/', "_")),
+                &k,
+                &provenance,
+                &format!("rtbake bake burley-profiles (Burley fit of {})", case.name),
+            ));
         }
     }
     files.push(text_file(

@@ -113,3 +113,37 @@ fn transmission_profiles_start_at_the_albedo_and_follow_the_closed_form() {
         }
     }
 }
+
+/// Every Burley fit gets its importance-sampled kernel (N = 40): the library's kernel of the fitted profile (closed-form
+/// CDF), weights summing to 1 per channel, its unnormalised weights to about the fitted albedo, and the binary table
+/// of 40 records of 8 f32.
+#[test]
+fn every_burley_fit_has_its_importance_kernel() {
+    use rtbake::sss_sampling::disk::{ImportanceKernel, SampledProfile};
+    let files = baked();
+    let fits = json(&files, "burley/fits.json");
+    for rec in fits["cases"].as_array().unwrap() {
+        let stem = rec["case"].as_str().unwrap().replace('/', "_");
+        let k = json(&files, &format!("burley/kernels/{stem}_n40.json"));
+        assert_eq!(k["inversion"], "burley-closed-form");
+        let samples = k["kernel"].as_array().unwrap();
+        assert_eq!(samples.len(), 40);
+        let b = RgbBurley([0, 1, 2].map(|c| {
+            Burley::new(
+                rec["fit"]["burley"]["albedo"][c].as_f64().unwrap(),
+                rec["fit"]["burley"]["d_mm"][c].as_f64().unwrap(),
+            )
+            .unwrap()
+        }));
+        let lib = ImportanceKernel::new(SampledProfile::Burley(&b), 40).unwrap();
+        for c in 0..3 {
+            let sum: f64 = samples.iter().map(|s| s["weight"][c].as_f64().unwrap()).sum();
+            assert!((sum - 1.0).abs() < 1e-6, "{stem} channel {c}: {sum}");
+            let raw: f64 = samples.iter().map(|s| s["weight_unnormalised"][c].as_f64().unwrap()).sum();
+            assert!((raw - b.0[c].albedo).abs() < 0.15 * b.0[c].albedo, "{stem} channel {c}: {raw} vs A");
+        }
+        assert!((samples[7]["r_mm"].as_f64().unwrap() - lib.samples[7].r_mm).abs() < 1e-6 * lib.samples[7].r_mm);
+        let bin = files.iter().find(|f| f.path == format!("burley/kernels/{stem}_n40_f32x8.bin")).unwrap();
+        assert_eq!(bin.bytes.len(), 40 * 8 * 4);
+    }
+}
