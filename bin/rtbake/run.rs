@@ -98,6 +98,10 @@ pub struct SssArgs {
     /// The profile --method importance samples.
     #[command(flatten)]
     profile: crate::importance::ImportanceProfileArgs,
+    /// A baked importance kernel for --method importance instead of --samples and a profile flag: a path listed in
+    /// the manifest of --baked-dir, e.g. sss/importance/skin1_dipole_n40.json or burley/kernels/dipole_skin1_n40.json.
+    #[arg(long, value_name = "JSON")]
+    importance_kernel: Option<String>,
     /// mm per world unit of --depth for --method importance (default 125: a head 1 unit tall).
     #[arg(long, default_value_t = ImportanceSssParams::default().mm_per_world_unit, allow_negative_numbers = true)]
     mm_per_world_unit: f32,
@@ -319,24 +323,42 @@ fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
     check_output(&a.output, &[&a.color, &a.depth])?;
     let baked = &a.common.baked;
-    if a.method != SssMethodArg::Importance && (a.samples.is_some() || a.profile.is_set()) {
+    if a.method != SssMethodArg::Importance
+        && (a.samples.is_some() || a.profile.is_set() || a.importance_kernel.is_some())
+    {
         return Err(usage_msg(
-            "--samples and the profile flags (--material, --profile-preset, …) need --method importance",
+            "--samples, --importance-kernel and the profile flags (--material, --profile-preset, …) need --method \
+             importance",
         ));
     }
-    let importance = match a.method {
-        SssMethodArg::Importance => {
+    let importance_params = ImportanceSssParams {
+        mm_per_world_unit: a.mm_per_world_unit,
+        fovy_deg: a.fovy,
+        follow_surface: !a.no_follow_surface,
+    };
+    let importance = match (a.method, &a.importance_kernel) {
+        (SssMethodArg::Importance, Some(path)) => {
+            if a.samples.is_some() || a.profile.is_set() {
+                return Err(usage_msg(
+                    "--importance-kernel is a baked kernel: give it alone, or --samples with a profile flag",
+                ));
+            }
+            importance_params.validate()?;
+            let k = loader::load_importance_kernel(baked, path).map_err(usage)?;
+            ctx.info(format!(
+                "importance kernel {path}: {} samples (cut-off {:.4} mm)",
+                k.offsets_mm.len(),
+                k.cutoff_mm
+            ));
+            Some((k, importance_params))
+        }
+        (SssMethodArg::Importance, None) => {
             let n = crate::importance::parse_samples(a.samples.unwrap_or(40))?;
             let resolved = a.profile.resolve()?;
             let k = resolved.kernel(n)?;
             ctx.info(format!("importance kernel: {} samples of {} (cut-off {:.4} mm)", n, resolved.stem, k.cutoff_mm));
-            let p = ImportanceSssParams {
-                mm_per_world_unit: a.mm_per_world_unit,
-                fovy_deg: a.fovy,
-                follow_surface: !a.no_follow_surface,
-            };
-            p.validate()?;
-            Some((ImportanceSamples::from_kernel(&k), p))
+            importance_params.validate()?;
+            Some((ImportanceSamples::from_kernel(&k), importance_params))
         }
         _ => None,
     };

@@ -364,6 +364,70 @@ pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<B
     Ok(BakedKernel { kernel, range, sss_width })
 }
 
+/// Loads an importance-sampled disk kernel JSON (`rtbake-importance-kernel/1`: `sss/importance/*.json`,
+/// `burley/kernels/*.json`) after the manifest checks, as the importance SSS pass takes it: offsets (x, y, r in mm)
+/// and per-channel weights. Refuses a kernel whose sample count differs from `samples`, whose radii disagree with
+/// the offsets (1e-6 mm relative), whose channels do not each sum to 1 (±1e-4), or with a non-positive cut-off.
+pub fn load_importance_kernel(
+    dir: &Path,
+    path: &str,
+) -> Result<crate::runtime::importance_sss::ImportanceSamples, LutError> {
+    let manifest = Manifest::load(dir)?;
+    let v = load_json(dir, &manifest, path)?;
+    importance_kernel_from_json(&v, path)
+}
+
+/// The content checks of [`load_importance_kernel`] on a parsed kernel file.
+pub fn importance_kernel_from_json(
+    v: &serde_json::Value,
+    path: &str,
+) -> Result<crate::runtime::importance_sss::ImportanceSamples, LutError> {
+    let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
+    if found != schema::IMPORTANCE_KERNEL {
+        return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::IMPORTANCE_KERNEL)));
+    }
+    #[derive(serde::Deserialize)]
+    struct Sample {
+        x_mm: f64,
+        y_mm: f64,
+        r_mm: f64,
+        weight: [f64; 3],
+    }
+    #[derive(serde::Deserialize)]
+    struct File {
+        samples: usize,
+        cutoff_mm: f64,
+        kernel: Vec<Sample>,
+    }
+    let file: File = typed(v.clone(), path)?;
+    if file.kernel.len() != file.samples {
+        return Err(content(path, format!("\"samples\" = {} but \"kernel\" has {}", file.samples, file.kernel.len())));
+    }
+    for (i, s) in file.kernel.iter().enumerate() {
+        let r = s.x_mm.hypot(s.y_mm);
+        if (r - s.r_mm).abs() > 1e-6 * s.r_mm.max(1e-3) {
+            return Err(content(path, format!("kernel[{i}]: |(x_mm, y_mm)| = {r} but r_mm = {}", s.r_mm)));
+        }
+    }
+    for c in 0..3 {
+        let sum: f64 = file.kernel.iter().map(|s| s.weight[c]).sum();
+        if (sum - 1.0).abs() > 1e-4 {
+            return Err(content(path, format!("channel {} weights sum to {sum}, must be 1", ["r", "g", "b"][c])));
+        }
+    }
+    let samples = crate::runtime::importance_sss::ImportanceSamples {
+        offsets_mm: file.kernel.iter().map(|s| [s.x_mm as f32, s.y_mm as f32, s.r_mm as f32, 0.0]).collect(),
+        weights: file
+            .kernel
+            .iter()
+            .map(|s| [s.weight[0] as f32, s.weight[1] as f32, s.weight[2] as f32, 0.0])
+            .collect(),
+        cutoff_mm: file.cutoff_mm as f32,
+    };
+    samples.validate().map_err(|e| content(path, e.to_string()))?;
+    Ok(samples)
+}
+
 /// A baked sum-of-Gaussians fit with the screen-space parameters derived from it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedGaussians {

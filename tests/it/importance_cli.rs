@@ -169,11 +169,45 @@ fn importance_run_sss_matches_the_library_and_refuses_mixed_flags() {
     assert!(max < 1e-3, "max difference {max}");
     assert!(got.data.iter().zip(&rgba).any(|(a, b)| (a - b).abs() > 0.05), "the blur did something");
     std::fs::remove_file(&out).unwrap();
+    // The baked deon6 kernel of 20 samples, read through the manifest, gives the same frame (its JSON holds 9
+    // significant digits, so the f32 samples may differ in the last bit).
+    let baked = crate::support::baked_dir();
+    let mut a = base.to_vec();
+    a.extend([
+        "--method",
+        "importance",
+        "--importance-kernel",
+        "sss/importance/deon6_n20.json",
+        "--baked-dir",
+        baked.to_str().unwrap(),
+    ]);
+    let o = rtbake(&a);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let (from_bake, _) = rtbake::io::exr::decode(&std::fs::read(&out).unwrap(), "o.exr").unwrap();
+    let max = from_bake.data.iter().zip(&got.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    assert!(max < 1e-5, "baked kernel vs computed kernel: max difference {max}");
+    std::fs::remove_file(&out).unwrap();
     for (extra, needle) in [
         (vec!["--method", "separable", "--samples", "20"], "--method importance"),
         (vec!["--method", "importance"], "give exactly one profile"),
         (vec!["--method", "importance", "--material", "skin1", "--samples", "0"], "--samples"),
         (vec!["--method", "importance", "--material", "skin1", "--mm-per-world-unit", "0"], "--mm-per-world-unit"),
+        (vec!["--importance-kernel", "sss/importance/deon6_n20.json"], "--method importance"),
+        (
+            vec!["--method", "importance", "--importance-kernel", "sss/importance/deon6_n20.json", "--samples", "20"],
+            "--importance-kernel",
+        ),
+        (
+            vec![
+                "--method",
+                "importance",
+                "--importance-kernel",
+                "sss/importance/nothing_n20.json",
+                "--baked-dir",
+                baked.to_str().unwrap(),
+            ],
+            "nothing_n20",
+        ),
     ] {
         let mut a = base.to_vec();
         a.extend(&extra);
