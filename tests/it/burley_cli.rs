@@ -66,41 +66,49 @@ fn bad_burley_input_exits_2_naming_the_flag() {
 }
 
 /// `--profile-csv` (issue 11): rtbake's own `profile --csv` output fed back reproduces the fit of the built-in
-/// profile (variances within 0.5 %, every weight above 1 % of the largest within 1 %, error within 0.05 points).
+/// profile (variances within 0.5 %, every weight above 1 % of the largest within 1 %, error within 0.05 points), for a
+/// dipole (skin1) and for the layered multipole of the physiological two-layer skin (Cm 0.1, Chd 0.1).
 #[test]
 fn profile_csv_of_a_built_in_profile_reproduces_its_gaussian_fit() {
     let t = tempfile::tempdir().unwrap();
-    let csv = t.path().join("skin1.csv");
-    let o = rtbake(&["profile", "--material", "skin1", "--csv", csv.to_str().unwrap(), "-q"]);
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
-    let fit = |args: &[&str]| -> serde_json::Value {
-        let mut a = vec!["--json", "fit", "gaussians"];
-        a.extend(args);
+    for (name, source, count) in [
+        ("skin1", &["--material", "skin1"][..], "6"),
+        ("skin", &["--skin-melanin", "0.1", "--skin-hemoglobin", "0.1"][..], "4"),
+    ] {
+        let csv = t.path().join(format!("{name}.csv"));
+        let mut a = vec!["profile", "--csv", csv.to_str().unwrap(), "-q"];
+        a.extend(source);
         let o = rtbake(&a);
-        assert_eq!(o.status.code(), Some(0), "{a:?}: {}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice(&o.stdout).unwrap()
-    };
-    let (built_in, from_csv) = (fit(&["--material", "skin1"]), fit(&["--profile-csv", csv.to_str().unwrap()]));
-    fn nums(v: &serde_json::Value) -> Vec<f64> {
-        match v {
-            serde_json::Value::Array(a) => a.iter().flat_map(nums).collect(),
-            x => vec![x.as_f64().unwrap()],
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let fit = |args: &[&str]| -> serde_json::Value {
+            let mut a = vec!["--json", "fit", "gaussians", "--count", count];
+            a.extend(args);
+            let o = rtbake(&a);
+            assert_eq!(o.status.code(), Some(0), "{a:?}: {}", String::from_utf8_lossy(&o.stderr));
+            serde_json::from_slice(&o.stdout).unwrap()
+        };
+        let (built_in, from_csv) = (fit(source), fit(&["--profile-csv", csv.to_str().unwrap()]));
+        fn nums(v: &serde_json::Value) -> Vec<f64> {
+            match v {
+                serde_json::Value::Array(a) => a.iter().flat_map(nums).collect(),
+                x => vec![x.as_f64().unwrap()],
+            }
         }
-    }
-    for (a, b) in nums(&built_in["variances"]).iter().zip(nums(&from_csv["variances"])) {
-        assert!((a - b).abs() <= 5e-3 * a, "variance {a} vs {b}");
-    }
-    let (wa, wb) = (nums(&built_in["weights"]), nums(&from_csv["weights"]));
-    let wmax = wa.iter().cloned().fold(0.0, f64::max);
-    for (a, b) in wa.iter().zip(&wb) {
-        if *a > 0.01 * wmax {
-            assert!((a - b).abs() <= 1e-2 * a, "weight {a} vs {b}");
+        for (a, b) in nums(&built_in["variances"]).iter().zip(nums(&from_csv["variances"])) {
+            assert!((a - b).abs() <= 5e-3 * a, "{name}: variance {a} vs {b}");
         }
+        let (wa, wb) = (nums(&built_in["weights"]), nums(&from_csv["weights"]));
+        let wmax = wa.iter().cloned().fold(0.0, f64::max);
+        for (a, b) in wa.iter().zip(&wb) {
+            if *a > 0.01 * wmax {
+                assert!((a - b).abs() <= 1e-2 * a, "{name}: weight {a} vs {b}");
+            }
+        }
+        for (a, b) in nums(&built_in["error_percent"]).iter().zip(nums(&from_csv["error_percent"])) {
+            assert!((a - b).abs() <= 0.05, "{name}: error {a} vs {b}");
+        }
+        assert_eq!(from_csv["source"]["model"], "tabulated", "{}", from_csv["source"]);
     }
-    for (a, b) in nums(&built_in["error_percent"]).iter().zip(nums(&from_csv["error_percent"])) {
-        assert!((a - b).abs() <= 0.05, "error {a} vs {b}");
-    }
-    assert_eq!(from_csv["source"]["model"], "tabulated", "{}", from_csv["source"]);
 }
 
 #[test]
