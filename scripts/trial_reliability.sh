@@ -2,12 +2,14 @@
 # Issue 15's trial, repeatable: concurrent bakes and verifies of one directory, and a kill at every step of the
 # bake's stage-and-swap; prints the counts of corrupt outcomes (must be 0).
 #   scripts/trial_reliability.sh [RTBAKE] [ROUNDS]     (defaults: target/debug/rtbake, 24)
+#   TRIAL_A / TRIAL_B name the two assets (defaults transmittance, smaa-search: a few ms each; burley-profiles and
+#   skin-color-lut take 0.2-0.3 s, so their bakes overlap for longer)
 set -uo pipefail
 R=${1:-target/debug/rtbake}
 N=${2:-24}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-A=transmittance; B=smaa-search
+A=${TRIAL_A:-transmittance}; B=${TRIAL_B:-smaa-search}
 bad=0; vbad=0
 for i in $(seq 1 "$N"); do
   d=$T/c$i
