@@ -2,12 +2,9 @@
 //! and source in [`crate::runtime::gaussian_sss`]). Values are rounded to f16 wherever the GPU stores them
 //! (input, RT1, RT2, RTF); the alpha blend of eq. 4.9 is computed in f32 and then rounded.
 
+use super::f16r;
 use crate::runtime::gaussian_sss::{GaussianBlurs, GaussianSssParams};
 use rayon::prelude::*;
-
-fn f16r(v: f32) -> f32 {
-    half::f16::from_f32(v).to_f32()
-}
 
 const W: [f32; 7] = [0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006];
 

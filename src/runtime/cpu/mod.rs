@@ -136,6 +136,38 @@ pub(crate) fn wgsl_round(v: f32) -> f32 {
     v.round_ties_even()
 }
 
+/// Rounds to f16 and back, as an `Rgba16Float` render target stores a value.
+pub(crate) fn f16r(v: f32) -> f32 {
+    half::f16::from_f32(v).to_f32()
+}
+
+/// A row-major f32 image of `ch` interleaved channels with the GPU's clamp-to-edge loads and bilinear fetches at
+/// normalised coordinates (texel centres at (i + 0.5)/w, f32 weights): the texture reads of the SSS twins.
+pub(crate) struct Img<'a> {
+    pub w: u32,
+    pub h: u32,
+    pub ch: usize,
+    pub data: &'a [f32],
+}
+
+impl Img<'_> {
+    pub fn load(&self, x: i32, y: i32, c: usize) -> f32 {
+        let x = x.clamp(0, self.w as i32 - 1) as usize;
+        let y = y.clamp(0, self.h as i32 - 1) as usize;
+        self.data[(y * self.w as usize + x) * self.ch + c]
+    }
+    pub fn bilinear(&self, u: f32, v: f32, c: usize) -> f32 {
+        let x = u * self.w as f32 - 0.5;
+        let y = v * self.h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i32, y0 as i32);
+        let top = self.load(x0, y0, c) + (self.load(x0 + 1, y0, c) - self.load(x0, y0, c)) * fx;
+        let bottom = self.load(x0, y0 + 1, c) + (self.load(x0 + 1, y0 + 1, c) - self.load(x0, y0 + 1, c)) * fx;
+        top + (bottom - top) * fy
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,37 +3,9 @@
 //! intermediate target); bilinear fetches are f32. Known difference: the hardware may filter f16 colour with
 //! reduced weight precision, so results agree to a stated tolerance, not bit for bit.
 
+use super::{f16r, Img};
 use crate::runtime::separable_sss::{SssKernel, SssParams};
 use rayon::prelude::*;
-
-fn f16r(v: f32) -> f32 {
-    half::f16::from_f32(v).to_f32()
-}
-
-struct Img<'a> {
-    w: u32,
-    h: u32,
-    ch: usize,
-    data: &'a [f32],
-}
-
-impl Img<'_> {
-    fn load(&self, x: i32, y: i32, c: usize) -> f32 {
-        let x = x.clamp(0, self.w as i32 - 1) as usize;
-        let y = y.clamp(0, self.h as i32 - 1) as usize;
-        self.data[(y * self.w as usize + x) * self.ch + c]
-    }
-    fn bilinear(&self, u: f32, v: f32, c: usize) -> f32 {
-        let x = u * self.w as f32 - 0.5;
-        let y = v * self.h as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i32, y0 as i32);
-        let top = self.load(x0, y0, c) + (self.load(x0 + 1, y0, c) - self.load(x0, y0, c)) * fx;
-        let bottom = self.load(x0, y0 + 1, c) + (self.load(x0 + 1, y0 + 1, c) - self.load(x0, y0 + 1, c)) * fx;
-        top + (bottom - top) * fy
-    }
-}
 
 fn pass(color: &Img, depth: &Img, kernel: &SssKernel, p: &SssParams, dir: [f32; 2]) -> Vec<f32> {
     let (w, h) = (color.w, color.h);

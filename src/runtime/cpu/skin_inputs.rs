@@ -2,12 +2,9 @@
 //! [`crate::runtime::skin_inputs`]). LUTs and rig maps are rounded to f16 as on the GPU; fetches are bilinear
 //! in f32; outputs are rounded to f16.
 
+use super::f16r;
 use crate::runtime::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinLuts};
 use rayon::prelude::*;
-
-fn f16r(v: f32) -> f32 {
-    half::f16::from_f32(v).to_f32()
-}
 
 /// Bilinear, clamp-to-edge fetch of `ch` channels at normalised (u, v).
 fn bilinear<const C: usize>(data: &[[f32; C]], w: u32, h: u32, u: f32, v: f32) -> [f32; C] {
