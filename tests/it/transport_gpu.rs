@@ -189,3 +189,75 @@ fn gpu_transport_refuses_bad_input() {
     assert_eq!(McSettings::new(0, 1, 10, 0.01, 10).unwrap_err().param, "photons");
     assert_eq!(McSettings::new(10, 1, 1, 0.01, 10).unwrap_err().param, "batches");
 }
+
+/// `rtbake transport --gpu` writes the CPU path's CSV and JSON layout (same columns, same keys), the JSON naming
+/// the path and the adapter, and the totals agree with the CPU run of the same seed within 4 combined SE.
+#[test]
+fn cli_gpu_writes_the_same_layout_and_names_the_adapter() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |gpu: bool, tag: &str| {
+        let (csv, out) = (dir.path().join(format!("{tag}.csv")), dir.path().join(format!("{tag}.json")));
+        let mut args = vec![
+            "transport",
+            "--material",
+            "skin1",
+            "--thickness-mm",
+            "1",
+            "--photons",
+            "5000",
+            "--seed",
+            "3",
+            "--bin-mm",
+            "0.2",
+            "--bins",
+            "20",
+            "-q",
+        ];
+        let (c, o) = (csv.to_str().unwrap().to_string(), out.to_str().unwrap().to_string());
+        args.extend(["--csv", &c, "--out", &o]);
+        if gpu {
+            args.push("--gpu");
+        }
+        let res = rtbake(&args);
+        assert!(res.status.success(), "{args:?}: {}", String::from_utf8_lossy(&res.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+        (std::fs::read_to_string(&csv).unwrap(), json)
+    };
+    let (gpu_csv, gpu_json) = run(true, "gpu");
+    let (cpu_csv, cpu_json) = run(false, "cpu");
+    let header = |s: &str| s.lines().find(|l| !l.starts_with('#')).unwrap().to_string();
+    assert_eq!(header(&gpu_csv), header(&cpu_csv));
+    assert_eq!(header(&gpu_csv), "r_mm,R_r,R_g,R_b,T_r,T_g,T_b");
+    assert_eq!(gpu_csv.lines().count(), cpu_csv.lines().count());
+    let keys = |v: &serde_json::Value| v.as_object().unwrap().keys().cloned().collect::<Vec<_>>();
+    assert_eq!(keys(&gpu_json), keys(&cpu_json));
+    assert!(gpu_json["provenance"]["path"].as_str().unwrap().starts_with("gpu"), "{}", gpu_json["provenance"]);
+    assert!(cpu_json["provenance"]["path"].as_str().unwrap().starts_with("cpu"), "{}", cpu_json["provenance"]);
+    let adapter = gpu_json["provenance"]["adapter"].as_str().unwrap();
+    assert!(!adapter.is_empty() && cpu_json["provenance"].get("adapter").is_none());
+    for c in 0..3 {
+        for key in ["total_R", "total_T"] {
+            let est = |v: &serde_json::Value| Estimate {
+                mean: v[key][c]["mean"].as_f64().unwrap(),
+                se: v[key][c]["se"].as_f64().unwrap(),
+            };
+            assert_agree(&format!("CLI {key} ch {c}"), est(&gpu_json), est(&cpu_json));
+        }
+    }
+}
+
+/// No adapter (here: `WGPU_ADAPTER_NAME` matching none): exit 2 naming `--gpu`, nothing written.
+#[test]
+fn cli_gpu_without_an_adapter_exits_2_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("mc.csv");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rtbake"))
+        .args(["transport", "--material", "skin1", "--photons", "100", "--gpu", "--csv", csv.to_str().unwrap()])
+        .env("WGPU_ADAPTER_NAME", "no-such-adapter-rtbake-test")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--gpu") && err.contains("no-such-adapter-rtbake-test"), "{err}");
+    assert!(!csv.exists());
+}
