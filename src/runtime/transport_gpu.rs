@@ -18,9 +18,9 @@
 //! u32 pairs: lo is added with `atomicAdd` and its carry goes into hi, so every sum is an exact integer whatever
 //! the order of the additions. Total R/T, absorbed per layer and the interaction count are first summed per
 //! workgroup (64 photons, workgroup atomics) and added once per workgroup; R(r) and T(r) bins are added directly.
-//! A weight below 2⁻³² is dropped (the smallest weight a photon carries is Rsp-free weight × σa/σt ≥ 10⁻⁵·σa/σt
-//! after roulette, so this truncation only matters below σa/σt ≈ 10⁻⁴ and then by < 2⁻³²/(10⁻⁹) ≈ 0.4 % of the
-//! absorbed increment — far below the statistical error of the absorbed totals). **Overflow bound**: photons are
+//! Each addition truncates its weight to the 2⁻³² grid (a loss below 2⁻³² per addition, one per exit and one per
+//! layer visit: a photon's absorbed weight is summed in f32 while it stays in a layer and added when it leaves
+//! it), about 10⁻⁹ of a photon's weight, far below any standard error. **Overflow bound**: photons are
 //! traced in segments of at most [`SEGMENT_PHOTONS`] = 2²⁴ per channel and read back after each; a 64-bit slot
 //! overflows only when the segment deposits 2³² units of weight in it, 256 per photon on average, while a photon
 //! deposits 1 in expectation (roulette's ×10 is balanced by its 9/10 loss); interaction counts reach at most
@@ -39,8 +39,9 @@
 //! **Limits**: the tally buffer is checked against the device's `max_storage_buffer_binding_size` and
 //! `max_buffer_size`, the dispatch against `max_compute_workgroups_per_dimension`, before anything is allocated;
 //! an adapter that cannot run compute shaders is refused with [`RuntimeError::Gpu`]. A photon history longer than
-//! [`MAX_STEPS_PER_PHOTON`] steps (impossible in practice: it needs a lossless layer of ~4000 transport mean free
-//! paths) is stopped, and the run fails naming the count rather than biasing the tallies.
+//! [`MAX_STEPS_PER_PHOTON`] steps (in practice never: a diffusing photon needs of the order of (thickness in
+//! transport mean free paths)² steps to cross a lossless layer, so thousands of them) is stopped, and the run
+//! fails naming the count rather than biasing the tallies.
 
 use super::gpu;
 use super::RuntimeError;
@@ -140,7 +141,7 @@ impl GpuPlan {
         }
         let slots_per_channel = 2 * settings.bins as u64 + layers as u64 + 4;
         let tally_bytes = 3 * slots_per_channel * 8;
-        let cap = u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+        let cap = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if tally_bytes > cap {
             return Err(InvalidInput::new(
                 "bins",
