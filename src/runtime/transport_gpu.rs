@@ -115,6 +115,16 @@ impl GpuPlan {
     /// within `max_compute_workgroups_per_dimension`, the shader's workgroup size and memory within the device's
     /// (else [`RuntimeError::Gpu`]: the adapter cannot run it).
     pub fn new(limits: &wgpu::Limits, stack: &McStack, settings: &McSettings) -> Result<Self, RuntimeError> {
+        Self::split(limits, stack, settings, SEGMENT_PHOTONS, MAX_GROUPS_X)
+    }
+
+    fn split(
+        limits: &wgpu::Limits,
+        stack: &McStack,
+        settings: &McSettings,
+        segment: u64,
+        max_groups_x: u32,
+    ) -> Result<Self, RuntimeError> {
         let layers = stack.layers().len();
         if layers > SHADER_MAX_LAYERS {
             return Err(InvalidInput::new(
@@ -155,23 +165,18 @@ impl GpuPlan {
             .into());
         }
         let per_dim = limits.max_compute_workgroups_per_dimension;
-        let groups_total = segment_photons(settings).div_ceil(u64::from(WORKGROUP_SIZE));
-        let groups_x = (groups_total.min(u64::from(MAX_GROUPS_X.min(per_dim)))).max(1) as u32;
+        let segment_photons = settings.photons_per_batch().min(segment);
+        let groups_total = segment_photons.div_ceil(u64::from(WORKGROUP_SIZE));
+        let groups_x = (groups_total.min(u64::from(max_groups_x.min(per_dim)))).max(1) as u32;
         let groups_z = groups_total.div_ceil(u64::from(groups_x));
         if groups_z > u64::from(per_dim) || per_dim < 3 {
             return Err(RuntimeError::Gpu(format!(
-                "a segment of {} photons needs {groups_x} x 3 x {groups_z} workgroups, beyond this adapter's \
-                 {per_dim} per dimension (max_compute_workgroups_per_dimension); use the CPU path",
-                segment_photons(settings)
+                "a segment of {segment_photons} photons needs {groups_x} x 3 x {groups_z} workgroups, beyond this \
+                 adapter's {per_dim} per dimension (max_compute_workgroups_per_dimension); use the CPU path"
             )));
         }
         Ok(Self { slots_per_channel, tally_bytes, groups_x })
     }
-}
-
-/// Photons per channel of the largest segment: min(⌈N/B⌉, [`SEGMENT_PHOTONS`]).
-fn segment_photons(settings: &McSettings) -> u64 {
-    settings.photons_per_batch().min(SEGMENT_PHOTONS)
 }
 
 /// Host memory of [`simulate_gpu`] beyond the stack, bytes: the CPU path's batch tallies and result
@@ -183,6 +188,10 @@ pub fn memory_estimate_bytes(settings: &McSettings, layers: usize) -> u64 {
 /// The compiled transport pipeline; create once per device and run many stacks.
 pub struct TransportGpu {
     pipeline: wgpu::ComputePipeline,
+    /// Photons per channel per read-back ([`SEGMENT_PHOTONS`] unless split finer).
+    segment_photons: u64,
+    /// Most workgroups along x per dispatch.
+    max_groups_x: u32,
 }
 
 impl TransportGpu {
@@ -201,7 +210,17 @@ impl TransportGpu {
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RuntimeError::Gpu(format!("transport shader: {e}")));
         }
-        Ok(Self { pipeline })
+        Ok(Self { pipeline, segment_photons: SEGMENT_PHOTONS, max_groups_x: MAX_GROUPS_X })
+    }
+
+    /// The same pipeline with finer segments (`segment_photons` in 1..=[`SEGMENT_PHOTONS`] photons per channel
+    /// per read-back) and at most `max_groups_x` (≥ 1) workgroups along x, the rest along z. The result does not
+    /// change (integer sums; every photon keeps its index): the test of the segment and dispatch indexing, which
+    /// the default sizes reach only beyond 2·10⁶ photons per batch.
+    pub fn split(self, segment_photons: u64, max_groups_x: u32) -> Result<Self, InvalidInput> {
+        crate::error::check_range("segment_photons", segment_photons, 1, SEGMENT_PHOTONS, "")?;
+        crate::error::check_range("max_groups_x", max_groups_x, 1, MAX_GROUPS_X, "")?;
+        Ok(Self { segment_photons, max_groups_x, ..self })
     }
 
     /// Runs the transport of every channel; `progress(fraction done)` after every segment. See the module docs.
@@ -213,7 +232,8 @@ impl TransportGpu {
         settings: &McSettings,
         progress: &dyn Fn(f64),
     ) -> Result<McResult, RuntimeError> {
-        let plan = GpuPlan::new(&device.limits(), stack, settings)?;
+        let plan = GpuPlan::split(&device.limits(), stack, settings, self.segment_photons, self.max_groups_x)?;
+        let segment = self.segment_photons;
         let layers = stack.layers();
         let n_layers = layers.len();
         let batches = settings.batches as usize;
@@ -268,7 +288,7 @@ impl TransportGpu {
             ],
         );
 
-        let segments_per_batch = per_batch.div_ceil(SEGMENT_PHOTONS);
+        let segments_per_batch = per_batch.div_ceil(segment);
         let total_segments = batches as u64 * segments_per_batch;
         let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
         let spc = plan.slots_per_channel as usize;
@@ -276,8 +296,8 @@ impl TransportGpu {
         let mut done = 0u64;
         for b in 0..batches {
             for s in 0..segments_per_batch {
-                let first_in_batch = s * SEGMENT_PHOTONS;
-                let count = SEGMENT_PHOTONS.min(per_batch - first_in_batch);
+                let first_in_batch = s * segment;
+                let count = segment.min(per_batch - first_in_batch);
                 let first = b as u64 * per_batch + first_in_batch;
                 let groups_total = count.div_ceil(u64::from(WORKGROUP_SIZE));
                 let groups_x = groups_total.min(u64::from(plan.groups_x)) as u32;
