@@ -28,6 +28,10 @@
 //! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
 //! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
 //! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
+//!
+//! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
+//! the same Philox streams) reads its tallies back and calls it too, so both report means and standard errors the
+//! same way.
 
 use super::rng::PhotonRng;
 use super::stack::McStack;
