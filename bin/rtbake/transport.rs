@@ -10,8 +10,11 @@ use rtbake::diffusion::source::ProfileSource;
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::plot::profile::{render, PlotFormat};
+use rtbake::runtime::chain;
+use rtbake::runtime::device::create_headless;
+use rtbake::runtime::RuntimeError;
 use rtbake::transport::compare::{bin_averaged, compare, diffusion_counterpart};
-use rtbake::transport::{mc, report, McLayer, McSettings, McStack};
+use rtbake::transport::{report, McLayer, McSettings, McStack};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -66,6 +69,11 @@ pub struct TransportArgs {
     /// Write a plot (.png or .svg): r R(r) and R(r) from Monte Carlo with +-1 SE bars, and the diffusion model.
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
+    /// Trace on the GPU (wgpu compute, f32, the same random streams; WGPU_BACKEND / WGPU_ADAPTER_NAME choose the
+    /// adapter) instead of the CPU reference (f64). The outputs have the same layout; the JSON names the path and
+    /// the adapter. No adapter: exit 2.
+    #[arg(long)]
+    gpu: bool,
 }
 
 /// Library parameter names → the flags a user typed.
@@ -152,11 +160,10 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let settings = McSettings::new(args.photons, args.seed, args.batches, args.bin_mm, args.bins)
         .map_err(|e| flag_error(e, None))?;
     let (stack, mut provenance, title) = resolve(&args)?;
-    ctx.check_memory("--bins/--batches", settings.memory_estimate_bytes(stack.layers().len()))?;
-    ctx.check_time(
-        &format!("--photons {}", args.photons),
-        settings.time_estimate_seconds(rayon::current_num_threads()),
-    )?;
+    let (bytes, seconds) =
+        chain::transport_estimate(&settings, stack.layers().len(), args.gpu, rayon::current_num_threads());
+    ctx.check_memory("--bins/--batches", bytes)?;
+    ctx.check_time(&format!("--photons {}", args.photons), seconds)?;
     for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
         if let Some(p) = path {
             check_output_file(flag, p)?;
@@ -170,9 +177,25 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => None,
     };
     provenance["model"] = json!("monte-carlo (MCML, Wang, Jacques & Zheng 1995)");
+    let gpu = if args.gpu {
+        let g = create_headless(&Default::default()).map_err(|e| usage(anyhow::anyhow!("--gpu: {e}")))?;
+        ctx.info(format!("adapter: {}", g.describe()));
+        provenance["path"] = json!("gpu (wgpu compute, f32; runtime::transport_gpu)");
+        provenance["adapter"] = json!(g.describe());
+        Some(g)
+    } else {
+        provenance["path"] = json!("cpu (f64 reference; transport::mc)");
+        None
+    };
 
     let pb = ctx.progress(1000, "photons");
-    let result = mc::simulate_with_progress(&stack, &settings, &|f| pb.set_position((f * 1000.0) as u64));
+    let result =
+        chain::transport(gpu.as_ref(), &stack, &settings, &|f| pb.set_position((f * 1000.0) as u64)).map_err(|e| {
+            match e {
+                RuntimeError::Invalid(e) => flag_error(e, None),
+                e => anyhow::Error::new(e),
+            }
+        })?;
     pb.finish_and_clear();
 
     let diffusion = diffusion_counterpart(&stack);

@@ -133,3 +133,36 @@ pub fn subsurface(
         }
     })
 }
+
+/// Monte Carlo photon transport ([`crate::transport::mc`]) on `gpu` ([`super::transport_gpu`], f32, the same
+/// random streams) or with the CPU reference when `gpu` is `None`; `progress(fraction done)` as the run advances.
+pub fn transport(
+    gpu: Option<&Gpu>,
+    stack: &crate::transport::McStack,
+    settings: &crate::transport::McSettings,
+    progress: &dyn Fn(f64),
+) -> Result<crate::transport::McResult, RuntimeError> {
+    match gpu {
+        Some(g) => {
+            super::transport_gpu::TransportGpu::new(&g.device)?.simulate(&g.device, &g.queue, stack, settings, progress)
+        }
+        None => Ok(crate::transport::mc::simulate_with_progress(stack, settings, progress)),
+    }
+}
+
+/// Peak host memory (bytes) and an upper wall time (s) of [`transport`]: the CPU path's figures
+/// ([`crate::transport::McSettings::time_estimate_seconds`] on `threads`) also bound a software adapter
+/// (llvmpipe runs the shader on the same cores); a hardware GPU is faster, so the time is an upper estimate there.
+pub fn transport_estimate(
+    settings: &crate::transport::McSettings,
+    layers: usize,
+    gpu: bool,
+    threads: usize,
+) -> (u64, f64) {
+    let bytes = if gpu {
+        super::transport_gpu::memory_estimate_bytes(settings, layers)
+    } else {
+        settings.memory_estimate_bytes(layers)
+    };
+    (bytes, settings.time_estimate_seconds(threads))
+}

@@ -28,6 +28,10 @@
 //! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
 //! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
 //! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
+//!
+//! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
+//! the same Philox streams) reads its tallies back and calls it too, so both report means and standard errors the
+//! same way.
 
 use super::rng::PhotonRng;
 use super::stack::McStack;
@@ -157,22 +161,32 @@ pub struct McResult {
     pub channels: [ChannelResult; 3],
 }
 
-/// Raw weight sums of a chunk or batch.
-#[derive(Clone, Debug)]
-struct Tally {
-    r: Vec<f64>,
-    t: Vec<f64>,
-    rd: f64,
-    td: f64,
-    absorbed: Vec<f64>,
-    interactions: u64,
+/// Raw weight sums of a chunk or batch of one channel (photon weights, not yet divided by the photon count or the
+/// annulus area). The CPU path fills them per chunk; the GPU path (`runtime::transport_gpu`) reads them back per
+/// batch; both hand them to [`assemble`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tally {
+    /// Weight leaving through the top face per radial bin.
+    pub r: Vec<f64>,
+    /// Weight leaving through the bottom face per radial bin.
+    pub t: Vec<f64>,
+    /// Weight leaving through the top face (all radii).
+    pub rd: f64,
+    /// Weight leaving through the bottom face (all radii).
+    pub td: f64,
+    /// Weight absorbed per layer.
+    pub absorbed: Vec<f64>,
+    /// Interactions traced.
+    pub interactions: u64,
 }
 
 impl Tally {
-    fn new(bins: usize, layers: usize) -> Self {
+    /// Zero tallies for `bins` radial bins and `layers` layers.
+    pub fn new(bins: usize, layers: usize) -> Self {
         Self { r: vec![0.0; bins], t: vec![0.0; bins], rd: 0.0, td: 0.0, absorbed: vec![0.0; layers], interactions: 0 }
     }
-    fn add(&mut self, o: &Tally) {
+    /// Adds `o` bin by bin.
+    pub fn add(&mut self, o: &Tally) {
         for (a, b) in self.r.iter_mut().zip(&o.r) {
             *a += b;
         }
@@ -375,9 +389,7 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
     let batches = settings.batches as usize;
     let per_batch = settings.photons_per_batch();
     let chunks_per_batch = per_batch.div_ceil(CHUNK_PHOTONS);
-    let photons = per_batch * u64::from(settings.batches);
-    let n1 = layers[0].eta;
-    let rsp = ((stack.eta_above() - n1) / (stack.eta_above() + n1)).powi(2);
+    let rsp = specular_reflectance(stack);
 
     // Media per channel.
     let media: Vec<Vec<Medium>> = (0..3)
@@ -436,6 +448,29 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
         progress(next as f64 / total_chunks as f64);
     }
 
+    assemble(stack, settings, &batch_tallies)
+}
+
+/// Rsp = ((n₀ − n₁)/(n₀ + n₁))², the specular reflection of the top surface under normal incidence (MCML §3.1).
+pub fn specular_reflectance(stack: &McStack) -> f64 {
+    let n1 = stack.layers()[0].eta;
+    ((stack.eta_above() - n1) / (stack.eta_above() + n1)).powi(2)
+}
+
+/// The result from the raw tallies of every (channel, batch), channel-major (`batch_tallies[c * batches + b]`):
+/// means over all photons, standard errors over the batches (module docs), R(r)/T(r) per annulus area. Shared by
+/// the CPU path and the GPU path so both report the same quantities the same way.
+///
+/// # Panics
+/// When `batch_tallies` does not hold 3 × batches tallies of `settings.bins` bins and the stack's layer count.
+pub fn assemble(stack: &McStack, settings: &McSettings, batch_tallies: &[Tally]) -> McResult {
+    let n_layers = stack.layers().len();
+    let batches = settings.batches as usize;
+    assert_eq!(batch_tallies.len(), 3 * batches, "one tally per channel and batch");
+    assert!(batch_tallies.iter().all(|t| t.r.len() == settings.bins && t.absorbed.len() == n_layers));
+    let per_batch = settings.photons_per_batch();
+    let photons = per_batch * u64::from(settings.batches);
+    let rsp = specular_reflectance(stack);
     let area = |i: usize| PI * (2 * i + 1) as f64 * settings.bin_mm * settings.bin_mm;
     let channels = [0, 1, 2].map(|c| {
         let bt = &batch_tallies[c * batches..(c + 1) * batches];
@@ -458,42 +493,4 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
         }
     });
     McResult { settings: *settings, photons, channels }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fresnel_limits() {
-        // Normal incidence: ((n1 - n2)/(n1 + n2))^2.
-        let (r, c) = fresnel(1.0, 1.5, 1.0);
-        assert!((r - 0.04).abs() < 1e-12 && (c - 1.0).abs() < 1e-12);
-        // Matched: no reflection. Past the critical angle from glass: total reflection.
-        assert_eq!(fresnel(1.4, 1.4, 0.3).0, 0.0);
-        assert_eq!(fresnel(1.5, 1.0, 0.5).0, 1.0);
-        // Grazing incidence reflects everything.
-        assert!(fresnel(1.0, 1.5, 1e-9).0 > 0.999);
-    }
-
-    #[test]
-    fn hg_mean_cosine_is_g() {
-        for g in [-0.5, 0.0, 0.75, 0.9] {
-            let n = 4000;
-            let mean: f64 = (0..n).map(|i| hg_cos_theta(g, (i as f64 + 0.5) / n as f64)).sum::<f64>() / n as f64;
-            assert!((mean - g).abs() < 2e-3, "g {g}: <cos> {mean}");
-        }
-    }
-
-    #[test]
-    fn settings_refuse_out_of_range() {
-        assert_eq!(McSettings::new(0, 1, 10, 0.01, 10).unwrap_err().param, "photons");
-        assert_eq!(McSettings::new(MAX_PHOTONS + 1, 1, 10, 0.01, 10).unwrap_err().param, "photons");
-        assert_eq!(McSettings::new(10, 1, 1, 0.01, 10).unwrap_err().param, "batches");
-        assert_eq!(McSettings::new(10, 1, 10, 1e-9, 10).unwrap_err().param, "bin_mm");
-        assert_eq!(McSettings::new(10, 1, 10, f64::NAN, 10).unwrap_err().param, "bin_mm");
-        assert_eq!(McSettings::new(10, 1, 10, 0.01, MAX_BINS + 1).unwrap_err().param, "bins");
-        assert_eq!(McSettings::new(10, 1, 10, 1.0, 20_000).unwrap_err().param, "bins");
-        assert_eq!(McSettings::new(10, 1, 10, 0.01, 100).unwrap().photons_per_batch(), 1);
-    }
 }

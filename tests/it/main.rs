@@ -66,4 +66,5 @@ mod skin_layers;
 mod skin_spectral_data;
 mod transmittance_table;
 mod transport_cli;
+mod transport_gpu;
 mod transport_physics;
