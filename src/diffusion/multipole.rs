@@ -147,16 +147,23 @@ impl Slab {
         let b = l + 2.0 * zb0;
         let ar = d - l;
         let av = d + l + 2.0 * zb0;
-        // g·(e^(−xs) − e^(xs)) with g = q/(1 − q), q = e^(−2Ls), for 0 ≤ x ≤ 2L.
+        // g·(e^(−xs) − e^(xs)) with g = q/(1 − q), q = e^(−2Ls), for 0 ≤ x ≤ 2L. The x-independent e^(2Ls) − 1
+        // (or q) is formed once for the four terms (the same values as forming it per term).
+        let two_ls = 2.0 * big_l * s;
+        let shared = if two_ls == 0.0 {
+            0.0
+        } else if two_ls < 50.0 {
+            two_ls.exp_m1()
+        } else {
+            (-two_ls).exp()
+        };
         let g_diff = |x: f64| -> f64 {
-            let two_ls = 2.0 * big_l * s;
             if two_ls == 0.0 {
                 -x / big_l
             } else if two_ls < 50.0 {
-                -2.0 * (x * s).sinh() / two_ls.exp_m1()
+                -2.0 * (x * s).sinh() / shared
             } else {
-                let q = (-two_ls).exp();
-                ((-(2.0 * big_l + x) * s).exp() - (-(2.0 * big_l - x) * s).exp()) / (1.0 - q)
+                ((-(2.0 * big_l + x) * s).exp() - (-(2.0 * big_l - x) * s).exp()) / (1.0 - shared)
             }
         };
         // e^(−xs)(1 + g) − e^(xs) g

@@ -162,21 +162,35 @@ fn accumulate_scalar(
     }
 }
 
+/// Per-texel intermediates of the vectorised loop, reused across bands and rows (no allocation per row).
+#[derive(Debug, Default)]
+pub(super) struct RowScratch {
+    interval: Vec<i32>,
+    t: Vec<f64>,
+}
+
 /// Adds one band's weighted symmetric stack reflectance of every texel of a row (Cm = `melanin[x]`) to the
 /// accumulator planes `acc` = (R, G, B). Bit-identical on every CPU path (see the module docs).
-pub(super) fn accumulate_symmetric_row(table: &EpidermisTable, k: &BandRow, melanin: &[f64], acc: [&mut [f64]; 3]) {
+pub(super) fn accumulate_symmetric_row(
+    table: &EpidermisTable,
+    k: &BandRow,
+    melanin: &[f64],
+    acc: [&mut [f64]; 3],
+    scratch: &mut RowScratch,
+) {
     assert!(acc.iter().all(|a| a.len() == melanin.len()), "one accumulator per texel");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2 (checked at run time).
-        return unsafe { avx2::accumulate_symmetric_row(table, k, melanin, acc) };
+        return unsafe { avx2::accumulate_symmetric_row(table, k, melanin, acc, scratch) };
     }
+    let _ = scratch;
     accumulate_scalar(table, k, melanin, acc, 0..melanin.len())
 }
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{accumulate_scalar, BandRow, EpidermisTable, IntervalCubic, TABLE_INTERVALS};
+    use super::{accumulate_scalar, BandRow, EpidermisTable, IntervalCubic, RowScratch, TABLE_INTERVALS};
     use std::arch::x86_64::*;
 
     /// Loads four f64.
@@ -213,46 +227,59 @@ mod avx2 {
     }
 
     /// [`super::accumulate_symmetric_row`] four texels at a time; the last `len % 4` texels take the scalar loop.
+    /// Two passes over the row: (1) σa, √σa and the interval (k, t) of every texel into `scratch`, (2) the look-up,
+    /// adding and accumulation. Splitting the long dependency chain (square root → index → load → cubic → division)
+    /// lets the out-of-order core overlap many more texels than one fused loop does (measured 2× faster).
     #[target_feature(enable = "avx2")]
     pub(super) fn accumulate_symmetric_row(
         table: &EpidermisTable,
         k: &BandRow,
         melanin: &[f64],
         acc: [&mut [f64]; 3],
+        scratch: &mut RowScratch,
     ) {
         let cubics: &[IntervalCubic; TABLE_INTERVALS] =
             table.down.as_slice().try_into().expect("one cubic per interval");
         let n = melanin.len();
         let n4 = n - n % 4;
-        let [acc_r, acc_g, acc_b] = acc;
-        let (one, zero, k_max) = (_mm256_set1_pd(1.0), _mm256_setzero_pd(), _mm256_set1_pd((TABLE_INTERVALS - 1) as f64));
-        let mel = _mm256_set1_pd(k.melanin_sigma_a_per_mm);
-        let che_blood = _mm256_set1_pd(k.che_blood_sigma_a_per_mm);
-        let che = _mm256_set1_pd(k.che);
-        let base = _mm256_set1_pd(k.baseline_sigma_a_per_mm);
-        let (y_lo, inv_h) = (_mm256_set1_pd(table.y_lo), _mm256_set1_pd(table.inv_h));
+        scratch.interval.resize(n4, 0);
+        scratch.t.resize(n4, 0.0);
+        let one = _mm256_set1_pd(1.0);
+        {
+            let (zero, k_max) = (_mm256_setzero_pd(), _mm256_set1_pd((TABLE_INTERVALS - 1) as f64));
+            let mel = _mm256_set1_pd(k.melanin_sigma_a_per_mm);
+            let che_blood = _mm256_set1_pd(k.che_blood_sigma_a_per_mm);
+            let che = _mm256_set1_pd(k.che);
+            let base = _mm256_set1_pd(k.baseline_sigma_a_per_mm);
+            let (y_lo, inv_h) = (_mm256_set1_pd(table.y_lo), _mm256_set1_pd(table.inv_h));
+            let lanes = melanin.chunks_exact(4).zip(scratch.interval.chunks_exact_mut(4)).zip(scratch.t.chunks_exact_mut(4));
+            for ((cm4, k4), t4) in lanes {
+                let cm = load(cm4.try_into().expect("4 lanes"));
+                // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base
+                let sigma_a = _mm256_add_pd(
+                    _mm256_add_pd(_mm256_mul_pd(cm, mel), che_blood),
+                    _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(one, cm), che), base),
+                );
+                let x = _mm256_mul_pd(_mm256_sub_pd(_mm256_sqrt_pd(sigma_a), y_lo), inv_h);
+                // max(x, 0) returns 0 for NaN like f64::max; the clamp keeps the conversion in range.
+                let ki = _mm256_cvttpd_epi32(_mm256_min_pd(_mm256_max_pd(x, zero), k_max));
+                let t = _mm256_sub_pd(x, _mm256_cvtepi32_pd(ki));
+                // SAFETY: `k4` is a valid, writable [i32; 4] (16 bytes) and `t4` a valid, writable [f64; 4]; the
+                // unaligned stores have no alignment requirement.
+                unsafe {
+                    _mm_storeu_si128(k4.as_mut_ptr().cast(), ki);
+                    _mm256_storeu_pd(t4.as_mut_ptr(), t);
+                }
+            }
+        }
         let r2 = _mm256_set1_pd(k.r2);
         let w = k.weights.map(|c| _mm256_set1_pd(c));
-        let planes = [acc_r.chunks_exact_mut(4), acc_g.chunks_exact_mut(4), acc_b.chunks_exact_mut(4)];
-        let [pr, pg, pb] = planes;
-        for (((cm4, ar), ag), ab) in melanin.chunks_exact(4).zip(pr).zip(pg).zip(pb) {
-            let cm = load(cm4.try_into().expect("4 lanes"));
-            // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base
-            let sigma_a = _mm256_add_pd(
-                _mm256_add_pd(_mm256_mul_pd(cm, mel), che_blood),
-                _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(one, cm), che), base),
-            );
-            let x = _mm256_mul_pd(_mm256_sub_pd(_mm256_sqrt_pd(sigma_a), y_lo), inv_h);
-            // max(x, 0) returns 0 for NaN like f64::max; the clamp keeps the conversion in range.
-            let ki = _mm256_cvttpd_epi32(_mm256_min_pd(_mm256_max_pd(x, zero), k_max));
-            let t = _mm256_sub_pd(x, _mm256_cvtepi32_pd(ki));
-            let idx = [
-                _mm_extract_epi32::<0>(ki),
-                _mm_extract_epi32::<1>(ki),
-                _mm_extract_epi32::<2>(ki),
-                _mm_extract_epi32::<3>(ki),
-            ];
-            let c = idx.map(|i| &cubics[i as usize & (TABLE_INTERVALS - 1)]);
+        let [acc_r, acc_g, acc_b] = acc;
+        let lanes = scratch.interval.chunks_exact(4).zip(scratch.t.chunks_exact(4));
+        let planes = acc_r.chunks_exact_mut(4).zip(acc_g.chunks_exact_mut(4)).zip(acc_b.chunks_exact_mut(4));
+        for ((k4, t4), ((ar, ag), ab)) in lanes.zip(planes) {
+            let t = load(t4.try_into().expect("4 lanes"));
+            let c = [0, 1, 2, 3].map(|j| &cubics[k4[j] as usize & (TABLE_INTERVALS - 1)]);
             let r1 = horner(transpose(load(&c[0].r), load(&c[1].r), load(&c[2].r), load(&c[3].r)), t);
             let t1 = horner(transpose(load(&c[0].t), load(&c[1].t), load(&c[2].t), load(&c[3].t)), t);
             // R = R1 + T1² R2 / (1 − R1 R2)
@@ -312,7 +339,7 @@ mod tests {
             let init: Vec<f64> = (0..n).map(|i| 0.1 * i as f64).collect();
             let (mut a, mut b) = ([init.clone(), init.clone(), init.clone()], [init.clone(), init.clone(), init]);
             let [ar, ag, ab] = &mut a;
-            accumulate_symmetric_row(&t, &k, &melanin, [ar.as_mut_slice(), ag, ab]);
+            accumulate_symmetric_row(&t, &k, &melanin, [ar.as_mut_slice(), ag, ab], &mut RowScratch::default());
             let [br, bg, bb] = &mut b;
             accumulate_scalar(&t, &k, &melanin, [br.as_mut_slice(), bg, bb], 0..n);
             for c in 0..3 {

@@ -32,7 +32,7 @@ use crate::spectral::skin_layers::{dermis_sigma_a_per_mm, epidermis_sigma_a_mixe
 use serde::{Deserialize, Serialize};
 
 pub use super::epidermis_table::{EpidermisTable, TABLE_INTERVALS};
-use super::epidermis_table::{accumulate_symmetric_row, BandRow};
+use super::epidermis_table::{accumulate_symmetric_row, BandRow, RowScratch};
 
 /// How the two layers' totals are combined at k = 0: the same choice as for layered profiles
 /// (symmetric = DJ05 as printed, the published LUT's form; directional = Kubelka 1954).
@@ -339,6 +339,7 @@ impl TwoLayerSkinModel {
         let mut acc = vec![0.0f64; 3 * n];
         let (acc_r, acc_gb) = acc.split_at_mut(n);
         let (acc_g, acc_b) = acc_gb.split_at_mut(n);
+        let mut scratch = RowScratch::default();
         for (b, (band, table)) in self.bands.iter().zip(tables).enumerate() {
             let wt = self.weights.linear_srgb[b];
             let rows = acc_r.chunks_exact_mut(w).zip(acc_g.chunks_exact_mut(w)).zip(acc_b.chunks_exact_mut(w));
@@ -355,7 +356,7 @@ impl TwoLayerSkinModel {
                             r2,
                             weights: wt,
                         };
-                        accumulate_symmetric_row(t, &k, melanin, [ar, ag, ab]);
+                        accumulate_symmetric_row(t, &k, melanin, [ar, ag, ab], &mut scratch);
                     }
                     Some(t) => self.accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| t.eval(sa)),
                     None => self.accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| {
