@@ -120,6 +120,8 @@ const TILE_COLS: usize = 256;
 /// Output texels summed together in registers over all chords of the disk (8 texels = four AVX2 vectors of
 /// (Σ, Σ²) pairs): the accumulators are loaded and stored once per texel, not once per chord.
 const BLOCK: usize = 8;
+/// Output rows summed together (see [`accumulate_pair`]).
+const ROW_PAIR: usize = 2;
 
 /// Exact disk statistics in O(r) per texel. `data` is `width × height` single-channel, top row first.
 /// The radius must pass [`check_radius`].
@@ -150,7 +152,12 @@ struct BandScratch {
     valid: Vec<bool>,
     /// (offset of P(x0 + hw + 1), offset of P(x0 − hw)) in `pre` of every valid chord of one output row.
     chords: Vec<(usize, usize)>,
+    /// Per chord (dy + r): its two prefix offsets within a row, for the current tile.
+    offsets: Vec<(usize, usize)>,
+    /// Sums of the current tile row (and of the next one when a pair of rows is summed together).
     acc: Vec<[f64; 2]>,
+    /// Whether `acc` holds the sums of the current pair of rows.
+    pair_ready: bool,
     mean: Vec<f64>,
     sigma: Vec<f64>,
 }
@@ -272,7 +279,7 @@ impl Context<'_> {
         s.valid.resize(n_in, false);
         s.mean.resize(rows * w, 0.0);
         s.sigma.resize(rows * w, 0.0);
-        s.acc.resize(TILE_COLS.min(w), [0.0; 2]);
+        s.acc.resize(ROW_PAIR * TILE_COLS.min(w), [0.0; 2]);
         for k in 0..n_in {
             let pos = lo + k as i64;
             let y = match self.border {
@@ -299,17 +306,33 @@ impl Context<'_> {
         // Tile columns so the prefix rows of a tile stay in cache across consecutive output rows.
         for x0 in (0..w).step_by(TILE_COLS) {
             let tw = TILE_COLS.min(w - x0);
+            // Chord offsets within a prefix row (of the tile's first column): P(x + hw + 1), P(x − hw).
+            s.offsets.clear();
+            s.offsets.extend(self.hws.iter().map(|&hw| (x0 + r + hw as usize + 1, x0 + r - hw as usize)));
             for (oy, (interior, edge)) in counts.iter().enumerate() {
-                s.chords.clear();
-                for (i, &hw) in self.hws.iter().enumerate() {
-                    let k = oy + i; // input position y0 + oy + i − r
-                    if s.valid[k] {
-                        let hw = hw as usize;
-                        s.chords.push((k * ext + x0 + r + hw + 1, k * ext + x0 + r - hw));
+                if oy % ROW_PAIR == 0 {
+                    // Two output rows share 2r of their 2r + 1 chord rows: summed together where both have them
+                    // all (each prefix row is then read from L2 once for two rows).
+                    let all = oy + ROW_PAIR <= rows && s.valid[oy..oy + ROW_PAIR + 2 * r].iter().all(|&v| v);
+                    s.pair_ready = all;
+                    if all {
+                        let (acc, acc_next) = s.acc.split_at_mut(TILE_COLS.min(w));
+                        accumulate_pair(&s.pre[oy * ext..], ext, &s.offsets, &mut acc[..tw], &mut acc_next[..tw]);
                     }
                 }
-                let acc = &mut s.acc[..tw];
-                accumulate(&s.pre, &s.chords, acc);
+                let pair_slot = oy % ROW_PAIR;
+                let acc_len = TILE_COLS.min(w);
+                if !s.pair_ready {
+                    s.chords.clear();
+                    for (i, &(hi, lo)) in s.offsets.iter().enumerate() {
+                        let k = oy + i; // input position y0 + oy + i − r
+                        if s.valid[k] {
+                            s.chords.push((k * ext + hi, k * ext + lo));
+                        }
+                    }
+                    accumulate(&s.pre, &s.chords, &mut s.acc[..tw]);
+                }
+                let acc = if s.pair_ready { &s.acc[pair_slot * acc_len..pair_slot * acc_len + tw] } else { &s.acc[..tw] };
                 let edge = match (self.border, edge) {
                     (Border::Wrap, _) => None,
                     (Border::Clip, Some(e)) => Some(e.as_slice()),
@@ -373,6 +396,80 @@ fn accumulate_body(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64;
             a[1] += pre[hi + j][1] - pre[lo + j][1];
         }
     }
+}
+
+/// The sums of two consecutive output rows at once: `pre` starts at the first row's first chord row, every chord
+/// row is valid, `offsets[i]` are the offsets of chord i (dy = i − r) within a row. Prefix row j carries chord j of
+/// the first row and chord j − 1 of the second, so each is loaded once for both; each texel still adds its chords
+/// in disk order (the same sums, bit for bit, as [`accumulate_body`]).
+#[inline(always)]
+fn accumulate_pair_body(
+    pre: &[[f64; 2]],
+    ext: usize,
+    offsets: &[(usize, usize)],
+    acc_a: &mut [[f64; 2]],
+    acc_b: &mut [[f64; 2]],
+) {
+    let tw = acc_a.len();
+    let n = offsets.len(); // 2r + 1
+    let chord = |a: &mut [[f64; 2]; BLOCK], row: usize, (hi, lo): (usize, usize), x: usize| {
+        let p_hi: &[[f64; 2]; BLOCK] = pre[row + hi + x..row + hi + x + BLOCK].try_into().expect("block");
+        let p_lo: &[[f64; 2]; BLOCK] = pre[row + lo + x..row + lo + x + BLOCK].try_into().expect("block");
+        for j in 0..BLOCK {
+            a[j][0] += p_hi[j][0] - p_lo[j][0];
+            a[j][1] += p_hi[j][1] - p_lo[j][1];
+        }
+    };
+    let mut x = 0;
+    while x + BLOCK <= tw {
+        let (mut a, mut b) = ([[0.0f64; 2]; BLOCK], [[0.0f64; 2]; BLOCK]);
+        chord(&mut a, 0, offsets[0], x);
+        for j in 1..n {
+            chord(&mut a, j * ext, offsets[j], x);
+            chord(&mut b, j * ext, offsets[j - 1], x);
+        }
+        chord(&mut b, n * ext, offsets[n - 1], x);
+        acc_a[x..x + BLOCK].copy_from_slice(&a);
+        acc_b[x..x + BLOCK].copy_from_slice(&b);
+        x += BLOCK;
+    }
+    for (q, acc) in [acc_a, acc_b].into_iter().enumerate() {
+        for (j, a) in acc.iter_mut().enumerate().skip(x) {
+            *a = [0.0, 0.0];
+            for (i, &(hi, lo)) in offsets.iter().enumerate() {
+                let row = (q + i) * ext;
+                a[0] += pre[row + hi + j][0] - pre[row + lo + j][0];
+                a[1] += pre[row + hi + j][1] - pre[row + lo + j][1];
+            }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn accumulate_pair_avx2(
+    pre: &[[f64; 2]],
+    ext: usize,
+    offsets: &[(usize, usize)],
+    acc_a: &mut [[f64; 2]],
+    acc_b: &mut [[f64; 2]],
+) {
+    accumulate_pair_body(pre, ext, offsets, acc_a, acc_b)
+}
+
+fn accumulate_pair(
+    pre: &[[f64; 2]],
+    ext: usize,
+    offsets: &[(usize, usize)],
+    acc_a: &mut [[f64; 2]],
+    acc_b: &mut [[f64; 2]],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked at run time).
+        return unsafe { accumulate_pair_avx2(pre, ext, offsets, acc_a, acc_b) };
+    }
+    accumulate_pair_body(pre, ext, offsets, acc_a, acc_b)
 }
 
 /// The same loop compiled for AVX2: identical IEEE operations in the same order (no FMA contraction), so the
@@ -545,6 +642,29 @@ mod tests {
                     }
                     assert_eq!((s[0].to_bits(), s[1].to_bits()), (v[0].to_bits(), v[1].to_bits()));
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn pair_of_rows_equals_each_row_alone_bit_for_bit() {
+        let (r, ext) = (4usize, 37 + 9);
+        let vals = noise_map(ext as u32, (2 * r + 2) as u32 * 2, 5, -0.25);
+        let pre: Vec<[f64; 2]> = vals.chunks(2).map(|p| [p[0] as f64 * 1e2, p[1] as f64]).collect();
+        let offsets: Vec<(usize, usize)> =
+            chord_half_widths(r as u32).iter().map(|&hw| (r + hw as usize + 1, r - hw as usize)).collect();
+        for tw in [37usize, 16, 3] {
+            let (mut a, mut b) = (vec![[0.0; 2]; tw], vec![[0.0; 2]; tw]);
+            accumulate_pair(&pre, ext, &offsets, &mut a, &mut b);
+            for (q, got) in [a, b].iter().enumerate() {
+                let chords: Vec<(usize, usize)> =
+                    offsets.iter().enumerate().map(|(i, &(hi, lo))| ((q + i) * ext + hi, (q + i) * ext + lo)).collect();
+                let mut want = vec![[0.0; 2]; tw];
+                accumulate_body(&pre, &chords, &mut want);
+                assert!(got
+                    .iter()
+                    .zip(&want)
+                    .all(|(x, y)| x[0].to_bits() == y[0].to_bits() && x[1].to_bits() == y[1].to_bits()));
             }
         }
     }
