@@ -8,7 +8,15 @@
 //!
 //! The disk is the set of integer texel offsets (dx, dy) with dx² + dy² ≤ r². It is the union of 2r + 1 horizontal
 //! chords of half-width `hw(dy) = floor(sqrt(r² − dy²))`, so with per-row prefix sums each chord costs two look-ups
-//! and a texel costs O(r) (not O(r²)). The inner loop runs over a whole output row per chord, which vectorises.
+//! and a texel costs O(r) (not O(r²)).
+//!
+//! Layout of the work (issue 17): the map is cut into bands of [`BAND_ROWS`] rows (the parallel tasks; each
+//! reads its `BAND_ROWS + 2r` prefix rows into per-thread buffers reused across bands), a band into tiles of 256
+//! columns (their prefix rows stay in L2), and a tile row into blocks of 8 texels whose sums stay in AVX2 registers
+//! across all 2r + 1 chords; two consecutive output rows are summed together, so every prefix row is read once for
+//! both. The inner loop is load-bound (two 32-byte loads, one subtraction and one addition per two texels and
+//! chord). [`disk_stats_bands`] hands each band's rows to a caller (the rig downsamples them at once, so no
+//! full-size map is stored); [`disk_stats`] collects them.
 //!
 //! Numerics: samples are shifted by the map's global mean `c` before summing (accumulation in f64), so the
 //! variance `E[(H−c)²] − E[H−c]²` does not cancel catastrophically for maps with a large mean; it is clamped at 0
@@ -298,7 +306,8 @@ impl Context<'_> {
                 if (0..self.hws.len()).all(rows_valid) {
                     return (self.full_count, None);
                 }
-                let interior = self.hws.iter().enumerate().filter(|&(i, _)| rows_valid(i)).map(|(_, &hw)| 2 * hw as u64 + 1).sum();
+                let interior =
+                    self.hws.iter().enumerate().filter(|&(i, _)| rows_valid(i)).map(|(_, &hw)| 2 * hw as u64 + 1).sum();
                 debug_assert!(self.border == Border::Clip, "wrapped bands have every chord row");
                 (interior, Some(edge_counts(&self.hws, w, r, rows_valid)))
             })
@@ -332,7 +341,8 @@ impl Context<'_> {
                     }
                     accumulate(&s.pre, &s.chords, &mut s.acc[..tw]);
                 }
-                let acc = if s.pair_ready { &s.acc[pair_slot * acc_len..pair_slot * acc_len + tw] } else { &s.acc[..tw] };
+                let acc =
+                    if s.pair_ready { &s.acc[pair_slot * acc_len..pair_slot * acc_len + tw] } else { &s.acc[..tw] };
                 let edge = match (self.border, edge) {
                     (Border::Wrap, _) => None,
                     (Border::Clip, Some(e)) => Some(e.as_slice()),
@@ -345,7 +355,13 @@ impl Context<'_> {
                     None => (x0, x0 + tw),
                     Some(_) => (x0.max(r).min(x0 + tw), (w - r).min(x0 + tw).max(x0.max(r).min(x0 + tw))),
                 };
-                finish(&acc[a - x0..b - x0], *interior as f64, self.shift, &mut out_m[a - x0..b - x0], &mut out_s[a - x0..b - x0]);
+                finish(
+                    &acc[a - x0..b - x0],
+                    *interior as f64,
+                    self.shift,
+                    &mut out_m[a - x0..b - x0],
+                    &mut out_s[a - x0..b - x0],
+                );
                 if let Some(edge) = edge {
                     for gx in (x0..a).chain(b..x0 + tw) {
                         let n = if gx < r { edge[gx] } else { edge[r + gx - (w - r)] } as f64;
@@ -379,12 +395,7 @@ fn accumulate_body(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64;
     while x + BLOCK <= tw {
         let mut a = [[0.0f64; 2]; BLOCK];
         for &(hi, lo) in chords {
-            let p_hi: &[[f64; 2]; BLOCK] = pre[hi + x..hi + x + BLOCK].try_into().expect("block");
-            let p_lo: &[[f64; 2]; BLOCK] = pre[lo + x..lo + x + BLOCK].try_into().expect("block");
-            for j in 0..BLOCK {
-                a[j][0] += p_hi[j][0] - p_lo[j][0];
-                a[j][1] += p_hi[j][1] - p_lo[j][1];
-            }
+            add_chord(&mut a, pre, hi + x, lo + x);
         }
         acc[x..x + BLOCK].copy_from_slice(&a);
         x += BLOCK;
@@ -395,6 +406,17 @@ fn accumulate_body(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64;
             a[0] += pre[hi + j][0] - pre[lo + j][0];
             a[1] += pre[hi + j][1] - pre[lo + j][1];
         }
+    }
+}
+
+/// `a[j] += P(hi + j) − P(lo + j)` for the block's texels.
+#[inline(always)]
+fn add_chord(a: &mut [[f64; 2]; BLOCK], pre: &[[f64; 2]], hi: usize, lo: usize) {
+    let p_hi: &[[f64; 2]; BLOCK] = pre[hi..hi + BLOCK].try_into().expect("block");
+    let p_lo: &[[f64; 2]; BLOCK] = pre[lo..lo + BLOCK].try_into().expect("block");
+    for j in 0..BLOCK {
+        a[j][0] += p_hi[j][0] - p_lo[j][0];
+        a[j][1] += p_hi[j][1] - p_lo[j][1];
     }
 }
 
@@ -413,12 +435,7 @@ fn accumulate_pair_body(
     let tw = acc_a.len();
     let n = offsets.len(); // 2r + 1
     let chord = |a: &mut [[f64; 2]; BLOCK], row: usize, (hi, lo): (usize, usize), x: usize| {
-        let p_hi: &[[f64; 2]; BLOCK] = pre[row + hi + x..row + hi + x + BLOCK].try_into().expect("block");
-        let p_lo: &[[f64; 2]; BLOCK] = pre[row + lo + x..row + lo + x + BLOCK].try_into().expect("block");
-        for j in 0..BLOCK {
-            a[j][0] += p_hi[j][0] - p_lo[j][0];
-            a[j][1] += p_hi[j][1] - p_lo[j][1];
-        }
+        add_chord(a, pre, row + hi + x, row + lo + x)
     };
     let mut x = 0;
     while x + BLOCK <= tw {

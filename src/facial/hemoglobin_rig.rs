@@ -181,19 +181,27 @@ pub fn build_rig_with_progress(
             .par_chunks_mut(band_rw)
             .zip(tmp_scale.par_chunks_mut(band_rw))
             .zip(sigma_n_floored.par_chunks(band_full));
-        disk_stats::disk_stats_bands(t, width, height, r, settings.border, outputs, |((tm, ts), sn), _, mean, sigma| {
-            let mut scale_row = vec![0.0f64; w];
-            let rows = mean.chunks_exact(w).zip(sigma.chunks_exact(w)).zip(sn.chunks_exact(w));
-            for (((m_row, s_row), sn_row), (tm_row, ts_row)) in
-                rows.zip(tm.chunks_exact_mut(rw as usize).zip(ts.chunks_exact_mut(rw as usize)))
-            {
-                res.horizontal_row(m_row, tm_row); // eq. 7.5: bias_i = μi
-                for ((o, &si), &sn) in scale_row.iter_mut().zip(s_row).zip(sn_row) {
-                    *o = si / sn; // eq. 7.5: scale_i = σi / max(σn, ε)
+        disk_stats::disk_stats_bands(
+            t,
+            width,
+            height,
+            r,
+            settings.border,
+            outputs,
+            |((tm, ts), sn), _, mean, sigma| {
+                let mut scale_row = vec![0.0f64; w];
+                let rows = mean.chunks_exact(w).zip(sigma.chunks_exact(w)).zip(sn.chunks_exact(w));
+                for (((m_row, s_row), sn_row), (tm_row, ts_row)) in
+                    rows.zip(tm.chunks_exact_mut(rw as usize).zip(ts.chunks_exact_mut(rw as usize)))
+                {
+                    res.horizontal_row(m_row, tm_row); // eq. 7.5: bias_i = μi
+                    for ((o, &si), &sn) in scale_row.iter_mut().zip(s_row).zip(sn_row) {
+                        *o = si / sn; // eq. 7.5: scale_i = σi / max(σn, ε)
+                    }
+                    res.horizontal_row(&scale_row, ts_row);
                 }
-                res.horizontal_row(&scale_row, ts_row);
-            }
-        })?;
+            },
+        )?;
         maps.push(RigMap { name: name.clone(), scale: down(&tmp_scale), bias: down(&tmp_mean) });
         progress(maps.len());
     }
@@ -306,8 +314,9 @@ pub fn evaluate(rig: &HemoglobinRig, weights: &[f64], global_scale: f64) -> Vec<
 }
 /// Wall time of [`build_rig`] on `maps` maps (neutral + targets) of `width`×`height` at disk radius `radius`
 /// (issue 15's budget check): 1.5 ns per texel, map and chord row (2r + 1 rows per disk) on one thread, divided by
-/// `threads`. Measured with the release build on the project's 2-core machine (4096², 9 maps, r = 32: 6.4 s on 2
-/// threads, i.e. 1.3 ns); the estimate rounds up.
+/// `threads`. Measured with the release build on the project's 2-core machine: 4096², 9 maps, r = 32: 6.4 s on 2
+/// threads before issue 17 (1.3 ns), 3.3 s of CPU after it (0.33 ns; `examples/bench_facial.rs`); the estimate
+/// keeps the older, larger figure, so it only ever over-estimates.
 pub fn time_estimate_seconds(width: u32, height: u32, maps: usize, radius: u32, threads: usize) -> f64 {
     1.5e-9 * width as f64 * height as f64 * maps as f64 * (2 * radius as u64 + 1) as f64 / threads.max(1) as f64
 }
@@ -326,9 +335,10 @@ pub fn evaluate_memory_estimate_bytes(width: u32, height: u32, rig_width: u32, r
     24 * width as u64 * height as u64 + 8 * maps as u64 * rig_width as u64 * rig_height as u64 + (32 << 20)
 }
 
-/// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32), the disk statistics of the
-/// neutral and of one target at a time (mean and σ, f64), the full-size scale and bias, and the encoded outputs —
-/// counted from the buffers as 4 bytes per texel per map plus 72 bytes per texel, plus 32 MiB.
+/// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32) and, counted from the buffers of
+/// the unfused build (full-size mean and σ of the neutral and of one target, f64, the full-size scale and bias,
+/// the encoded outputs), 72 bytes per texel, plus 32 MiB. Since issue 17 the build keeps only the floored σn (f64)
+/// and H0 (f32) at full size, so this over-estimates.
 pub fn memory_estimate_bytes(width: u32, height: u32, maps: usize) -> u64 {
     let texels = width as u64 * height as u64;
     texels * (4 * maps as u64 + 72) + (32 << 20)

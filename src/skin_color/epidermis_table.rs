@@ -23,7 +23,7 @@
 //! whole default 256² table the tabulated and direct results differ by at most 6e−8 in linear RGB, i.e. f32 rounding
 //! (`examples/bench_skin.rs` prints it; `tests/it/skin_color.rs` bounds it).
 //!
-//! The table's inner loop ([`accumulate_symmetric_row`]) evaluates one band for a row of texels: σa of the
+//! The table's inner loop (`accumulate_symmetric_row`) evaluates one band for a row of texels: σa of the
 //! epidermis, the table look-up, the adding above and the band's colour weights. On x86-64 with AVX2 (checked at
 //! run time) it runs four texels per instruction: the four intervals' coefficients are loaded as one 256-bit vector
 //! each and transposed, so the look-up needs no gather. The AVX2 loop performs the same IEEE operations in the same
@@ -136,9 +136,8 @@ pub(super) struct BandRow {
 /// Symmetric stack reflectance of one texel: the scalar form of the vectorised loop (same operations, same order).
 #[inline(always)]
 fn symmetric_texel(table: &EpidermisTable, k: &BandRow, cm: f64) -> f64 {
-    let sigma_a = cm * k.melanin_sigma_a_per_mm
-        + k.che_blood_sigma_a_per_mm
-        + (1.0 - cm - k.che) * k.baseline_sigma_a_per_mm;
+    let sigma_a =
+        cm * k.melanin_sigma_a_per_mm + k.che_blood_sigma_a_per_mm + (1.0 - cm - k.che) * k.baseline_sigma_a_per_mm;
     let [r1, t1] = table.eval_down(sigma_a);
     // DJ05 adding as printed ("symmetric"), at k = 0.
     r1 + t1 * t1 * k.r2 / (1.0 - r1 * k.r2)
@@ -252,7 +251,8 @@ mod avx2 {
             let che = _mm256_set1_pd(k.che);
             let base = _mm256_set1_pd(k.baseline_sigma_a_per_mm);
             let (y_lo, inv_h) = (_mm256_set1_pd(table.y_lo), _mm256_set1_pd(table.inv_h));
-            let lanes = melanin.chunks_exact(4).zip(scratch.interval.chunks_exact_mut(4)).zip(scratch.t.chunks_exact_mut(4));
+            let lanes =
+                melanin.chunks_exact(4).zip(scratch.interval.chunks_exact_mut(4)).zip(scratch.t.chunks_exact_mut(4));
             for ((cm4, k4), t4) in lanes {
                 let cm = load(cm4.try_into().expect("4 lanes"));
                 // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base

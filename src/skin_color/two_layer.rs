@@ -31,8 +31,8 @@ use crate::spectral::colorimetry::{srgb8, ColorWeights, Illuminant, SpectralGrid
 use crate::spectral::skin_layers::{dermis_sigma_a_per_mm, epidermis_sigma_a_mixed, SkinPhysiology};
 use serde::{Deserialize, Serialize};
 
-pub use super::epidermis_table::{EpidermisTable, TABLE_INTERVALS};
 use super::epidermis_table::{accumulate_symmetric_row, BandRow, RowScratch};
+pub use super::epidermis_table::{EpidermisTable, TABLE_INTERVALS};
 
 /// How the two layers' totals are combined at k = 0: the same choice as for layered profiles
 /// (symmetric = DJ05 as printed, the published LUT's form; directional = Kubelka 1954).
@@ -359,9 +359,8 @@ impl TwoLayerSkinModel {
                         accumulate_symmetric_row(t, &k, melanin, [ar, ag, ab], &mut scratch);
                     }
                     Some(t) => self.accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| t.eval(sa)),
-                    None => self.accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| {
-                        self.epidermis_totals(band, sa)
-                    }),
+                    None => self
+                        .accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| self.epidermis_totals(band, sa)),
                 }
             }
         }

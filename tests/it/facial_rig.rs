@@ -181,7 +181,11 @@ fn fused_rig_equals_full_size_statistics_and_area_resampling_bit_for_bit() {
                 s ^= s >> 17;
                 s ^= s << 5;
                 // Flat in the top rows (σn below the floor there), noisy below.
-                if i < 20 * w { 0.25 } else { 0.2 + (s % 10000) as f32 / 50000.0 }
+                if i < 20 * w {
+                    0.25
+                } else {
+                    0.2 + (s % 10000) as f32 / 50000.0
+                }
             })
             .collect()
     };
