@@ -125,6 +125,13 @@ impl Slab {
         self.hankel_rt(0.0, series)
     }
 
+    /// R̂(0) of the exact series alone: the bits of `totals(Series::Exact).0` without the transmittance's terms
+    /// (the skin-colour table needs only the dermis' reflectance, at every row and wavelength).
+    pub fn total_reflectance_exact(&self) -> f64 {
+        let s = (self.sigma_tr().powi(2) + 0.0 * 0.0).sqrt();
+        self.hankel_exact_parts(s, false).0
+    }
+
     fn hankel_truncated(&self, s: f64, n: i64) -> (f64, f64) {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let d = self.thickness_mm;
@@ -141,6 +148,12 @@ impl Slab {
     }
 
     fn hankel_exact(&self, s: f64) -> (f64, f64) {
+        self.hankel_exact_parts(s, true)
+    }
+
+    /// (R̂, T̂) at `s`; T̂ = 0 unless `transmittance`.
+    #[inline(always)]
+    fn hankel_exact_parts(&self, s: f64, transmittance: bool) -> (f64, f64) {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let d = self.thickness_mm;
         let a = l;
@@ -170,6 +183,9 @@ impl Slab {
         let term = |x: f64| (-x * s).exp() + g_diff(x);
         let h = 0.5 * self.albedo_prime();
         let r = term(a) + term(b);
+        if !transmittance {
+            return (h * r, 0.0);
+        }
         let t = ar.signum() * (-ar.abs() * s).exp() + g_diff(ar) - term(av);
         (h * r, h * t)
     }
@@ -334,6 +350,15 @@ mod tests {
 
     fn skinlike(d: f64, sigma_a: f64) -> Slab {
         Slab::new(sigma_a, 1.5, d, 1.4, 1.4, FdrForm::Dj05).unwrap()
+    }
+
+    #[test]
+    fn reflectance_alone_has_the_bits_of_the_totals() {
+        // Thin and thick slabs: 2Ls below 50 (expm1 branch) and above it (q branch), and σa = 0.
+        for (d, sigma_a) in [(1.0, 0.01), (1.0, 30.0), (20.0, 0.02), (20.0, 2.0), (1.0, 0.0)] {
+            let slab = skinlike(d, sigma_a);
+            assert_eq!(slab.total_reflectance_exact().to_bits(), slab.totals(Series::Exact).0.to_bits(), "d {d}");
+        }
     }
 
     #[test]

@@ -252,7 +252,7 @@ impl TwoLayerSkinModel {
 
     /// Top-lit dermis reflectance R2 at every band for dermal hemoglobin `chd`.
     pub fn dermis_reflectance(&self, chd: f64) -> DermisReflectance {
-        DermisReflectance(self.bands.iter().map(|b| self.dermis_slab(b, chd).totals(Series::Exact).0).collect())
+        DermisReflectance(self.bands.iter().map(|b| self.dermis_slab(b, chd).total_reflectance_exact()).collect())
     }
 
     /// Stack reflectance at `band` given the dermis reflectance `r2`.
