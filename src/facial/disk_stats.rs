@@ -375,14 +375,30 @@ impl Context<'_> {
 }
 
 /// μ = c + Σ/n, σ = sqrt(max(Σ²/n − (Σ/n)², 0)) of texels sharing the count `n`.
-#[inline]
-fn finish(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
+#[inline(always)]
+fn finish_body(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
     for ((a, m_out), s_out) in acc.iter().zip(out_m).zip(out_s) {
         let m = a[0] / n;
         let var = (a[1] / n - m * m).max(0.0);
         *m_out = shift + m;
         *s_out = var.sqrt();
     }
+}
+
+/// [`finish_body`] compiled for AVX2 (correctly rounded division and square root: the same bits, four lanes).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn finish_avx2(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
+    finish_body(acc, n, shift, out_m, out_s)
+}
+
+fn finish(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if acc.len() > 1 && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked at run time).
+        return unsafe { finish_avx2(acc, n, shift, out_m, out_s) };
+    }
+    finish_body(acc, n, shift, out_m, out_s)
 }
 
 /// `acc[x] = Σ_chords P(x + hw + 1) − P(x − hw)` for the tile's columns, chords in disk order: the O(r) inner
