@@ -125,6 +125,13 @@ impl Slab {
         self.hankel_rt(0.0, series)
     }
 
+    /// R̂(0) of the exact series alone: the bits of `totals(Series::Exact).0` without the transmittance's terms
+    /// (the skin-colour table needs only the dermis' reflectance, at every row and wavelength).
+    pub fn total_reflectance_exact(&self) -> f64 {
+        let s = (self.sigma_tr().powi(2) + 0.0 * 0.0).sqrt();
+        self.hankel_exact_parts(s, false).0
+    }
+
     fn hankel_truncated(&self, s: f64, n: i64) -> (f64, f64) {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let d = self.thickness_mm;
@@ -141,28 +148,44 @@ impl Slab {
     }
 
     fn hankel_exact(&self, s: f64) -> (f64, f64) {
+        self.hankel_exact_parts(s, true)
+    }
+
+    /// (R̂, T̂) at `s`; T̂ = 0 unless `transmittance`.
+    #[inline(always)]
+    fn hankel_exact_parts(&self, s: f64, transmittance: bool) -> (f64, f64) {
         let (l, zb0, _, big_l) = self.geometry_mm();
         let d = self.thickness_mm;
         let a = l;
         let b = l + 2.0 * zb0;
         let ar = d - l;
         let av = d + l + 2.0 * zb0;
-        // g·(e^(−xs) − e^(xs)) with g = q/(1 − q), q = e^(−2Ls), for 0 ≤ x ≤ 2L.
+        // g·(e^(−xs) − e^(xs)) with g = q/(1 − q), q = e^(−2Ls), for 0 ≤ x ≤ 2L. The x-independent e^(2Ls) − 1
+        // (or q) is formed once for the four terms (the same values as forming it per term).
+        let two_ls = 2.0 * big_l * s;
+        let shared = if two_ls == 0.0 {
+            0.0
+        } else if two_ls < 50.0 {
+            two_ls.exp_m1()
+        } else {
+            (-two_ls).exp()
+        };
         let g_diff = |x: f64| -> f64 {
-            let two_ls = 2.0 * big_l * s;
             if two_ls == 0.0 {
                 -x / big_l
             } else if two_ls < 50.0 {
-                -2.0 * (x * s).sinh() / two_ls.exp_m1()
+                -2.0 * (x * s).sinh() / shared
             } else {
-                let q = (-two_ls).exp();
-                ((-(2.0 * big_l + x) * s).exp() - (-(2.0 * big_l - x) * s).exp()) / (1.0 - q)
+                ((-(2.0 * big_l + x) * s).exp() - (-(2.0 * big_l - x) * s).exp()) / (1.0 - shared)
             }
         };
         // e^(−xs)(1 + g) − e^(xs) g
         let term = |x: f64| (-x * s).exp() + g_diff(x);
         let h = 0.5 * self.albedo_prime();
         let r = term(a) + term(b);
+        if !transmittance {
+            return (h * r, 0.0);
+        }
         let t = ar.signum() * (-ar.abs() * s).exp() + g_diff(ar) - term(av);
         (h * r, h * t)
     }
@@ -327,6 +350,15 @@ mod tests {
 
     fn skinlike(d: f64, sigma_a: f64) -> Slab {
         Slab::new(sigma_a, 1.5, d, 1.4, 1.4, FdrForm::Dj05).unwrap()
+    }
+
+    #[test]
+    fn reflectance_alone_has_the_bits_of_the_totals() {
+        // Thin and thick slabs: 2Ls below 50 (expm1 branch) and above it (q branch), and σa = 0.
+        for (d, sigma_a) in [(1.0, 0.01), (1.0, 30.0), (20.0, 0.02), (20.0, 2.0), (1.0, 0.0)] {
+            let slab = skinlike(d, sigma_a);
+            assert_eq!(slab.total_reflectance_exact().to_bits(), slab.totals(Series::Exact).0.to_bits(), "d {d}");
+        }
     }
 
     #[test]

@@ -148,32 +148,73 @@ pub fn build_rig_with_progress(
     let r = settings.radius_texels;
     let eps = settings.sigma_floor;
 
-    let stats_n = disk_stats::disk_stats(neutral, width, height, r, settings.border)?;
-    let sigma_floored_texels = stats_n.sigma.par_iter().filter(|&&s| s < eps).count() as u64;
-    let sigma_n_floored: Vec<f64> = stats_n.sigma.par_iter().map(|&s| s.max(eps)).collect();
-
-    let down = |v: &[f64]| -> Vec<f32> {
-        resample::resample_area(v, width, height, 1, rw, rh).into_iter().map(|x| x as f32).collect()
-    };
-    // eq. 7.5, i = 0
-    let bias0 = down(&stats_n.mean);
-    drop(stats_n);
-    let mut maps = vec![RigMap { name: NEUTRAL.into(), scale: vec![1.0; (rw * rh) as usize], bias: bias0 }];
+    // One fused pass per map (eq. 7.1 band by band): each band's μ and σ rows go straight into the horizontal
+    // half of the area downsampling, so no full-size μ, σ or scale map is stored except the floored σn that every
+    // target divides by; the buffers are allocated once for all maps. The values are those of `disk_stats` +
+    // `resample_area`, bit for bit.
+    let (w, h) = (width as usize, height as usize);
+    let res = resample::AreaResampler::new(width, height, rw, rh);
+    let down = |tmp: &[f64]| -> Vec<f32> { res.vertical(tmp).into_iter().map(|x| x as f32).collect() };
+    let (band_full, band_rw) = (disk_stats::BAND_ROWS * w, disk_stats::BAND_ROWS * rw as usize);
+    let mut tmp_mean = vec![0.0f64; h * rw as usize];
+    let mut tmp_scale = vec![0.0f64; h * rw as usize];
+    let mut sigma_n_floored = vec![0.0f64; n];
+    let floored = std::sync::atomic::AtomicU64::new(0);
+    let outputs = sigma_n_floored.par_chunks_mut(band_full).zip(tmp_mean.par_chunks_mut(band_rw));
+    disk_stats::disk_stats_bands(neutral, width, height, r, settings.border, outputs, |(sn, tm), _, mean, sigma| {
+        for (row, out) in mean.chunks_exact(w).zip(tm.chunks_exact_mut(rw as usize)) {
+            res.horizontal_row(row, out); // eq. 7.5, i = 0: bias_0 = μn
+        }
+        let mut count = 0u64;
+        for (o, &s) in sn.iter_mut().zip(sigma) {
+            count += (s < eps) as u64;
+            *o = s.max(eps);
+        }
+        floored.fetch_add(count, std::sync::atomic::Ordering::Relaxed);
+    })?;
+    let sigma_floored_texels = floored.into_inner();
+    let mut maps = vec![RigMap { name: NEUTRAL.into(), scale: vec![1.0; (rw * rh) as usize], bias: down(&tmp_mean) }];
     progress(1);
 
     for (name, t) in targets {
-        let st = disk_stats::disk_stats(t, width, height, r, settings.border)?;
-        let scale_full: Vec<f64> = st.sigma.par_iter().zip(&sigma_n_floored).map(|(&si, &sn)| si / sn).collect(); // eq. 7.5
-        let bias = down(&st.mean); // eq. 7.5: bias_i = μi
-        drop(st);
-        let scale = down(&scale_full);
-        maps.push(RigMap { name: name.clone(), scale, bias });
+        let outputs = tmp_mean
+            .par_chunks_mut(band_rw)
+            .zip(tmp_scale.par_chunks_mut(band_rw))
+            .zip(sigma_n_floored.par_chunks(band_full));
+        disk_stats::disk_stats_bands(
+            t,
+            width,
+            height,
+            r,
+            settings.border,
+            outputs,
+            |((tm, ts), sn), _, mean, sigma| {
+                let mut scale_row = vec![0.0f64; w];
+                let rows = mean.chunks_exact(w).zip(sigma.chunks_exact(w)).zip(sn.chunks_exact(w));
+                for (((m_row, s_row), sn_row), (tm_row, ts_row)) in
+                    rows.zip(tm.chunks_exact_mut(rw as usize).zip(ts.chunks_exact_mut(rw as usize)))
+                {
+                    res.horizontal_row(m_row, tm_row); // eq. 7.5: bias_i = μi
+                    for ((o, &si), &sn) in scale_row.iter_mut().zip(s_row).zip(sn_row) {
+                        *o = si / sn; // eq. 7.5: scale_i = σi / max(σn, ε)
+                    }
+                    res.horizontal_row(&scale_row, ts_row);
+                }
+            },
+        )?;
+        maps.push(RigMap { name: name.clone(), scale: down(&tmp_scale), bias: down(&tmp_mean) });
         progress(maps.len());
     }
+    drop(sigma_n_floored);
 
-    // eq. 7.4 against the stored neutral bias (see module docs).
-    let b0 = resample::upsample_bilinear(&maps[0].bias, rw, rh, width, height);
-    let h0: Vec<f32> = neutral.par_iter().zip(&b0).map(|(&hn, &b)| (hn as f64 - b) as f32).collect();
+    // eq. 7.4 against the stored neutral bias (see module docs), read bilinearly as `upsample_bilinear` does.
+    let (ax, ay) = (resample::bilinear_axis(w, rw as usize), resample::bilinear_axis(h, rh as usize));
+    let mut h0 = vec![0.0f32; n];
+    h0.par_chunks_mut(w).zip(neutral.par_chunks(w)).enumerate().for_each(|(y, (out, hn))| {
+        for (x, (o, &hn)) in out.iter_mut().zip(hn).enumerate() {
+            *o = (hn as f64 - resample::bilinear_at(&maps[0].bias, rw as usize, ax[x], ay[y])) as f32;
+        }
+    });
     Ok(HemoglobinRig {
         width,
         height,
@@ -273,8 +314,9 @@ pub fn evaluate(rig: &HemoglobinRig, weights: &[f64], global_scale: f64) -> Vec<
 }
 /// Wall time of [`build_rig`] on `maps` maps (neutral + targets) of `width`×`height` at disk radius `radius`
 /// (issue 15's budget check): 1.5 ns per texel, map and chord row (2r + 1 rows per disk) on one thread, divided by
-/// `threads`. Measured with the release build on the project's 2-core machine (4096², 9 maps, r = 32: 6.4 s on 2
-/// threads, i.e. 1.3 ns); the estimate rounds up.
+/// `threads`. Measured with the release build on the project's 2-core machine: 4096², 9 maps, r = 32: 6.4 s on 2
+/// threads before issue 17 (1.3 ns), 3.3 s of CPU after it (0.33 ns; `examples/bench_facial.rs`); the estimate
+/// keeps the older, larger figure, so it only ever over-estimates.
 pub fn time_estimate_seconds(width: u32, height: u32, maps: usize, radius: u32, threads: usize) -> f64 {
     1.5e-9 * width as f64 * height as f64 * maps as f64 * (2 * radius as u64 + 1) as f64 / threads.max(1) as f64
 }
@@ -293,9 +335,10 @@ pub fn evaluate_memory_estimate_bytes(width: u32, height: u32, rig_width: u32, r
     24 * width as u64 * height as u64 + 8 * maps as u64 * rig_width as u64 * rig_height as u64 + (32 << 20)
 }
 
-/// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32), the disk statistics of the
-/// neutral and of one target at a time (mean and σ, f64), the full-size scale and bias, and the encoded outputs —
-/// counted from the buffers as 4 bytes per texel per map plus 72 bytes per texel, plus 32 MiB.
+/// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32) and, counted from the buffers of
+/// the unfused build (full-size mean and σ of the neutral and of one target, f64, the full-size scale and bias,
+/// the encoded outputs), 72 bytes per texel, plus 32 MiB. Since issue 17 the build keeps only the floored σn (f64)
+/// and H0 (f32) at full size, so this over-estimates.
 pub fn memory_estimate_bytes(width: u32, height: u32, maps: usize) -> u64 {
     let texels = width as u64 * height as u64;
     texels * (4 * maps as u64 + 72) + (32 << 20)

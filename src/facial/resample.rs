@@ -75,6 +75,51 @@ pub fn resample_area(src: &[f64], width: u32, height: u32, channels: u32, out_w:
     out
 }
 
+/// [`resample_area`] of single-channel maps in two steps, so that a producer of rows can downsample each row as it
+/// is computed (no full-size buffer): [`Self::horizontal_row`] per input row into an `height × out_w` intermediate,
+/// then [`Self::vertical`]. The values are those of `resample_area(…, 1, out_w, out_h)`, bit for bit.
+#[derive(Clone, Debug)]
+pub struct AreaResampler {
+    width: usize,
+    height: usize,
+    out_w: usize,
+    out_h: usize,
+    wx: Vec<(usize, Vec<u64>)>,
+    wy: Vec<(usize, Vec<u64>)>,
+}
+
+impl AreaResampler {
+    /// Sizes must be non-zero (callers validate).
+    pub fn new(width: u32, height: u32, out_w: u32, out_h: u32) -> Self {
+        let (w, h, ow, oh) = (width as usize, height as usize, out_w as usize, out_h as usize);
+        assert!(ow > 0 && oh > 0 && w > 0 && h > 0);
+        Self { width: w, height: h, out_w: ow, out_h: oh, wx: axis_weights(w, ow), wy: axis_weights(h, oh) }
+    }
+
+    /// The horizontal pass of one input row (`width` values) into `out` (`out_w` values).
+    pub fn horizontal_row(&self, row: &[f64], out: &mut [f64]) {
+        assert_eq!((row.len(), out.len()), (self.width, self.out_w), "row lengths");
+        for ((first, ov), o) in self.wx.iter().zip(out) {
+            *o = weighted(row[*first..*first + ov.len()].iter().copied(), ov, self.width);
+        }
+    }
+
+    /// The vertical pass over the `height × out_w` rows of [`Self::horizontal_row`]: the `out_w × out_h` result.
+    pub fn vertical(&self, tmp: &[f64]) -> Vec<f64> {
+        let (ow, h) = (self.out_w, self.height);
+        assert_eq!(tmp.len(), h * ow, "intermediate size");
+        let mut out = vec![0.0f64; self.out_h * ow];
+        out.par_chunks_mut(ow).enumerate().for_each(|(j, orow)| {
+            let (first, ov) = &self.wy[j];
+            for (x, o) in orow.iter_mut().enumerate() {
+                let vals = (0..ov.len()).map(|k| tmp[(first + k) * ow + x]);
+                *o = weighted(vals, ov, h);
+            }
+        });
+        out
+    }
+}
+
 /// Sample position of full-resolution texel `x` (of `full`) in a map of `stored` texels: (i0, i1, t).
 #[inline]
 pub fn bilinear_coord(x: usize, full: usize, stored: usize) -> (usize, usize, f64) {

@@ -6,10 +6,12 @@
 //! [`crate::spectral::skin_layers`], the colorimetry in [`crate::spectral::colorimetry`]).
 //!
 //! - [`two_layer`]: R(λ) of the epidermis-over-dermis stack (multipole totals + adding) and its linear sRGB colour.
+//! - [`epidermis_table`]: the epidermis' totals tabulated against √σa and the table's vectorised row loop.
 //! - [`lut`]: the cube-root-indexed melanin × hemoglobin table and its texel convention.
 //! - [`SkinColorParams`]: every parameter with the published defaults, as JSON (asset parameters) and CLI flags
 //!   (`--melanin-blend` ↔ `melanin_blend`).
 
+pub mod epidermis_table;
 pub mod lut;
 pub mod two_layer;
 

@@ -31,6 +31,9 @@ use crate::spectral::colorimetry::{srgb8, ColorWeights, Illuminant, SpectralGrid
 use crate::spectral::skin_layers::{dermis_sigma_a_per_mm, epidermis_sigma_a_mixed, SkinPhysiology};
 use serde::{Deserialize, Serialize};
 
+use super::epidermis_table::{accumulate_symmetric_row, BandRow, RowScratch};
+pub use super::epidermis_table::{EpidermisTable, TABLE_INTERVALS};
+
 /// How the two layers' totals are combined at k = 0: the same choice as for layered profiles
 /// (symmetric = DJ05 as printed, the published LUT's form; directional = Kubelka 1954).
 pub use crate::diffusion::layered::Adding;
@@ -249,7 +252,7 @@ impl TwoLayerSkinModel {
 
     /// Top-lit dermis reflectance R2 at every band for dermal hemoglobin `chd`.
     pub fn dermis_reflectance(&self, chd: f64) -> DermisReflectance {
-        DermisReflectance(self.bands.iter().map(|b| self.dermis_slab(b, chd).totals(Series::Exact).0).collect())
+        DermisReflectance(self.bands.iter().map(|b| self.dermis_slab(b, chd).total_reflectance_exact()).collect())
     }
 
     /// Stack reflectance at `band` given the dermis reflectance `r2`.
@@ -309,7 +312,7 @@ impl TwoLayerSkinModel {
                         up.push([e[2], e[3]]);
                     }
                 }
-                Some(EpidermisTable { y_lo, inv_h: 1.0 / h, rt, up })
+                Some(EpidermisTable::from_nodes(y_lo, h, &rt, &up))
             })
             .collect()
     }
@@ -330,31 +333,49 @@ impl TwoLayerSkinModel {
         assert_eq!(tables.len(), self.bands.len(), "one table slot per band");
         let ches: Vec<f64> = hemoglobin.iter().map(|&chd| self.physiology.epidermal_hemoglobin(chd)).collect();
         let dermis: Vec<DermisReflectance> = hemoglobin.iter().map(|&chd| self.dermis_reflectance(chd)).collect();
-        let mut acc = vec![[0.0f64; 3]; out.len() / 3];
+        // Accumulator planes R, G, B (one f64 per texel each), so that the vectorised loop reads and writes whole
+        // vectors.
+        let n = out.len() / 3;
+        let mut acc = vec![0.0f64; 3 * n];
+        let (acc_r, acc_gb) = acc.split_at_mut(n);
+        let (acc_g, acc_b) = acc_gb.split_at_mut(n);
+        let mut scratch = RowScratch::default();
         for (b, (band, table)) in self.bands.iter().zip(tables).enumerate() {
             let wt = self.weights.linear_srgb[b];
-            for (r, acc_row) in acc.chunks_exact_mut(w).enumerate() {
+            let rows = acc_r.chunks_exact_mut(w).zip(acc_g.chunks_exact_mut(w)).zip(acc_b.chunks_exact_mut(w));
+            for (r, ((ar, ag), ab)) in rows.enumerate() {
                 let (r2, che) = (dermis[r].0[b], ches[r]);
                 // The table/direct choice is made once per band and row, not per texel (monomorphised loops).
                 match table {
-                    Some(t) => self.accumulate_row(acc_row, melanin, band, che, r2, wt, |sa| t.eval(sa)),
-                    None => {
-                        self.accumulate_row(acc_row, melanin, band, che, r2, wt, |sa| self.epidermis_totals(band, sa))
+                    Some(t) if self.options.adding == Adding::Symmetric => {
+                        let k = BandRow {
+                            melanin_sigma_a_per_mm: band.melanin,
+                            che,
+                            che_blood_sigma_a_per_mm: che * band.blood,
+                            baseline_sigma_a_per_mm: band.spectra.baseline,
+                            r2,
+                            weights: wt,
+                        };
+                        accumulate_symmetric_row(t, &k, melanin, [ar, ag, ab], &mut scratch);
                     }
+                    Some(t) => self.accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| t.eval(sa)),
+                    None => self
+                        .accumulate_row([ar, ag, ab], melanin, band, che, r2, wt, |sa| self.epidermis_totals(band, sa)),
                 }
             }
         }
-        for (o, a) in out.chunks_exact_mut(3).zip(&acc) {
-            o.copy_from_slice(&a.map(|c| c as f32));
+        for (i, o) in out.chunks_exact_mut(3).enumerate() {
+            o.copy_from_slice(&[acc_r[i] as f32, acc_g[i] as f32, acc_b[i] as f32]);
         }
     }
 
-    /// Adds band `band`'s weighted stack reflectance of every texel of one row to `acc_row`.
+    /// Adds band `band`'s weighted stack reflectance of every texel of one row to the accumulator planes `acc`
+    /// (the directional and direct paths; symmetric tabulated adding takes `epidermis_table::accumulate_symmetric_row`).
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn accumulate_row(
         &self,
-        acc_row: &mut [[f64; 3]],
+        acc: [&mut [f64]; 3],
         melanin: &[f64],
         band: &Band,
         che: f64,
@@ -362,11 +383,12 @@ impl TwoLayerSkinModel {
         wt: [f64; 3],
         totals: impl Fn(f64) -> [f64; 4],
     ) {
-        for (a, &cm) in acc_row.iter_mut().zip(melanin) {
+        let [acc_r, acc_g, acc_b] = acc;
+        for (x, &cm) in melanin.iter().enumerate() {
             let refl = self.add_layers(totals(self.epidermis_sigma_a(band, cm, che)), r2);
-            a[0] += wt[0] * refl;
-            a[1] += wt[1] * refl;
-            a[2] += wt[2] * refl;
+            acc_r[x] += wt[0] * refl;
+            acc_g[x] += wt[1] * refl;
+            acc_b[x] += wt[2] * refl;
         }
     }
 
@@ -385,60 +407,6 @@ impl TwoLayerSkinModel {
         let reflectance = self.reflectance_unchecked(cm, chd, &dermis);
         let linear_rgb = self.weights.linear_srgb_of(&reflectance);
         Ok(SkinColorSample { melanin: cm, hemoglobin: chd, linear_rgb, srgb8: srgb8(linear_rgb), reflectance })
-    }
-}
-
-/// Intervals of each band's [`EpidermisTable`] over the table's √σa range.
-pub const TABLE_INTERVALS: usize = 512;
-
-/// The epidermis' exact multipole totals at one band, tabulated against y = √σa on a uniform grid of
-/// [`TABLE_INTERVALS`] intervals spanning the σa range a lookup table needs, and interpolated with the 4-point
-/// Lagrange cubic through the nodes around y. Every node value is `Slab::totals(Series::Exact)`; only the
-/// interpolation is added. √σa is the natural variable: the totals depend on σa through σtr = √(3σaσt′), smoothly down
-/// to σa = 0, and a square root is far cheaper than a logarithm in the inner loop. Interpolation error ≈ 0.023 h⁴
-/// max|f⁗| with h ≈ 0.025 mm^−½ (≈ 1e−8 in R); over the whole default 256² table the tabulated and direct results
-/// differ by at most 6e−8 in linear RGB, i.e. f32 rounding (`examples/bench_skin.rs` prints it; `tests/skin_color.rs`
-/// bounds it). It replaces ~65 000 series evaluations per wavelength of a 256² table by 515, which is what makes the
-/// 1 nm bake fast.
-#[derive(Clone, Debug)]
-pub struct EpidermisTable {
-    y_lo: f64,
-    inv_h: f64,
-    /// (R1↓, T1↓) at σa = y², y = y_lo + (k − 1)·h, k = 0..=TABLE_INTERVALS + 2.
-    rt: Vec<[f64; 2]>,
-    /// (R1↑, T1↑) at the same nodes, for directional adding only.
-    up: Vec<[f64; 2]>,
-}
-
-impl EpidermisTable {
-    /// (R1↓, T1↓, R1↑, T1↑) at `sigma_a_per_mm` (the ↑ pair is 0 for symmetric adding).
-    #[inline]
-    pub fn eval(&self, sigma_a_per_mm: f64) -> [f64; 4] {
-        let x = (sigma_a_per_mm.sqrt() - self.y_lo) * self.inv_h;
-        // floor(x) clamped to ≥ 0, as a truncating cast of max(x, 0) (the same integer, without the out-of-line
-        // libm `floor` of baseline x86-64).
-        let k = (x.max(0.0) as usize).min(TABLE_INTERVALS - 1);
-        let t = x - k as f64;
-        // Lagrange weights for nodes at −1, 0, 1, 2 (relative to interval k's left node); halving is exact, so
-        // `* 0.5` gives the bits of `/ 2`.
-        let (tm1, tm2, tp1) = (t - 1.0, t - 2.0, t + 1.0);
-        let w = [-t * tm1 * tm2 / 6.0, tp1 * tm1 * tm2 * 0.5, -tp1 * t * tm2 * 0.5, tp1 * t * tm1 / 6.0];
-        let lerp4 = |v: &[[f64; 2]]| -> [f64; 2] {
-            // A fixed-size view: k ≤ TABLE_INTERVALS − 1 then bounds the stencil statically (no per-texel check).
-            let v: &[[f64; 2]; TABLE_INTERVALS + 3] = v.try_into().expect("one node per grid point");
-            let n = &v[k..k + 4];
-            [
-                w[0] * n[0][0] + w[1] * n[1][0] + w[2] * n[2][0] + w[3] * n[3][0],
-                w[0] * n[0][1] + w[1] * n[1][1] + w[2] * n[2][1] + w[3] * n[3][1],
-            ]
-        };
-        let [r, t1] = lerp4(&self.rt);
-        if self.up.is_empty() {
-            [r, t1, 0.0, 0.0]
-        } else {
-            let [ru, tu] = lerp4(&self.up);
-            [r, t1, ru, tu]
-        }
     }
 }
 

@@ -166,6 +166,55 @@ fn same_bytes_for_any_thread_count() {
     assert_eq!(fa, fb);
 }
 
+/// The fused build (disk statistics band by band straight into the downsampling, buffers reused across maps) gives
+/// the bits of the unfused chain: full-size `disk_stats`, σi / max(σn, ε), `resample_area`, `upsample_bilinear`.
+/// Maps wider than one cache tile and taller than one band, a non-integer storage ratio, both borders.
+#[test]
+fn fused_rig_equals_full_size_statistics_and_area_resampling_bit_for_bit() {
+    use rtbake::facial::resample::{resample_area, upsample_bilinear};
+    let (w, h, r, rig_size) = (300u32, 150u32, 6u32, 37u32);
+    let map = |seed: u32| -> Vec<f32> {
+        let mut s = seed.wrapping_mul(2654435761).wrapping_add(1);
+        (0..w * h)
+            .map(|i| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                // Flat in the top rows (σn below the floor there), noisy below.
+                if i < 20 * w {
+                    0.25
+                } else {
+                    0.2 + (s % 10000) as f32 / 50000.0
+                }
+            })
+            .collect()
+    };
+    let neutral = map(1);
+    let targets = [("joy".to_string(), map(2)), ("anger".to_string(), map(3))];
+    let refs: Vec<(String, &[f32])> = targets.iter().map(|(n, v)| (n.clone(), v.as_slice())).collect();
+    for border in [Border::Clip, Border::Wrap] {
+        let settings = RigSettings { radius_texels: r, border, sigma_floor: 1e-3, rig_size };
+        let rig = build_rig(&neutral, w, h, &refs, &settings).unwrap();
+        let down = |v: &[f64]| -> Vec<f32> {
+            resample_area(v, w, h, 1, rig_size, rig_size).into_iter().map(|x| x as f32).collect()
+        };
+        let sn = disk_stats(&neutral, w, h, r, border).unwrap();
+        let floored: Vec<f64> = sn.sigma.iter().map(|&s| s.max(1e-3)).collect();
+        assert_eq!(rig.sigma_floored_texels, sn.sigma.iter().filter(|&&s| s < 1e-3).count() as u64);
+        assert!(rig.sigma_floored_texels > 0, "the flat rows floor σn ({border:?})");
+        assert_eq!(rig.maps[0].bias, down(&sn.mean), "{border:?} neutral bias");
+        for ((_, t), m) in targets.iter().zip(&rig.maps[1..]) {
+            let st = disk_stats(t, w, h, r, border).unwrap();
+            let scale: Vec<f64> = st.sigma.iter().zip(&floored).map(|(s, n)| s / n).collect();
+            assert_eq!(m.bias, down(&st.mean), "{border:?} {} bias", m.name);
+            assert_eq!(m.scale, down(&scale), "{border:?} {} scale", m.name);
+        }
+        let b0 = upsample_bilinear(&rig.maps[0].bias, rig_size, rig_size, w, h);
+        let h0: Vec<f32> = neutral.iter().zip(&b0).map(|(&hn, &b)| (hn as f64 - b) as f32).collect();
+        assert_eq!(rig.h0, h0, "{border:?} H0");
+    }
+}
+
 #[test]
 fn example_rig_asset_is_complete_and_readable() {
     let asset = rtbake::bake::registry().into_iter().find(|a| a.name == "hemoglobin-rig-example").unwrap();

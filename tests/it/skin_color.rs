@@ -185,6 +185,34 @@ fn lut_bytes_do_not_depend_on_the_thread_count() {
     }
 }
 
+/// The default 256² table at 1 nm (the vectorised tabulated path) against the committed bake of `baked/skin/`
+/// (baked before the loop was vectorised, with the Lagrange form of the interpolation): within the asset's verify
+/// tolerance `LUT_TOLERANCE` = 1e-6, and the same bits on 1 and 2 threads.
+#[test]
+fn default_lut_matches_the_committed_bake_within_the_verify_tolerance_on_any_thread_count() {
+    let dir = crate::support::baked_dir();
+    let manifest = rtbake::manifest::Manifest::load(&dir).unwrap();
+    let record = manifest.assets.iter().find(|a| a.name == "skin-color-lut").expect("skin-color-lut is baked");
+    let p: SkinColorParams = serde_json::from_value(record.params.clone()).unwrap();
+    assert_eq!(p, SkinColorParams::default(), "the committed bake uses the default parameters");
+    let bytes = std::fs::read(dir.join("skin/skin_color_lut.exr")).unwrap();
+    let (baked, _) = rtbake::io::exr::decode(&bytes, "skin/skin_color_lut.exr").unwrap();
+    let (model, layout) = (p.model().unwrap(), p.layout().unwrap());
+    let bake = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| bake_lut(&model, &layout, LutEvaluation::Tabulated).unwrap())
+    };
+    let (one, two) = (bake(1), bake(2));
+    assert!(
+        one.data.iter().zip(&two.data).all(|(a, b)| a.to_bits() == b.to_bits()),
+        "1 and 2 threads give different tables"
+    );
+    assert_eq!((baked.width, baked.height, baked.channels), (one.width, one.height, one.channels));
+    let max = one.data.iter().zip(&baked.data).map(|(a, b)| (*a as f64 - *b as f64).abs()).fold(0.0f64, f64::max);
+    eprintln!("max |new - baked| = {max:e} (linear RGB)");
+    assert!(max <= rtbake::bake::skin::LUT_TOLERANCE, "max |new - baked| = {max:e}");
+}
+
 #[test]
 fn spectral_step_and_dermis_bottom_sensitivities_are_as_documented() {
     let base = SkinColorParams::default();
