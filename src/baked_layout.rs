@@ -45,6 +45,8 @@ pub mod path {
 
     /// Folder of the importance-sampled disk kernels (`sss-importance-kernels`).
     pub const IMPORTANCE_DIR: &str = "sss/importance";
+    /// The importance kernel `rtbake run demo --sss importance` reads (skin1 dipole, 40 samples).
+    pub const IMPORTANCE_KERNEL_DEFAULT: &str = "sss/importance/skin1_dipole_n40.json";
 
     /// Stem of an importance kernel's files in [`IMPORTANCE_DIR`]: `{name}_n{samples}` (`.json`, `.hlsl`, `.glsl`,
     /// `.wgsl`, `_f32x8.bin`).

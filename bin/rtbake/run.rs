@@ -138,6 +138,8 @@ pub enum Method {
     Separable,
     /// Screen-space sum of Gaussians (thesis ch. 4), α scaled from its 720-pixel viewport to the image height.
     Gaussians,
+    /// Importance-sampled disk kernel of the skin1 dipole, 40 samples (the baked sss/importance/skin1_dipole_n40.json).
+    Importance,
 }
 
 #[derive(clap::Args)]
@@ -154,7 +156,8 @@ pub struct DemoArgs {
     /// Antialiasing of the final frame.
     #[arg(long, value_enum, default_value = "smaa")]
     aa: DemoAa,
-    /// SSS pass of the demo: separable (baked kernel) or gaussians (baked sum-of-Gaussians fit).
+    /// SSS pass of the demo: separable (baked kernel), gaussians (baked sum-of-Gaussians fit) or importance (baked
+    /// importance-sampled kernel).
     #[arg(long, value_enum, default_value = "separable")]
     sss: Method,
     /// Also write the scene's SSS inputs into DIR, as `rtbake run sss` reads them: irradiance.exr (linear RGBA
@@ -442,6 +445,7 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
     let method = match d.sss {
         Method::Separable => SssMethod::Separable,
         Method::Gaussians => SssMethod::Gaussians,
+        Method::Importance => SssMethod::Importance,
     };
     let gpu = device(ctx, d.common.cpu)?;
     let t = Instant::now();

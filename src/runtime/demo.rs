@@ -1,6 +1,6 @@
 //! The procedural demo frame: skin-shaded spheres (a "head" and two smaller ones) in front of hard-edged shapes,
 //! through the whole chain — skin inputs (rig → hemoglobin → albedo LUT, T(s)·E) → diffuse lighting →
-//! separable SSS (or the screen-space sum of Gaussians) → + transmittance → sRGB encode → SMAA / MLAA. Every
+//! separable SSS (or the screen-space sum of Gaussians, or the importance-sampled kernel) → + transmittance → sRGB encode → SMAA / MLAA. Every
 //! stage runs on the GPU passes, or on their CPU references when no device is given. No input images.
 //!
 //! Every table comes from the bake directory through the manifest-checked [`super::loader`]: the skin colour
@@ -13,6 +13,7 @@ use super::chain::{self, Antialiasing};
 use super::cpu;
 use super::device::Gpu;
 use super::gaussian_sss::{GaussianBlurs, GaussianSssParams};
+use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use super::loader::{self, LutError};
 use super::separable_sss::{SssKernel, SssParams};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinInputs, SkinLuts};
@@ -29,6 +30,8 @@ pub enum SssMethod {
     Separable,
     /// Screen-space sum of Gaussians (thesis ch. 4) with the baked fit.
     Gaussians,
+    /// Importance-sampled disk kernel (Unity HDRP's sampling) with the baked skin1 kernel of 40 samples.
+    Importance,
 }
 
 /// The tables the demo renders with.
@@ -48,6 +51,8 @@ pub struct DemoAssets {
     pub baked_rig: Option<loader::BakedRig>,
     /// Where the rig came from, for the command's report.
     pub rig_source: String,
+    /// The baked importance kernel ([`path::IMPORTANCE_KERNEL_DEFAULT`]), when the bake has it.
+    pub importance: Option<ImportanceSamples>,
 }
 
 impl DemoAssets {
@@ -62,7 +67,12 @@ impl DemoAssets {
         let k = loader::load_separable_kernel(dir, kernel_path)?;
         let g = loader::load_gaussians(dir, path::GAUSSIANS_DEFAULT)?;
         let sss = SssParams { sss_width: k.sss_width.unwrap_or(SssParams::default().sss_width), ..Default::default() };
-        let listed = crate::manifest::Manifest::load(dir)?.entry(path::RIG_EXAMPLE).is_some();
+        let manifest = crate::manifest::Manifest::load(dir)?;
+        let listed = manifest.entry(path::RIG_EXAMPLE).is_some();
+        let importance = match manifest.entry(path::IMPORTANCE_KERNEL_DEFAULT) {
+            Some(_) => Some(loader::load_importance_kernel(dir, path::IMPORTANCE_KERNEL_DEFAULT)?),
+            None => None,
+        };
         let (rig, rig_weights, rig_names, baked_rig, rig_source) = if listed {
             let b = loader::load_hemoglobin_rig(dir, path::RIG_EXAMPLE)?;
             // 60 % neutral, 40 % joy (or the second target) — a mild flush.
@@ -87,6 +97,7 @@ impl DemoAssets {
             rig_names,
             baked_rig,
             rig_source,
+            importance,
         })
     }
 }
@@ -260,9 +271,19 @@ pub fn render(
     let Lit { geo, albedo, transmitted, diffuse } = lit(gpu, w, h, assets)?;
     let n = (w * h) as usize;
     let (kernel, params) = (&assets.kernel, &assets.sss);
+    let importance_params = ImportanceSssParams::default();
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
         SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },
+        SssMethod::Importance => chain::Subsurface::Importance {
+            samples: assets.importance.as_ref().ok_or_else(|| {
+                InvalidInput::new(
+                    "--sss importance",
+                    format!("needs {} in the bake directory", path::IMPORTANCE_KERNEL_DEFAULT),
+                )
+            })?,
+            params: &importance_params,
+        },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
     // Composite over the hard-edged background shapes; add back-lit transmittance; encode sRGB.
