@@ -23,6 +23,7 @@ use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
 use crate::io::{self, IoError};
 use crate::manifest::{sha256_hex, Manifest, ManifestError, MANIFEST_NAME};
+use rayon::prelude::*;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -110,7 +111,7 @@ pub fn bake_into(dir: &Path, jobs: &[(&Asset, Value)]) -> Result<BakeSummary, Ba
 pub fn bake_into_with_progress(
     dir: &Path,
     jobs: &[(&Asset, Value)],
-    progress: &dyn Fn(usize, &str),
+    progress: &(dyn Fn(usize, &str) + Sync),
 ) -> Result<BakeSummary, BakeDirError> {
     bake_into_with(dir, jobs, progress, &Wait::Yes(&|_| {}))
 }
@@ -119,15 +120,23 @@ pub fn bake_into_with_progress(
 pub fn bake_into_with(
     dir: &Path,
     jobs: &[(&Asset, Value)],
-    progress: &dyn Fn(usize, &str),
+    progress: &(dyn Fn(usize, &str) + Sync),
     wait: &Wait,
 ) -> Result<BakeSummary, BakeDirError> {
-    // 1. Compute everything in memory (pure; a bad parameter writes nothing). No lock is needed for this.
-    let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::new();
-    for (k, (asset, params)) in jobs.iter().enumerate() {
-        progress(k, asset.name);
-        let files = asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
-        produced.push((asset, params, files));
+    // 1. Compute everything in memory (pure; a bad parameter writes nothing). No lock is needed for this. The assets
+    //    run side by side (each is a pure function of its parameters, so the bytes do not depend on the order or the
+    //    thread count); results are kept in job order and the first failing job in that order is the error reported.
+    let results: Vec<Result<Vec<BakedFile>, BakeDirError>> = jobs
+        .par_iter()
+        .enumerate()
+        .map(|(k, (asset, params))| {
+            progress(k, asset.name);
+            asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })
+        })
+        .collect();
+    let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::with_capacity(jobs.len());
+    for ((asset, params), files) in jobs.iter().zip(results) {
+        produced.push((asset, params, files?));
     }
     progress(jobs.len(), "writing");
     // 2. From here to the swap, the directory is ours: the existing state read below cannot change under us.
