@@ -96,27 +96,11 @@ pub fn kernel_for_source(source: &ProfileSource, n: usize) -> Result<ImportanceK
     }
 }
 
-fn check_name(name: &str) -> Result<(), BakeError> {
-    let ok = !name.is_empty()
-        && name.len() <= 64
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-        && !name.starts_with('-');
-    if ok {
-        Ok(())
-    } else {
-        Err(crate::error::InvalidInput::new(
-            "sss-importance-kernels.profiles[].name",
-            format!("must be 1..=64 characters of [A-Za-z0-9_-], got {name:?}"),
-        )
-        .into())
-    }
-}
-
 fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: Params = parse_params("sss-importance-kernels", params)?;
     let mut files = Vec::new();
     for (i, np) in p.profiles.iter().enumerate() {
-        check_name(&np.name)?;
+        super::check_kernel_name("sss-importance-kernels.profiles[].name", &np.name)?;
         let source = ProfileSource::from_json(&np.profile).map_err(|e| {
             crate::error::InvalidInput::new(
                 format!("sss-importance-kernels.profiles[{i}].profile.{}", e.param),

@@ -256,6 +256,21 @@ pub fn text_file(path: &str, text: String, kind: &str, format: &str, convention:
     BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, format, convention) }
 }
 
+/// A kernel's file stem in an asset's parameters (`param` names the field): 1..=64 characters of `[A-Za-z0-9_-]`,
+/// not starting with `-`.
+pub fn check_kernel_name(param: &str, name: &str) -> Result<(), BakeError> {
+    let ok = !name.is_empty()
+        && name.len() <= 64
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        && !name.starts_with('-');
+    if ok {
+        Ok(())
+    } else {
+        Err(crate::error::InvalidInput::new(param, format!("must be 1..=64 characters of [A-Za-z0-9_-], got {name:?}"))
+            .into())
+    }
+}
+
 /// Deserialises asset parameters, naming the asset in the error.
 pub fn parse_params<T: serde::de::DeserializeOwned>(asset: &str, params: &Value) -> Result<T, BakeError> {
     serde_json::from_value(params.clone()).map_err(|e| {

@@ -124,27 +124,11 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
     files
 }
 
-fn check_name(name: &str) -> Result<(), BakeError> {
-    let ok = !name.is_empty()
-        && name.len() <= 64
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-        && !name.starts_with('-');
-    if ok {
-        Ok(())
-    } else {
-        Err(crate::error::InvalidInput::new(
-            "sss-separable-kernels.kernels[].name",
-            format!("must be 1..=64 characters of [A-Za-z0-9_-], got {name:?}"),
-        )
-        .into())
-    }
-}
-
 fn bake_kernels(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: KernelsParams = parse_params("sss-separable-kernels", params)?;
     let mut files = Vec::new();
     for nk in &p.kernels {
-        check_name(&nk.name)?;
+        super::check_kernel_name("sss-separable-kernels.kernels[].name", &nk.name)?;
         let k = kernel::generate(&nk.spec)?;
         let source = format!(
             "SeparableSSS kernel generator (N={}, strength {:?}, falloff {:?}, {})",

@@ -237,17 +237,7 @@ impl GaussianSss {
 
     /// Uploads `color` (RGBA f32, linear, alpha = SSS level) and `depth` (linear), both top row first.
     pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        let n = self.width as usize * self.height as usize;
-        if color.len() != 4 * n || depth.len() != n {
-            return Err(InvalidInput::new(
-                "--color/--depth",
-                format!("must be {}x{} (RGBA and one channel)", self.width, self.height),
-            ));
-        }
-        let half: Vec<half::f16> = color.iter().map(|v| half::f16::from_f32(*v)).collect();
-        gpu::upload(queue, &self.input, bytemuck::cast_slice(&half));
-        gpu::upload(queue, &self.depth, bytemuck::cast_slice(depth));
-        Ok(())
+        gpu::upload_sss_frame(queue, (&self.input, &self.depth), color, depth)
     }
 
     /// Records the whole chain; pass k (0-based, H and V alternating) uses timer slot `first + k`.

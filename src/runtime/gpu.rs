@@ -56,6 +56,29 @@ pub fn bytes_per_texel(format: wgpu::TextureFormat) -> u32 {
 }
 
 /// Uploads tightly packed texels (top row first) into the whole texture.
+/// Uploads an SSS pass's frame: `color` RGBA f32 (linear; alpha = strength) as f16 into `color_tex`
+/// (`Rgba16Float`) and `depth` (linear, f32) into `depth_tex`, both `width`×`height`, top row first; other sizes are
+/// refused naming `--color/--depth`.
+pub fn upload_sss_frame(
+    queue: &wgpu::Queue,
+    (color_tex, depth_tex): (&wgpu::Texture, &wgpu::Texture),
+    color: &[f32],
+    depth: &[f32],
+) -> Result<(), crate::error::InvalidInput> {
+    let (w, h) = (color_tex.width(), color_tex.height());
+    let n = w as usize * h as usize;
+    if color.len() != 4 * n || depth.len() != n {
+        return Err(crate::error::InvalidInput::new(
+            "--color/--depth",
+            format!("must be {w}x{h} (RGBA and one channel)"),
+        ));
+    }
+    let half: Vec<half::f16> = color.iter().map(|v| half::f16::from_f32(*v)).collect();
+    upload(queue, color_tex, bytemuck::cast_slice(&half));
+    upload(queue, depth_tex, bytemuck::cast_slice(depth));
+    Ok(())
+}
+
 pub fn upload(queue: &wgpu::Queue, tex: &wgpu::Texture, data: &[u8]) {
     let bpt = bytes_per_texel(tex.format());
     let (w, h) = (tex.width(), tex.height());

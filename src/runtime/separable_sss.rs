@@ -74,8 +74,6 @@ const SHADER: &str = include_str!("shaders/separable_sss.wgsl");
 
 /// Separable SSS for one frame size and kernel.
 pub struct SeparableSss {
-    width: u32,
-    height: u32,
     color: wgpu::Texture,
     depth: wgpu::Texture,
     output: wgpu::Texture,
@@ -147,7 +145,7 @@ impl SeparableSss {
             ),
         ];
         let targets = [tv, view(&output)];
-        Ok(Self { width, height, color, depth, output, pipe, groups, targets })
+        Ok(Self { color, depth, output, pipe, groups, targets })
     }
 
     /// The irradiance input (`Rgba16Float`, linear, alpha = strength); other passes may render into it.
@@ -161,17 +159,7 @@ impl SeparableSss {
 
     /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.
     pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        let n = self.width as usize * self.height as usize;
-        if color.len() != 4 * n || depth.len() != n {
-            return Err(InvalidInput::new(
-                "--color/--depth",
-                format!("must be {}x{} (RGBA and one channel)", self.width, self.height),
-            ));
-        }
-        let half: Vec<half::f16> = color.iter().map(|v| half::f16::from_f32(*v)).collect();
-        gpu::upload(queue, &self.color, bytemuck::cast_slice(&half));
-        gpu::upload(queue, &self.depth, bytemuck::cast_slice(depth));
-        Ok(())
+        gpu::upload_sss_frame(queue, (&self.color, &self.depth), color, depth)
     }
 
     /// Records the horizontal and vertical passes.

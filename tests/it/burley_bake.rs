@@ -102,6 +102,18 @@ fn transmission_profiles_start_at_the_albedo_and_follow_the_closed_form() {
                 assert!((got - b.plane_transmittance(s)).abs() <= 1e-7, "{case} texel {i} channel {c}");
             }
         }
+        // The KTX2 copy read the way Bevy reads KTX2 (the `ktx2` crate): RGBA16F, one level, texel 0 = A.
+        let ktx = files.iter().find(|f| f.path == format!("burley/transmission/{stem}_burley_physical.ktx2")).unwrap();
+        let reader = ktx2::Reader::new(&ktx.bytes[..]).unwrap();
+        assert_eq!(reader.header().format, Some(ktx2::Format::R16G16B16A16_SFLOAT));
+        assert_eq!((reader.header().pixel_width, reader.header().pixel_height), (n, 1));
+        let level = reader.levels().next().unwrap();
+        assert_eq!(level.data.len(), n as usize * 8);
+        for c in 0..3 {
+            let h = half::f16::from_le_bytes([level.data[2 * c], level.data[2 * c + 1]]).to_f64();
+            let a = rec["fit"]["burley"]["albedo"][c].as_f64().unwrap();
+            assert!((h - a).abs() <= 1e-3 * a.max(1e-2), "{case} KTX2 texel 0 channel {c}: {h} vs {a}");
+        }
         // The Gaussian table's T(0) is the Gaussians' total Σw.
         let g = json(&files, &format!("burley/transmission/{stem}_gaussians4_physical.json"));
         let exr =

@@ -218,3 +218,28 @@ fn importance_run_sss_matches_the_library_and_refuses_mixed_flags() {
         assert!(!out.exists(), "{extra:?} wrote the output");
     }
 }
+
+/// The importance-kernel loader's content checks (what a kernel file edited together with its manifest hash would
+/// still have to pass): a wrong schema, a count that disagrees, an offset whose length is not its radius, a channel
+/// whose weights do not sum to 1 — each refused naming the file and the defect; the baked file itself loads.
+#[test]
+fn importance_kernel_loader_refuses_inconsistent_kernels() {
+    use rtbake::runtime::loader::importance_kernel_from_json;
+    let baked = crate::support::baked_dir();
+    let path = "sss/importance/deon6_n20.json";
+    let good: serde_json::Value = serde_json::from_slice(&std::fs::read(baked.join(path)).unwrap()).unwrap();
+    let k = importance_kernel_from_json(&good, path).unwrap();
+    assert_eq!(k.offsets_mm.len(), 20);
+    let edits: [(&str, &dyn Fn(&mut serde_json::Value)); 4] = [
+        ("schema", &|v| v["schema"] = "rtbake-separable-kernel/1".into()),
+        ("\"samples\" = 21", &|v| v["samples"] = 21.into()),
+        ("kernel[3]", &|v| v["kernel"][3]["r_mm"] = 9.0.into()),
+        ("channel g", &|v| v["kernel"][0]["weight"][1] = 0.9.into()),
+    ];
+    for (needle, edit) in edits {
+        let mut v = good.clone();
+        edit(&mut v);
+        let err = importance_kernel_from_json(&v, path).unwrap_err().to_string();
+        assert!(err.contains(needle) && err.contains("deon6_n20"), "{needle}: {err}");
+    }
+}
