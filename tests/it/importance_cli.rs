@@ -243,3 +243,54 @@ fn importance_kernel_loader_refuses_inconsistent_kernels() {
         assert!(err.contains(needle) && err.contains("deon6_n20"), "{needle}: {err}");
     }
 }
+
+/// Every baked importance-kernel include compiles where a shader author pastes it: the GLSL include in a GLSL 4.50
+/// fragment shader and the HLSL include in an HLSL pixel shader, both through glslangValidator (Khronos' reference
+/// front end; `.ci/run` installs it), each reading the arrays so they are not dead code.
+#[test]
+fn baked_importance_includes_compile_with_glslang() {
+    if !crate::support::tool_available(
+        "importance include compile",
+        "glslangValidator",
+        &["--version"],
+        "apt-get install glslang-tools",
+    ) {
+        return;
+    }
+    let baked = crate::support::baked_dir();
+    let t = tempfile::tempdir().unwrap();
+    let spv = t.path().join("k.spv");
+    let mut compiled = 0;
+    for dir in ["sss/importance", "burley/kernels"] {
+        for entry in std::fs::read_dir(baked.join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_string();
+            if ext != "glsl" && ext != "hlsl" {
+                continue;
+            }
+            let body = std::fs::read_to_string(&path).unwrap();
+            let (src, args): (String, Vec<&str>) = match ext.as_str() {
+                "glsl" => (
+                    format!(
+                        "#version 450\n{body}\nlayout(location = 0) out vec4 o;\nvoid main() {{\n    o = vec4(SSS_IMPORTANCE_WEIGHTS[SSS_IMPORTANCE_N_SAMPLES - 1] * SSS_IMPORTANCE_OFFSETS[0].z, SSS_IMPORTANCE_CUTOFF_MM);\n}}\n"
+                    ),
+                    vec!["-S", "frag"],
+                ),
+                "hlsl" => (
+                    format!(
+                        "{body}\nfloat4 main() : SV_Target {{\n    return float4(SSS_IMPORTANCE_WEIGHTS[SSS_IMPORTANCE_N_SAMPLES - 1] * SSS_IMPORTANCE_OFFSETS[0].z, SSS_IMPORTANCE_CUTOFF_MM);\n}}\n"
+                    ),
+                    vec!["-D", "-V", "-e", "main", "-S", "frag", "-o", spv.to_str().unwrap()],
+                ),
+                _ => continue,
+            };
+            let file = t.path().join(format!("k.{ext}"));
+            std::fs::write(&file, src).unwrap();
+            let o = std::process::Command::new("glslangValidator").args(&args).arg(&file).output().unwrap();
+            assert!(o.status.success(), "{}: {}", path.display(), String::from_utf8_lossy(&o.stdout));
+            compiled += 1;
+        }
+    }
+    // 9 kernels of sss-importance-kernels and 14 of burley-profiles, two languages each.
+    assert_eq!(compiled, 2 * (9 + 14));
+}
