@@ -230,7 +230,8 @@ fn importance_kernel_loader_refuses_inconsistent_kernels() {
     let good: serde_json::Value = serde_json::from_slice(&std::fs::read(baked.join(path)).unwrap()).unwrap();
     let k = importance_kernel_from_json(&good, path).unwrap();
     assert_eq!(k.offsets_mm.len(), 20);
-    let edits: [(&str, &dyn Fn(&mut serde_json::Value)); 4] = [
+    type Edit<'a> = (&'a str, &'a dyn Fn(&mut serde_json::Value));
+    let edits: [Edit; 4] = [
         ("schema", &|v| v["schema"] = "rtbake-separable-kernel/1".into()),
         ("\"samples\" = 21", &|v| v["samples"] = 21.into()),
         ("kernel[3]", &|v| v["kernel"][3]["r_mm"] = 9.0.into()),
