@@ -155,6 +155,7 @@ pub mod separable;
 pub mod skin_color;
 pub mod spectral;
 pub mod sss_sampling;
+pub mod study;
 pub mod transmittance;
 pub mod transport;
 

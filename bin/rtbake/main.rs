@@ -14,6 +14,7 @@ mod kernel;
 mod maps;
 mod profile;
 mod profile_source;
+mod report;
 mod run;
 mod skin_color;
 mod transmittance;
@@ -91,6 +92,9 @@ enum Command {
     /// Run the GPU runtime (or its CPU reference with --cpu) on images.
     #[command(subcommand)]
     Run(run::RunCommand),
+    /// Statistics of the published studies: the 2AFC chi-square of TAP 2009 Table II.
+    #[command(subcommand)]
+    Report(report::ReportCommand),
 }
 
 /// The command line, with every value-taking flag of every subcommand accepting a negative number after a space
@@ -143,6 +147,7 @@ fn main() {
         Command::SkinColor(a) => skin_color::run(a, &ctx),
         Command::Maps(c) => maps::run(c, &ctx),
         Command::Run(c) => run::run(c, &ctx),
+        Command::Report(c) => report::run(c, &ctx),
     };
     if let Err(e) = result {
         cli::exit_with(&e, ctx.json);

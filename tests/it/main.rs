@@ -46,6 +46,7 @@ mod reliability_cli;
 mod reliability_dir;
 mod reliability_files;
 mod reliability_limits;
+mod report_cli;
 mod runtime_cli;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;

@@ -1,0 +1,70 @@
+//! Issue 14: `rtbake report chi2` — TAP 2009 Table II's χ² and significance from the counts the paper implies, the
+//! same from a user's counts file, and bad counts files refused (exit 2, the line and column named, nothing written).
+
+use crate::support::rtbake;
+use rtbake::study::tap2009::PUBLISHED;
+use serde_json::Value;
+
+/// The built-in implied counts reproduce every printed χ² exactly and every printed p to its 3 decimals; the
+/// significance column is the paper's reading (only SS Full at Zoom 110° of the SS Full column differs from TS).
+#[test]
+fn reproduces_tap2009_table_ii_from_the_implied_counts() {
+    let o = rtbake(&["--json", "report", "chi2", "--counts", "tap2009"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 36);
+    let mut not_significant = 0;
+    for (r, p) in rows.iter().zip(PUBLISHED.iter()) {
+        assert_eq!(r["chi2"].as_f64().unwrap(), p.chi2, "{r}");
+        assert!((r["p_value"].as_f64().unwrap() - p.p_value).abs() <= 5e-4, "{r} vs printed p {}", p.p_value);
+        not_significant += usize::from(!r["significant"].as_bool().unwrap());
+    }
+    assert_eq!(not_significant, 11, "the paper: SS Full not significantly different from TS in 11 of 12");
+}
+
+/// A counts file gives the same table as the built-in counts, and `--out` writes it as CSV.
+#[test]
+fn a_counts_file_and_the_csv_output() {
+    let t = tempfile::tempdir().unwrap();
+    let counts = t.path().join("counts.csv");
+    std::fs::write(&counts, format!("# TAP 2009, implied\n{}", rtbake::study::tap2009::implied_counts_csv())).unwrap();
+    let out = t.path().join("table.csv");
+    let o = rtbake(&["report", "chi2", "--counts", counts.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("TS - Zoom - 110°") && text.contains("22/32"), "{text}");
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let line = csv.lines().find(|l| l.starts_with("TS - Zoom - 110°,TS vs SS Full,")).unwrap();
+    assert!(line.starts_with("TS - Zoom - 110°,TS vs SS Full,22,32,4.5,0.0338"), "{line}");
+    assert!(line.ends_with(",true"), "{line}");
+}
+
+#[test]
+fn bad_counts_exit_2_naming_line_and_column_and_write_nothing() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("table.csv");
+    let h = "configuration,comparison,chosen,total\n";
+    for (body, needle) in [
+        (format!("{h}a,b,-1,32\n"), "line 2 column chosen"),
+        (format!("{h}a,b,3.5,32\n"), "line 2 column chosen"),
+        (format!("{h}a,b,12,ten\n"), "line 2 column total"),
+        (format!("{h}a,b,33,32\n"), "line 2 column chosen"),
+        (format!("{h}a,b,0,0\n"), "line 2 column total"),
+        ("chosen,total\n1,2\n".to_string(), "line 1"),
+        (String::new(), "empty"),
+    ] {
+        let f = t.path().join("c.csv");
+        std::fs::write(&f, &body).unwrap();
+        let o = rtbake(&["report", "chi2", "--counts", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{body:?}: {err}");
+        assert!(err.contains("--counts") && err.contains(needle), "{body:?}: {err}");
+        assert!(!out.exists());
+    }
+    let o = rtbake(&["report", "chi2", "--counts", "tap2009", "--alpha", "1.5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--alpha"));
+    let o = rtbake(&["report", "chi2", "--counts", t.path().join("missing.csv").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+}
