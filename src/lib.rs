@@ -148,6 +148,7 @@ pub mod fitting;
 pub mod image_buf;
 pub mod io;
 pub mod manifest;
+pub mod mesh;
 pub mod plot;
 #[cfg(feature = "runtime")]
 pub mod runtime;
