@@ -5,9 +5,10 @@ use super::cpu::{self, FilterPrecision};
 use super::device::Gpu;
 use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
 use super::importance_sss::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
-use super::mlaa::{Mlaa, MlaaAreaMap};
+use super::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
 use super::separable_sss::{SeparableSss, SssKernel, SssParams};
-use super::smaa::{Smaa, SmaaTextures};
+use super::smaa::{Smaa, SmaaOptions, SmaaTextures};
+use super::smaa_edges::{AaInputs, EdgeSettings};
 use super::RuntimeError;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
@@ -53,6 +54,45 @@ pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Resul
         }
         (None, Antialiasing::Smaa(t)) => cpu::smaa::smaa(&img.data, w, h, t, FilterPrecision::Exact).output,
         (None, Antialiasing::Mlaa(m)) => cpu::mlaa::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output,
+    };
+    Ok(Image::from_vec(w, h, 4, data))
+}
+
+/// As [`antialias`] with an edge detector other than luma, predicated thresholding and/or a matte/stencil mask
+/// ([`super::smaa_edges`]): `inputs.depth` when `edges` need it, `inputs.mask` (one byte per pixel, ≥ 128 = inside)
+/// masks the pass when present.
+pub fn antialias_with(
+    gpu: Option<&Gpu>,
+    img: &Image<u8>,
+    aa: &Antialiasing,
+    edges: &EdgeSettings,
+    inputs: &AaInputs,
+) -> Result<Image<u8>, RuntimeError> {
+    if img.channels != 4 {
+        return Err(InvalidInput::new("image", format!("must be RGBA8, got {} channels", img.channels)).into());
+    }
+    let (w, h) = (img.width, img.height);
+    crate::error::check_size("--input", w as u64, h as u64)?;
+    let masked = inputs.mask.is_some();
+    let data = match (gpu, aa) {
+        (Some(g), Antialiasing::Smaa(t)) => {
+            let options = SmaaOptions { edges: *edges, masked, ..Default::default() };
+            Smaa::with_options(&g.device, &g.queue, w, h, t, &options)?
+                .run_with(&g.device, &g.queue, &img.data, inputs)?
+        }
+        (Some(g), Antialiasing::Mlaa(m)) => {
+            let options = MlaaOptions { edges: *edges, masked };
+            Mlaa::with_options(&g.device, &g.queue, w, h, m, &options)?
+                .run_with(&g.device, &g.queue, &img.data, inputs)?
+        }
+        (None, Antialiasing::Smaa(t)) => {
+            let options = SmaaOptions { edges: *edges, masked, ..Default::default() };
+            cpu::smaa::smaa_with_options(&img.data, (w, h), t, FilterPrecision::Exact, &options, inputs)?.output
+        }
+        (None, Antialiasing::Mlaa(m)) => {
+            let options = MlaaOptions { edges: *edges, masked };
+            cpu::mlaa::mlaa_with_options(&img.data, (w, h), m, FilterPrecision::Exact, &options, inputs)?.output
+        }
     };
     Ok(Image::from_vec(w, h, 4, data))
 }
