@@ -5,6 +5,8 @@
 //!
 //! Textures: colour `Rgba8Unorm` (sRGB-encoded values), edges `Rg8Unorm`, weights `Rgba8Unorm`, area map
 //! `Rg8Unorm` 5N×5N, output `Rgba8Unorm`. Created once in [`Mlaa::new`]; CPU twin [`super::cpu::mlaa`].
+//! Listing 9.1's depth edges (its main variant), colour edges, predication and a matte/stencil mask:
+//! [`Mlaa::with_options`] ([`super::smaa_edges`]).
 
 use super::gpu::{self, GpuTimer};
 use super::smaa_edges::{AaInputs, EdgeSettings, EdgeStage};

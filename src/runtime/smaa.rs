@@ -6,6 +6,8 @@
 //! Textures: colour `Rgba8Unorm` holding sRGB-encoded values (decoded in the shader), edges `Rg8Unorm`, weights
 //! `Rgba8Unorm`, area `Rg8Unorm` 160×560, search `R8Unorm` 64×16, output `Rgba8Unorm` (sRGB-encoded). All
 //! resources are created once in [`Smaa::new`] and reused for every frame. The CPU twin is [`super::cpu::smaa`].
+//! Colour or depth edges, predicated thresholding and a matte/stencil mask: [`Smaa::with_options`]
+//! ([`super::smaa_edges`]).
 
 use super::gpu::{self, GpuTimer};
 use super::smaa_edges::{AaInputs, EdgeSettings, EdgeStage, SMAA_LOCAL_CONTRAST_ADAPTATION};
