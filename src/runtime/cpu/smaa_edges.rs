@@ -32,16 +32,24 @@ pub fn edge_detection(color: &Tex8, depth: Option<&[f32]>, settings: &EdgeSettin
     });
     let depth_at =
         |d: &[f32], x: i32, y: i32| d[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
-    let rgb = |x: i32, y: i32| [color.load(x, y, 0), color.load(x, y, 1), color.load(x, y, 2)];
+    // Every pixel's encoded colour (the value a load returns, `byte / 255`) or its luma once, as the luma pass does.
     let colour_metric = settings.detector == EdgeDetector::Color;
+    let n = if settings.detector == EdgeDetector::Depth { 0 } else { w * h };
+    let mut px = vec![[0.0f32; 3]; n];
+    px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, p) in row.iter_mut().enumerate() {
+            let c = &color.data[(y * w + x) * color.ch as usize..][..3];
+            let v = [c[0] as f32 / 255.0, c[1] as f32 / 255.0, c[2] as f32 / 255.0];
+            *p = if colour_metric { v } else { [v[0] * LUMA[0] + v[1] * LUMA[1] + v[2] * LUMA[2], 0.0, 0.0] };
+        }
+    });
+    let rgb = |x: i32, y: i32| px[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
     let contrast = |a: [f32; 3], b: [f32; 3]| {
         if colour_metric {
             let t = [(a[0] - b[0]).abs(), (a[1] - b[1]).abs(), (a[2] - b[2]).abs()];
             t[0].max(t[1]).max(t[2])
         } else {
-            let la = a[0] * LUMA[0] + a[1] * LUMA[1] + a[2] * LUMA[2];
-            let lb = b[0] * LUMA[0] + b[1] * LUMA[1] + b[2] * LUMA[2];
-            (la - lb).abs()
+            (a[0] - b[0]).abs()
         }
     };
     let mut out = vec![0u8; w * h * 2];
