@@ -276,7 +276,9 @@ fn antialias_file(ctx: &Ctx, a: &AaArgs, img: Image<u8>, aa: &Antialiasing, name
     let extra = a.edges.load(img.width, img.height)?;
     let gpu = device(ctx, a.common.cpu)?;
     let t = Instant::now();
-    let (bytes, seconds) = chain::antialias_estimate(img.width, img.height, aa, gpu.is_some());
+    let masked = extra.inputs().mask.is_some();
+    let (bytes, seconds) =
+        chain::antialias_estimate_with(img.width, img.height, aa, gpu.is_some(), &extra.settings, masked);
     ctx.check_budget(&format!("--input {} ({}x{})", a.input.display(), img.width, img.height), bytes, seconds)?;
     let out = chain::antialias_with(gpu.as_ref(), &img, aa, &extra.settings, &extra.inputs())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;

@@ -113,6 +113,30 @@ pub fn antialias_estimate(w: u32, h: u32, aa: &Antialiasing, gpu: bool) -> (u64,
     (24 * w as u64 * h as u64 + (32 << 20), seconds)
 }
 
+/// [`antialias_estimate`] with the edge options of [`antialias_with`]: per pixel, 16 more bytes for a detector other
+/// than plain luma (the CPU twin's per-pixel colour, 12 B), 8 for the depth (decoded f32 and the file) and 6 for a
+/// mask (the byte and the composite); time as for luma plus 100 % for colour/predication (measured at 1080p on the
+/// CPU path, dev profile, 2 cores: luma 100 ms, colour 161 ms, predicated luma 169 ms, depth 98 ms, mask 109 ms).
+/// Peak RSS measured at 1080p on the CPU path: 37 MB plain, 68 MB with colour + predication + depth + mask (the
+/// estimate says 83 MB and 145 MB).
+pub fn antialias_estimate_with(
+    w: u32,
+    h: u32,
+    aa: &Antialiasing,
+    gpu: bool,
+    edges: &EdgeSettings,
+    masked: bool,
+) -> (u64, f64) {
+    let (bytes, seconds) = antialias_estimate(w, h, aa, gpu);
+    let px = w as u64 * h as u64;
+    let per_px = if edges.is_plain_luma() { 0 } else { 16 }
+        + if edges.needs_depth() { 8 } else { 0 }
+        + if masked { 6 } else { 0 };
+    let slower =
+        if edges.is_plain_luma() || edges.detector == super::smaa_edges::EdgeDetector::Depth { 1.0 } else { 2.0 };
+    (bytes + per_px * px, seconds * slower)
+}
+
 /// Peak memory (bytes) and wall time (s) of `rtbake run sss` on a `w`×`h` frame, EXR decoding and encoding included:
 /// measured with the release build on the project's 2-core machine at 1024² on the CPU path (separable 0.49 s and
 /// 103 MB, sum of Gaussians 0.84 s and 136 MB), doubled; the GPU path as for [`antialias_estimate`]. The importance
