@@ -28,7 +28,7 @@ pub struct EdgeArgs {
     /// finite values (any monotonic depth; thresholds are in its units).
     #[arg(long, value_name = "EXR")]
     depth: Option<PathBuf>,
-    /// Threshold of --edges depth, in --depth's units (default 0.01, SMAA's SMAA_DEPTH_THRESHOLD).
+    /// Threshold of --edges depth, in --depth's units (SMAA's SMAA_DEPTH_THRESHOLD, 0.1 · its colour threshold).
     #[arg(long, default_value_t = DEFAULT_DEPTH_THRESHOLD, allow_negative_numbers = true, value_name = "DEPTH")]
     depth_threshold: f32,
     /// Predicated thresholding of --edges luma|color from --depth: the threshold becomes
