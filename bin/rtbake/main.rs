@@ -16,6 +16,7 @@ mod profile;
 mod profile_source;
 mod report;
 mod run;
+mod run_edges;
 mod skin_color;
 mod transmittance;
 mod transport;

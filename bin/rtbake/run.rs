@@ -48,6 +48,8 @@ pub struct AaArgs {
     #[arg(long, value_name = "PNG")]
     output: PathBuf,
     #[command(flatten)]
+    edges: crate::run_edges::EdgeArgs,
+    #[command(flatten)]
     common: Common,
 }
 
@@ -176,13 +178,13 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
     ensure_runtime_dir();
     match cmd {
         RunCommand::Smaa(a) => {
-            check_output(&a.output, &[&a.input])?;
+            check_output(&a.output, &[&[a.input.as_path()][..], &a.edges.files()].concat())?;
             let img = read_png(&a.input)?;
             let aa = Antialiasing::Smaa(loader::load_smaa_textures(&a.common.baked).map_err(usage)?);
             antialias_file(ctx, &a, img, &aa, "smaa")
         }
         RunCommand::Mlaa(m) => {
-            check_output(&m.aa.output, &[&m.aa.input])?;
+            check_output(&m.aa.output, &[&[m.aa.input.as_path()][..], &m.aa.edges.files()].concat())?;
             let map = load_mlaa(&m.aa.common.baked, m.max_distance)?;
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
@@ -271,11 +273,14 @@ fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
 }
 
 fn antialias_file(ctx: &Ctx, a: &AaArgs, img: Image<u8>, aa: &Antialiasing, name: &str) -> anyhow::Result<()> {
+    let extra = a.edges.load(img.width, img.height)?;
     let gpu = device(ctx, a.common.cpu)?;
     let t = Instant::now();
-    let (bytes, seconds) = chain::antialias_estimate(img.width, img.height, aa, gpu.is_some());
+    let masked = extra.inputs().mask.is_some();
+    let (bytes, seconds) =
+        chain::antialias_estimate_with(img.width, img.height, aa, gpu.is_some(), &extra.settings, masked);
     ctx.check_budget(&format!("--input {} ({}x{})", a.input.display(), img.width, img.height), bytes, seconds)?;
-    let out = chain::antialias(gpu.as_ref(), &img, aa)?;
+    let out = chain::antialias_with(gpu.as_ref(), &img, aa, &extra.settings, &extra.inputs())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &io::png::encode_u8_frame(&out)?)?;
     report(ctx, name, &a.output, &out, gpu.as_ref(), ms);

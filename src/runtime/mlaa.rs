@@ -5,8 +5,11 @@
 //!
 //! Textures: colour `Rgba8Unorm` (sRGB-encoded values), edges `Rg8Unorm`, weights `Rgba8Unorm`, area map
 //! `Rg8Unorm` 5N×5N, output `Rgba8Unorm`. Created once in [`Mlaa::new`]; CPU twin [`super::cpu::mlaa`].
+//! Listing 9.1's depth edges (its main variant), colour edges, predication and a matte/stencil mask:
+//! [`Mlaa::with_options`] ([`super::smaa_edges`]).
 
 use super::gpu::{self, GpuTimer};
+use super::smaa_edges::{AaInputs, EdgeSettings, EdgeStage};
 use super::RuntimeError;
 use crate::aa::mlaa_area::MlaaVersion;
 use crate::error::InvalidInput;
@@ -47,6 +50,14 @@ impl MlaaAreaMap {
     }
 }
 
+/// What [`Mlaa::with_options`] can set: the edge detector (Listing 9.1's depth variant, colour, predicated
+/// thresholding; [`super::smaa_edges`], no local contrast adaptation) and the matte/stencil mask.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct MlaaOptions {
+    pub edges: EdgeSettings,
+    pub masked: bool,
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Params {
@@ -67,6 +78,7 @@ pub struct Mlaa {
     views: [wgpu::TextureView; 3],
     pipes: [wgpu::RenderPipeline; 3],
     groups: [wgpu::BindGroup; 3],
+    extra: EdgeStage,
 }
 
 impl Mlaa {
@@ -76,6 +88,18 @@ impl Mlaa {
         width: u32,
         height: u32,
         map: &MlaaAreaMap,
+    ) -> Result<Self, RuntimeError> {
+        Self::with_options(device, queue, width, height, map, &MlaaOptions::default())
+    }
+
+    /// As [`Self::new`] with an edge detector and mask; depth and mask come through [`Self::run_with`].
+    pub fn with_options(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        width: u32,
+        height: u32,
+        map: &MlaaAreaMap,
+        options: &MlaaOptions,
     ) -> Result<Self, RuntimeError> {
         crate::error::check_size("image", width as u64, height as u64)?;
         super::device::check_image_fits(device, width, height, 4)?;
@@ -128,8 +152,10 @@ impl Mlaa {
                 &[(0, ubo.as_entire_binding()), (1, R::TextureView(&cv)), (5, R::TextureView(&wv))],
             ),
         ];
-        let views = [ev, wv, view(&output)];
-        Ok(Self { width, height, color, edges, weights, output, views, pipes, groups })
+        let ov = view(&output);
+        let extra = EdgeStage::new(device, (width, height), (&cv, &ov), &options.edges, 0.0, options.masked)?;
+        let views = [ev, wv, ov];
+        Ok(Self { width, height, color, edges, weights, output, views, pipes, groups, extra })
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -138,8 +164,9 @@ impl Mlaa {
     pub fn input(&self) -> &wgpu::Texture {
         &self.color
     }
+    /// The antialiased output (masked when the options say so).
     pub fn output(&self) -> &wgpu::Texture {
-        &self.output
+        self.extra.masked_output().unwrap_or(&self.output)
     }
     pub fn edges(&self) -> &wgpu::Texture {
         &self.edges
@@ -162,16 +189,37 @@ impl Mlaa {
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         for (k, label) in ["mlaa edges", "mlaa weights", "mlaa blend"].iter().enumerate() {
             let slot = timer.map(|(t, first)| (t, first + k as u32));
+            if k == 0 && self.extra.encode_edges(enc, &self.views[0], slot) {
+                continue;
+            }
             gpu::draw_fullscreen(enc, label, &self.pipes[k], &self.groups[k], &self.views[k], slot);
         }
+        self.extra.encode_mask(enc);
+    }
+
+    /// Validates and uploads the depth and mask the options read (named `--depth`/`--mask`).
+    pub fn upload_inputs(&self, queue: &wgpu::Queue, inputs: &AaInputs) -> Result<(), InvalidInput> {
+        self.extra.upload(queue, inputs)
     }
 
     /// Uploads `rgba`, runs the three passes and reads the result back.
     pub fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, rgba: &[u8]) -> Result<Vec<u8>, RuntimeError> {
+        self.run_with(device, queue, rgba, &AaInputs::default())
+    }
+
+    /// As [`Self::run`] with the depth and mask the options read.
+    pub fn run_with(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        rgba: &[u8],
+        inputs: &AaInputs,
+    ) -> Result<Vec<u8>, RuntimeError> {
         self.upload(queue, rgba)?;
+        self.upload_inputs(queue, inputs)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mlaa") });
         self.encode(&mut enc, None);
         queue.submit([enc.finish()]);
-        gpu::read_texture(device, queue, &self.output)
+        gpu::read_texture(device, queue, self.output())
     }
 }

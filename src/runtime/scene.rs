@@ -99,3 +99,57 @@ pub fn render_shapes(w: u32, h: u32, n: u32) -> Vec<u8> {
     });
     out
 }
+
+/// The shapes scene with other colours: shape `i` gets `colours[i % colours.len()]`, the background `background`
+/// (linear RGB); `n` as in [`render_shapes`]. For scenes whose edges luma cannot see (equal-luma colours).
+pub fn render_shapes_recoloured(w: u32, h: u32, n: u32, colours: &[[f64; 3]], background: [f64; 3]) -> Vec<u8> {
+    assert!(!colours.is_empty(), "at least one colour");
+    let scene: Vec<_> =
+        shapes(w, h).into_iter().enumerate().map(|(i, (s, _))| (s, colours[i % colours.len()])).collect();
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        for x in 0..w as usize {
+            let mut acc = [0.0f64; 3];
+            for j in 0..n {
+                for i in 0..n {
+                    let (sx, sy) = (x as f64 + (i as f64 + 0.5) / n as f64, y as f64 + (j as f64 + 0.5) / n as f64);
+                    let mut c = background;
+                    for (shape, col) in &scene {
+                        if shape.contains(sx, sy) {
+                            c = *col;
+                        }
+                    }
+                    for k in 0..3 {
+                        acc[k] += c[k];
+                    }
+                }
+            }
+            for k in 0..3 {
+                row[x * 4 + k] = super::cpu::unorm8(super::cpu::linear_to_srgb((acc[k] / (n * n) as f64) as f32));
+            }
+            row[x * 4 + 3] = 255;
+        }
+    });
+    out
+}
+
+/// Linear depth of the shapes scene at each pixel centre (what an aliased depth buffer holds): shape `i` (drawn
+/// later = nearer) at 10 − i units, tilted by 0.0004 units per pixel in x (below any depth threshold between
+/// neighbours), the background at 100.
+pub fn render_shapes_depth(w: u32, h: u32) -> Vec<f32> {
+    let scene = shapes(w, h);
+    let mut out = vec![0.0f32; (w * h) as usize];
+    out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, d) in row.iter_mut().enumerate() {
+            let (sx, sy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let mut depth = 100.0;
+            for (i, (shape, _)) in scene.iter().enumerate() {
+                if shape.contains(sx, sy) {
+                    depth = 10.0 - i as f64 + 0.0004 * sx;
+                }
+            }
+            *d = depth as f32;
+        }
+    });
+    out
+}

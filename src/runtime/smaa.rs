@@ -6,8 +6,11 @@
 //! Textures: colour `Rgba8Unorm` holding sRGB-encoded values (decoded in the shader), edges `Rg8Unorm`, weights
 //! `Rgba8Unorm`, area `Rg8Unorm` 160×560, search `R8Unorm` 64×16, output `Rgba8Unorm` (sRGB-encoded). All
 //! resources are created once in [`Smaa::new`] and reused for every frame. The CPU twin is [`super::cpu::smaa`].
+//! Colour or depth edges, predicated thresholding and a matte/stencil mask: [`Smaa::with_options`]
+//! ([`super::smaa_edges`]).
 
 use super::gpu::{self, GpuTimer};
+use super::smaa_edges::{AaInputs, EdgeSettings, EdgeStage, SMAA_LOCAL_CONTRAST_ADAPTATION};
 use super::RuntimeError;
 use crate::error::InvalidInput;
 
@@ -76,6 +79,22 @@ impl SubsampleIndices {
     }
 }
 
+/// Everything [`Smaa::with_options`] can set: the area-texture slices, the edge detector (luma, colour, depth,
+/// predicated thresholding; [`super::smaa_edges`]) and whether a matte/stencil mask leaves pixels outside it
+/// untouched. The default is SMAA 1x with luma edges, unmasked ([`Smaa::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmaaOptions {
+    pub subsample: SubsampleIndices,
+    pub edges: EdgeSettings,
+    pub masked: bool,
+}
+
+impl Default for SmaaOptions {
+    fn default() -> Self {
+        Self { subsample: SubsampleIndices::SMAA_1X, edges: EdgeSettings::default(), masked: false }
+    }
+}
+
 /// Uniform block of `smaa.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -106,6 +125,7 @@ pub struct Smaa {
     bg_edges: wgpu::BindGroup,
     bg_weights: wgpu::BindGroup,
     bg_blend: wgpu::BindGroup,
+    extra: EdgeStage,
 }
 
 impl Smaa {
@@ -129,6 +149,20 @@ impl Smaa {
         luts: &SmaaTextures,
         subsample: SubsampleIndices,
     ) -> Result<Self, RuntimeError> {
+        Self::with_options(device, queue, width, height, luts, &SmaaOptions { subsample, ..Default::default() })
+    }
+
+    /// As [`Self::new`] with every option; a pass that reads depth or a mask takes them through [`Self::run_with`]
+    /// (or [`Self::upload_inputs`]).
+    pub fn with_options(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        width: u32,
+        height: u32,
+        luts: &SmaaTextures,
+        options: &SmaaOptions,
+    ) -> Result<Self, RuntimeError> {
+        let subsample = options.subsample;
         crate::error::check_size("image", width as u64, height as u64)?;
         super::device::check_image_fits(device, width, height, 4)?;
         subsample.validate()?;
@@ -180,6 +214,14 @@ impl Smaa {
             &pipe_blend.get_bind_group_layout(0),
             &[(0, ubo.as_entire_binding()), (1, R::TextureView(&color_view)), (5, R::TextureView(&weights_view))],
         );
+        let extra = EdgeStage::new(
+            device,
+            (width, height),
+            (&color_view, &output_view),
+            &options.edges,
+            SMAA_LOCAL_CONTRAST_ADAPTATION,
+            options.masked,
+        )?;
         Ok(Self {
             width,
             height,
@@ -196,6 +238,7 @@ impl Smaa {
             bg_edges,
             bg_weights,
             bg_blend,
+            extra,
         })
     }
 
@@ -208,9 +251,9 @@ impl Smaa {
         &self.color
     }
 
-    /// The antialiased output (`Rgba8Unorm`, sRGB-encoded values).
+    /// The antialiased output (`Rgba8Unorm`, sRGB-encoded values; masked when the options say so).
     pub fn output(&self) -> &wgpu::Texture {
-        &self.output
+        self.extra.masked_output().unwrap_or(&self.output)
     }
 
     /// The edges texture (`Rg8Unorm`: R left edge, G top edge).
@@ -236,17 +279,37 @@ impl Smaa {
     /// Records the three passes; `timer` slots `first..first+3` receive their timestamps.
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
-        gpu::draw_fullscreen(enc, "smaa edges", &self.pipe_edges, &self.bg_edges, &self.edges_view, slot(0));
+        if !self.extra.encode_edges(enc, &self.edges_view, slot(0)) {
+            gpu::draw_fullscreen(enc, "smaa edges", &self.pipe_edges, &self.bg_edges, &self.edges_view, slot(0));
+        }
         gpu::draw_fullscreen(enc, "smaa weights", &self.pipe_weights, &self.bg_weights, &self.weights_view, slot(1));
         gpu::draw_fullscreen(enc, "smaa blend", &self.pipe_blend, &self.bg_blend, &self.output_view, slot(2));
+        self.extra.encode_mask(enc);
+    }
+
+    /// Validates and uploads the depth and mask the options read (sizes, finiteness; named `--depth`/`--mask`).
+    pub fn upload_inputs(&self, queue: &wgpu::Queue, inputs: &AaInputs) -> Result<(), InvalidInput> {
+        self.extra.upload(queue, inputs)
     }
 
     /// Uploads `rgba`, runs the three passes and reads the result back.
     pub fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, rgba: &[u8]) -> Result<Vec<u8>, RuntimeError> {
+        self.run_with(device, queue, rgba, &AaInputs::default())
+    }
+
+    /// As [`Self::run`] with the depth and mask the options read.
+    pub fn run_with(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        rgba: &[u8],
+        inputs: &AaInputs,
+    ) -> Result<Vec<u8>, RuntimeError> {
         self.upload(queue, rgba)?;
+        self.upload_inputs(queue, inputs)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("smaa") });
         self.encode(&mut enc, None);
         queue.submit([enc.finish()]);
-        gpu::read_texture(device, queue, &self.output)
+        gpu::read_texture(device, queue, self.output())
     }
 }

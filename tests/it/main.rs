@@ -65,6 +65,7 @@ mod skin_cli;
 mod skin_color;
 mod skin_layers;
 mod skin_spectral_data;
+mod smaa_edges;
 mod transmittance_table;
 mod transport_cli;
 mod transport_gpu;

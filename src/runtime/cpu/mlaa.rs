@@ -2,7 +2,9 @@
 //! [`crate::runtime::mlaa`]). Same pixel-unit arithmetic, same bilinear/point fetches through [`Tex8`].
 
 use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
-use crate::runtime::mlaa::{MlaaAreaMap, MLAA_THRESHOLD};
+use crate::error::InvalidInput;
+use crate::runtime::mlaa::{MlaaAreaMap, MlaaOptions, MLAA_THRESHOLD};
+use crate::runtime::smaa_edges::AaInputs;
 use rayon::prelude::*;
 
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
@@ -22,6 +24,32 @@ pub fn mlaa(rgba: &[u8], w: u32, h: u32, map: &MlaaAreaMap, prec: FilterPrecisio
     let weights = blending_weights(&Tex8::new(w, h, 2, &edges), map, prec);
     let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
     MlaaCpuOutput { edges, weights, output }
+}
+
+/// Runs MLAA with an edge detector and mask (the twin of [`crate::runtime::mlaa::Mlaa::with_options`]).
+pub fn mlaa_with_options(
+    rgba: &[u8],
+    (w, h): (u32, u32),
+    map: &MlaaAreaMap,
+    prec: FilterPrecision,
+    options: &MlaaOptions,
+    inputs: &AaInputs,
+) -> Result<MlaaCpuOutput, InvalidInput> {
+    options.edges.validate()?;
+    inputs.validate(w, h, &options.edges, options.masked)?;
+    assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
+    let color = Tex8::new(w, h, 4, rgba);
+    let edges = if options.edges.is_plain_luma() {
+        edge_detection(&color)
+    } else {
+        super::smaa_edges::edge_detection(&color, inputs.depth, &options.edges, 0.0)
+    };
+    let weights = blending_weights(&Tex8::new(w, h, 2, &edges), map, prec);
+    let mut output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
+    if let Some(mask) = inputs.mask.filter(|_| options.masked) {
+        output = super::smaa_edges::apply_mask(rgba, &output, mask);
+    }
+    Ok(MlaaCpuOutput { edges, weights, output })
 }
 
 /// Listing 9.1, luminance variant.

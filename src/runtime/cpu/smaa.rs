@@ -8,7 +8,9 @@
 //! [`FilterPrecision`].
 
 use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
-use crate::runtime::smaa::{SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
+use crate::error::InvalidInput;
+use crate::runtime::smaa::{SmaaOptions, SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
+use crate::runtime::smaa_edges::{AaInputs, SMAA_LOCAL_CONTRAST_ADAPTATION};
 use rayon::prelude::*;
 
 const THRESHOLD: f32 = 0.1;
@@ -51,6 +53,36 @@ pub fn smaa_with_subsample(
     let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, subsample);
     let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
     SmaaCpuOutput { edges, weights, output }
+}
+
+/// Runs SMAA with every option of [`SmaaOptions`] (the twin of [`crate::runtime::smaa::Smaa::with_options`]);
+/// `inputs` as for the GPU pass, validated the same way.
+pub fn smaa_with_options(
+    rgba: &[u8],
+    (w, h): (u32, u32),
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    options: &SmaaOptions,
+    inputs: &AaInputs,
+) -> Result<SmaaCpuOutput, InvalidInput> {
+    options.edges.validate()?;
+    inputs.validate(w, h, &options.edges, options.masked)?;
+    if options.edges.is_plain_luma() && !options.masked {
+        return Ok(smaa_with_subsample(rgba, w, h, luts, prec, options.subsample));
+    }
+    assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
+    let color = Tex8::new(w, h, 4, rgba);
+    let edges = if options.edges.is_plain_luma() {
+        edge_detection(&color)
+    } else {
+        super::smaa_edges::edge_detection(&color, inputs.depth, &options.edges, SMAA_LOCAL_CONTRAST_ADAPTATION)
+    };
+    let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, options.subsample);
+    let mut output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
+    if let Some(mask) = inputs.mask.filter(|_| options.masked) {
+        output = super::smaa_edges::apply_mask(rgba, &output, mask);
+    }
+    Ok(SmaaCpuOutput { edges, weights, output })
 }
 
 /// Pass 1: luma edge detection with local contrast adaptation.
