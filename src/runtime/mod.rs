@@ -18,6 +18,7 @@ pub mod gaussian_sss;
 pub mod gpu;
 pub mod importance_sss;
 pub mod loader;
+pub mod mesh_raster;
 pub mod mlaa;
 pub mod scene;
 pub mod separable_sss;

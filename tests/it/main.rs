@@ -35,6 +35,7 @@ mod fitting_cli;
 mod fitting_determinism;
 mod fitting_published;
 mod importance_cli;
+mod mesh_raster;
 mod newcomer_cli;
 mod newcomer_profile_floor;
 mod newcomer_provenance;

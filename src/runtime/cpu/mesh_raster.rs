@@ -1,0 +1,124 @@
+//! CPU twin of [`crate::runtime::mesh_raster`]: the same G-buffer by a reference rasteriser — triangles in index
+//! order, pixel centres inside all three edge functions (a centre exactly on a shared edge is drawn by both
+//! triangles, where the GPU's top-left rule picks one; the depth test keeps the first), back faces culled, depth
+//! linear in screen space with a strict less-than test, attributes interpolated perspective-correctly (barycentrics
+//! divided by clip w), the normal renormalised as the fragment shader does. Triangles with a vertex behind the near
+//! plane are skipped (the GPU clips them), so the camera must keep the mesh in front of its near plane.
+
+use crate::mesh::camera::Camera;
+use crate::mesh::Mesh;
+use crate::runtime::mesh_raster::{camera_uniform, MeshGBuffer};
+use nalgebra::{Matrix4, Vector4};
+
+/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer (values rounded to f16 as the GPU stores them).
+pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
+    let u = camera_uniform(mesh, camera, width, height);
+    let vp = Matrix4::from_column_slice(&u[..16]);
+    let view = Matrix4::from_column_slice(&u[16..32]);
+    let (wf, hf) = (width as f32, height as f32);
+    let mut g = MeshGBuffer::empty(width, height);
+    let mut zbuf = vec![1.0f32; (width * height) as usize];
+    struct V {
+        x: f32,
+        y: f32,
+        z: f32,
+        inv_w: f32,
+        n: [f32; 3],
+        depth_mm: f32,
+        uv: [f32; 2],
+    }
+    let vert = |i: u32| -> Option<V> {
+        let p = mesh.positions[i as usize];
+        let c = vp * Vector4::new(p[0], p[1], p[2], 1.0);
+        if c.w <= camera.near * 0.5 {
+            return None;
+        }
+        let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
+        let n = mesh.normals[i as usize];
+        let nv = view * Vector4::new(n[0], n[1], n[2], 0.0);
+        Some(V {
+            x: (c.x / c.w * 0.5 + 0.5) * wf,
+            y: (0.5 - c.y / c.w * 0.5) * hf,
+            z: c.z / c.w,
+            inv_w: 1.0 / c.w,
+            n: [nv.x, nv.y, nv.z],
+            depth_mm: -pv.z * mesh.mm_per_unit,
+            uv: mesh.uvs[i as usize],
+        })
+    };
+    for t in mesh.indices.chunks_exact(3) {
+        let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
+        // Counter-clockwise in NDC (y up) is clockwise on screen (y down): signed area < 0 is a front face.
+        let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+        if !(area < 0.0) {
+            continue;
+        }
+        let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
+        let x1 = (a.x.max(b.x).max(c.x).ceil() as i64).clamp(0, width as i64) as u32;
+        let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
+        let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
+        let edge = |p: &V, q: &V, x: f32, y: f32| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
+        for py in y0..y1 {
+            for px in x0..x1 {
+                let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
+                // Each weight is the signed area opposite a vertex, same sign as `area` inside.
+                let (wa, wb, wc) = (edge(&b, &c, x, y) / area, edge(&c, &a, x, y) / area, edge(&a, &b, x, y) / area);
+                if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                    continue;
+                }
+                let z = wa * a.z + wb * b.z + wc * c.z;
+                let i = (py * width + px) as usize;
+                if !(z < zbuf[i]) || z < 0.0 {
+                    continue;
+                }
+                zbuf[i] = z;
+                let (pa, pb, pc) = (wa * a.inv_w, wb * b.inv_w, wc * c.inv_w);
+                let s = 1.0 / (pa + pb + pc);
+                let lerp = |fa: f32, fb: f32, fc: f32| (pa * fa + pb * fb + pc * fc) * s;
+                let n: [f32; 3] = std::array::from_fn(|k| lerp(a.n[k], b.n[k], c.n[k]));
+                let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+                g.covered[i] = true;
+                g.normal_view[i] = n.map(|v| f16(v / l));
+                g.depth_mm[i] = f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm));
+                g.uv[i] = [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1]))];
+            }
+        }
+    }
+    g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A square facing the camera covers exactly the pixel centres inside its projection; seen from behind it is
+    /// culled.
+    #[test]
+    fn a_facing_square_covers_its_projection_and_its_back_is_culled() {
+        let q = 0.1f32;
+        let mesh = Mesh::new(
+            "square",
+            vec![[-q, -q, 0.0], [q, -q, 0.0], [q, q, 0.0], [-q, q, 0.0]],
+            vec![[0.0, 0.0, 1.0]; 4],
+            vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]],
+            vec![0, 1, 2, 0, 2, 3],
+            1000.0,
+        )
+        .unwrap();
+        let cam = Camera::facing(1.0).unwrap();
+        let g = rasterise(&mesh, &cam, 64, 64);
+        // Half-width on screen: q / tan(15°) of the half image = 0.1 / 0.26795 · 32 = 11.94 px around the centre.
+        let half = 0.1 / (15f32).to_radians().tan() * 32.0;
+        let expect = (0..64u32).filter(|&x| ((x as f32 + 0.5) - 32.0).abs() < half).count().pow(2);
+        assert_eq!(g.covered.iter().filter(|&&c| c).count(), expect);
+        let centre = (32 * 64 + 32) as usize;
+        assert_eq!(g.depth_mm[centre], 1000.0);
+        assert_eq!(g.normal_view[centre], [0.0, 0.0, 1.0]);
+        // uv: v = 0 at the top of the square, which is the top of the image.
+        let top_left = ((32.0 - half).floor() as u32 * 64 + (32.0 - half).floor() as u32) as usize;
+        assert!(g.uv[top_left][0] < 0.05 && g.uv[top_left][1] < 0.05, "{:?}", g.uv[top_left]);
+        let behind = Camera { eye: [0.0, 0.0, -1.0], ..cam };
+        assert!(rasterise(&mesh, &behind, 64, 64).covered.iter().all(|&c| !c));
+    }
+}

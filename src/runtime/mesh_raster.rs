@@ -1,0 +1,195 @@
+//! The mesh G-buffer pass of the skin renderer (issue 14; TAP 2009 §5 renders heads, thesis ch. 3–5 shades them):
+//! a wgpu render pipeline with a `Depth32Float` depth buffer (less-than test, back faces culled, counter-clockwise
+//! front faces) that writes per pixel the view-space unit normal and the linear view depth in mm
+//! (`Rgba16Float`), and the texture coordinates with a coverage flag (`Rgba16Float`) — the inputs the
+//! screen-space passes and texture-space diffusion need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
+//! [`MeshGBuffer`].
+
+use super::gpu;
+use super::RuntimeError;
+use crate::error::InvalidInput;
+use crate::mesh::camera::Camera;
+use crate::mesh::Mesh;
+use wgpu::util::DeviceExt;
+
+/// A rasterised mesh, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshGBuffer {
+    pub width: u32,
+    pub height: u32,
+    /// View-space unit normal (camera looks down −z); zero where nothing is covered.
+    pub normal_view: Vec<[f32; 3]>,
+    /// Linear view depth, mm (distance along the view axis); 0 where nothing is covered.
+    pub depth_mm: Vec<f32>,
+    pub uv: Vec<[f32; 2]>,
+    pub covered: Vec<bool>,
+}
+
+impl MeshGBuffer {
+    pub(crate) fn empty(width: u32, height: u32) -> Self {
+        let n = (width * height) as usize;
+        MeshGBuffer {
+            width,
+            height,
+            normal_view: vec![[0.0; 3]; n],
+            depth_mm: vec![0.0; n],
+            uv: vec![[0.0; 2]; n],
+            covered: vec![false; n],
+        }
+    }
+}
+
+/// Column-major camera uniform: view-projection, view, (mm per unit, 0, 0, 0).
+pub(crate) fn camera_uniform(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> [f32; 36] {
+    let view = camera.view();
+    let vp = camera.projection(width as f32 / height as f32) * view;
+    let mut u = [0.0f32; 36];
+    u[..16].copy_from_slice(vp.as_slice());
+    u[16..32].copy_from_slice(view.as_slice());
+    u[32] = mesh.mm_per_unit;
+    u
+}
+
+/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
+pub fn rasterise(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+) -> Result<MeshGBuffer, RuntimeError> {
+    camera.validate()?;
+    super::device::check_image_fits(device, width, height, 8 + 8 + 4)?;
+    let vertex_bytes = mesh.positions.len() as u64 * 32;
+    if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
+        return Err(InvalidInput::new(
+            "--mesh",
+            format!("{vertex_bytes} bytes of vertices exceed the adapter's buffer limit"),
+        )
+        .into());
+    }
+    let mut vertices = Vec::with_capacity(mesh.positions.len() * 8);
+    for ((p, n), t) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs) {
+        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1]]);
+    }
+    let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("mesh vertices"),
+        contents: bytemuck::cast_slice(&vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("mesh indices"),
+        contents: bytemuck::cast_slice(&mesh.indices),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    let ubuf =
+        gpu::uniform_buffer(device, "mesh camera", bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)));
+    let module = gpu::shader(device, "mesh_raster", include_str!("shaders/mesh_raster.wgsl"));
+    let gformat = wgpu::TextureFormat::Rgba16Float;
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("mesh g-buffer"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_mesh"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 32,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: Some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_mesh"),
+            compilation_options: Default::default(),
+            targets: &[
+                Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+                Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+            ],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let bind =
+        gpu::bind_group(device, "mesh camera", &pipeline.get_bind_group_layout(0), &[(0, ubuf.as_entire_binding())]);
+    let g0 = gpu::texture(device, "normal+depth", width, height, gformat);
+    let g1 = gpu::texture(device, "uv+cover", width, height, gformat);
+    let depth = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("mesh depth"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let (v0, v1, vd) = (
+        g0.create_view(&Default::default()),
+        g1.create_view(&Default::default()),
+        depth.create_view(&Default::default()),
+    );
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
+    {
+        let attach = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("mesh g-buffer"),
+            color_attachments: &[attach(&v0), attach(&v1)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &vd,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.set_vertex_buffer(0, vbuf.slice(..));
+        pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..mesh.indices.len() as u32, 0, 0..1);
+    }
+    queue.submit([enc.finish()]);
+    let read = |t| -> Result<Vec<f32>, RuntimeError> {
+        let b = gpu::read_texture(device, queue, t)?;
+        Ok(bytemuck::cast_slice::<u8, half::f16>(&b).iter().map(|v| v.to_f32()).collect())
+    };
+    let (a, b) = (read(&g0)?, read(&g1)?);
+    let mut g = MeshGBuffer::empty(width, height);
+    for i in 0..(width * height) as usize {
+        if b[4 * i + 2] > 0.5 {
+            g.covered[i] = true;
+            g.normal_view[i] = [a[4 * i], a[4 * i + 1], a[4 * i + 2]];
+            g.depth_mm[i] = a[4 * i + 3];
+            g.uv[i] = [b[4 * i], b[4 * i + 1]];
+        }
+    }
+    Ok(g)
+}
