@@ -19,6 +19,7 @@ pub mod gpu;
 pub mod importance_sss;
 pub mod loader;
 pub mod mlaa;
+pub mod moving_scene;
 pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
