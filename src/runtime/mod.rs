@@ -24,6 +24,7 @@ pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
 pub mod smaa;
+pub mod smaa_modes;
 pub mod transport_gpu;
 
 /// Errors of the runtime.
