@@ -15,6 +15,7 @@ mod maps;
 mod profile;
 mod profile_source;
 mod run;
+mod run_smaa_modes;
 mod skin_color;
 mod transmittance;
 mod transport;

@@ -222,6 +222,25 @@ pub fn scene_frame(scene: &MovingScene, mode: SmaaMode, frame: u64) -> (Vec<Vec<
     (samples, scene.velocity(t))
 }
 
+/// The displayed image of a mode's output: alpha (the encoded velocity) set to 255.
+pub fn opaque(mut rgba: Vec<u8>) -> Vec<u8> {
+    rgba.chunks_mut(4).for_each(|p| p[3] = 255);
+    rgba
+}
+
+/// Peak memory (bytes) and wall time (s) of `rtbake run smaa --mode` on `frames` frames of `w`×`h`, `kept` of
+/// which are held for writing: per sample the SMAA 1x figures of [`super::chain::antialias_estimate`] (0.8 µs/px on
+/// the CPU path, a tenth of it plus 1 s of set-up on the GPU), doubled for the scene or file decoding and the
+/// resolves; memory 24 B/px per sample plus 12 B/px of velocity and history, 4 B/px per kept frame, 32 MiB.
+pub fn estimate(w: u32, h: u32, mode: SmaaMode, frames: u64, kept: u64, gpu: bool) -> (u64, f64) {
+    let px = w as f64 * h as f64;
+    let n = mode.samples_per_frame() as f64;
+    let cpu_s = 2.0 * 0.8e-6 * px * n * frames as f64;
+    let seconds = if gpu { 1.0 + 0.1 * cpu_s + 0.4e-6 * px * n * frames as f64 } else { 0.2 + cpu_s };
+    let bytes = (24.0 * n + 12.0 + 4.0 * kept as f64) * px + (32u64 << 20) as f64;
+    (bytes as u64, seconds)
+}
+
 /// Uniform block of `smaa_temporal.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
