@@ -193,3 +193,203 @@ fn smaa_velocity_weighting_reduces_ghosting() {
     );
     assert!(weighted < 0.5 * plain, "velocity weighting {weighted} vs plain blend {plain}");
 }
+
+fn s(p: &std::path::Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Writes frames 0..n of the moving scene for `mode` as `--input-dir` files.
+fn write_user_frames(dir: &std::path::Path, scene: &MovingScene, mode: SmaaMode, n: u64) {
+    use rtbake::image_buf::Image;
+    let (w, h) = scene.size();
+    for f in 0..n {
+        let (samples, velocity) = scene_frame(scene, mode, f);
+        let names: Vec<String> = if samples.len() == 1 {
+            vec![format!("frame_{f:04}.png")]
+        } else {
+            (0..2).map(|k| format!("frame_{f:04}_s{k}.png")).collect()
+        };
+        for (name, rgba) in names.iter().zip(samples) {
+            let png = rtbake::io::png::encode_u8(&Image::from_vec(w, h, 4, rgba)).unwrap();
+            std::fs::write(dir.join(name), png).unwrap();
+        }
+        let exr = rtbake::io::exr::encode(&Image::from_vec(w, h, 2, velocity), rtbake::io::exr::ExrPrecision::F32);
+        std::fs::write(dir.join(format!("frame_{f:04}_velocity.exr")), exr.unwrap()).unwrap();
+    }
+}
+
+#[test]
+fn run_smaa_mode_writes_the_sequence_and_reads_user_frames() {
+    let t = tempfile::tempdir().unwrap();
+    let baked = baked_dir();
+    // Procedural sequence, every frame.
+    let out = t.path().join("seq");
+    let o = rtbake(&[
+        "run",
+        "smaa",
+        "--mode",
+        "4x",
+        "--cpu",
+        "--frames",
+        "3",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out",
+        s(&out),
+        "--baked-dir",
+        s(&baked),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in 0..3 {
+        let bytes = std::fs::read(out.join(format!("frame_{f:04}.png"))).unwrap();
+        let rtbake::io::png::DecodedPng::U8(img) = rtbake::io::png::decode(&bytes, "frame").unwrap() else {
+            panic!("8-bit")
+        };
+        assert_eq!((img.width, img.height, img.channels), (64, 48, 4));
+        assert!(img.data.chunks(4).all(|p| p[3] == 255), "displayed frames are opaque");
+    }
+    // User frames of the same scene give what the library's CPU twin gives.
+    let (w, h) = (72u32, 40u32);
+    let scene = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap();
+    let input = t.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    write_user_frames(&input, &scene, SmaaMode::T2x, 3);
+    let last = t.path().join("last.png");
+    let o = rtbake(&[
+        "run",
+        "smaa",
+        "--mode",
+        "t2x",
+        "--cpu",
+        "--input-dir",
+        s(&input),
+        "--out",
+        s(&last),
+        "--baked-dir",
+        s(&baked),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut twin = SmaaModesCpu::new(
+        w,
+        h,
+        &baked_smaa(),
+        rtbake::runtime::cpu::FilterPrecision::Exact,
+        SmaaMode::T2x,
+        TemporalResolve::default(),
+    )
+    .unwrap();
+    let mut want = Vec::new();
+    for f in 0..3 {
+        let (samples, velocity) = scene_frame(&scene, SmaaMode::T2x, f);
+        want = twin.run_frame(&ModeFrame { samples: &samples, velocity_px: &velocity }).unwrap();
+    }
+    let rtbake::io::png::DecodedPng::U8(got) = rtbake::io::png::decode(&std::fs::read(&last).unwrap(), "last").unwrap()
+    else {
+        panic!("8-bit")
+    };
+    let want = rtbake::runtime::smaa_modes::opaque(want);
+    assert_eq!(got.data, want, "the command runs the library's CPU twin on the decoded frames");
+}
+
+#[test]
+fn run_smaa_mode_refuses_bad_frame_sequences_naming_the_file() {
+    use rtbake::image_buf::Image;
+    let t = tempfile::tempdir().unwrap();
+    let baked = baked_dir();
+    let scene = MovingScene::new(32, 24, SceneMotion::DEFAULT).unwrap();
+    let run = |dir: &std::path::Path, mode: &str, out: &std::path::Path| {
+        rtbake(&[
+            "run",
+            "smaa",
+            "--mode",
+            mode,
+            "--cpu",
+            "--input-dir",
+            s(dir),
+            "--out",
+            s(out),
+            "--baked-dir",
+            s(&baked),
+        ])
+    };
+    let case = |name: &str, mode: SmaaMode, edit: &dyn Fn(&std::path::Path), want: &[&str]| {
+        let dir = t.path().join(name);
+        std::fs::create_dir(&dir).unwrap();
+        write_user_frames(&dir, &scene, mode, 2);
+        edit(&dir);
+        let out = t.path().join(format!("{name}-out"));
+        let o = run(&dir, mode.name(), &out);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        for w in want {
+            assert!(err.contains(w), "{name}: {err:?} must name {w:?}");
+        }
+        assert!(!out.exists(), "{name}: nothing written");
+    };
+    let write_png =
+        |p: std::path::PathBuf, img: Image<u8>| std::fs::write(p, rtbake::io::png::encode_u8(&img).unwrap()).unwrap();
+    let write_exr = |p: std::path::PathBuf, img: Image<f32>| {
+        std::fs::write(p, rtbake::io::exr::encode(&img, rtbake::io::exr::ExrPrecision::F32).unwrap()).unwrap()
+    };
+    case(
+        "size",
+        SmaaMode::T2x,
+        &|d| write_png(d.join("frame_0001.png"), Image::from_vec(31, 24, 4, vec![9u8; 31 * 24 * 4])),
+        &["frame_0001.png", "31x24", "32x24"],
+    );
+    case(
+        "velocity-size",
+        SmaaMode::X1,
+        &|d| write_exr(d.join("frame_0001_velocity.exr"), Image::from_vec(32, 23, 2, vec![0.0; 32 * 23 * 2])),
+        &["frame_0001_velocity.exr", "32x23"],
+    );
+    case(
+        "missing-velocity",
+        SmaaMode::T2x,
+        &|d| std::fs::remove_file(d.join("frame_0001_velocity.exr")).unwrap(),
+        &["frame_0001_velocity.exr", "missing"],
+    );
+    case(
+        "missing-sample",
+        SmaaMode::S2x,
+        &|d| std::fs::remove_file(d.join("frame_0000_s1.png")).unwrap(),
+        &["frame_0000_s1.png", "missing"],
+    );
+    case(
+        "velocity-channels",
+        SmaaMode::T2x,
+        &|d| write_exr(d.join("frame_0000_velocity.exr"), Image::from_vec(32, 24, 1, vec![0.0; 32 * 24])),
+        &["frame_0000_velocity.exr", "1 channel"],
+    );
+    case(
+        "colour-channels",
+        SmaaMode::X4,
+        &|d| write_png(d.join("frame_0001_s0.png"), Image::from_vec(32, 24, 1, vec![9u8; 32 * 24])),
+        &["frame_0001_s0.png", "1 channel"],
+    );
+    case(
+        "non-finite",
+        SmaaMode::T2x,
+        &|d| {
+            let mut v = vec![0.0f32; 32 * 24 * 2];
+            v[2 * (3 * 32 + 5) + 1] = f32::NAN;
+            write_exr(d.join("frame_0001_velocity.exr"), Image::from_vec(32, 24, 2, v))
+        },
+        &["frame_0001_velocity.exr", "finite", "(5, 3)"],
+    );
+    // No frames at all, and bad flags.
+    let empty = t.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let o = run(&empty, "t2x", &t.path().join("o"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("frame_0000.png"));
+    let o = rtbake(&["run", "smaa", "--mode", "t2x", "--cpu", "--frames", "0", "--out", s(&t.path().join("o"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--frames"));
+    let o = rtbake(&["run", "smaa", "--mode", "t2x", "--cpu", "--k", "-1", "--out", s(&t.path().join("o"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--k"));
+    assert!(!t.path().join("o").exists());
+}
