@@ -22,8 +22,11 @@ use std::time::Instant;
 
 const RUNS: usize = 7;
 
+/// (median, min, max), ms.
+type Stats = (f64, f64, f64);
+
 /// (median, min, max).
-fn stats(mut v: Vec<f64>) -> (f64, f64, f64) {
+fn stats(mut v: Vec<f64>) -> Stats {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
     (v[v.len() / 2], v[0], v[v.len() - 1])
 }
@@ -45,7 +48,7 @@ fn anchor(mode: SmaaMode) -> f64 {
 
 /// Times the current frame of `pass` RUNS times (after one warm-up): per-pass medians (timestamps) and the
 /// sum / wall-time statistics.
-fn time_gpu(g: &Gpu, pass: &SmaaModes) -> (Vec<f64>, (f64, f64, f64), (f64, f64, f64)) {
+fn time_gpu(g: &Gpu, pass: &SmaaModes) -> (Vec<f64>, Stats, Stats) {
     let slots = pass.timed_passes();
     let timer = g.timestamps.then(|| GpuTimer::new(&g.device, slots));
     let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); slots as usize];

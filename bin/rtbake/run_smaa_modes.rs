@@ -224,7 +224,7 @@ pub fn run(ctx: &Ctx, a: SmaaArgs, cpu: bool, baked: &Path) -> anyhow::Result<()
             return Err(usage_msg(format!("--out {}: directory {} does not exist", out.display(), dir.display())));
         }
     }
-    rtbake::io::file_set::check_outputs_not_inputs(&[out.clone()], &inputs)
+    rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(&out), &inputs)
         .map_err(|e| usage(anyhow::anyhow!("--out: {e}")))?;
     // The sequence: user frames (all read and checked first) or the procedural scene.
     let (w, h, user, scene) = match &a.input_dir {
