@@ -80,9 +80,29 @@ fn time_gpu(g: &Gpu, pass: &SmaaModes) -> (Vec<f64>, Stats, Stats) {
     (pp, sum, stats(wall))
 }
 
+/// Whether the adapter named `name` offers 2× multisampling of `Rgba8Unorm` (`TextureFormatFeatures`), which a
+/// renderer feeding S2x/4x needs (wgpu guarantees only 1× and 4×); `None` when it is not found again.
+fn msaa_2x_supported(name: &str) -> Option<bool> {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
+    let backends = desc.backends;
+    let instance = wgpu::Instance::new(desc);
+    let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    let a = adapters.into_iter().find(|a| a.get_info().name == name)?;
+    Some(a.get_texture_format_features(wgpu::TextureFormat::Rgba8Unorm).flags.sample_count_supported(2))
+}
+
 fn main() {
     let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
     println!("adapter: {}", g.describe());
+    println!(
+        "2x MSAA of Rgba8Unorm on this adapter: {} (the passes take one image per sample either way)",
+        match msaa_2x_supported(&g.adapter_info.name) {
+            Some(true) => "supported",
+            Some(false) => "not supported",
+            None => "unknown",
+        }
+    );
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
     println!("medians of {RUNS} runs (min–max); scene: rtbake::runtime::moving_scene, frame 1");
     let luts = loader::load_smaa_textures(&baked_dir()).unwrap_or_else(|e| panic!("{e}"));
