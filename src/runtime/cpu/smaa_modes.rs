@@ -9,8 +9,20 @@ use crate::runtime::smaa::SmaaTextures;
 use crate::runtime::smaa_modes::{with_velocity_alpha, ModeFrame, SmaaMode, TemporalResolve};
 use rayon::prelude::*;
 
+/// `srgb_to_linear(v / 255)` for every byte: the same f32 values as decoding each fetch, computed once.
+fn decode_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)))
+}
+
+/// The shader's `lin(textureLoad(…))`: clamp-to-edge load, RGB decoded to linear, alpha as stored.
 fn lin(t: &Tex8, x: i32, y: i32) -> [f32; 4] {
-    [srgb_to_linear(t.load(x, y, 0)), srgb_to_linear(t.load(x, y, 1)), srgb_to_linear(t.load(x, y, 2)), t.load(x, y, 3)]
+    let x = x.clamp(0, t.w as i32 - 1) as usize;
+    let y = y.clamp(0, t.h as i32 - 1) as usize;
+    let i = (y * t.w as usize + x) * 4;
+    let d = decode_table();
+    let p = &t.data[i..i + 4];
+    [d[p[0] as usize], d[p[1] as usize], d[p[2] as usize], p[3] as f32 / 255.0]
 }
 
 /// The shader's `blend`: linear-light lerp of two sRGB-encoded colours (alpha linear), re-encoded.
@@ -132,6 +144,16 @@ impl SmaaModesCpu {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decode_table_equals_decoding_each_fetch() {
+        for v in 0..=255u8 {
+            let data = [v, v, v, v];
+            let t = Tex8::new(1, 1, 4, &data);
+            assert_eq!(lin(&t, 0, 0)[0], srgb_to_linear(t.load(0, 0, 0)));
+            assert_eq!(lin(&t, 3, -2)[3], t.load(0, 0, 3));
+        }
+    }
 
     #[test]
     fn resolve_weights_follow_eq_10_6() {
