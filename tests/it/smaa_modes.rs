@@ -415,5 +415,10 @@ fn run_smaa_mode_refuses_bad_frame_sequences_naming_the_file() {
     let o = rtbake(&["run", "smaa", "--mode", "t2x", "--cpu", "--k", "-1", "--out", s(&t.path().join("o"))]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--k"));
+    // A sequence over the memory budget is refused before any work.
+    let o = rtbake(&["run", "smaa", "--mode", "4x", "--cpu", "--max-memory", "1M", "--out", s(&t.path().join("o"))]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--mode 4x (8 frames of 640x360)") && err.contains("--max-memory"), "{err}");
     assert!(!t.path().join("o").exists());
 }
