@@ -17,8 +17,9 @@ use std::time::Instant;
 
 #[derive(clap::Subcommand)]
 pub enum RunCommand {
-    /// Antialias a PNG with SMAA 1x (area/search textures from the bake directory).
-    Smaa(AaArgs),
+    /// Antialias a PNG with SMAA 1x (area/search textures from the bake directory), or a frame sequence with
+    /// SMAA 1x/S2x/T2x/4x (--mode).
+    Smaa(crate::run_smaa_modes::SmaaArgs),
     /// Antialias a PNG with Jimenez's MLAA (area map of --max-distance from the bake directory).
     Mlaa(MlaaArgs),
     /// Subsurface scattering on a linear EXR (RGBA, alpha = strength) with its linear-depth EXR: separable SSS
@@ -177,7 +178,13 @@ pub struct DemoArgs {
 pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
     ensure_runtime_dir();
     match cmd {
-        RunCommand::Smaa(a) => {
+        RunCommand::Smaa(s) if s.mode.is_some() => {
+            let (cpu, baked) = (s.common.cpu, s.common.baked.clone());
+            crate::run_smaa_modes::run(ctx, s, cpu, &baked)
+        }
+        RunCommand::Smaa(s) => {
+            let (input, output) = (s.input.expect("clap: --input"), s.output.expect("clap: --output"));
+            let a = AaArgs { input, output, edges: s.edges, common: s.common };
             check_output(&a.output, &[&[a.input.as_path()][..], &a.edges.files()].concat())?;
             let img = read_png(&a.input)?;
             let aa = Antialiasing::Smaa(loader::load_smaa_textures(&a.common.baked).map_err(usage)?);
@@ -262,7 +269,7 @@ fn read_png(path: &Path) -> anyhow::Result<Image<u8>> {
     Ok(chain::to_rgba8(&img)?)
 }
 
-fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
+pub(crate) fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
     if cpu {
         ctx.info("backend: CPU reference");
         return Ok(None);

@@ -232,3 +232,45 @@ pub fn transport_estimate(
     };
     (bytes, settings.time_estimate_seconds(threads))
 }
+
+/// SMAA 1x/S2x/T2x/4x over a frame sequence, on the GPU ([`super::smaa_modes::SmaaModes`]) or its CPU twin
+/// ([`super::cpu::smaa_modes::SmaaModesCpu`]).
+pub enum SmaaSequence<'g> {
+    Gpu(&'g Gpu, Box<super::smaa_modes::SmaaModes>),
+    Cpu(Box<super::cpu::smaa_modes::SmaaModesCpu>),
+}
+
+impl<'g> SmaaSequence<'g> {
+    /// `gpu: None` = the CPU twin.
+    pub fn new(
+        gpu: Option<&'g Gpu>,
+        (w, h): (u32, u32),
+        luts: &super::smaa::SmaaTextures,
+        mode: super::smaa_modes::SmaaMode,
+        resolve: super::smaa_modes::TemporalResolve,
+    ) -> Result<Self, RuntimeError> {
+        Ok(match gpu {
+            Some(g) => Self::Gpu(
+                g,
+                Box::new(super::smaa_modes::SmaaModes::new(&g.device, &g.queue, w, h, luts, mode, resolve)?),
+            ),
+            None => Self::Cpu(Box::new(super::cpu::smaa_modes::SmaaModesCpu::new(
+                w,
+                h,
+                luts,
+                super::cpu::FilterPrecision::Exact,
+                mode,
+                resolve,
+            )?)),
+        })
+    }
+
+    /// Runs one frame; returns the displayed image (RGBA8, sRGB-encoded, alpha 255).
+    pub fn run_frame(&mut self, frame: &super::smaa_modes::ModeFrame<'_>) -> Result<Vec<u8>, RuntimeError> {
+        let out = match self {
+            Self::Gpu(g, p) => p.run_frame(&g.device, &g.queue, frame)?,
+            Self::Cpu(p) => p.run_frame(frame)?,
+        };
+        Ok(super::smaa_modes::opaque(out))
+    }
+}

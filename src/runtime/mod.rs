@@ -20,11 +20,13 @@ pub mod importance_sss;
 pub mod loader;
 pub mod mesh_raster;
 pub mod mlaa;
+pub mod moving_scene;
 pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
 pub mod smaa;
 pub mod smaa_edges;
+pub mod smaa_modes;
 pub mod transport_gpu;
 
 /// Errors of the runtime.

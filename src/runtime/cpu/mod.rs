@@ -14,6 +14,7 @@ pub mod separable_sss;
 pub mod skin_inputs;
 pub mod smaa;
 pub mod smaa_edges;
+pub mod smaa_modes;
 
 /// How a bilinear fetch of an 8-bit texture is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -1,0 +1,73 @@
+// SMAA S2x / T2x / 4x resolves (thesis ch. 10, §10.4.3–10.4.4; Jimenez et al., Eurographics 2012):
+// - fs_average: the S2x resolve, the mean of the two per-sample SMAA outputs in linear light;
+// - fs_resolve: the temporal resolve of T2x and 4x, eq. 10.6–10.7: the previous SMAA'd frame is reprojected to
+//   p − v (nearest texel, v = velocity in pixels per frame) and blended with weight
+//   w = 0.5 · max(0, 1 − K · sqrt(| ‖v_c‖ − ‖v_p‖ |)), c = (1 − w) · c_c + w · c_p,
+//   with ‖v‖ in normalised screen units carried in the alpha channel as a = sqrt(5 ‖v‖) (so that SMAA, which blends
+//   alpha like colour, propagates velocity to the antialiased pixels, as the thesis prescribes); or the plain 50/50
+//   blend without reprojection.
+// Written for rtbake from the thesis' equations; the CPU twin is `runtime/cpu/smaa_modes.rs` (keep in sync).
+// Colour textures are Rgba8Unorm holding sRGB-encoded values; the velocity texture is Rg32Float (px/frame).
+
+struct Params {
+    // (1/width, 1/height, width, height)
+    rt: vec4<f32>,
+    // x: K of eq. 10.6; y: 1 = plain 50/50 blend (no reprojection), 0 = velocity-weighted reprojection;
+    // z: 1 when a previous frame exists (else the current frame passes through).
+    resolve: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var a_tex: texture_2d<f32>;
+@group(0) @binding(2) var b_tex: texture_2d<f32>;
+@group(0) @binding(3) var velocity_tex: texture_2d<f32>;
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((i << 1u) & 2u);
+    let y = f32(i & 2u);
+    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
+}
+
+fn lin(c: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(srgb_to_linear(c.rgb), c.a);
+}
+
+// Linear-light lerp of two sRGB-encoded colours (alpha linear), re-encoded.
+fn blend(cur: vec4<f32>, prev: vec4<f32>, w: f32) -> vec4<f32> {
+    let c = lin(cur) + (lin(prev) - lin(cur)) * w;
+    return vec4<f32>(linear_to_srgb(c.rgb), c.a);
+}
+
+@fragment
+fn fs_average(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(floor(pos.xy));
+    return blend(textureLoad(a_tex, p, 0), textureLoad(b_tex, p, 0), 0.5);
+}
+
+@fragment
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let p = vec2<i32>(floor(pos.xy));
+    let cur = textureLoad(a_tex, p, 0);
+    if (P.resolve.z < 0.5) {
+        return cur;
+    }
+    if (P.resolve.y > 0.5) {
+        return blend(cur, textureLoad(b_tex, p, 0), 0.5);
+    }
+    let v = textureLoad(velocity_tex, p, 0).xy;
+    let size = vec2<i32>(P.rt.zw);
+    let q = clamp(vec2<i32>(floor(pos.xy - v)), vec2<i32>(0, 0), size - vec2<i32>(1, 1));
+    let prev = textureLoad(b_tex, q, 0);
+    let delta = abs(cur.a * cur.a - prev.a * prev.a) / 5.0;
+    let w = 0.5 * clamp(1.0 - P.resolve.x * sqrt(delta), 0.0, 1.0);
+    return blend(cur, prev, w);
+}
