@@ -367,3 +367,80 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
     });
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::manifest::sha256_hex;
+    use crate::runtime::scene::render_shapes;
+
+    fn luts() -> SmaaTextures {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("baked");
+        crate::runtime::loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Blocks of pseudo-random colour (sizes 1–5 px) with sparse single-pixel noise: edges of every
+    /// orientation, diagonal staircases, edges at the image border and isolated texels.
+    fn blocks(w: u32, h: u32, seed: u64) -> Vec<u8> {
+        let mut s = seed;
+        let mut next = move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        let palette: Vec<[u8; 3]> = (0..6).map(|_| [next() as u8, next() as u8, next() as u8]).collect();
+        let (bw, bh) = (1 + next() % 5, 1 + next() % 5);
+        let cells: Vec<usize> = (0..(w / bw + 1) * (h / bh + 1)).map(|_| (next() % 6) as usize).collect();
+        let mut out = vec![255u8; (w * h * 4) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                let mut c = palette[cells[((y / bh) * (w / bw + 1) + x / bw) as usize]];
+                if next() % 17 == 0 {
+                    c = [next() as u8, next() as u8, next() as u8];
+                }
+                let i = ((y * w + x) * 4) as usize;
+                out[i..i + 3].copy_from_slice(&c);
+            }
+        }
+        out
+    }
+
+    fn digest(o: &SmaaCpuOutput) -> String {
+        format!("{} {} {}", &sha256_hex(&o.edges)[..16], &sha256_hex(&o.weights)[..16], &sha256_hex(&o.output)[..16])
+    }
+
+    /// The CPU twin is the GPU pass' reference: its bytes are pinned (edges, weights, output) on the procedural
+    /// scene at 1080p (both filter-precision models, 1x and one 4x slice set) and on random block images of odd
+    /// sizes, so a faster implementation cannot change a byte. Digests computed with the straightforward
+    /// per-texel implementation (rtbake 8582a9a).
+    #[test]
+    fn smaa_cpu_bytes_are_pinned() {
+        let luts = luts();
+        let mut got = Vec::new();
+        let img = render_shapes(1920, 1080, 1);
+        got.push(digest(&smaa(&img, 1920, 1080, &luts, FilterPrecision::Exact)));
+        got.push(digest(&smaa(&img, 1920, 1080, &luts, FilterPrecision::Unorm8)));
+        let s = SubsampleIndices::SMAA_4X[1];
+        got.push(digest(&smaa_with_subsample(&img, 1920, 1080, &luts, FilterPrecision::Exact, s)));
+        for (w, h, seed) in [(131u32, 77u32, 1u64), (64, 1, 2), (1, 50, 3), (257, 129, 4), (300, 200, 5)] {
+            let img = blocks(w, h, seed);
+            got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Exact)));
+            got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Unorm8)));
+        }
+        let want = [
+            "9c60cb7d5f0b648a 9c2269e7d6522968 9c85caf4f6f2dd1c",
+            "9c60cb7d5f0b648a 45e800a8a42441f9 9ceb3e987dac90ca",
+            "9c60cb7d5f0b648a b39f37d76131e0af daf083e9dd5930de",
+            "f1ce57e563bac39f 98404b72142a8bf3 e3ec6c9cbe8cbe3a",
+            "f1ce57e563bac39f ecd91d891171d995 caf1e9790aa64c89",
+            "464293f4d76270ee 5341e6b2646979a7 b317eb6f91cea9af",
+            "464293f4d76270ee 5341e6b2646979a7 b317eb6f91cea9af",
+            "f5d6c615338bc967 6d9c54dee5660c46 c89a862cd48d6651",
+            "f5d6c615338bc967 6d9c54dee5660c46 c89a862cd48d6651",
+            "e17ecef60f12243a 9d631b98f6b45308 63c3b0da32742251",
+            "e17ecef60f12243a 16219f835b547026 6bf7d3d8a711872b",
+            "58515544228b9611 9fecddf279cc44df c32f924a55ad1083",
+            "58515544228b9611 f559fc10f825a238 f6f8b9ad91ecae85",
+        ];
+        assert_eq!(got, want);
+    }
+}
