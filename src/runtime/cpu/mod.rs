@@ -55,7 +55,7 @@ impl<'a> Tex8<'a> {
     pub fn load(&self, x: i32, y: i32, c: u32) -> f32 {
         let x = x.clamp(0, self.w as i32 - 1) as usize;
         let y = y.clamp(0, self.h as i32 - 1) as usize;
-        self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as f32 / 255.0
+        UNORM8_F32[self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as usize]
     }
 
     /// Nearest fetch of channels 0 and 1 at normalised coordinates (clamp-to-edge).
@@ -79,13 +79,19 @@ impl<'a> Tex8<'a> {
             fx = (fx * 256.0).round() / 256.0;
             fy = (fy * 256.0).round() / 256.0;
         }
+        // The four texels' offsets once (clamp-to-edge), then one table read per texel and channel.
+        let (wm, hm) = (self.w as i32 - 1, self.h as i32 - 1);
+        let (xa, xb) = (x0.clamp(0, wm) as usize, x0.saturating_add(1).clamp(0, wm) as usize);
+        let (ya, yb) =
+            (y0.clamp(0, hm) as usize * self.w as usize, y0.saturating_add(1).clamp(0, hm) as usize * self.w as usize);
+        let ch = self.ch as usize;
+        let (i00, i10, i01, i11) = ((ya + xa) * ch, (ya + xb) * ch, (yb + xa) * ch, (yb + xb) * ch);
         let mut out = [0.0f32; 2];
-        for (c, o) in out.iter_mut().enumerate().take(self.ch.min(2) as usize) {
-            let c = c as u32;
-            let t00 = self.load(x0, y0, c);
-            let t10 = self.load(x0 + 1, y0, c);
-            let t01 = self.load(x0, y0 + 1, c);
-            let t11 = self.load(x0 + 1, y0 + 1, c);
+        for (c, o) in out.iter_mut().enumerate().take(ch.min(2)) {
+            let t00 = UNORM8_F32[self.data[i00 + c] as usize];
+            let t10 = UNORM8_F32[self.data[i10 + c] as usize];
+            let t01 = UNORM8_F32[self.data[i01 + c] as usize];
+            let t11 = UNORM8_F32[self.data[i11 + c] as usize];
             *o = match prec {
                 FilterPrecision::Exact => {
                     let top = t00 + (t10 - t00) * fx;
@@ -103,6 +109,18 @@ impl<'a> Tex8<'a> {
         out
     }
 }
+
+/// `v as f32 / 255.0` for every byte `v`: an 8-bit UNORM texel as the shader reads it (the same correctly rounded
+/// quotient, looked up instead of divided).
+pub const UNORM8_F32: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = i as f32 / 255.0;
+        i += 1;
+    }
+    t
+};
 
 /// Stores a float in an 8-bit UNORM render target (clamp, round to nearest).
 #[inline]
@@ -194,6 +212,13 @@ mod tests {
         assert_eq!(t.load(-5, -5, 0), 10.0 / 255.0);
         assert_eq!(t.load(9, 9, 0), 40.0 / 255.0);
         assert_eq!(t.sample2_nearest(0.74, 0.26,)[0], 20.0 / 255.0);
+    }
+
+    #[test]
+    fn unorm8_table_is_the_quotient() {
+        for v in 0..=255u8 {
+            assert_eq!(UNORM8_F32[v as usize].to_bits(), (v as f32 / 255.0).to_bits());
+        }
     }
 
     #[test]

@@ -53,40 +53,56 @@ pub fn smaa_with_subsample(
     SmaaCpuOutput { edges, weights, output }
 }
 
+/// Rows per parallel band of the edge pass: the band's luma rows (plus two above, one below) stay in cache.
+const EDGE_BAND_ROWS: usize = 32;
+
 /// Pass 1: luma edge detection with local contrast adaptation.
+///
+/// Row bands in parallel (disjoint outputs, so the bytes do not depend on the thread count). Each band tabulates
+/// the luma of its rows and of the two rows above and one below (clamped), each row padded with two clamped
+/// texels on the left and one on the right, so the per-texel test reads without clamping. The luma is the
+/// shader's dot product, evaluated in the same order.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
     let (w, h) = (color.w as usize, color.h as usize);
-    // Luma of every pixel once (same expression as the shader's dot product, evaluated per texel).
-    let mut lum = vec![0.0f32; w * h];
-    lum.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, l) in row.iter_mut().enumerate() {
-            let i = (y * w + x) * 4;
-            let c = &color.data[i..i + 3];
-            *l = (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
-        }
-    });
-    let luma = |x: i32, y: i32| lum[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
-    let step = |edge: f32, x: f32| if x >= edge { 1.0f32 } else { 0.0 };
     let mut out = vec![0u8; w * h * 2];
-    out.par_chunks_mut(w * 2).enumerate().for_each(|(y, row)| {
-        let y = y as i32;
-        for x in 0..w as i32 {
-            let l = luma(x, y);
-            let (l_left, l_top) = (luma(x - 1, y), luma(x, y - 1));
-            let delta = [(l - l_left).abs(), (l - l_top).abs()];
-            let mut edges = [step(THRESHOLD, delta[0]), step(THRESHOLD, delta[1])];
-            if edges[0] + edges[1] == 0.0 {
-                continue;
+    if out.is_empty() {
+        return out;
+    }
+    let stride = w + 3;
+    out.par_chunks_mut(w * 2 * EDGE_BAND_ROWS).enumerate().for_each(|(b, band)| {
+        let y0 = b * EDGE_BAND_ROWS;
+        let rows = band.len() / (2 * w);
+        let mut lum = vec![0.0f32; stride * (rows + 3)];
+        for (k, lrow) in lum.chunks_exact_mut(stride).enumerate() {
+            let y = (y0 + k).saturating_sub(2).min(h - 1);
+            let src = &color.data[y * w * 4..(y + 1) * w * 4];
+            for (l, c) in lrow[2..2 + w].iter_mut().zip(src.chunks_exact(4)) {
+                *l =
+                    (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
             }
-            let (l_right, l_bottom) = (luma(x + 1, y), luma(x, y + 1));
-            let mut max_delta = [delta[0].max((l - l_right).abs()), delta[1].max((l - l_bottom).abs())];
-            let (l_leftleft, l_toptop) = (luma(x - 2, y), luma(x, y - 2));
-            max_delta = [max_delta[0].max((l_left - l_leftleft).abs()), max_delta[1].max((l_top - l_toptop).abs())];
-            let final_delta = max_delta[0].max(max_delta[1]);
-            edges[0] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[0]);
-            edges[1] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[1]);
-            row[x as usize * 2] = unorm8(edges[0]);
-            row[x as usize * 2 + 1] = unorm8(edges[1]);
+            (lrow[0], lrow[1], lrow[w + 2]) = (lrow[2], lrow[2], lrow[w + 1]);
+        }
+        for (r, orow) in band.chunks_exact_mut(2 * w).enumerate() {
+            // Rows y − 2, y − 1, y, y + 1 of the band's table; texel x is at index x + 2.
+            let tt = &lum[r * stride..(r + 1) * stride];
+            let t = &lum[(r + 1) * stride..(r + 2) * stride];
+            let c = &lum[(r + 2) * stride..(r + 3) * stride];
+            let bo = &lum[(r + 3) * stride..(r + 4) * stride];
+            // Branch-free over the row (the compiler vectorises it); the shader's early exit only skips work.
+            let (cl, cc, cr, cll) = (&c[1..w + 1], &c[2..w + 2], &c[3..w + 3], &c[0..w]);
+            let (tc, ttc, bc) = (&t[2..w + 2], &tt[2..w + 2], &bo[2..w + 2]);
+            for (x, o) in orow.chunks_exact_mut(2).enumerate() {
+                let l = cc[x];
+                let delta = [(l - cl[x]).abs(), (l - tc[x]).abs()];
+                let max_delta = [delta[0].max((l - cr[x]).abs()), delta[1].max((l - bc[x]).abs())];
+                let max_delta = [max_delta[0].max((cl[x] - cll[x]).abs()), max_delta[1].max((tc[x] - ttc[x]).abs())];
+                let final_delta = max_delta[0].max(max_delta[1]);
+                // step(THRESHOLD, delta) · step(final_delta, 2·delta); a set edge is stored as unorm8(1.0) = 255.
+                let edge =
+                    |d: f32| if d >= THRESHOLD && LOCAL_CONTRAST_ADAPTATION * d >= final_delta { 255 } else { 0 };
+                o[0] = edge(delta[0]);
+                o[1] = edge(delta[1]);
+            }
         }
     });
     out
@@ -312,22 +328,42 @@ pub fn blending_weights_with_subsample(
     let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
         let erow = &edges.data[y * w as usize * 2..(y + 1) * w as usize * 2];
-        for x in 0..w {
-            if erow[x as usize * 2] == 0 && erow[x as usize * 2 + 1] == 0 {
-                continue; // no edge: all weights are zero
+        // No edge, no weights: skip the (mostly zero) edge row eight bytes, four texels, at a time.
+        let mut words = erow.chunks_exact(8);
+        let mut x0 = 0usize;
+        for word in words.by_ref() {
+            if u64::from_ne_bytes(word.try_into().unwrap()) != 0 {
+                blend_weights_of(&ctx, erow, row, x0..x0 + 4, y as u32);
             }
-            let wgt = ctx.pixel(x, y as u32);
-            for c in 0..4 {
-                row[x as usize * 4 + c] = unorm8(wgt[c]);
-            }
+            x0 += 4;
         }
+        blend_weights_of(&ctx, erow, row, x0..w as usize, y as u32);
     });
     out
 }
 
+/// Weights of the texels `xs` of row `y` that have an edge, stored in that row of the output.
+#[inline]
+fn blend_weights_of(ctx: &Ctx, erow: &[u8], row: &mut [u8], xs: std::ops::Range<usize>, y: u32) {
+    for x in xs {
+        if erow[x * 2] == 0 && erow[x * 2 + 1] == 0 {
+            continue; // no edge: all weights are zero
+        }
+        let wgt = ctx.pixel(x as u32, y);
+        for c in 0..4 {
+            row[x * 4 + c] = unorm8(wgt[c]);
+        }
+    }
+}
+
 /// Pass 3: neighbourhood blending in linear light; output RGBA8 sRGB-encoded.
+///
+/// A texel whose four blending weights (its own R and B, the right neighbour's A, the lower neighbour's G) are
+/// all zero keeps its input bytes (their sum is below the shader's 1e-5 exactly when every byte is 0), so the
+/// output starts as a copy of the input and only texels next to an edge are blended, found eight at a time.
 pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
-    let (w, h) = (color.w, color.h);
+    let (w, h) = (color.w as usize, color.h as usize);
+    assert_eq!((weights.w as usize, weights.h as usize, weights.ch, color.ch), (w, h, 4, 4), "texture sizes");
     let color_lin = |x: i32, y: i32| {
         [
             srgb_to_linear(color.load(x, y, 0)),
@@ -336,32 +372,56 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
             color.load(x, y, 3),
         ]
     };
-    let mut out = vec![0u8; (w * h * 4) as usize];
-    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
-        let y = y as i32;
-        for x in 0..w as i32 {
-            let a =
-                [weights.load(x + 1, y, 3), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x, y, 0)];
-            let o = x as usize * 4;
-            if a[0] + a[1] + a[2] + a[3] < 1e-5 {
-                let i = (y as usize * w as usize + x as usize) * 4;
-                row[o..o + 4].copy_from_slice(&color.data[i..i + 4]);
+    let mut out = vec![0u8; w * h * 4];
+    if out.is_empty() {
+        return out;
+    }
+    out.par_chunks_mut(w * 4).enumerate().for_each(|(y, row)| {
+        row.copy_from_slice(&color.data[y * w * 4..(y + 1) * w * 4]);
+        let wrow = &weights.data[y * w * 4..(y + 1) * w * 4];
+        let yb = (y + 1).min(h - 1);
+        let wbelow = &weights.data[yb * w * 4..(yb + 1) * w * 4];
+        let zero = |s: &[u8]| s.iter().fold(0u8, |a, &b| a | b) == 0;
+        let zero32 = |s: &[u8]| <&[u8; 32]>::try_from(s).unwrap().iter().fold(0u8, |a, &b| a | b) == 0;
+        for x0 in (0..w).step_by(8) {
+            let x1 = (x0 + 8).min(w);
+            // Bytes any texel of x0..x1 reads: this row's up to texel x1 (its A), the row below's.
+            let quiet = if x1 == x0 + 8 {
+                zero32(&wrow[x0 * 4..x1 * 4]) && zero32(&wbelow[x0 * 4..x1 * 4]) && (x1 == w || wrow[x1 * 4 + 3] == 0)
+            } else {
+                zero(&wrow[x0 * 4..w * 4]) && zero(&wbelow[x0 * 4..w * 4])
+            };
+            if quiet {
                 continue;
             }
-            let c = color_lin(x, y);
-            let horizontal = a[0].max(a[2]) > a[1].max(a[3]);
-            let (wt, n0, n1) = if horizontal {
-                ([a[0], a[2]], color_lin(x + 1, y), color_lin(x - 1, y))
-            } else {
-                ([a[1], a[3]], color_lin(x, y + 1), color_lin(x, y - 1))
-            };
-            let s = wt[0] + wt[1];
-            let wn = [wt[0] / s, wt[1] / s];
-            for k in 0..4 {
-                let m0 = c[k] + (n0[k] - c[k]) * wt[0];
-                let m1 = c[k] + (n1[k] - c[k]) * wt[1];
-                let v = wn[0] * m0 + wn[1] * m1;
-                row[o + k] = unorm8(if k < 3 { linear_to_srgb(v) } else { v });
+            for x in x0..x1 {
+                let wx = x * 4;
+                let right = (x + 1).min(w - 1) * 4 + 3;
+                if wrow[right] == 0 && wbelow[wx + 1] == 0 && wrow[wx + 2] == 0 && wrow[wx] == 0 {
+                    continue;
+                }
+                let (xi, yi) = (x as i32, y as i32);
+                let a = [
+                    weights.load(xi + 1, yi, 3),
+                    weights.load(xi, yi + 1, 1),
+                    weights.load(xi, yi, 2),
+                    weights.load(xi, yi, 0),
+                ];
+                let c = color_lin(xi, yi);
+                let horizontal = a[0].max(a[2]) > a[1].max(a[3]);
+                let (wt, n0, n1) = if horizontal {
+                    ([a[0], a[2]], color_lin(xi + 1, yi), color_lin(xi - 1, yi))
+                } else {
+                    ([a[1], a[3]], color_lin(xi, yi + 1), color_lin(xi, yi - 1))
+                };
+                let s = wt[0] + wt[1];
+                let wn = [wt[0] / s, wt[1] / s];
+                for k in 0..4 {
+                    let m0 = c[k] + (n0[k] - c[k]) * wt[0];
+                    let m1 = c[k] + (n1[k] - c[k]) * wt[1];
+                    let v = wn[0] * m0 + wn[1] * m1;
+                    row[wx + k] = unorm8(if k < 3 { linear_to_srgb(v) } else { v });
+                }
             }
         }
     });
