@@ -45,12 +45,34 @@ pub fn smaa_with_subsample(
     prec: FilterPrecision,
     subsample: SubsampleIndices,
 ) -> SmaaCpuOutput {
+    let mut out = SmaaCpuOutput { edges: Vec::new(), weights: Vec::new(), output: Vec::new() };
+    smaa_into(rgba, w, h, luts, prec, subsample, &mut out);
+    out
+}
+
+/// [`smaa_with_subsample`] into the buffers of a previous run (resized as needed), the CPU counterpart of the GPU
+/// pass creating its textures once and reusing them every frame: a frame then allocates nothing and touches no
+/// fresh pages (at 1080p the three buffers are 20 MB; first-touch page faults cost more than the passes).
+/// Same bytes as [`smaa_with_subsample`].
+pub fn smaa_into(
+    rgba: &[u8],
+    w: u32,
+    h: u32,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+    out: &mut SmaaCpuOutput,
+) {
     assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
+    let n = (w * h) as usize;
+    out.edges.resize(2 * n, 0);
+    out.weights.resize(4 * n, 0);
+    out.output.resize(4 * n, 0);
     let color = Tex8::new(w, h, 4, rgba);
-    let edges = edge_detection(&color);
-    let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, subsample);
-    let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
-    SmaaCpuOutput { edges, weights, output }
+    edge_detection_into(&color, &mut out.edges);
+    let edges = Tex8::new(w, h, 2, &out.edges);
+    blending_weights_into(&edges, luts, prec, subsample, &mut out.weights);
+    neighbourhood_blending_into(&color, &Tex8::new(w, h, 4, &out.weights), &mut out.output);
 }
 
 /// Rows per parallel band of the edge pass: the band's luma rows (plus two above, one below) stay in cache.
@@ -63,10 +85,17 @@ const EDGE_BAND_ROWS: usize = 32;
 /// texels on the left and one on the right, so the per-texel test reads without clamping. The luma is the
 /// shader's dot product, evaluated in the same order.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
+    let mut out = vec![0u8; color.w as usize * color.h as usize * 2];
+    edge_detection_into(color, &mut out);
+    out
+}
+
+/// [`edge_detection`] into `out` (`w·h·2` bytes; every byte is written).
+pub fn edge_detection_into(color: &Tex8, out: &mut [u8]) {
     let (w, h) = (color.w as usize, color.h as usize);
-    let mut out = vec![0u8; w * h * 2];
+    assert_eq!(out.len(), w * h * 2, "edge buffer size");
     if out.is_empty() {
-        return out;
+        return;
     }
     let stride = w + 3;
     out.par_chunks_mut(w * 2 * EDGE_BAND_ROWS).enumerate().for_each(|(b, band)| {
@@ -105,7 +134,6 @@ pub fn edge_detection(color: &Tex8) -> Vec<u8> {
             }
         }
     });
-    out
 }
 
 struct Ctx<'a> {
@@ -316,7 +344,24 @@ pub fn blending_weights_with_subsample(
     prec: FilterPrecision,
     subsample: SubsampleIndices,
 ) -> Vec<u8> {
+    let mut out = vec![0u8; (edges.w * edges.h * 4) as usize];
+    blending_weights_into(edges, luts, prec, subsample, &mut out);
+    out
+}
+
+/// [`blending_weights_with_subsample`] into `out` (`w·h·4` bytes; every byte is written).
+pub fn blending_weights_into(
+    edges: &Tex8,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+    out: &mut [u8],
+) {
     let (w, h) = (edges.w, edges.h);
+    assert_eq!(out.len(), (w * h * 4) as usize, "weight buffer size");
+    if out.is_empty() {
+        return;
+    }
     let ctx = Ctx {
         edges: *edges,
         area: Tex8::new(AREA_TEX_SIZE.0, AREA_TEX_SIZE.1, 2, &luts.area),
@@ -325,8 +370,8 @@ pub fn blending_weights_with_subsample(
         prec,
         subsample: subsample.as_f32(),
     };
-    let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        row.fill(0);
         let erow = &edges.data[y * w as usize * 2..(y + 1) * w as usize * 2];
         // No edge, no weights: skip the (mostly zero) edge row eight bytes, four texels, at a time.
         let mut words = erow.chunks_exact(8);
@@ -339,7 +384,6 @@ pub fn blending_weights_with_subsample(
         }
         blend_weights_of(&ctx, erow, row, x0..w as usize, y as u32);
     });
-    out
 }
 
 /// Weights of the texels `xs` of row `y` that have an edge, stored in that row of the output.
@@ -362,7 +406,15 @@ fn blend_weights_of(ctx: &Ctx, erow: &[u8], row: &mut [u8], xs: std::ops::Range<
 /// all zero keeps its input bytes (their sum is below the shader's 1e-5 exactly when every byte is 0), so the
 /// output starts as a copy of the input and only texels next to an edge are blended, found eight at a time.
 pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
+    let mut out = vec![0u8; color.w as usize * color.h as usize * 4];
+    neighbourhood_blending_into(color, weights, &mut out);
+    out
+}
+
+/// [`neighbourhood_blending`] into `out` (`w·h·4` bytes; every byte is written).
+pub fn neighbourhood_blending_into(color: &Tex8, weights: &Tex8, out: &mut [u8]) {
     let (w, h) = (color.w as usize, color.h as usize);
+    assert_eq!(out.len(), w * h * 4, "output buffer size");
     assert_eq!((weights.w as usize, weights.h as usize, weights.ch, color.ch), (w, h, 4, 4), "texture sizes");
     let color_lin = |x: i32, y: i32| {
         [
@@ -372,9 +424,8 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
             color.load(x, y, 3),
         ]
     };
-    let mut out = vec![0u8; w * h * 4];
     if out.is_empty() {
-        return out;
+        return;
     }
     out.par_chunks_mut(w * 4).enumerate().for_each(|(y, row)| {
         row.copy_from_slice(&color.data[y * w * 4..(y + 1) * w * 4]);
@@ -425,7 +476,6 @@ pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
             }
         }
     });
-    out
 }
 
 #[cfg(test)]
@@ -485,6 +535,13 @@ mod tests {
             let img = blocks(w, h, seed);
             got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Exact)));
             got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Unorm8)));
+        }
+        // The reusing entry point gives the same bytes, also into buffers of another size and content.
+        let mut reused = smaa(&blocks(300, 200, 9), 300, 200, &luts, FilterPrecision::Exact);
+        for (w, h, seed) in [(131u32, 77u32, 1u64), (300, 200, 5)] {
+            let img = blocks(w, h, seed);
+            smaa_into(&img, w, h, &luts, FilterPrecision::Unorm8, SubsampleIndices::SMAA_1X, &mut reused);
+            assert_eq!(digest(&reused), digest(&smaa(&img, w, h, &luts, FilterPrecision::Unorm8)), "{w}x{h}");
         }
         let want = [
             "9c60cb7d5f0b648a 9c2269e7d6522968 9c85caf4f6f2dd1c",
