@@ -7,7 +7,7 @@
 //! multiply-adds; both can flip an output byte by one. The bilinear precision of the adapter is modelled by
 //! [`FilterPrecision`].
 
-use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
+use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8, UNORM8_F32};
 use crate::runtime::smaa::{SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
 use rayon::prelude::*;
 
@@ -75,6 +75,20 @@ pub fn smaa_into(
     neighbourhood_blending_into(&color, &Tex8::new(w, h, 4, &out.weights), &mut out.output);
 }
 
+/// `(v as f32 / 255.0) * LUMA[k]` for every byte `v`: the shader's per-channel luma products, looked up.
+const LUMA_TABLES: [[f32; 256]; 3] = {
+    let mut t = [[0.0f32; 256]; 3];
+    let mut i = 0;
+    while i < 256 {
+        let v = i as f32 / 255.0;
+        t[0][i] = v * LUMA[0];
+        t[1][i] = v * LUMA[1];
+        t[2][i] = v * LUMA[2];
+        i += 1;
+    }
+    t
+};
+
 /// Rows per parallel band of the edge pass: the band's luma rows (plus two above, one below) stay in cache.
 const EDGE_BAND_ROWS: usize = 32;
 
@@ -102,12 +116,12 @@ pub fn edge_detection_into(color: &Tex8, out: &mut [u8]) {
         let y0 = b * EDGE_BAND_ROWS;
         let rows = band.len() / (2 * w);
         let mut lum = vec![0.0f32; stride * (rows + 3)];
+        let mut planes = [vec![0u8; w], vec![0u8; w]];
         for (k, lrow) in lum.chunks_exact_mut(stride).enumerate() {
             let y = (y0 + k).saturating_sub(2).min(h - 1);
             let src = &color.data[y * w * 4..(y + 1) * w * 4];
             for (l, c) in lrow[2..2 + w].iter_mut().zip(src.chunks_exact(4)) {
-                *l =
-                    (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
+                *l = LUMA_TABLES[0][c[0] as usize] + LUMA_TABLES[1][c[1] as usize] + LUMA_TABLES[2][c[2] as usize];
             }
             (lrow[0], lrow[1], lrow[w + 2]) = (lrow[2], lrow[2], lrow[w + 1]);
         }
@@ -117,20 +131,25 @@ pub fn edge_detection_into(color: &Tex8, out: &mut [u8]) {
             let t = &lum[(r + 1) * stride..(r + 2) * stride];
             let c = &lum[(r + 2) * stride..(r + 3) * stride];
             let bo = &lum[(r + 3) * stride..(r + 4) * stride];
-            // Branch-free over the row (the compiler vectorises it); the shader's early exit only skips work.
+            // Branch-free over the row into one plane per edge (the compiler vectorises it), then interleaved; the
+            // shader's early exit only skips work. max is exact, so its grouping does not change the result.
             let (cl, cc, cr, cll) = (&c[1..w + 1], &c[2..w + 2], &c[3..w + 3], &c[0..w]);
             let (tc, ttc, bc) = (&t[2..w + 2], &tt[2..w + 2], &bo[2..w + 2]);
-            for (x, o) in orow.chunks_exact_mut(2).enumerate() {
+            for x in 0..w {
                 let l = cc[x];
-                let delta = [(l - cl[x]).abs(), (l - tc[x]).abs()];
-                let max_delta = [delta[0].max((l - cr[x]).abs()), delta[1].max((l - bc[x]).abs())];
-                let max_delta = [max_delta[0].max((cl[x] - cll[x]).abs()), max_delta[1].max((tc[x] - ttc[x]).abs())];
-                let final_delta = max_delta[0].max(max_delta[1]);
+                let (d0, d1) = ((l - cl[x]).abs(), (l - tc[x]).abs());
+                let m0 = d0.max((l - cr[x]).abs()).max((cl[x] - cll[x]).abs());
+                let m1 = d1.max((l - bc[x]).abs()).max((tc[x] - ttc[x]).abs());
+                let final_delta = m0.max(m1);
                 // step(THRESHOLD, delta) · step(final_delta, 2·delta); a set edge is stored as unorm8(1.0) = 255.
-                let edge =
-                    |d: f32| if d >= THRESHOLD && LOCAL_CONTRAST_ADAPTATION * d >= final_delta { 255 } else { 0 };
-                o[0] = edge(delta[0]);
-                o[1] = edge(delta[1]);
+                let e0 = (d0 >= THRESHOLD) & (LOCAL_CONTRAST_ADAPTATION * d0 >= final_delta);
+                let e1 = (d1 >= THRESHOLD) & (LOCAL_CONTRAST_ADAPTATION * d1 >= final_delta);
+                planes[0][x] = 0u8.wrapping_sub(e0 as u8);
+                planes[1][x] = 0u8.wrapping_sub(e1 as u8);
+            }
+            for ((o, &e0), &e1) in orow.chunks_exact_mut(2).zip(&planes[0][..w]).zip(&planes[1][..w]) {
+                o[0] = e0;
+                o[1] = e1;
             }
         }
     });
@@ -416,13 +435,13 @@ pub fn neighbourhood_blending_into(color: &Tex8, weights: &Tex8, out: &mut [u8])
     let (w, h) = (color.w as usize, color.h as usize);
     assert_eq!(out.len(), w * h * 4, "output buffer size");
     assert_eq!((weights.w as usize, weights.h as usize, weights.ch, color.ch), (w, h, 4, 4), "texture sizes");
+    // srgb_to_linear of every 8-bit value, once per pass (the same function of the same texel values).
+    let to_linear: [f32; 256] = std::array::from_fn(|v| srgb_to_linear(UNORM8_F32[v]));
     let color_lin = |x: i32, y: i32| {
-        [
-            srgb_to_linear(color.load(x, y, 0)),
-            srgb_to_linear(color.load(x, y, 1)),
-            srgb_to_linear(color.load(x, y, 2)),
-            color.load(x, y, 3),
-        ]
+        let x = x.clamp(0, w as i32 - 1) as usize;
+        let y = y.clamp(0, h as i32 - 1) as usize;
+        let c = &color.data[(y * w + x) * 4..(y * w + x) * 4 + 4];
+        [to_linear[c[0] as usize], to_linear[c[1] as usize], to_linear[c[2] as usize], UNORM8_F32[c[3] as usize]]
     };
     if out.is_empty() {
         return;
