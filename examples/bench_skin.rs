@@ -14,6 +14,12 @@
 //! epidermis tables 0.011 s; 1.11–1.13× the 30 ms goal, not reached: a third of the time is the exact-series set-up
 //! (401 × 515 epidermis nodes, 256 × 401 dermis rows), which the vectorised loop does not touch. Whole asset 0.205 s
 //! → 0.073 s.
+//!
+//! 2026-11-25, with the AVX-512F row loop (same bits; the square root and division that bound the AVX2 loop on
+//! 512-bit vectors), on the same machine under load 7.8 (five engineers' builds): alternating with the AVX2 build,
+//! 2 threads, medians of 7 runs 0.113 / 0.134 / 0.141 s vs 0.117 / 0.157 / 0.197 s; one-thread CPU time of the
+//! table (thread CPU clock, 9 runs) 66–69 ms vs 82–112 ms, the epidermis tables 16 ms in both. Under such load the
+//! wall figures are 3–5× the idle ones; the idle figure against the 30 ms goal is still to be measured.
 
 use rtbake::bake::skin::skin_color_lut_files;
 use rtbake::skin_color::lut::{bake_lut, LutEvaluation};

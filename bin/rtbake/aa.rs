@@ -327,11 +327,20 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let mut files = files;
     a.zstd.apply(&mut files)?;
     prepare_out_dir("--out", &a.out)?;
-    crate::cli::write_set(ctx, "--out", &a.out, &files, &[])?;
+    // The sha256 lines are hashed on a second thread while the set is written (the write mostly waits for the
+    // disk flush): same digests, printed only after the write succeeded.
+    let (result, shas) = std::thread::scope(|s| {
+        let hashes = s.spawn(|| {
+            let hex = |f: &BakedFile| Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
+            files.iter().map(hex).collect::<Vec<String>>()
+        });
+        let result = crate::cli::write_set(ctx, "--out", &a.out, &files, &[]);
+        (result, hashes.join().expect("the sha256 thread does not panic"))
+    });
+    result?;
     let mut written = Vec::new();
-    for f in &files {
+    for (f, sha) in files.iter().zip(shas) {
         let path = a.out.join(&f.path);
-        let sha: String = Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect();
         ctx.info(format!("wrote {} ({} bytes, sha256 {sha})", path.display(), f.bytes.len()));
         written.push(serde_json::json!({
             "path": path.display().to_string(),

@@ -106,7 +106,7 @@ pub enum LutEvaluation {
 }
 
 /// Rows per parallel task (a multiple of nothing in particular: results do not depend on it).
-const ROWS_PER_TASK: usize = 4;
+const ROWS_PER_TASK: usize = 8;
 
 /// Bakes the table: W × H linear sRGB (3 channels, f32), top row first, deterministic for any thread count
 /// (every texel sums its wavelengths in the same order whichever task computes it).

@@ -58,7 +58,7 @@ impl<'a> Tex8<'a> {
     pub fn load(&self, x: i32, y: i32, c: u32) -> f32 {
         let x = x.clamp(0, self.w as i32 - 1) as usize;
         let y = y.clamp(0, self.h as i32 - 1) as usize;
-        self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as f32 / 255.0
+        UNORM8_F32[self.data[(y * self.w as usize + x) * self.ch as usize + c as usize] as usize]
     }
 
     /// Nearest fetch of channels 0 and 1 at normalised coordinates (clamp-to-edge).
@@ -75,20 +75,26 @@ impl<'a> Tex8<'a> {
     pub fn sample2(&self, u: f32, v: f32, prec: FilterPrecision) -> [f32; 2] {
         let x = u * self.w as f32 - 0.5;
         let y = v * self.h as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (mut fx, mut fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i32, y0 as i32);
         if prec == FilterPrecision::Unorm8 {
             fx = (fx * 256.0).round() / 256.0;
             fy = (fy * 256.0).round() / 256.0;
         }
+        // The four texels' offsets once (clamp-to-edge), then one table read per texel and channel.
+        let (wm, hm) = (self.w as i32 - 1, self.h as i32 - 1);
+        let (xa, xb) = (x0.clamp(0, wm) as usize, x0.saturating_add(1).clamp(0, wm) as usize);
+        let (ya, yb) =
+            (y0.clamp(0, hm) as usize * self.w as usize, y0.saturating_add(1).clamp(0, hm) as usize * self.w as usize);
+        let ch = self.ch as usize;
+        let (i00, i10, i01, i11) = ((ya + xa) * ch, (ya + xb) * ch, (yb + xa) * ch, (yb + xb) * ch);
         let mut out = [0.0f32; 2];
-        for (c, o) in out.iter_mut().enumerate().take(self.ch.min(2) as usize) {
-            let c = c as u32;
-            let t00 = self.load(x0, y0, c);
-            let t10 = self.load(x0 + 1, y0, c);
-            let t01 = self.load(x0, y0 + 1, c);
-            let t11 = self.load(x0 + 1, y0 + 1, c);
+        for (c, o) in out.iter_mut().enumerate().take(ch.min(2)) {
+            let t00 = UNORM8_F32[self.data[i00 + c] as usize];
+            let t10 = UNORM8_F32[self.data[i10 + c] as usize];
+            let t01 = UNORM8_F32[self.data[i01 + c] as usize];
+            let t11 = UNORM8_F32[self.data[i11 + c] as usize];
             *o = match prec {
                 FilterPrecision::Exact => {
                     let top = t00 + (t10 - t00) * fx;
@@ -106,6 +112,35 @@ impl<'a> Tex8<'a> {
         out
     }
 }
+
+/// `x.floor()`, without the libm call that baseline x86-64 (no SSE4.1 `roundss`) makes for it: below 2²³ in
+/// magnitude the truncation to an integer, less one where it rounded up (a zero keeps the sign of `x`); every other value (integral already,
+/// infinite or NaN) goes to `floor` itself. Same result for every input.
+#[inline(always)]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t > x {
+            t - 1.0
+        } else {
+            t.copysign(x) // −0.0 stays −0.0
+        }
+    } else {
+        x.floor()
+    }
+}
+
+/// `v as f32 / 255.0` for every byte `v`: an 8-bit UNORM texel as the shader reads it (the same correctly rounded
+/// quotient, looked up instead of divided).
+pub const UNORM8_F32: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = i as f32 / 255.0;
+        i += 1;
+    }
+    t
+};
 
 /// Stores a float in an 8-bit UNORM render target (clamp, round to nearest).
 #[inline]
@@ -197,6 +232,24 @@ mod tests {
         assert_eq!(t.load(-5, -5, 0), 10.0 / 255.0);
         assert_eq!(t.load(9, 9, 0), 40.0 / 255.0);
         assert_eq!(t.sample2_nearest(0.74, 0.26,)[0], 20.0 / 255.0);
+    }
+
+    #[test]
+    fn unorm8_table_is_the_quotient() {
+        for v in 0..=255u8 {
+            assert_eq!(UNORM8_F32[v as usize].to_bits(), (v as f32 / 255.0).to_bits());
+        }
+    }
+
+    #[test]
+    fn floor_is_f32_floor() {
+        let mut xs = vec![0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, 8_388_607.5, -8_388_607.5, 8_388_608.0, 1e30, -1e30];
+        xs.extend([f32::INFINITY, f32::NEG_INFINITY, f32::MIN_POSITIVE, -f32::MIN_POSITIVE, f32::EPSILON]);
+        xs.extend((0..20_000).map(|i| (i as f32 - 10_000.0) * 0.173_1));
+        for x in xs {
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "{x}");
+        }
+        assert!(floor(f32::NAN).is_nan());
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! multiply-adds; both can flip an output byte by one. The bilinear precision of the adapter is modelled by
 //! [`FilterPrecision`].
 
-use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8};
+use super::{linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8, UNORM8_F32};
 use crate::error::InvalidInput;
 use crate::runtime::smaa::{SmaaOptions, SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
 use crate::runtime::smaa_edges::{AaInputs, SMAA_LOCAL_CONTRAST_ADAPTATION};
@@ -47,12 +47,9 @@ pub fn smaa_with_subsample(
     prec: FilterPrecision,
     subsample: SubsampleIndices,
 ) -> SmaaCpuOutput {
-    assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
-    let color = Tex8::new(w, h, 4, rgba);
-    let edges = edge_detection(&color);
-    let weights = blending_weights_with_subsample(&Tex8::new(w, h, 2, &edges), luts, prec, subsample);
-    let output = neighbourhood_blending(&color, &Tex8::new(w, h, 4, &weights));
-    SmaaCpuOutput { edges, weights, output }
+    let mut out = SmaaCpuOutput { edges: Vec::new(), weights: Vec::new(), output: Vec::new() };
+    smaa_into(rgba, w, h, luts, prec, subsample, &mut out);
+    out
 }
 
 /// Runs SMAA with every option of [`SmaaOptions`] (the twin of [`crate::runtime::smaa::Smaa::with_options`]);
@@ -85,43 +82,109 @@ pub fn smaa_with_options(
     Ok(SmaaCpuOutput { edges, weights, output })
 }
 
+/// [`smaa_with_subsample`] into the buffers of a previous run (resized as needed), the CPU counterpart of the GPU
+/// pass creating its textures once and reusing them every frame: a frame then allocates nothing and touches no
+/// fresh pages (at 1080p the three buffers are 20 MB; first-touch page faults cost more than the passes).
+/// Same bytes as [`smaa_with_subsample`].
+pub fn smaa_into(
+    rgba: &[u8],
+    w: u32,
+    h: u32,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+    out: &mut SmaaCpuOutput,
+) {
+    assert_eq!(rgba.len(), (w * h * 4) as usize, "image size");
+    let n = (w * h) as usize;
+    out.edges.resize(2 * n, 0);
+    out.weights.resize(4 * n, 0);
+    out.output.resize(4 * n, 0);
+    let color = Tex8::new(w, h, 4, rgba);
+    edge_detection_into(&color, &mut out.edges);
+    let edges = Tex8::new(w, h, 2, &out.edges);
+    blending_weights_into(&edges, luts, prec, subsample, &mut out.weights);
+    neighbourhood_blending_into(&color, &Tex8::new(w, h, 4, &out.weights), &mut out.output);
+}
+
+/// `(v as f32 / 255.0) * LUMA[k]` for every byte `v`: the shader's per-channel luma products, looked up.
+const LUMA_TABLES: [[f32; 256]; 3] = {
+    let mut t = [[0.0f32; 256]; 3];
+    let mut i = 0;
+    while i < 256 {
+        let v = i as f32 / 255.0;
+        t[0][i] = v * LUMA[0];
+        t[1][i] = v * LUMA[1];
+        t[2][i] = v * LUMA[2];
+        i += 1;
+    }
+    t
+};
+
+/// Rows per parallel band of the edge pass: the band's luma rows (plus two above, one below) stay in cache.
+const EDGE_BAND_ROWS: usize = 32;
+
 /// Pass 1: luma edge detection with local contrast adaptation.
+///
+/// Row bands in parallel (disjoint outputs, so the bytes do not depend on the thread count). Each band tabulates
+/// the luma of its rows and of the two rows above and one below (clamped), each row padded with two clamped
+/// texels on the left and one on the right, so the per-texel test reads without clamping. The luma is the
+/// shader's dot product, evaluated in the same order.
 pub fn edge_detection(color: &Tex8) -> Vec<u8> {
-    let (w, h) = (color.w as usize, color.h as usize);
-    // Luma of every pixel once (same expression as the shader's dot product, evaluated per texel).
-    let mut lum = vec![0.0f32; w * h];
-    lum.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, l) in row.iter_mut().enumerate() {
-            let i = (y * w + x) * 4;
-            let c = &color.data[i..i + 3];
-            *l = (c[0] as f32 / 255.0) * LUMA[0] + (c[1] as f32 / 255.0) * LUMA[1] + (c[2] as f32 / 255.0) * LUMA[2];
-        }
-    });
-    let luma = |x: i32, y: i32| lum[y.clamp(0, h as i32 - 1) as usize * w + x.clamp(0, w as i32 - 1) as usize];
-    let step = |edge: f32, x: f32| if x >= edge { 1.0f32 } else { 0.0 };
-    let mut out = vec![0u8; w * h * 2];
-    out.par_chunks_mut(w * 2).enumerate().for_each(|(y, row)| {
-        let y = y as i32;
-        for x in 0..w as i32 {
-            let l = luma(x, y);
-            let (l_left, l_top) = (luma(x - 1, y), luma(x, y - 1));
-            let delta = [(l - l_left).abs(), (l - l_top).abs()];
-            let mut edges = [step(THRESHOLD, delta[0]), step(THRESHOLD, delta[1])];
-            if edges[0] + edges[1] == 0.0 {
-                continue;
-            }
-            let (l_right, l_bottom) = (luma(x + 1, y), luma(x, y + 1));
-            let mut max_delta = [delta[0].max((l - l_right).abs()), delta[1].max((l - l_bottom).abs())];
-            let (l_leftleft, l_toptop) = (luma(x - 2, y), luma(x, y - 2));
-            max_delta = [max_delta[0].max((l_left - l_leftleft).abs()), max_delta[1].max((l_top - l_toptop).abs())];
-            let final_delta = max_delta[0].max(max_delta[1]);
-            edges[0] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[0]);
-            edges[1] *= step(final_delta, LOCAL_CONTRAST_ADAPTATION * delta[1]);
-            row[x as usize * 2] = unorm8(edges[0]);
-            row[x as usize * 2 + 1] = unorm8(edges[1]);
-        }
-    });
+    let mut out = vec![0u8; color.w as usize * color.h as usize * 2];
+    edge_detection_into(color, &mut out);
     out
+}
+
+/// [`edge_detection`] into `out` (`w·h·2` bytes; every byte is written).
+pub fn edge_detection_into(color: &Tex8, out: &mut [u8]) {
+    let (w, h) = (color.w as usize, color.h as usize);
+    assert_eq!(out.len(), w * h * 2, "edge buffer size");
+    if out.is_empty() {
+        return;
+    }
+    let stride = w + 3;
+    out.par_chunks_mut(w * 2 * EDGE_BAND_ROWS).enumerate().for_each(|(b, band)| {
+        let y0 = b * EDGE_BAND_ROWS;
+        let rows = band.len() / (2 * w);
+        let mut lum = vec![0.0f32; stride * (rows + 3)];
+        let mut planes = [vec![0u8; w], vec![0u8; w]];
+        for (k, lrow) in lum.chunks_exact_mut(stride).enumerate() {
+            let y = (y0 + k).saturating_sub(2).min(h - 1);
+            let src = &color.data[y * w * 4..(y + 1) * w * 4];
+            for (l, c) in lrow[2..2 + w].iter_mut().zip(src.chunks_exact(4)) {
+                *l = LUMA_TABLES[0][c[0] as usize] + LUMA_TABLES[1][c[1] as usize] + LUMA_TABLES[2][c[2] as usize];
+            }
+            (lrow[0], lrow[1], lrow[w + 2]) = (lrow[2], lrow[2], lrow[w + 1]);
+        }
+        for (r, orow) in band.chunks_exact_mut(2 * w).enumerate() {
+            // Rows y − 2, y − 1, y, y + 1 of the band's table; texel x is at index x + 2.
+            let tt = &lum[r * stride..(r + 1) * stride];
+            let t = &lum[(r + 1) * stride..(r + 2) * stride];
+            let c = &lum[(r + 2) * stride..(r + 3) * stride];
+            let bo = &lum[(r + 3) * stride..(r + 4) * stride];
+            // Branch-free over the row into one plane per edge (the compiler vectorises it), then interleaved; the
+            // shader's early exit only skips work. max is exact, so its grouping does not change the result.
+            let (cl, cc, cr, cll) = (&c[1..w + 1], &c[2..w + 2], &c[3..w + 3], &c[0..w]);
+            let (tc, ttc, bc) = (&t[2..w + 2], &tt[2..w + 2], &bo[2..w + 2]);
+            for x in 0..w {
+                let l = cc[x];
+                let (d0, d1) = ((l - cl[x]).abs(), (l - tc[x]).abs());
+                let m0 = d0.max((l - cr[x]).abs()).max((cl[x] - cll[x]).abs());
+                let m1 = d1.max((l - bc[x]).abs()).max((tc[x] - ttc[x]).abs());
+                let final_delta = m0.max(m1);
+                // step(THRESHOLD, delta) · step(final_delta, 2·delta); a set edge is stored as unorm8(1.0) = 255.
+                let e0 = (d0 >= THRESHOLD) & (LOCAL_CONTRAST_ADAPTATION * d0 >= final_delta);
+                let e1 = (d1 >= THRESHOLD) & (LOCAL_CONTRAST_ADAPTATION * d1 >= final_delta);
+                planes[0][x] = 0u8.wrapping_sub(e0 as u8);
+                planes[1][x] = 0u8.wrapping_sub(e1 as u8);
+            }
+            for ((o, &e0), &e1) in orow.chunks_exact_mut(2).zip(&planes[0][..w]).zip(&planes[1][..w]) {
+                o[0] = e0;
+                o[1] = e1;
+            }
+        }
+    });
 }
 
 struct Ctx<'a> {
@@ -332,7 +395,24 @@ pub fn blending_weights_with_subsample(
     prec: FilterPrecision,
     subsample: SubsampleIndices,
 ) -> Vec<u8> {
+    let mut out = vec![0u8; (edges.w * edges.h * 4) as usize];
+    blending_weights_into(edges, luts, prec, subsample, &mut out);
+    out
+}
+
+/// [`blending_weights_with_subsample`] into `out` (`w·h·4` bytes; every byte is written).
+pub fn blending_weights_into(
+    edges: &Tex8,
+    luts: &SmaaTextures,
+    prec: FilterPrecision,
+    subsample: SubsampleIndices,
+    out: &mut [u8],
+) {
     let (w, h) = (edges.w, edges.h);
+    assert_eq!(out.len(), (w * h * 4) as usize, "weight buffer size");
+    if out.is_empty() {
+        return;
+    }
     let ctx = Ctx {
         edges: *edges,
         area: Tex8::new(AREA_TEX_SIZE.0, AREA_TEX_SIZE.1, 2, &luts.area),
@@ -341,61 +421,194 @@ pub fn blending_weights_with_subsample(
         prec,
         subsample: subsample.as_f32(),
     };
-    let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        row.fill(0);
         let erow = &edges.data[y * w as usize * 2..(y + 1) * w as usize * 2];
-        for x in 0..w {
-            if erow[x as usize * 2] == 0 && erow[x as usize * 2 + 1] == 0 {
-                continue; // no edge: all weights are zero
+        // No edge, no weights: skip the (mostly zero) edge row eight bytes, four texels, at a time.
+        let mut words = erow.chunks_exact(8);
+        let mut x0 = 0usize;
+        for word in words.by_ref() {
+            if u64::from_ne_bytes(word.try_into().unwrap()) != 0 {
+                blend_weights_of(&ctx, erow, row, x0..x0 + 4, y as u32);
             }
-            let wgt = ctx.pixel(x, y as u32);
-            for c in 0..4 {
-                row[x as usize * 4 + c] = unorm8(wgt[c]);
-            }
+            x0 += 4;
         }
+        blend_weights_of(&ctx, erow, row, x0..w as usize, y as u32);
     });
-    out
+}
+
+/// Weights of the texels `xs` of row `y` that have an edge, stored in that row of the output.
+#[inline]
+fn blend_weights_of(ctx: &Ctx, erow: &[u8], row: &mut [u8], xs: std::ops::Range<usize>, y: u32) {
+    for x in xs {
+        if erow[x * 2] == 0 && erow[x * 2 + 1] == 0 {
+            continue; // no edge: all weights are zero
+        }
+        let wgt = ctx.pixel(x as u32, y);
+        for c in 0..4 {
+            row[x * 4 + c] = unorm8(wgt[c]);
+        }
+    }
 }
 
 /// Pass 3: neighbourhood blending in linear light; output RGBA8 sRGB-encoded.
+///
+/// A texel whose four blending weights (its own R and B, the right neighbour's A, the lower neighbour's G) are
+/// all zero keeps its input bytes (their sum is below the shader's 1e-5 exactly when every byte is 0), so the
+/// output starts as a copy of the input and only texels next to an edge are blended, found eight at a time.
 pub fn neighbourhood_blending(color: &Tex8, weights: &Tex8) -> Vec<u8> {
-    let (w, h) = (color.w, color.h);
+    let mut out = vec![0u8; color.w as usize * color.h as usize * 4];
+    neighbourhood_blending_into(color, weights, &mut out);
+    out
+}
+
+/// [`neighbourhood_blending`] into `out` (`w·h·4` bytes; every byte is written).
+pub fn neighbourhood_blending_into(color: &Tex8, weights: &Tex8, out: &mut [u8]) {
+    let (w, h) = (color.w as usize, color.h as usize);
+    assert_eq!(out.len(), w * h * 4, "output buffer size");
+    assert_eq!((weights.w as usize, weights.h as usize, weights.ch, color.ch), (w, h, 4, 4), "texture sizes");
+    // srgb_to_linear of every 8-bit value, once per pass (the same function of the same texel values).
+    let to_linear: [f32; 256] = std::array::from_fn(|v| srgb_to_linear(UNORM8_F32[v]));
     let color_lin = |x: i32, y: i32| {
-        [
-            srgb_to_linear(color.load(x, y, 0)),
-            srgb_to_linear(color.load(x, y, 1)),
-            srgb_to_linear(color.load(x, y, 2)),
-            color.load(x, y, 3),
-        ]
+        let x = x.clamp(0, w as i32 - 1) as usize;
+        let y = y.clamp(0, h as i32 - 1) as usize;
+        let c = &color.data[(y * w + x) * 4..(y * w + x) * 4 + 4];
+        [to_linear[c[0] as usize], to_linear[c[1] as usize], to_linear[c[2] as usize], UNORM8_F32[c[3] as usize]]
     };
-    let mut out = vec![0u8; (w * h * 4) as usize];
-    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
-        let y = y as i32;
-        for x in 0..w as i32 {
-            let a =
-                [weights.load(x + 1, y, 3), weights.load(x, y + 1, 1), weights.load(x, y, 2), weights.load(x, y, 0)];
-            let o = x as usize * 4;
-            if a[0] + a[1] + a[2] + a[3] < 1e-5 {
-                let i = (y as usize * w as usize + x as usize) * 4;
-                row[o..o + 4].copy_from_slice(&color.data[i..i + 4]);
+    if out.is_empty() {
+        return;
+    }
+    out.par_chunks_mut(w * 4).enumerate().for_each(|(y, row)| {
+        row.copy_from_slice(&color.data[y * w * 4..(y + 1) * w * 4]);
+        let wrow = &weights.data[y * w * 4..(y + 1) * w * 4];
+        let yb = (y + 1).min(h - 1);
+        let wbelow = &weights.data[yb * w * 4..(yb + 1) * w * 4];
+        let zero = |s: &[u8]| s.iter().fold(0u8, |a, &b| a | b) == 0;
+        let zero32 = |s: &[u8]| <&[u8; 32]>::try_from(s).unwrap().iter().fold(0u8, |a, &b| a | b) == 0;
+        for x0 in (0..w).step_by(8) {
+            let x1 = (x0 + 8).min(w);
+            // Bytes any texel of x0..x1 reads: this row's up to texel x1 (its A), the row below's.
+            let quiet = if x1 == x0 + 8 {
+                zero32(&wrow[x0 * 4..x1 * 4]) && zero32(&wbelow[x0 * 4..x1 * 4]) && (x1 == w || wrow[x1 * 4 + 3] == 0)
+            } else {
+                zero(&wrow[x0 * 4..w * 4]) && zero(&wbelow[x0 * 4..w * 4])
+            };
+            if quiet {
                 continue;
             }
-            let c = color_lin(x, y);
-            let horizontal = a[0].max(a[2]) > a[1].max(a[3]);
-            let (wt, n0, n1) = if horizontal {
-                ([a[0], a[2]], color_lin(x + 1, y), color_lin(x - 1, y))
-            } else {
-                ([a[1], a[3]], color_lin(x, y + 1), color_lin(x, y - 1))
-            };
-            let s = wt[0] + wt[1];
-            let wn = [wt[0] / s, wt[1] / s];
-            for k in 0..4 {
-                let m0 = c[k] + (n0[k] - c[k]) * wt[0];
-                let m1 = c[k] + (n1[k] - c[k]) * wt[1];
-                let v = wn[0] * m0 + wn[1] * m1;
-                row[o + k] = unorm8(if k < 3 { linear_to_srgb(v) } else { v });
+            for x in x0..x1 {
+                let wx = x * 4;
+                let right = (x + 1).min(w - 1) * 4 + 3;
+                if wrow[right] == 0 && wbelow[wx + 1] == 0 && wrow[wx + 2] == 0 && wrow[wx] == 0 {
+                    continue;
+                }
+                let (xi, yi) = (x as i32, y as i32);
+                let a = [
+                    weights.load(xi + 1, yi, 3),
+                    weights.load(xi, yi + 1, 1),
+                    weights.load(xi, yi, 2),
+                    weights.load(xi, yi, 0),
+                ];
+                let c = color_lin(xi, yi);
+                let horizontal = a[0].max(a[2]) > a[1].max(a[3]);
+                let (wt, n0, n1) = if horizontal {
+                    ([a[0], a[2]], color_lin(xi + 1, yi), color_lin(xi - 1, yi))
+                } else {
+                    ([a[1], a[3]], color_lin(xi, yi + 1), color_lin(xi, yi - 1))
+                };
+                let s = wt[0] + wt[1];
+                let wn = [wt[0] / s, wt[1] / s];
+                for k in 0..4 {
+                    let m0 = c[k] + (n0[k] - c[k]) * wt[0];
+                    let m1 = c[k] + (n1[k] - c[k]) * wt[1];
+                    let v = wn[0] * m0 + wn[1] * m1;
+                    row[wx + k] = unorm8(if k < 3 { linear_to_srgb(v) } else { v });
+                }
             }
         }
     });
-    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::manifest::sha256_hex;
+    use crate::runtime::scene::render_shapes;
+
+    fn luts() -> SmaaTextures {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("baked");
+        crate::runtime::loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Blocks of pseudo-random colour (sizes 1–5 px) with sparse single-pixel noise: edges of every
+    /// orientation, diagonal staircases, edges at the image border and isolated texels.
+    fn blocks(w: u32, h: u32, seed: u64) -> Vec<u8> {
+        let mut s = seed;
+        let mut next = move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 33) as u32
+        };
+        let palette: Vec<[u8; 3]> = (0..6).map(|_| [next() as u8, next() as u8, next() as u8]).collect();
+        let (bw, bh) = (1 + next() % 5, 1 + next() % 5);
+        let cells: Vec<usize> = (0..(w / bw + 1) * (h / bh + 1)).map(|_| (next() % 6) as usize).collect();
+        let mut out = vec![255u8; (w * h * 4) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                let mut c = palette[cells[((y / bh) * (w / bw + 1) + x / bw) as usize]];
+                if next() % 17 == 0 {
+                    c = [next() as u8, next() as u8, next() as u8];
+                }
+                let i = ((y * w + x) * 4) as usize;
+                out[i..i + 3].copy_from_slice(&c);
+            }
+        }
+        out
+    }
+
+    fn digest(o: &SmaaCpuOutput) -> String {
+        format!("{} {} {}", &sha256_hex(&o.edges)[..16], &sha256_hex(&o.weights)[..16], &sha256_hex(&o.output)[..16])
+    }
+
+    /// The CPU twin is the GPU pass' reference: its bytes are pinned (edges, weights, output) on the procedural
+    /// scene at 1080p (both filter-precision models, 1x and one 4x slice set) and on random block images of odd
+    /// sizes, so a faster implementation cannot change a byte. Digests computed with the straightforward
+    /// per-texel implementation (rtbake 8582a9a).
+    #[test]
+    fn smaa_cpu_bytes_are_pinned() {
+        let luts = luts();
+        let mut got = Vec::new();
+        let img = render_shapes(1920, 1080, 1);
+        got.push(digest(&smaa(&img, 1920, 1080, &luts, FilterPrecision::Exact)));
+        got.push(digest(&smaa(&img, 1920, 1080, &luts, FilterPrecision::Unorm8)));
+        let s = SubsampleIndices::SMAA_4X[1];
+        got.push(digest(&smaa_with_subsample(&img, 1920, 1080, &luts, FilterPrecision::Exact, s)));
+        for (w, h, seed) in [(131u32, 77u32, 1u64), (64, 1, 2), (1, 50, 3), (257, 129, 4), (300, 200, 5)] {
+            let img = blocks(w, h, seed);
+            got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Exact)));
+            got.push(digest(&smaa(&img, w, h, &luts, FilterPrecision::Unorm8)));
+        }
+        // The reusing entry point gives the same bytes, also into buffers of another size and content.
+        let mut reused = smaa(&blocks(300, 200, 9), 300, 200, &luts, FilterPrecision::Exact);
+        for (w, h, seed) in [(131u32, 77u32, 1u64), (300, 200, 5)] {
+            let img = blocks(w, h, seed);
+            smaa_into(&img, w, h, &luts, FilterPrecision::Unorm8, SubsampleIndices::SMAA_1X, &mut reused);
+            assert_eq!(digest(&reused), digest(&smaa(&img, w, h, &luts, FilterPrecision::Unorm8)), "{w}x{h}");
+        }
+        let want = [
+            "9c60cb7d5f0b648a 9c2269e7d6522968 9c85caf4f6f2dd1c",
+            "9c60cb7d5f0b648a 45e800a8a42441f9 9ceb3e987dac90ca",
+            "9c60cb7d5f0b648a b39f37d76131e0af daf083e9dd5930de",
+            "f1ce57e563bac39f 98404b72142a8bf3 e3ec6c9cbe8cbe3a",
+            "f1ce57e563bac39f ecd91d891171d995 caf1e9790aa64c89",
+            "464293f4d76270ee 5341e6b2646979a7 b317eb6f91cea9af",
+            "464293f4d76270ee 5341e6b2646979a7 b317eb6f91cea9af",
+            "f5d6c615338bc967 6d9c54dee5660c46 c89a862cd48d6651",
+            "f5d6c615338bc967 6d9c54dee5660c46 c89a862cd48d6651",
+            "e17ecef60f12243a 9d631b98f6b45308 63c3b0da32742251",
+            "e17ecef60f12243a 16219f835b547026 6bf7d3d8a711872b",
+            "58515544228b9611 9fecddf279cc44df c32f924a55ad1083",
+            "58515544228b9611 f559fc10f825a238 f6f8b9ad91ecae85",
+        ];
+        assert_eq!(got, want);
+    }
 }
