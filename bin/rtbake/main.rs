@@ -17,6 +17,7 @@ mod profile_source;
 mod report;
 mod run;
 mod run_edges;
+mod run_skin;
 mod run_smaa_modes;
 mod skin_color;
 mod transmittance;

@@ -28,16 +28,19 @@ pub enum RunCommand {
     /// Render a procedural scene (skin spheres over hard-edged shapes) through the whole chain: skin inputs,
     /// separable SSS, transmittance, SMAA/MLAA; writes a PNG, needs no input files.
     Demo(DemoArgs),
+    /// Render heads from a mesh (the procedural head, or --mesh glTF/OBJ) through the skin chain: shadow-map
+    /// thickness, skin colour, no SSS / sum-of-Gaussians / separable SSS, transmittance; writes a PNG.
+    Skin(Box<crate::run_skin::SkinArgs>),
 }
 
 #[derive(clap::Args)]
 pub struct Common {
     /// Run the CPU reference implementation instead of the GPU (no adapter needed).
     #[arg(long)]
-    cpu: bool,
+    pub(crate) cpu: bool,
     /// Bake directory holding manifest.json and the LUTs (every table is checked against the manifest).
     #[arg(long = "baked-dir", alias = "baked", value_name = "DIR", default_value = "baked")]
-    baked: PathBuf,
+    pub(crate) baked: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -198,6 +201,10 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
         }
         RunCommand::Sss(a) => sss(ctx, *a),
         RunCommand::Demo(d) => run_demo(ctx, d),
+        RunCommand::Skin(s) => {
+            ensure_runtime_dir();
+            crate::run_skin::run(ctx, *s)
+        }
     }
 }
 
@@ -249,6 +256,11 @@ fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
 
 /// The output's directory must exist and be writable before any work is done.
 /// `--output` must be in an existing directory and must not be one of the command's `inputs` (exit 2, both named).
+/// `--output` in an existing directory and not one of the inputs (exit 2 otherwise).
+pub(crate) fn check_output_of(path: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+    check_output(path, inputs)
+}
+
 fn check_output(path: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {

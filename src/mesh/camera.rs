@@ -42,7 +42,7 @@ impl Camera {
             ));
         }
         let dir = Vector3::from(self.target) - Vector3::from(self.eye);
-        if !(dir.norm() > 0.0) || dir.cross(&Vector3::from(self.up)).norm() <= 1e-6 * dir.norm() {
+        if dir.norm().is_nan() || dir.norm() <= 0.0 || dir.cross(&Vector3::from(self.up)).norm() <= 1e-6 * dir.norm() {
             return Err(InvalidInput::new("camera", "eye, target and up must be finite, distinct and not collinear"));
         }
         Ok(())

@@ -102,7 +102,7 @@ pub fn parse_gltf(
                 Some(i) => i.into_u32().collect(),
                 None => (0..positions.len() as u32).collect(),
             };
-            if local.len() % 3 != 0 || idx.len() / 3 + local.len() / 3 > super::MAX_TRIANGLES {
+            if !local.len().is_multiple_of(3) || idx.len() / 3 + local.len() / 3 > super::MAX_TRIANGLES {
                 return Err(bad(format!(
                     "{name} has {} indices (a multiple of 3 up to the triangle cap needed)",
                     local.len()

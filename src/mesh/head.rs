@@ -8,7 +8,7 @@
 //!   nose (22 mm), brow (6 mm), chin (8 mm) and cheeks (4 mm);
 //! - the ears: flattened ellipsoids 6 × 60 × 34 mm (x thickness), centred on the skull's sides at eye level.
 //!
-//! UV unwrap in three islands: the skull's (φ/2π·0.75, θ/π) in u ∈ [0, 0.75], the left ear in u ∈ [0.76, 0.99],
+//! UV unwrap in three islands: the skull's ((φ + π)/2π·0.75, θ/π), the seam at the back, in u ∈ [0, 0.75], the left ear in u ∈ [0.76, 0.99],
 //! v ∈ [0.01, 0.49], the right ear below it; v = 0 is the texture's top row. Normals are the area-weighted face
 //! normals, averaged over vertices that share a position (the φ seam and the poles), so shading is smooth across
 //! the seams.
@@ -126,7 +126,8 @@ fn smooth_normals(pos: &[[f32; 3]], idx: &[u32]) -> Vec<[f32; 3]> {
 pub fn head(rows: usize, cols: usize) -> Mesh {
     let (rows, cols) = (rows.max(4), cols.max(4));
     let (mut pos, mut uvs, mut idx) = (Vec::new(), Vec::new(), Vec::new());
-    shell(rows, cols, skull_point, |s, t| [0.75 * s, t], &mut pos, &mut uvs, &mut idx);
+    // φ from −π to π: the texture seam runs down the back of the head, not the face.
+    shell(rows, cols, |th, ph| skull_point(th, ph - PI), |s, t| [0.75 * s, t], &mut pos, &mut uvs, &mut idx);
     for (side, v0) in [(-1.0f32, 0.01f32), (1.0, 0.51)] {
         let centre = [side * (SKULL_RADII_M[0] + 0.001), -0.005, -0.008];
         let ear = move |theta: f32, phi: f32| {

@@ -92,7 +92,7 @@ impl Mesh {
                 ),
             ));
         }
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(InvalidInput::new(what, format!("has {} indices, not a multiple of 3", indices.len())));
         }
         if !(mm_per_unit.is_finite() && mm_per_unit > 0.0) {
@@ -130,7 +130,8 @@ impl Mesh {
             .enumerate()
             .filter(|(_, t)| {
                 let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
-                !(0.5 * length(cross(sub(b, a), sub(c, a))) > 1e-12 * diag2)
+                let area = 0.5 * length(cross(sub(b, a), sub(c, a)));
+                area.is_nan() || area <= 1e-12 * diag2
             })
             .map(|(i, _)| i)
             .collect();
@@ -173,7 +174,9 @@ impl Mesh {
 mod tests {
     use super::*;
 
-    fn quad() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>) {
+    type Parts = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>);
+
+    fn quad() -> Parts {
         (
             vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
             vec![[0.0, 0.0, 2.0]; 4],
@@ -192,7 +195,7 @@ mod tests {
 
     #[test]
     fn malformed_meshes_are_refused_with_the_defect_named() {
-        let msg = |f: &dyn Fn(&mut (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 2]>, Vec<u32>))| {
+        let msg = |f: &dyn Fn(&mut Parts)| {
             let mut q = quad();
             f(&mut q);
             let (p, n, uv, i) = q;

@@ -144,10 +144,12 @@ pub fn synthetic_rig() -> RigScaleBiasMaps {
     RigScaleBiasMaps { width: s, height: s, targets: vec![neutral, blush] }
 }
 
-struct Geometry {
-    frame: SkinFrame,
-    depth: Vec<f32>,
-    skin: Vec<bool>,
+/// A frame's geometry before shading: the skin inputs per pixel, the linear depth the SSS passes read (world
+/// units of the kernel's `sss_width`) and which pixels are skin.
+pub(crate) struct Geometry {
+    pub(crate) frame: SkinFrame,
+    pub(crate) depth: Vec<f32>,
+    pub(crate) skin: Vec<bool>,
 }
 
 /// Spheres as (centre x, centre y in units of the frame height, radius, depth of the centre).
@@ -204,6 +206,10 @@ pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
     120 * w as u64 * h as u64 + (64 << 20)
 }
 
+/// Direction to the key light (Lambert) and to the back light (transmittance), view space, unit length.
+pub(crate) const KEY_LIGHT_VIEW: [f32; 3] = [-0.5 / 0.9798, 0.6 / 0.9798, 0.62 / 0.9798];
+pub(crate) const BACK_LIGHT_VIEW: [f32; 3] = [0.3 / 0.9929, 0.2 / 0.9929, -0.93 / 0.9929];
+
 /// The demo frame before SSS: geometry, skin albedo and transmittance, and the lit diffuse layer.
 struct Lit {
     geo: Geometry,
@@ -215,11 +221,16 @@ struct Lit {
 
 fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
     crate::error::check_size("--width/--height", w as u64, h as u64)?;
-    let geo = geometry(w, h, assets.baked_rig.as_ref());
+    lit_geometry(gpu, geometry(w, h, assets.baked_rig.as_ref()), assets)
+}
+
+/// Skin inputs (albedo from the LUT through the rig, transmittance T(s)·E for the back light) and the lit diffuse
+/// layer of `geo`.
+fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
+    let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
-    let key = normalise([-0.5, 0.6, 0.62]);
-    let back = normalise([0.3, 0.2, -0.93]);
+    let (key, back) = (KEY_LIGHT_VIEW, BACK_LIGHT_VIEW);
     let (albedo, transmitted) = match gpu {
         Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?
             .run(&g.device, &g.queue, &geo.frame, weights, back)?,
@@ -268,10 +279,39 @@ pub fn render(
     method: SssMethod,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
-    let Lit { geo, albedo, transmitted, diffuse } = lit(gpu, w, h, assets)?;
-    let n = (w * h) as usize;
+    let lit = lit(gpu, w, h, assets)?;
+    shade(gpu, lit, assets, Some(method), super::scene::render_shapes(w, h, 1), aa)
+}
+
+/// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
+/// `method` (None: no SSS), plus transmittance, tone-mapped and encoded, then antialiased.
+pub(crate) fn render_geometry(
+    gpu: Option<&Gpu>,
+    geo: Geometry,
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+    background: Vec<u8>,
+    aa: Option<&Antialiasing>,
+) -> Result<Image<u8>, RuntimeError> {
+    let lit = lit_geometry(gpu, geo, assets)?;
+    shade(gpu, lit, assets, method, background, aa)
+}
+
+fn shade(
+    gpu: Option<&Gpu>,
+    lit: Lit,
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+    rgba: Vec<u8>,
+    aa: Option<&Antialiasing>,
+) -> Result<Image<u8>, RuntimeError> {
+    let Lit { geo, albedo, transmitted, diffuse } = lit;
+    let (w, h) = (geo.frame.width, geo.frame.height);
     let (kernel, params) = (&assets.kernel, &assets.sss);
     let importance_params = ImportanceSssParams::default();
+    let Some(method) = method else {
+        return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, aa);
+    };
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
         SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },
@@ -286,8 +326,22 @@ pub fn render(
         },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
-    // Composite over the hard-edged background shapes; add back-lit transmittance; encode sRGB.
-    let mut rgba = super::scene::render_shapes(w, h, 1);
+    composite(gpu, &geo, &blurred, &albedo, &transmitted, rgba, aa)
+}
+
+/// Composites the (blurred) diffuse layer plus back-lit transmittance over the background, tone-maps, encodes sRGB
+/// and antialiases.
+fn composite(
+    gpu: Option<&Gpu>,
+    geo: &Geometry,
+    blurred: &[f32],
+    albedo: &[f32],
+    transmitted: &[f32],
+    mut rgba: Vec<u8>,
+    aa: Option<&Antialiasing>,
+) -> Result<Image<u8>, RuntimeError> {
+    let (w, h) = (geo.frame.width, geo.frame.height);
+    let n = (w * h) as usize;
     for i in 0..n {
         if !geo.skin[i] {
             continue;
@@ -309,10 +363,6 @@ pub fn render(
     }
 }
 
-fn normalise(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / l, v[1] / l, v[2] / l]
-}
 /// Wall time of [`render`] at `w`×`h` plus the PNG encoding (issue 15's budget check): 1 µs per pixel on the CPU
 /// path (0.94 s at 1024² on the project's 2-core machine, release), a tenth of it with a GPU, plus 0.5 s start-up.
 pub fn time_estimate_seconds(w: u32, h: u32, cpu: bool) -> f64 {

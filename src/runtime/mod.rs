@@ -24,6 +24,7 @@ pub mod moving_scene;
 pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
+pub mod skin_render;
 pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;

@@ -50,7 +50,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
         let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
         // Counter-clockwise in NDC (y up) is clockwise on screen (y down): signed area < 0 is a front face.
         let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-        if !(area < 0.0) {
+        if area.is_nan() || area >= 0.0 {
             continue;
         }
         let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
@@ -68,7 +68,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
                 }
                 let z = wa * a.z + wb * b.z + wc * c.z;
                 let i = (py * width + px) as usize;
-                if !(z < zbuf[i]) || z < 0.0 {
+                if z.is_nan() || z >= zbuf[i] || z < 0.0 {
                     continue;
                 }
                 zbuf[i] = z;

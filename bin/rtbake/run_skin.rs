@@ -1,0 +1,141 @@
+//! `rtbake run skin`: heads from a mesh through the skin chain (library: `rtbake::runtime::skin_render`, meshes:
+//! `rtbake::mesh`).
+
+use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::io::{self, atomic::write_atomic};
+use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
+use rtbake::runtime::demo::DemoAssets;
+use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Largest mesh file read, bytes (a scanned head with 10⁶ triangles is ~100 MB of glTF).
+pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum ShaderArg {
+    /// Diffuse lighting, no subsurface scattering (TAP 2009's "No SSS").
+    None,
+    /// Screen-space sum of Gaussians with the baked fit (TAP 2009's "SS Full", thesis ch. 4).
+    SsFull,
+    /// Separable SSS with the baked kernel (thesis ch. 6).
+    Separable,
+}
+
+#[derive(clap::Args)]
+pub struct SkinArgs {
+    /// Output PNG (RGBA8, sRGB-encoded).
+    #[arg(long, value_name = "PNG")]
+    output: PathBuf,
+    /// Skin shader.
+    #[arg(long, value_enum, default_value = "separable")]
+    shader: ShaderArg,
+    /// Heads side by side, 0.25 m apart, 1..=16 (TAP 2009 Table III: 1, 3, 5).
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    heads: u32,
+    /// Camera distance from the heads, metres, 0.2..=100 (30° vertical field of view).
+    #[arg(long, default_value_t = 0.6, allow_negative_numbers = true, value_name = "M")]
+    distance: f32,
+    /// Mesh: glTF 2.0 (.gltf with embedded or neighbouring buffers, .glb) or Wavefront OBJ, with vertex normals
+    /// and texture coordinates (TEXCOORD_0 / vt); default: the procedural head (about 6 600 triangles).
+    #[arg(long, value_name = "FILE")]
+    mesh: Option<PathBuf>,
+    /// Millimetres per OBJ unit (glTF is in metres).
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    mesh_mm_per_unit: f32,
+    /// Melanin volume fraction Cm of the skin, 0..=0.5.
+    #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
+    melanin: f32,
+    /// Frame width in pixels (TAP 2009 measured 1280×720).
+    #[arg(long, default_value_t = 1280, value_name = "PIXELS")]
+    width: u32,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 720, value_name = "PIXELS")]
+    height: u32,
+    #[command(flatten)]
+    common: crate::run::Common,
+}
+
+/// Reads and validates `--mesh` (exit 2 naming the file and the defect).
+fn load_mesh(path: &Path, mm_per_unit: f32) -> anyhow::Result<Mesh> {
+    let name = format!("--mesh {}", path.display());
+    let meta = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+    if meta.len() > MAX_MESH_FILE_BYTES {
+        return Err(usage_msg(format!("{name}: {} bytes; accepted at most {MAX_MESH_FILE_BYTES}", meta.len())));
+    }
+    let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mesh = match ext.as_deref() {
+        Some("gltf") | Some("glb") => parse_gltf(&name, &bytes, &|uri: &str| {
+            let p = dir.join(uri);
+            let len = std::fs::metadata(&p).map_err(|e| format!("{}: {e}", p.display()))?.len();
+            if len > MAX_MESH_FILE_BYTES {
+                return Err(format!("{}: {len} bytes; accepted at most {MAX_MESH_FILE_BYTES}", p.display()));
+            }
+            std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))
+        }),
+        Some("obj") => parse_obj(&name, &bytes, mm_per_unit),
+        _ => return Err(usage_msg(format!("{name}: unknown extension; accepted .gltf, .glb, .obj"))),
+    };
+    mesh.map_err(usage)
+}
+
+pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
+    let settings = SkinRenderSettings {
+        shader: match a.shader {
+            ShaderArg::None => SkinShader::None,
+            ShaderArg::SsFull => SkinShader::SsFull,
+            ShaderArg::Separable => SkinShader::Separable,
+        },
+        heads: a.heads,
+        distance_m: a.distance,
+        width: a.width,
+        height: a.height,
+        melanin: a.melanin,
+    };
+    settings.validate().map_err(usage)?;
+    if !(a.mesh_mm_per_unit.is_finite() && a.mesh_mm_per_unit > 0.0) {
+        return Err(usage_msg(format!("--mesh-mm-per-unit must be a finite number > 0, got {}", a.mesh_mm_per_unit)));
+    }
+    let inputs: Vec<&Path> = a.mesh.iter().map(|p| p.as_path()).collect();
+    crate::run::check_output_of(&a.output, &inputs)?;
+    ctx.check_budget(
+        &format!("--width {} --height {}", a.width, a.height),
+        rtbake::runtime::demo::memory_estimate_bytes(a.width, a.height) + (96 << 20),
+        rtbake::runtime::demo::time_estimate_seconds(a.width, a.height, a.common.cpu) + 0.5,
+    )?;
+    let mesh = match &a.mesh {
+        Some(p) => load_mesh(p, a.mesh_mm_per_unit)?,
+        None => default_head(),
+    };
+    let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
+    let gpu = crate::run::device(ctx, a.common.cpu)?;
+    let t = Instant::now();
+    let out = skin_render::render(gpu.as_ref(), &mesh, &settings, &assets)?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    write_atomic(&a.output, &io::png::encode_u8_frame(&out)?)?;
+    ctx.info(format!(
+        "skin ({:?}, {} head(s), {} triangles each): {}x{} in {ms:.1} ms -> {}",
+        a.shader,
+        a.heads,
+        mesh.triangle_count(),
+        out.width,
+        out.height,
+        a.output.display()
+    ));
+    if ctx.json {
+        ctx.emit_json(&serde_json::json!({
+            "pass": "skin",
+            "shader": format!("{:?}", a.shader),
+            "heads": a.heads,
+            "triangles_per_head": mesh.triangle_count(),
+            "output": a.output.display().to_string(),
+            "width": out.width,
+            "height": out.height,
+            "adapter": gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU reference".into()),
+            "wall_ms": ms,
+        }));
+    }
+    Ok(())
+}

@@ -1,0 +1,214 @@
+//! `rtbake run skin`: heads rendered from a triangle mesh through the skin chain (issue 14; TAP 2009 §5–6 compares
+//! shaders on heads; thesis ch. 4–6 for the screen-space passes, ch. 5 Listing 5.1 for thickness from a shadow map).
+//!
+//! 1. The mesh (the procedural [`crate::mesh::head::default_head`] or a glTF/OBJ), repeated `heads` times 0.25 m
+//!    apart along x, is rasterised into a G-buffer ([`super::mesh_raster`], GPU or its CPU twin).
+//! 2. A 512² shadow map from the back light (TAP 2009 used 512²) gives the thickness the light crosses to reach
+//!    each visible point: the point's distance from the light minus the shadow map's nearest distance along the
+//!    same ray (Listing 5.1), in mm.
+//! 3. Skin inputs per pixel: melanin `melanin` (uniform), mean-free hemoglobin H0 of the baked rig read at the
+//!    mesh's texture coordinates (the face maps are texture-space maps), view-space normals, thickness; the rig's
+//!    scale and bias maps are not applied (the runtime's skin-inputs pass samples them in screen space, which is
+//!    right for the screen-space demo and wrong for a mesh: a neutral rig is used).
+//! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
+//!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
+//!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
+//!    tone-mapped and encoded over a grey background.
+
+use super::cpu;
+use super::demo::{render_geometry, DemoAssets, Geometry, SssMethod, BACK_LIGHT_VIEW};
+use super::device::Gpu;
+use super::mesh_raster::{self, MeshGBuffer};
+use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
+use super::RuntimeError;
+use crate::error::{check_range, InvalidInput};
+use crate::image_buf::Image;
+use crate::mesh::camera::Camera;
+use crate::mesh::Mesh;
+use nalgebra::{Matrix4, Vector3, Vector4};
+
+/// The skin shaders of `run skin` available so far.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkinShader {
+    /// Diffuse lighting with no subsurface scattering (TAP's "No SSS").
+    None,
+    /// Screen-space sum of Gaussians (TAP's "SS Full", thesis ch. 4) with the baked fit.
+    SsFull,
+    /// Separable SSS (thesis ch. 6) with the baked kernel.
+    Separable,
+}
+
+/// Heads side by side, centre to centre, metres.
+pub const HEAD_SPACING_M: f32 = 0.25;
+/// Shadow-map edge, texels (TAP 2009: "a shadow map resolution of 512x512").
+pub const SHADOW_MAP_SIZE: u32 = 512;
+/// Listing 5.1's shrink of the position along the normal before the shadow-map lookup, mm.
+pub const SHADOW_SHRINK_MM: f32 = 5.0;
+/// World units of the SSS passes per metre: their parameters (sssWidth, α, β) are stated for a head one world
+/// unit tall (`runtime::gaussian_sss`), and the default head is 0.21 m tall.
+pub const WORLD_UNITS_PER_M: f32 = 1.0 / 0.21;
+/// Most heads per frame (TAP 2009 Table III measures 1, 3 and 5).
+pub const MAX_HEADS: u32 = 16;
+
+/// What `run skin` renders.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SkinRenderSettings {
+    pub shader: SkinShader,
+    pub heads: u32,
+    /// Camera distance from the heads' plane, metres.
+    pub distance_m: f32,
+    pub width: u32,
+    pub height: u32,
+    /// Melanin volume fraction Cm (uniform over the skin).
+    pub melanin: f32,
+}
+
+impl SkinRenderSettings {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_range("--heads", self.heads, 1, MAX_HEADS, "")?;
+        check_range("--distance", self.distance_m as f64, 0.2, 100.0, "m")?;
+        check_range("--melanin", self.melanin as f64, 0.0, 0.5, "(volume fraction)")?;
+        crate::error::check_size("--width/--height", self.width as u64, self.height as u64)?;
+        Ok(())
+    }
+
+    /// The camera: on +z looking at the row of heads' centre.
+    pub fn camera(&self) -> Camera {
+        Camera::facing(self.distance_m).expect("distance validated")
+    }
+}
+
+/// `heads` copies of `mesh`, `HEAD_SPACING_M` apart along x, centred on x = 0 (mesh units are converted with
+/// `mm_per_unit`).
+pub fn row_of_heads(mesh: &Mesh, heads: u32) -> Result<Mesh, InvalidInput> {
+    if heads == 1 {
+        return Ok(mesh.clone());
+    }
+    let spacing = HEAD_SPACING_M * 1000.0 / mesh.mm_per_unit;
+    let n = mesh.positions.len() as u32;
+    let (mut pos, mut nrm, mut uvs, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for k in 0..heads {
+        let dx = (k as f32 - 0.5 * (heads - 1) as f32) * spacing;
+        pos.extend(mesh.positions.iter().map(|p| [p[0] + dx, p[1], p[2]]));
+        nrm.extend_from_slice(&mesh.normals);
+        uvs.extend_from_slice(&mesh.uvs);
+        idx.extend(mesh.indices.iter().map(|i| i + k * n));
+    }
+    Mesh::new("--heads", pos, nrm, uvs, idx, mesh.mm_per_unit)
+}
+
+fn rasterise(gpu: Option<&Gpu>, mesh: &Mesh, cam: &Camera, w: u32, h: u32) -> Result<MeshGBuffer, RuntimeError> {
+    match gpu {
+        Some(g) => mesh_raster::rasterise(&g.device, &g.queue, mesh, cam, w, h),
+        None => Ok(cpu::mesh_raster::rasterise(mesh, cam, w, h)),
+    }
+}
+
+/// The light camera of the shadow map: 1.5 m from the heads towards the back light, looking at them.
+fn light_camera(cam: &Camera) -> Camera {
+    // View → world for directions: the transpose of the view rotation.
+    let view = cam.view();
+    let l = Vector3::from(BACK_LIGHT_VIEW);
+    let rot = view.fixed_view::<3, 3>(0, 0).transpose();
+    let dir = rot * l;
+    let target = Vector3::from(cam.target);
+    let eye = target + dir * 1.5;
+    Camera { eye: eye.into(), target: cam.target, up: [0.0, 1.0, 0.0], fov_y_deg: 40.0, near: 0.3, far: 3.0 }
+}
+
+/// Per covered pixel, the thickness (mm) the back light crosses to reach it (Listing 5.1), from a shadow map.
+fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Camera, mm_per_unit: f32) -> Vec<f32> {
+    let (w, h) = (g.width, g.height);
+    let inv_view = cam.view().try_inverse().expect("a look-at view is invertible");
+    let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
+    let aspect = w as f32 / h as f32;
+    let light_view = light.view();
+    let light_vp: Matrix4<f32> = light.projection(1.0) * light_view;
+    let s = SHADOW_MAP_SIZE as f32;
+    let mut out = vec![0.0f32; (w * h) as usize];
+    for (i, o) in out.iter_mut().enumerate() {
+        if !g.covered[i] {
+            continue;
+        }
+        let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+        let (xn, yn) = (px / w as f32 * 2.0 - 1.0, 1.0 - py / h as f32 * 2.0);
+        let depth = g.depth_mm[i] / mm_per_unit;
+        let p_view = Vector4::new(xn * t * aspect * depth, yn * t * depth, -depth, 1.0);
+        // Listing 5.1: the position shrunk along the normal before the shadow-map lookup (5 mm), so the surface
+        // facing the light does not read its own depth back as a thickness (acne).
+        let n = g.normal_view[i];
+        let shrink = SHADOW_SHRINK_MM / mm_per_unit;
+        let p_view = p_view - Vector4::new(n[0], n[1], n[2], 0.0) * shrink;
+        let p = inv_view * p_view;
+        let c = light_vp * p;
+        let (sx, sy) = ((c.x / c.w * 0.5 + 0.5) * s, (0.5 - c.y / c.w * 0.5) * s);
+        let d_light_mm = -(light_view * p).z * mm_per_unit;
+        let (ix, iy) = (sx.floor() as i64, sy.floor() as i64);
+        let inside = (0..SHADOW_MAP_SIZE as i64).contains(&ix) && (0..SHADOW_MAP_SIZE as i64).contains(&iy);
+        let j = (iy * SHADOW_MAP_SIZE as i64 + ix) as usize;
+        *o = if inside && shadow.covered[j] { (d_light_mm - shadow.depth_mm[j]).max(0.0) } else { 0.0 };
+    }
+    out
+}
+
+/// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask.
+fn geometry(
+    gpu: Option<&Gpu>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    assets: &DemoAssets,
+) -> Result<Geometry, RuntimeError> {
+    let cam = s.camera();
+    let g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
+    let light = light_camera(&cam);
+    let shadow = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
+    let thickness = thickness_mm(&g, &cam, &shadow, &light, mesh.mm_per_unit);
+    let n = (s.width * s.height) as usize;
+    let mut frame = SkinFrame {
+        width: s.width,
+        height: s.height,
+        melanin: vec![0.0; n],
+        h0: vec![0.0; n],
+        thickness_mm: vec![assets.luts.s_max_mm; n],
+        normals: vec![[0.0, 0.0, 1.0]; n],
+    };
+    let mut depth = vec![100.0f32; n];
+    for i in 0..n {
+        if !g.covered[i] {
+            continue;
+        }
+        frame.melanin[i] = s.melanin;
+        frame.h0[i] = match &assets.baked_rig {
+            Some(r) => r.h0_at(g.uv[i][0], g.uv[i][1]),
+            None => 0.006 * ((g.uv[i][0] * 400.0).sin() * (g.uv[i][1] * 300.0).cos()),
+        };
+        frame.thickness_mm[i] = thickness[i].min(assets.luts.s_max_mm);
+        frame.normals[i] = g.normal_view[i];
+        depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
+    }
+    Ok(Geometry { frame, depth, skin: g.covered })
+}
+
+/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded).
+pub fn render(
+    gpu: Option<&Gpu>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    assets: &DemoAssets,
+) -> Result<Image<u8>, RuntimeError> {
+    s.validate()?;
+    let heads = row_of_heads(mesh, s.heads)?;
+    let geo = geometry(gpu, &heads, s, assets)?;
+    let mut assets = assets.clone();
+    // A neutral rig (scale 1, bias 0): see the module doc.
+    assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
+    assets.rig_weights = vec![1.0];
+    assets.sss.fovy_deg = s.camera().fov_y_deg;
+    let method = match s.shader {
+        SkinShader::None => None,
+        SkinShader::SsFull => Some(SssMethod::Gaussians),
+        SkinShader::Separable => Some(SssMethod::Separable),
+    };
+    let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
+    render_geometry(gpu, geo, &assets, method, background, None)
+}

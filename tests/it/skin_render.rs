@@ -1,0 +1,132 @@
+//! Issue 14: `rtbake run skin` — heads from a mesh through the skin chain. The GPU chain agrees with its CPU twin,
+//! the SSS shaders soften the lit skin (red more than blue, as the skin profiles are widest in red), a mesh file is
+//! rendered like the built-in head, and bad meshes and settings exit 2 naming the file or flag, writing nothing.
+
+use crate::support::rtbake;
+use rtbake::mesh::head::default_head;
+
+fn render(args: &[&str], out: &std::path::Path) -> Vec<u8> {
+    let mut a = vec!["run", "skin", "--width", "320", "--height", "180", "--output", out.to_str().unwrap()];
+    a.extend_from_slice(args);
+    let o = rtbake(&a);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    image::open(out).unwrap().to_rgba8().into_raw()
+}
+
+/// Mean squared Laplacian of one channel over pixels whose 3×3 neighbourhood differs from the background.
+fn roughness(img: &[u8], w: usize, h: usize, c: usize) -> f64 {
+    let at = |x: usize, y: usize| img[4 * (y * w + x) + c] as f64;
+    let bg = at(0, 0);
+    let (mut sum, mut n) = (0.0, 0usize);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let nb = [at(x, y), at(x - 1, y), at(x + 1, y), at(x, y - 1), at(x, y + 1)];
+            if nb.contains(&bg) {
+                continue;
+            }
+            let l = 4.0 * nb[0] - nb[1] - nb[2] - nb[3] - nb[4];
+            sum += l * l;
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64
+}
+
+#[test]
+fn gpu_and_cpu_chains_agree_and_sss_softens_red_most() {
+    let t = tempfile::tempdir().unwrap();
+    let p = |n: &str| t.path().join(n);
+    let gpu = render(&["--shader", "separable"], &p("gpu.png"));
+    let cpu = render(&["--shader", "separable", "--cpu"], &p("cpu.png"));
+    let close = gpu.iter().zip(&cpu).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+    assert!(close as f64 >= 0.99 * gpu.len() as f64, "{close} of {} channels within 2/255", gpu.len());
+    let none = render(&["--shader", "none"], &p("none.png"));
+    let full = render(&["--shader", "ss-full"], &p("full.png"));
+    let covered = none.chunks(4).filter(|px| px[..3] != [46, 48, 52]).count();
+    assert!(covered > 5000, "{covered} head pixels");
+    for (name, img) in [("separable", &gpu), ("ss-full", &full)] {
+        let ratio = |c| roughness(img, 320, 180, c) / roughness(&none, 320, 180, c);
+        let (r, b) = (ratio(0), ratio(2));
+        eprintln!("{name}: Laplacian energy vs no SSS: red {r:.3}, blue {b:.3}");
+        assert!(r < 0.9, "{name} does not soften red: {r}");
+        assert!(r < b, "{name}: red {r} must be softened more than blue {b}");
+    }
+}
+
+#[test]
+fn a_mesh_file_renders_like_the_built_in_head_and_heads_multiply() {
+    let t = tempfile::tempdir().unwrap();
+    let m = default_head();
+    let mut obj = String::new();
+    for p in &m.positions {
+        obj.push_str(&format!("v {} {} {}\n", p[0], p[1], p[2]));
+    }
+    for n in &m.normals {
+        obj.push_str(&format!("vn {} {} {}\n", n[0], n[1], n[2]));
+    }
+    for uv in &m.uvs {
+        obj.push_str(&format!("vt {} {}\n", uv[0], 1.0 - uv[1]));
+    }
+    for f in m.indices.chunks(3) {
+        let v = |i: u32| format!("{0}/{0}/{0}", i + 1);
+        obj.push_str(&format!("f {} {} {}\n", v(f[0]), v(f[1]), v(f[2])));
+    }
+    let path = t.path().join("head.obj");
+    std::fs::write(&path, obj).unwrap();
+    let built_in = render(&["--shader", "none", "--cpu"], &t.path().join("a.png"));
+    let from_file = render(&["--shader", "none", "--cpu", "--mesh", path.to_str().unwrap()], &t.path().join("b.png"));
+    let close = built_in.iter().zip(&from_file).filter(|(a, b)| a.abs_diff(**b) <= 1).count();
+    assert!(close as f64 >= 0.999 * built_in.len() as f64, "{close} of {}", built_in.len());
+    // Three heads at 1 m: three separate silhouettes along the middle row.
+    let three = render(&["--shader", "none", "--cpu", "--heads", "3", "--distance", "1.0"], &t.path().join("c.png"));
+    let row = 90 * 320 * 4;
+    let mut runs = 0;
+    let mut inside = false;
+    for x in 0..320 {
+        let skin = three[row + 4 * x..row + 4 * x + 3] != [46, 48, 52];
+        runs += usize::from(skin && !inside);
+        inside = skin;
+    }
+    assert!(runs >= 3, "{runs} silhouettes on the middle row");
+}
+
+#[test]
+fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("out.png");
+    let o = out.to_str().unwrap();
+    let write = |name: &str, body: &[u8]| {
+        let p = t.path().join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let no_vn = write("no_vn.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\n");
+    let no_vt = write("no_vt.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n");
+    let degenerate = write("flat.obj", b"v 0 0 0\nv 1 0 0\nv 2 0 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n");
+    let empty = write("empty.obj", b"");
+    let garbage = write("bad.gltf", b"{\"asset\": 7}");
+    let unknown = write("head.stl", b"solid");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--mesh", &no_vn], "vn"),
+        (vec!["--mesh", &no_vt], "TEXCOORD_0"),
+        (vec!["--mesh", &degenerate], "degenerate"),
+        (vec!["--mesh", &empty], "no triangles"),
+        (vec!["--mesh", &garbage], "not a valid glTF"),
+        (vec!["--mesh", &unknown], "extension"),
+        (vec!["--mesh", "/nonexistent/head.glb"], "--mesh"),
+        (vec!["--heads", "0"], "--heads"),
+        (vec!["--heads", "17"], "--heads"),
+        (vec!["--distance", "0"], "--distance"),
+        (vec!["--melanin", "-0.1"], "--melanin"),
+        (vec!["--mesh-mm-per-unit", "0"], "--mesh-mm-per-unit"),
+    ];
+    for (args, needle) in cases {
+        let mut a = vec!["run", "skin", "--cpu", "--width", "64", "--height", "64", "--output", o];
+        a.extend_from_slice(&args);
+        let r = rtbake(&a);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote the output");
+    }
+}
