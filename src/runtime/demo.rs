@@ -206,9 +206,20 @@ pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
     120 * w as u64 * h as u64 + (64 << 20)
 }
 
-/// Direction to the key light (Lambert) and to the back light (transmittance), view space, unit length.
-pub(crate) const KEY_LIGHT_VIEW: [f32; 3] = [-0.5 / 0.9798, 0.6 / 0.9798, 0.62 / 0.9798];
-pub(crate) const BACK_LIGHT_VIEW: [f32; 3] = [0.3 / 0.9929, 0.2 / 0.9929, -0.93 / 0.9929];
+/// Direction to the key light (Lambert), view space, unit length.
+pub(crate) fn key_light_view() -> [f32; 3] {
+    normalise([-0.5, 0.6, 0.62])
+}
+
+/// Direction to the back light (transmittance), view space, unit length.
+pub(crate) fn back_light_view() -> [f32; 3] {
+    normalise([0.3, 0.2, -0.93])
+}
+
+fn normalise(v: [f32; 3]) -> [f32; 3] {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / l, v[1] / l, v[2] / l]
+}
 
 /// The demo frame before SSS: geometry, skin albedo and transmittance, and the lit diffuse layer.
 struct Lit {
@@ -230,7 +241,7 @@ fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
-    let (key, back) = (KEY_LIGHT_VIEW, BACK_LIGHT_VIEW);
+    let (key, back) = (key_light_view(), back_light_view());
     let (albedo, transmitted) = match gpu {
         Some(g) => SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?
             .run(&g.device, &g.queue, &geo.frame, weights, back)?,

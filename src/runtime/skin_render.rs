@@ -16,7 +16,7 @@
 //!    tone-mapped and encoded over a grey background.
 
 use super::cpu;
-use super::demo::{render_geometry, DemoAssets, Geometry, SssMethod, BACK_LIGHT_VIEW};
+use super::demo::{back_light_view, render_geometry, DemoAssets, Geometry, SssMethod};
 use super::device::Gpu;
 use super::mesh_raster::{self, MeshGBuffer};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
@@ -108,7 +108,7 @@ fn rasterise(gpu: Option<&Gpu>, mesh: &Mesh, cam: &Camera, w: u32, h: u32) -> Re
 fn light_camera(cam: &Camera) -> Camera {
     // View → world for directions: the transpose of the view rotation.
     let view = cam.view();
-    let l = Vector3::from(BACK_LIGHT_VIEW);
+    let l = Vector3::from(back_light_view());
     let rot = view.fixed_view::<3, 3>(0, 0).transpose();
     let dir = rot * l;
     let target = Vector3::from(cam.target);
