@@ -202,19 +202,57 @@ impl Tally {
     }
 }
 
-/// Per-layer constants of one channel.
+/// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug)]
 struct Medium {
     z_top_mm: f64,
     z_bottom_mm: f64,
     sigma_t: f64,
+    /// 1/σt (unused in a clear layer).
+    inv_sigma_t: f64,
     /// σa/σt (0 in a clear layer).
     absorb_fraction: f64,
-    g: f64,
+    hg: HenyeyGreenstein,
     eta: f64,
 }
 
-/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ [0, 1], and the cosine of
+/// Henyey–Greenstein sampling constants of one g (MCML eq. 3.28):
+/// cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g), cos θ = 2ξ − 1 for |g| < 10⁻⁶.
+#[derive(Clone, Copy, Debug)]
+struct HenyeyGreenstein {
+    isotropic: bool,
+    /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
+    one_minus_g2: f64,
+    one_minus_g: f64,
+    two_g: f64,
+    one_plus_g2: f64,
+    inv_two_g: f64,
+}
+
+impl HenyeyGreenstein {
+    fn new(g: f64) -> Self {
+        Self {
+            isotropic: g.abs() < 1e-6,
+            one_minus_g2: 1.0 - g * g,
+            one_minus_g: 1.0 - g,
+            two_g: 2.0 * g,
+            one_plus_g2: 1.0 + g * g,
+            inv_two_g: 0.5 / g,
+        }
+    }
+
+    /// cos θ from a uniform ξ.
+    #[inline]
+    fn cos_theta(&self, xi: f64) -> f64 {
+        if self.isotropic {
+            return 2.0 * xi - 1.0;
+        }
+        let f = self.one_minus_g2 / (self.one_minus_g + self.two_g * xi);
+        ((self.one_plus_g2 - f * f) * self.inv_two_g).clamp(-1.0, 1.0)
+    }
+}
+
+/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ `[0, 1]`, and the cosine of
 /// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
 fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     if n_i == n_t {
@@ -230,32 +268,24 @@ fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     (0.5 * (rs * rs + rp * rp), cos_t)
 }
 
-/// HG cos θ from a uniform ξ (MCML eq. 3.28).
+/// Rotates direction `u` by polar cos θ and the azimuth (cos φ, sin φ) (MCML eq. 3.30–3.31). sin θ/√(1 − uz²) is
+/// taken as one square root of a quotient, and sin θ·√(1 − uz²) as that times 1 − uz² (the same expressions as
+/// MCML's `Spin`, one square root fewer).
 #[inline]
-fn hg_cos_theta(g: f64, xi: f64) -> f64 {
-    if g.abs() < 1e-6 {
-        return 2.0 * xi - 1.0;
-    }
-    let f = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
-    ((1.0 + g * g - f * f) / (2.0 * g)).clamp(-1.0, 1.0)
-}
-
-/// Rotates direction `u` by polar cos θ and azimuth φ (MCML eq. 3.30–3.31).
-#[inline]
-fn spin(u: [f64; 3], cos_t: f64, phi: f64) -> [f64; 3] {
-    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    // One cosine and a square root instead of sin and cos (MCML's `Spin` does the same).
-    let cos_p = phi.cos();
-    let sin_p = (1.0 - cos_p * cos_p).max(0.0).sqrt().copysign(PI - phi);
+fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
+    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
     let [ux, uy, uz] = u;
     if uz.abs() > 0.99999 {
+        let sin_t = sin2_t.sqrt();
         [sin_t * cos_p, sin_t * sin_p, cos_t * uz.signum()]
     } else {
-        let tmp = (1.0 - uz * uz).sqrt();
+        let one_minus_uz2 = 1.0 - uz * uz;
+        // sin θ / √(1 − uz²)
+        let a = (sin2_t / one_minus_uz2).sqrt();
         [
-            sin_t * (ux * uz * cos_p - uy * sin_p) / tmp + ux * cos_t,
-            sin_t * (uy * uz * cos_p + ux * sin_p) / tmp + uy * cos_t,
-            -sin_t * cos_p * tmp + uz * cos_t,
+            a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t,
+            a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t,
+            -a * one_minus_uz2 * cos_p + uz * cos_t,
         ]
     }
 }
@@ -271,11 +301,16 @@ struct Channel<'a> {
 }
 
 /// Traces photons `first..first + count` of channel `ch` into `tally`.
+///
+/// Per step the common case — an interaction inside the layer — is decided without a division: the packet's new
+/// depth z + uz·s/σt is compared with the face it heads for; only a packet that reaches it computes the distance to
+/// the face (and then stops there exactly, as MCML's `PathToBoundary`/`CrossOrNot`).
 fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
     let Channel { media, eta_above, eta_below, start_weight, index: channel } = *ch;
     let inv_bin = 1.0 / settings.bin_mm;
     let bins = settings.bins;
     let last = media.len() - 1;
+    let mut interactions = 0u64;
     for k in first..first + count {
         let mut rng = PhotonRng::new(settings.seed, k, channel);
         let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
@@ -288,86 +323,88 @@ fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, 
             if s_left == 0.0 {
                 s_left = -rng.uniform().ln();
             }
-            let d_face = if u[2] > 0.0 {
-                (m.z_bottom_mm - z) / u[2]
-            } else if u[2] < 0.0 {
-                (m.z_top_mm - z) / u[2]
-            } else {
-                f64::INFINITY
-            };
-            let d_step = if m.sigma_t > 0.0 { s_left / m.sigma_t } else { f64::INFINITY };
-            if d_step.is_infinite() && d_face.is_infinite() {
-                // Gliding parallel to the faces of a clear layer: it never leaves; score it as absorbed there.
+            let down = u[2] > 0.0;
+            let face_z = if down { m.z_bottom_mm } else { m.z_top_mm };
+            if m.sigma_t > 0.0 {
+                let d_step = s_left * m.inv_sigma_t;
+                let z_new = z + u[2] * d_step;
+                // Strictly short of the face it heads for (never for uz = 0, which meets no face).
+                if u[2] == 0.0 || (z_new - face_z) * u[2] < 0.0 {
+                    // Interaction inside the layer.
+                    x += u[0] * d_step;
+                    y += u[1] * d_step;
+                    z = z_new;
+                    s_left = 0.0;
+                    interactions += 1;
+                    let dw = w * m.absorb_fraction;
+                    tally.absorbed[layer] += dw;
+                    w -= dw;
+                    let cos_t = m.hg.cos_theta(rng.uniform());
+                    let (cos_p, sin_p) = rng.azimuth_cos_sin();
+                    u = spin(u, cos_t, cos_p, sin_p);
+                    if w < ROULETTE_THRESHOLD {
+                        if w == 0.0 {
+                            break;
+                        }
+                        if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
+                            w *= ROULETTE_CHANCE;
+                        } else {
+                            break;
+                        }
+                    }
+                    continue;
+                }
+            }
+            let d_face = if u[2] != 0.0 { (face_z - z) / u[2] } else { f64::INFINITY };
+            if d_face.is_infinite() {
+                // Gliding parallel to the faces of a clear layer (or down a clear semi-infinite one): it never
+                // leaves; score it as absorbed there.
                 tally.absorbed[layer] += w;
                 break;
             }
-            if d_face <= d_step {
-                // Move to the face, keep the rest of the optical depth.
-                x += u[0] * d_face;
-                y += u[1] * d_face;
-                z = if u[2] > 0.0 { m.z_bottom_mm } else { m.z_top_mm };
-                if m.sigma_t > 0.0 {
-                    s_left = (s_left - d_face * m.sigma_t).max(0.0);
-                }
-                let down = u[2] > 0.0;
-                let n_t = match (down, layer) {
-                    (false, 0) => eta_above,
-                    (false, j) => media[j - 1].eta,
-                    (true, j) if j == last => eta_below,
-                    (true, j) => media[j + 1].eta,
-                };
-                let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
-                if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
-                    u[2] = -u[2];
-                    continue;
-                }
-                let ratio = m.eta / n_t;
-                u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
-                match (down, layer) {
-                    (false, 0) => {
-                        tally.rd += w;
-                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                        if bin < bins {
-                            tally.r[bin] += w;
-                        }
-                        break;
-                    }
-                    (true, j) if j == last => {
-                        tally.td += w;
-                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                        if bin < bins {
-                            tally.t[bin] += w;
-                        }
-                        break;
-                    }
-                    (false, _) => layer -= 1,
-                    (true, _) => layer += 1,
-                }
+            // Move to the face, keep the rest of the optical depth.
+            x += u[0] * d_face;
+            y += u[1] * d_face;
+            z = face_z;
+            if m.sigma_t > 0.0 {
+                s_left = (s_left - d_face * m.sigma_t).max(0.0);
+            }
+            let n_t = match (down, layer) {
+                (false, 0) => eta_above,
+                (false, j) => media[j - 1].eta,
+                (true, j) if j == last => eta_below,
+                (true, j) => media[j + 1].eta,
+            };
+            let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
+            if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
+                u[2] = -u[2];
                 continue;
             }
-            // Interaction inside the layer.
-            x += u[0] * d_step;
-            y += u[1] * d_step;
-            z += u[2] * d_step;
-            s_left = 0.0;
-            tally.interactions += 1;
-            let dw = w * m.absorb_fraction;
-            tally.absorbed[layer] += dw;
-            w -= dw;
-            let cos_t = hg_cos_theta(m.g, rng.uniform());
-            u = spin(u, cos_t, 2.0 * PI * rng.uniform());
-            if w < ROULETTE_THRESHOLD {
-                if w == 0.0 {
+            let ratio = m.eta / n_t;
+            u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
+            match (down, layer) {
+                (false, 0) => {
+                    tally.rd += w;
+                    let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
+                    if bin < bins {
+                        tally.r[bin] += w;
+                    }
                     break;
                 }
-                if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
-                    w *= ROULETTE_CHANCE;
-                } else {
+                (true, j) if j == last => {
+                    tally.td += w;
+                    let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
+                    if bin < bins {
+                        tally.t[bin] += w;
+                    }
                     break;
                 }
+                (false, _) => layer -= 1,
+                (true, _) => layer += 1,
             }
         }
     }
+    tally.interactions += interactions;
 }
 
 fn estimate(batch_values: impl Iterator<Item = f64> + Clone, total: f64, batches: usize) -> Estimate {
@@ -403,8 +440,9 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                         z_top_mm: z,
                         z_bottom_mm: z + l.thickness_mm,
                         sigma_t,
+                        inv_sigma_t: if sigma_t > 0.0 { 1.0 / sigma_t } else { 0.0 },
                         absorb_fraction: if sigma_t > 0.0 { l.sigma_a_per_mm[c] / sigma_t } else { 0.0 },
-                        g: l.g[c],
+                        hg: HenyeyGreenstein::new(l.g[c]),
                         eta: l.eta,
                     };
                     z += l.thickness_mm;
