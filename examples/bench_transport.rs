@@ -26,6 +26,33 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// CPU time of this process (all threads), s. On the shared machine other processes take turns on the cores, so
+/// wall time depends on their load; CPU time counts only the time this work ran on a core.
+fn process_cpu_s() -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec for the call.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_PROCESS_CPUTIME_ID)");
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// User + system CPU time of the waited-for children (MCML runs), s.
+fn children_cpu_s() -> f64 {
+    // SAFETY: an all-zero rusage is a valid value of the plain C struct.
+    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `ru` is a valid, writable rusage for the call.
+    let rc = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut ru) };
+    assert_eq!(rc, 0, "getrusage(RUSAGE_CHILDREN)");
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(ru.ru_utime) + tv(ru.ru_stime)
+}
+
+/// Median, min and max.
+fn stats(v: &[f64]) -> (f64, f64, f64) {
+    let (lo, hi) = v.iter().fold((f64::MAX, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
+    (median(v.to_vec()), lo, hi)
+}
+
 /// MCML input for one run (lengths in cm).
 fn mci(thickness_cm: &str, n: f64, g: f64, photons: u64) -> String {
     format!(
@@ -73,32 +100,85 @@ fn main() {
             None
         }
     };
+    let rounds: usize = std::env::var("RTBAKE_BENCH_ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(5);
+    let pools: Vec<(usize, rayon::ThreadPool)> = [1, threads]
+        .into_iter()
+        .map(|n| (n, rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()))
+        .collect();
     for (name, stack, photons, thickness_cm, n, g) in cases {
         let settings = McSettings::new(photons, 1, 10, 0.1, 100).unwrap();
         let histories = 3.0 * photons as f64;
-        let mut per_pool = Vec::new();
-        for pool_threads in [threads, 1] {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(pool_threads).build().unwrap();
-            let mut times = Vec::new();
-            let mut result = None;
-            for _ in 0..5 {
-                let t0 = Instant::now();
-                result = Some(pool.install(|| simulate(&stack, &settings)));
-                times.push(t0.elapsed().as_secs_f64());
+        let dir = std::env::temp_dir().join(format!("rtbake_bench_mcml_{}", std::process::id()));
+        if mcml.is_some() {
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join("in.mci"), mci(thickness_cm, n, g, photons)).unwrap();
+        }
+        // Rounds of (rtbake on 1 thread, MCML, rtbake on the pool), so that the load of the shared machine
+        // falls on both alike. Per core = CPU time of the 1-thread run and of MCML (user + system), taken per
+        // round; wall times are printed too.
+        let mut wall: Vec<Vec<f64>> = vec![Vec::new(); pools.len()];
+        let mut cpu_one = Vec::new();
+        let (mut mcml_wall, mut mcml_cpu, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+        let mut results = Vec::new();
+        for _ in 0..rounds {
+            for (i, (_, pool)) in pools.iter().enumerate() {
+                let (t0, c0) = (Instant::now(), process_cpu_s());
+                let r = pool.install(|| simulate(&stack, &settings));
+                wall[i].push(t0.elapsed().as_secs_f64());
+                if i == 0 {
+                    cpu_one.push(process_cpu_s() - c0);
+                }
+                results.push(r);
+                if let (0, Some(bin)) = (i, &mcml) {
+                    let (t0, c0) = (Instant::now(), children_cpu_s());
+                    let out = std::process::Command::new(bin).arg("in.mci").current_dir(&dir).output().unwrap();
+                    assert!(out.status.success(), "MCML failed: {}", String::from_utf8_lossy(&out.stderr));
+                    mcml_wall.push(t0.elapsed().as_secs_f64());
+                    let c = children_cpu_s() - c0;
+                    mcml_cpu.push(c);
+                    ratios.push((histories / cpu_one.last().unwrap()) / (photons as f64 / c));
+                }
             }
-            let r = result.unwrap();
-            let t = median(times);
-            let interactions: u64 = r.channels.iter().map(|c| c.interactions).sum();
+        }
+        assert!(results.windows(2).all(|w| w[0] == w[1]), "the same bytes for every run and thread count");
+        let r = &results[0];
+        let interactions: u64 = r.channels.iter().map(|c| c.interactions).sum();
+        let mut per_pool = Vec::new();
+        for ((pool_threads, _), t) in pools.iter().zip(&wall) {
+            let (m, lo, hi) = stats(t);
+            print!(
+                "{name}: {pool_threads} thread(s): wall median {m:.3} s (min {lo:.3}, max {hi:.3}) for {histories:.0} \
+                 histories = {:.3e} photons/s",
+                histories / m
+            );
+            if *pool_threads == 1 {
+                let (c, clo, chi) = stats(&cpu_one);
+                print!(
+                    "; CPU median {c:.3} s (min {clo:.3}, max {chi:.3}) = {:.3e} photons/s, {:.3e} interactions/s",
+                    histories / c,
+                    interactions as f64 / c
+                );
+            }
             println!(
-                "{name}: {pool_threads} thread(s): median {:.3} s for {histories:.0} histories = {:.3e} photons/s, \
-                 {:.3e} interactions/s; Rd {:.5}, T {:.5}",
-                t,
-                histories / t,
-                interactions as f64 / t,
+                "; Rd {:.5}, T {:.5}",
                 r.channels[0].diffuse_reflectance.mean,
                 r.channels[0].transmittance.mean
             );
-            per_pool.push((pool_threads, histories / t, interactions as f64 / t));
+            per_pool.push((*pool_threads, histories / m, interactions as f64 / m));
+        }
+        if mcml.is_some() {
+            let (m, lo, hi) = stats(&mcml_wall);
+            let (c, clo, chi) = stats(&mcml_cpu);
+            let (rm, rlo, rhi) = stats(&ratios);
+            println!(
+                "{name}: MCML 2.0 (1 thread): wall median {m:.3} s (min {lo:.3}, max {hi:.3}); CPU median {c:.3} s \
+                 (min {clo:.3}, max {chi:.3}) for {photons} photons = {:.3e} photons/s; rtbake per core / MCML \
+                 (CPU time) = {rm:.2} (per round: min {rlo:.2}, max {rhi:.2}; {rounds} rounds); rtbake on {threads} \
+                 threads / MCML (wall) = {:.2}",
+                photons as f64 / c,
+                per_pool[1].1 / (photons as f64 / m)
+            );
+            let _ = std::fs::remove_dir_all(&dir);
         }
         if let Some((g, pipeline)) = &gpu {
             let run = || pipeline.simulate(&g.device, &g.queue, &stack, &settings, &|_| {}).expect("GPU transport");
@@ -120,35 +200,13 @@ fn main() {
                  steps/s goal); Rd {:.5} ± {:.5}, T {:.5} ± {:.5}",
                 g.adapter_info.name,
                 histories / t,
-                steps / per_pool[0].2,
+                steps / per_pool[1].2,
                 steps / 1e9,
                 warm.channels[0].diffuse_reflectance.mean,
                 warm.channels[0].diffuse_reflectance.se,
                 warm.channels[0].transmittance.mean,
                 warm.channels[0].transmittance.se
             );
-        }
-        if let Some(bin) = &mcml {
-            let dir = std::env::temp_dir().join(format!("rtbake_bench_mcml_{}", std::process::id()));
-            std::fs::create_dir_all(&dir).unwrap();
-            std::fs::write(dir.join("in.mci"), mci(thickness_cm, n, g, photons)).unwrap();
-            let mut times = Vec::new();
-            for _ in 0..5 {
-                let t0 = Instant::now();
-                let out = std::process::Command::new(bin).arg("in.mci").current_dir(&dir).output().unwrap();
-                assert!(out.status.success(), "MCML failed: {}", String::from_utf8_lossy(&out.stderr));
-                times.push(t0.elapsed().as_secs_f64());
-            }
-            let t = median(times);
-            let rate = photons as f64 / t;
-            let one = per_pool.iter().find(|p| p.0 == 1).unwrap().1;
-            println!(
-                "{name}: MCML 2.0 (1 thread): median {t:.3} s for {photons} photons = {rate:.3e} photons/s; \
-                 rtbake per core / MCML = {:.2}; rtbake on {threads} threads / MCML = {:.2}",
-                one / rate,
-                per_pool[0].1 / rate
-            );
-            let _ = std::fs::remove_dir_all(&dir);
         }
     }
 }

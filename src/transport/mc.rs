@@ -35,6 +35,7 @@
 
 use super::rng::PhotonRng;
 use super::stack::McStack;
+use super::ziggurat::ExponentialZiggurat;
 use crate::error::InvalidInput;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -298,113 +299,147 @@ struct Channel<'a> {
     /// 1 − Rsp.
     start_weight: f64,
     index: u32,
+    /// Step lengths −ln ξ by the ziggurat method.
+    exponential: &'a ExponentialZiggurat,
 }
 
-/// Traces photons `first..first + count` of channel `ch` into `tally`.
-///
-/// Per step the common case — an interaction inside the layer — is decided without a division: the packet's new
-/// depth z + uz·s/σt is compared with the face it heads for; only a packet that reaches it computes the distance to
-/// the face (and then stops there exactly, as MCML's `PathToBoundary`/`CrossOrNot`).
-fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
-    let Channel { media, eta_above, eta_below, start_weight, index: channel } = *ch;
-    let inv_bin = 1.0 / settings.bin_mm;
-    let bins = settings.bins;
-    let last = media.len() - 1;
-    let mut interactions = 0u64;
-    for k in first..first + count {
-        let mut rng = PhotonRng::new(settings.seed, k, channel);
-        let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
-        let mut u = [0.0f64, 0.0, 1.0];
-        let mut w = start_weight;
-        let mut layer = 0usize;
-        let mut s_left = 0.0f64;
-        loop {
-            let m = &media[layer];
-            if s_left == 0.0 {
-                s_left = -rng.uniform().ln();
-            }
-            let down = u[2] > 0.0;
-            let face_z = if down { m.z_bottom_mm } else { m.z_top_mm };
-            if m.sigma_t > 0.0 {
-                let d_step = s_left * m.inv_sigma_t;
-                let z_new = z + u[2] * d_step;
-                // Strictly short of the face it heads for (never for uz = 0, which meets no face).
-                if u[2] == 0.0 || (z_new - face_z) * u[2] < 0.0 {
-                    // Interaction inside the layer.
-                    x += u[0] * d_step;
-                    y += u[1] * d_step;
-                    z = z_new;
-                    s_left = 0.0;
-                    interactions += 1;
-                    let dw = w * m.absorb_fraction;
-                    tally.absorbed[layer] += dw;
-                    w -= dw;
-                    let cos_t = m.hg.cos_theta(rng.uniform());
-                    let (cos_p, sin_p) = rng.azimuth_cos_sin();
-                    u = spin(u, cos_t, cos_p, sin_p);
-                    if w < ROULETTE_THRESHOLD {
-                        if w == 0.0 {
-                            break;
-                        }
-                        if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
-                            w *= ROULETTE_CHANCE;
-                        } else {
-                            break;
-                        }
-                    }
-                    continue;
-                }
-            }
-            let d_face = if u[2] != 0.0 { (face_z - z) / u[2] } else { f64::INFINITY };
-            if d_face.is_infinite() {
-                // Gliding parallel to the faces of a clear layer (or down a clear semi-infinite one): it never
-                // leaves; score it as absorbed there.
-                tally.absorbed[layer] += w;
-                break;
-            }
-            // Move to the face, keep the rest of the optical depth.
-            x += u[0] * d_face;
-            y += u[1] * d_face;
-            z = face_z;
-            if m.sigma_t > 0.0 {
-                s_left = (s_left - d_face * m.sigma_t).max(0.0);
-            }
-            let n_t = match (down, layer) {
-                (false, 0) => eta_above,
-                (false, j) => media[j - 1].eta,
-                (true, j) if j == last => eta_below,
-                (true, j) => media[j + 1].eta,
-            };
-            let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
-            if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
-                u[2] = -u[2];
-                continue;
-            }
-            let ratio = m.eta / n_t;
-            u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
-            match (down, layer) {
-                (false, 0) => {
-                    tally.rd += w;
-                    let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                    if bin < bins {
-                        tally.r[bin] += w;
-                    }
-                    break;
-                }
-                (true, j) if j == last => {
-                    tally.td += w;
-                    let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                    if bin < bins {
-                        tally.t[bin] += w;
-                    }
-                    break;
-                }
-                (false, _) => layer -= 1,
-                (true, _) => layer += 1,
-            }
+/// One photon packet in flight.
+struct Photon {
+    x: f64,
+    y: f64,
+    z: f64,
+    u: [f64; 3],
+    w: f64,
+    /// Optical depth left of the current step (0: draw a new one).
+    s_left: f64,
+    layer: usize,
+    rng: PhotonRng,
+}
+
+impl Photon {
+    /// Photon `k` of the channel at the origin, heading down with weight 1 − Rsp.
+    fn launch(ch: &Channel<'_>, seed: u64, k: u64) -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            u: [0.0, 0.0, 1.0],
+            w: ch.start_weight,
+            s_left: 0.0,
+            layer: 0,
+            rng: PhotonRng::new(seed, k, ch.index),
         }
     }
-    tally.interactions += interactions;
+
+    /// One event: an interaction inside the layer or the arrival at a face. Returns false when the packet has
+    /// ended (left the stack, lost the roulette, or glides in a clear layer forever).
+    ///
+    /// The common case — an interaction inside the layer — is decided without a division: the new depth
+    /// z + uz·s/σt is compared with the face the packet heads for; only a packet that reaches it computes the
+    /// distance to the face (and then stops there exactly, as MCML's `PathToBoundary` and `CrossOrNot`).
+    #[inline(always)]
+    fn event(&mut self, ch: &Channel<'_>, bins: usize, inv_bin: f64, tally: &mut Tally) -> bool {
+        let media = ch.media;
+        let m = &media[self.layer];
+        let rng = &mut self.rng;
+        if self.s_left == 0.0 {
+            self.s_left = ch.exponential.sample(rng);
+        }
+        let u = self.u;
+        let down = u[2] > 0.0;
+        let face_z = if down { m.z_bottom_mm } else { m.z_top_mm };
+        if m.sigma_t > 0.0 {
+            let d_step = self.s_left * m.inv_sigma_t;
+            let z_new = self.z + u[2] * d_step;
+            // Strictly short of the face it heads for (always for uz = 0, which meets no face).
+            if u[2] == 0.0 || (z_new - face_z) * u[2] < 0.0 {
+                self.x += u[0] * d_step;
+                self.y += u[1] * d_step;
+                self.z = z_new;
+                self.s_left = 0.0;
+                tally.interactions += 1;
+                let dw = self.w * m.absorb_fraction;
+                tally.absorbed[self.layer] += dw;
+                self.w -= dw;
+                let cos_t = m.hg.cos_theta(rng.uniform());
+                let (cos_p, sin_p) = rng.azimuth_cos_sin();
+                self.u = spin(u, cos_t, cos_p, sin_p);
+                if self.w < ROULETTE_THRESHOLD {
+                    if self.w == 0.0 {
+                        return false;
+                    }
+                    if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
+                        self.w *= ROULETTE_CHANCE;
+                    } else {
+                        return false;
+                    }
+                }
+                return true;
+            }
+        }
+        let d_face = if u[2] != 0.0 { (face_z - self.z) / u[2] } else { f64::INFINITY };
+        if d_face.is_infinite() {
+            // Gliding parallel to the faces of a clear layer (or down a clear semi-infinite one): it never leaves;
+            // score it as absorbed there.
+            tally.absorbed[self.layer] += self.w;
+            return false;
+        }
+        // Move to the face, keep the rest of the optical depth.
+        self.x += u[0] * d_face;
+        self.y += u[1] * d_face;
+        self.z = face_z;
+        if m.sigma_t > 0.0 {
+            self.s_left = (self.s_left - d_face * m.sigma_t).max(0.0);
+        }
+        let last = media.len() - 1;
+        let n_t = match (down, self.layer) {
+            (false, 0) => ch.eta_above,
+            (false, j) => media[j - 1].eta,
+            (true, j) if j == last => ch.eta_below,
+            (true, j) => media[j + 1].eta,
+        };
+        let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
+        if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
+            self.u[2] = -u[2];
+            return true;
+        }
+        let ratio = m.eta / n_t;
+        self.u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
+        let exit = match (down, self.layer) {
+            (false, 0) => {
+                tally.rd += self.w;
+                &mut tally.r
+            }
+            (true, j) if j == last => {
+                tally.td += self.w;
+                &mut tally.t
+            }
+            (false, _) => {
+                self.layer -= 1;
+                return true;
+            }
+            (true, _) => {
+                self.layer += 1;
+                return true;
+            }
+        };
+        let bin = ((self.x * self.x + self.y * self.y).sqrt() * inv_bin) as usize;
+        if bin < bins {
+            exit[bin] += self.w;
+        }
+        false
+    }
+}
+
+/// Traces photons `first..first + count` of channel `ch` into `tally`, one after the other. (Tracing four photons
+/// side by side, one event each in turn, to overlap their dependency chains was measured slower: the events'
+/// branches do not predict across photons.)
+fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
+    let inv_bin = 1.0 / settings.bin_mm;
+    for k in first..first + count {
+        let mut p = Photon::launch(ch, settings.seed, k);
+        while p.event(ch, settings.bins, inv_bin, tally) {}
+    }
 }
 
 fn estimate(batch_values: impl Iterator<Item = f64> + Clone, total: f64, batches: usize) -> Estimate {
@@ -454,6 +489,7 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
 
     // Work list: (channel, batch, chunk) in a fixed order; every batch tally sums its chunks in chunk order.
     let total_chunks = 3 * batches as u64 * chunks_per_batch;
+    let exponential = ExponentialZiggurat::new();
     let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
     let mut next = 0u64;
     while next < total_chunks {
@@ -474,6 +510,7 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                     eta_below: stack.eta_below(),
                     start_weight: 1.0 - rsp,
                     index: channel as u32,
+                    exponential: &exponential,
                 };
                 trace_chunk(&ch, settings, first, count, &mut t);
                 ((channel as usize) * batches + batch as usize, t)
