@@ -54,14 +54,16 @@ impl ExponentialZiggurat {
         (x, last)
     }
 
-    /// An exponential variate of mean 1 from `rng`: two words (layer from the low 8 bits, U from the top 53) in the
-    /// common case, more in the rare rejection and tail cases.
+    /// An exponential variate of mean 1 from `rng`: one word in the common case (the layer from its low 8 bits, U
+    /// from its top 24 bits on the grid k/2²⁴, so x resolves a layer's width to 6·10⁻⁸ — the tail beyond r is drawn
+    /// afresh with 32 bits), more in the rare rejection and tail cases. Two words with a 53-bit U were measured 7 %
+    /// slower over the whole transport.
     #[inline]
     pub fn sample(&self, rng: &mut PhotonRng) -> f64 {
         loop {
-            let bits = (u64::from(rng.word()) << 32) | u64::from(rng.word());
-            let i = (bits & 0xff) as usize;
-            let u = (bits >> 11) as f64 * (1.0 / 9_007_199_254_740_992.0);
+            let word = rng.word();
+            let i = (word & 0xff) as usize;
+            let u = f64::from(word >> 8) * (1.0 / 16_777_216.0);
             let x = u * self.x[i];
             if x < self.x[i + 1] {
                 return x;
