@@ -4,10 +4,14 @@
 //! (b) a semi-infinite medium: μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0, n = 1.5 under air.
 //! The issue's goal is ≥ 2× MCML per core; issue 12's GPU goal is ≥ 10⁹ interaction steps/s on an H100.
 //!
-//! `cargo run --release --example bench_transport` prints, per case, the median wall time of 5 runs on the default
-//! rayon pool and on 1 thread, photon histories per second (3 channels × photons), the totals (which must not change
-//! with the thread count) and, when `RTBAKE_MCML` names an MCML 2.0 binary, MCML's median time on the same input
-//! (one channel, its own tallies at the sample's grid) and the per-core ratio.
+//! `cargo run --release --example bench_transport` runs each case in rounds (5, or `RTBAKE_BENCH_ROUNDS`) of
+//! rtbake on 1 thread, MCML (when `RTBAKE_MCML` names an MCML 2.0 binary: one channel, its own tallies at the
+//! sample's grid) and rtbake on the default rayon pool, alternately, so that the load of the shared machine falls on
+//! both alike. It prints the median and min–max wall time per pool, the 1-thread run's CPU time (photon histories
+//! = 3 channels × photons, and interactions, per CPU second), MCML's wall and CPU time (user + system of the child),
+//! and the per-core ratio: rtbake's histories per CPU second over MCML's photons per CPU second, median and min–max
+//! of the per-round ratios. CPU time, not wall time, is the per-core measure on a machine whose cores other
+//! processes share (wall time there counts their turns). It also checks that every run and pool gave the same bytes.
 //!
 //! When an adapter is found (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME` as for the runtime) the GPU path
 //! (`runtime::transport_gpu`, pipeline compiled once, one warm-up run) is timed the same way: median and min–max

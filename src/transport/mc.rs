@@ -5,7 +5,8 @@
 //! Rsp = ((n₀ − n₁)/(n₀ + n₁))² is the specular reflection of the top surface (§3.1; MCML's special case of a
 //! clear first layer is not made: a clear layer is simply traced). Then, repeatedly (§3.2–3.8):
 //!
-//! * **Step**: a dimensionless optical depth s = −ln ξ is drawn; in a layer of σt = σa + σs the packet moves s/σt
+//! * **Step**: a dimensionless optical depth s, exponential of mean 1 (distributed as −ln ξ; drawn by the ziggurat
+//!   method, [`super::ziggurat`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
 //!   unless it reaches the layer's face first, in which case it stops there and keeps the rest of s for the next
 //!   layer (§3.3.2, with σt = 0 in a clear layer).
 //! * **Face**: unpolarised Fresnel reflectance R(θi) = ½(rs² + rp²) between the layer's index and the neighbour's
@@ -14,7 +15,9 @@
 //!   its weight in R(r), through the bottom face in T(r), at r = √(x² + y²).
 //! * **Interaction**: implicit capture — the weight w·σa/σt is scored as absorbed in the layer and w keeps the rest
 //!   (§3.4); the direction is scattered by the Henyey–Greenstein phase function
-//!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ = 2πξ (§3.5, eq. 3.28–3.30).
+//!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ uniform on `[0, 2π)`
+//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ from a point uniform in the unit disk, [`PhotonRng::azimuth_cos_sin`],
+//!   instead of MCML's cos(2πξ)).
 //! * **Russian roulette** below w = [`ROULETTE_THRESHOLD`]: the packet survives with chance 1/[`ROULETTE_CHANCE`]
 //!   with weight w·`ROULETTE_CHANCE`, else ends (§3.6; energy is conserved in expectation).
 //!
@@ -24,13 +27,18 @@
 //! Standard errors come from [`McSettings::batches`] independent batches of equal size:
 //! SE = √(Σ_b (x_b − x̄)²/(B(B − 1))).
 //!
+//! Each event draws, in order: the step (one word, more in the ziggurat's rare slow cases) when none is pending;
+//! then either the Fresnel ξ at a face (only where 0 < R < 1) or, at an interaction, the HG ξ, the azimuth (two
+//! words per disk try, 2.55 on average) and the roulette ξ (only below the threshold).
+//!
 //! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, block)
 //! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
 //! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
 //! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
 //!
 //! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
-//! the same Philox streams) reads its tallies back and calls it too, so both report means and standard errors the
+//! the same Philox streams but consumed MCML's way: −ln ξ, φ = 2πξ, 24-bit uniforms, so its histories are not the
+//! CPU's and the two agree statistically) reads its tallies back and calls it too, so both report means and standard errors the
 //! same way.
 
 use super::rng::PhotonRng;
