@@ -163,11 +163,7 @@ fn main() {
                     interactions as f64 / c
                 );
             }
-            println!(
-                "; Rd {:.5}, T {:.5}",
-                r.channels[0].diffuse_reflectance.mean,
-                r.channels[0].transmittance.mean
-            );
+            println!("; Rd {:.5}, T {:.5}", r.channels[0].diffuse_reflectance.mean, r.channels[0].transmittance.mean);
             per_pool.push((*pool_threads, histories / m, interactions as f64 / m));
         }
         if mcml.is_some() {
