@@ -5,7 +5,8 @@
 //! Rsp = ((n₀ − n₁)/(n₀ + n₁))² is the specular reflection of the top surface (§3.1; MCML's special case of a
 //! clear first layer is not made: a clear layer is simply traced). Then, repeatedly (§3.2–3.8):
 //!
-//! * **Step**: a dimensionless optical depth s = −ln ξ is drawn; in a layer of σt = σa + σs the packet moves s/σt
+//! * **Step**: a dimensionless optical depth s, exponential of mean 1 (distributed as −ln ξ; drawn by the ziggurat
+//!   method, [`super::ziggurat`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
 //!   unless it reaches the layer's face first, in which case it stops there and keeps the rest of s for the next
 //!   layer (§3.3.2, with σt = 0 in a clear layer).
 //! * **Face**: unpolarised Fresnel reflectance R(θi) = ½(rs² + rp²) between the layer's index and the neighbour's
@@ -14,7 +15,9 @@
 //!   its weight in R(r), through the bottom face in T(r), at r = √(x² + y²).
 //! * **Interaction**: implicit capture — the weight w·σa/σt is scored as absorbed in the layer and w keeps the rest
 //!   (§3.4); the direction is scattered by the Henyey–Greenstein phase function
-//!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ = 2πξ (§3.5, eq. 3.28–3.30).
+//!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ uniform on `[0, 2π)`
+//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ from a point uniform in the unit disk, [`PhotonRng::azimuth_cos_sin`],
+//!   instead of MCML's cos(2πξ)).
 //! * **Russian roulette** below w = [`ROULETTE_THRESHOLD`]: the packet survives with chance 1/[`ROULETTE_CHANCE`]
 //!   with weight w·`ROULETTE_CHANCE`, else ends (§3.6; energy is conserved in expectation).
 //!
@@ -24,17 +27,23 @@
 //! Standard errors come from [`McSettings::batches`] independent batches of equal size:
 //! SE = √(Σ_b (x_b − x̄)²/(B(B − 1))).
 //!
+//! Each event draws, in order: the step (one word, more in the ziggurat's rare slow cases) when none is pending;
+//! then either the Fresnel ξ at a face (only where 0 < R < 1) or, at an interaction, the HG ξ, the azimuth (two
+//! words per disk try, 2.55 on average) and the roulette ξ (only below the threshold).
+//!
 //! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, block)
 //! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
 //! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
 //! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
 //!
 //! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
-//! the same Philox streams) reads its tallies back and calls it too, so both report means and standard errors the
+//! the same Philox streams but consumed MCML's way: −ln ξ, φ = 2πξ, 24-bit uniforms, so its histories are not the
+//! CPU's and the two agree statistically) reads its tallies back and calls it too, so both report means and standard errors the
 //! same way.
 
 use super::rng::PhotonRng;
 use super::stack::McStack;
+use super::ziggurat::ExponentialZiggurat;
 use crate::error::InvalidInput;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -202,19 +211,57 @@ impl Tally {
     }
 }
 
-/// Per-layer constants of one channel.
+/// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug)]
 struct Medium {
     z_top_mm: f64,
     z_bottom_mm: f64,
     sigma_t: f64,
+    /// 1/σt (unused in a clear layer).
+    inv_sigma_t: f64,
     /// σa/σt (0 in a clear layer).
     absorb_fraction: f64,
-    g: f64,
+    hg: HenyeyGreenstein,
     eta: f64,
 }
 
-/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ [0, 1], and the cosine of
+/// Henyey–Greenstein sampling constants of one g (MCML eq. 3.28):
+/// cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g), cos θ = 2ξ − 1 for |g| < 10⁻⁶.
+#[derive(Clone, Copy, Debug)]
+struct HenyeyGreenstein {
+    isotropic: bool,
+    /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
+    one_minus_g2: f64,
+    one_minus_g: f64,
+    two_g: f64,
+    one_plus_g2: f64,
+    inv_two_g: f64,
+}
+
+impl HenyeyGreenstein {
+    fn new(g: f64) -> Self {
+        Self {
+            isotropic: g.abs() < 1e-6,
+            one_minus_g2: 1.0 - g * g,
+            one_minus_g: 1.0 - g,
+            two_g: 2.0 * g,
+            one_plus_g2: 1.0 + g * g,
+            inv_two_g: 0.5 / g,
+        }
+    }
+
+    /// cos θ from a uniform ξ.
+    #[inline]
+    fn cos_theta(&self, xi: f64) -> f64 {
+        if self.isotropic {
+            return 2.0 * xi - 1.0;
+        }
+        let f = self.one_minus_g2 / (self.one_minus_g + self.two_g * xi);
+        ((self.one_plus_g2 - f * f) * self.inv_two_g).clamp(-1.0, 1.0)
+    }
+}
+
+/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ `[0, 1]`, and the cosine of
 /// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
 fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     if n_i == n_t {
@@ -230,32 +277,24 @@ fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     (0.5 * (rs * rs + rp * rp), cos_t)
 }
 
-/// HG cos θ from a uniform ξ (MCML eq. 3.28).
+/// Rotates direction `u` by polar cos θ and the azimuth (cos φ, sin φ) (MCML eq. 3.30–3.31). sin θ/√(1 − uz²) is
+/// taken as one square root of a quotient, and sin θ·√(1 − uz²) as that times 1 − uz² (the same expressions as
+/// MCML's `Spin`, one square root fewer).
 #[inline]
-fn hg_cos_theta(g: f64, xi: f64) -> f64 {
-    if g.abs() < 1e-6 {
-        return 2.0 * xi - 1.0;
-    }
-    let f = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
-    ((1.0 + g * g - f * f) / (2.0 * g)).clamp(-1.0, 1.0)
-}
-
-/// Rotates direction `u` by polar cos θ and azimuth φ (MCML eq. 3.30–3.31).
-#[inline]
-fn spin(u: [f64; 3], cos_t: f64, phi: f64) -> [f64; 3] {
-    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    // One cosine and a square root instead of sin and cos (MCML's `Spin` does the same).
-    let cos_p = phi.cos();
-    let sin_p = (1.0 - cos_p * cos_p).max(0.0).sqrt().copysign(PI - phi);
+fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
+    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
     let [ux, uy, uz] = u;
     if uz.abs() > 0.99999 {
+        let sin_t = sin2_t.sqrt();
         [sin_t * cos_p, sin_t * sin_p, cos_t * uz.signum()]
     } else {
-        let tmp = (1.0 - uz * uz).sqrt();
+        let one_minus_uz2 = 1.0 - uz * uz;
+        // sin θ / √(1 − uz²)
+        let a = (sin2_t / one_minus_uz2).sqrt();
         [
-            sin_t * (ux * uz * cos_p - uy * sin_p) / tmp + ux * cos_t,
-            sin_t * (uy * uz * cos_p + ux * sin_p) / tmp + uy * cos_t,
-            -sin_t * cos_p * tmp + uz * cos_t,
+            a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t,
+            a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t,
+            -a * one_minus_uz2 * cos_p + uz * cos_t,
         ]
     }
 }
@@ -268,105 +307,146 @@ struct Channel<'a> {
     /// 1 − Rsp.
     start_weight: f64,
     index: u32,
+    /// Step lengths −ln ξ by the ziggurat method.
+    exponential: &'a ExponentialZiggurat,
 }
 
-/// Traces photons `first..first + count` of channel `ch` into `tally`.
-fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
-    let Channel { media, eta_above, eta_below, start_weight, index: channel } = *ch;
-    let inv_bin = 1.0 / settings.bin_mm;
-    let bins = settings.bins;
-    let last = media.len() - 1;
-    for k in first..first + count {
-        let mut rng = PhotonRng::new(settings.seed, k, channel);
-        let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
-        let mut u = [0.0f64, 0.0, 1.0];
-        let mut w = start_weight;
-        let mut layer = 0usize;
-        let mut s_left = 0.0f64;
-        loop {
-            let m = &media[layer];
-            if s_left == 0.0 {
-                s_left = -rng.uniform().ln();
-            }
-            let d_face = if u[2] > 0.0 {
-                (m.z_bottom_mm - z) / u[2]
-            } else if u[2] < 0.0 {
-                (m.z_top_mm - z) / u[2]
-            } else {
-                f64::INFINITY
-            };
-            let d_step = if m.sigma_t > 0.0 { s_left / m.sigma_t } else { f64::INFINITY };
-            if d_step.is_infinite() && d_face.is_infinite() {
-                // Gliding parallel to the faces of a clear layer: it never leaves; score it as absorbed there.
-                tally.absorbed[layer] += w;
-                break;
-            }
-            if d_face <= d_step {
-                // Move to the face, keep the rest of the optical depth.
-                x += u[0] * d_face;
-                y += u[1] * d_face;
-                z = if u[2] > 0.0 { m.z_bottom_mm } else { m.z_top_mm };
-                if m.sigma_t > 0.0 {
-                    s_left = (s_left - d_face * m.sigma_t).max(0.0);
-                }
-                let down = u[2] > 0.0;
-                let n_t = match (down, layer) {
-                    (false, 0) => eta_above,
-                    (false, j) => media[j - 1].eta,
-                    (true, j) if j == last => eta_below,
-                    (true, j) => media[j + 1].eta,
-                };
-                let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
-                if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
-                    u[2] = -u[2];
-                    continue;
-                }
-                let ratio = m.eta / n_t;
-                u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
-                match (down, layer) {
-                    (false, 0) => {
-                        tally.rd += w;
-                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                        if bin < bins {
-                            tally.r[bin] += w;
-                        }
-                        break;
+/// One photon packet in flight.
+struct Photon {
+    x: f64,
+    y: f64,
+    z: f64,
+    u: [f64; 3],
+    w: f64,
+    /// Optical depth left of the current step (0: draw a new one).
+    s_left: f64,
+    layer: usize,
+    rng: PhotonRng,
+}
+
+impl Photon {
+    /// Photon `k` of the channel at the origin, heading down with weight 1 − Rsp.
+    fn launch(ch: &Channel<'_>, seed: u64, k: u64) -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            u: [0.0, 0.0, 1.0],
+            w: ch.start_weight,
+            s_left: 0.0,
+            layer: 0,
+            rng: PhotonRng::new(seed, k, ch.index),
+        }
+    }
+
+    /// One event: an interaction inside the layer or the arrival at a face. Returns false when the packet has
+    /// ended (left the stack, lost the roulette, or glides in a clear layer forever).
+    ///
+    /// The common case — an interaction inside the layer — is decided without a division: the new depth
+    /// z + uz·s/σt is compared with the face the packet heads for; only a packet that reaches it computes the
+    /// distance to the face (and then stops there exactly, as MCML's `PathToBoundary` and `CrossOrNot`).
+    #[inline(always)]
+    fn event(&mut self, ch: &Channel<'_>, bins: usize, inv_bin: f64, tally: &mut Tally) -> bool {
+        let media = ch.media;
+        let m = &media[self.layer];
+        let rng = &mut self.rng;
+        if self.s_left == 0.0 {
+            self.s_left = ch.exponential.sample(rng);
+        }
+        let u = self.u;
+        let down = u[2] > 0.0;
+        let face_z = if down { m.z_bottom_mm } else { m.z_top_mm };
+        if m.sigma_t > 0.0 {
+            let d_step = self.s_left * m.inv_sigma_t;
+            let z_new = self.z + u[2] * d_step;
+            // Strictly short of the face it heads for (always for uz = 0, which meets no face).
+            if u[2] == 0.0 || (z_new - face_z) * u[2] < 0.0 {
+                self.x += u[0] * d_step;
+                self.y += u[1] * d_step;
+                self.z = z_new;
+                self.s_left = 0.0;
+                tally.interactions += 1;
+                let dw = self.w * m.absorb_fraction;
+                tally.absorbed[self.layer] += dw;
+                self.w -= dw;
+                let cos_t = m.hg.cos_theta(rng.uniform());
+                let (cos_p, sin_p) = rng.azimuth_cos_sin();
+                self.u = spin(u, cos_t, cos_p, sin_p);
+                if self.w < ROULETTE_THRESHOLD {
+                    if self.w == 0.0 {
+                        return false;
                     }
-                    (true, j) if j == last => {
-                        tally.td += w;
-                        let bin = ((x * x + y * y).sqrt() * inv_bin) as usize;
-                        if bin < bins {
-                            tally.t[bin] += w;
-                        }
-                        break;
+                    if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
+                        self.w *= ROULETTE_CHANCE;
+                    } else {
+                        return false;
                     }
-                    (false, _) => layer -= 1,
-                    (true, _) => layer += 1,
                 }
-                continue;
-            }
-            // Interaction inside the layer.
-            x += u[0] * d_step;
-            y += u[1] * d_step;
-            z += u[2] * d_step;
-            s_left = 0.0;
-            tally.interactions += 1;
-            let dw = w * m.absorb_fraction;
-            tally.absorbed[layer] += dw;
-            w -= dw;
-            let cos_t = hg_cos_theta(m.g, rng.uniform());
-            u = spin(u, cos_t, 2.0 * PI * rng.uniform());
-            if w < ROULETTE_THRESHOLD {
-                if w == 0.0 {
-                    break;
-                }
-                if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
-                    w *= ROULETTE_CHANCE;
-                } else {
-                    break;
-                }
+                return true;
             }
         }
+        let d_face = if u[2] != 0.0 { (face_z - self.z) / u[2] } else { f64::INFINITY };
+        if d_face.is_infinite() {
+            // Gliding parallel to the faces of a clear layer (or down a clear semi-infinite one): it never leaves;
+            // score it as absorbed there.
+            tally.absorbed[self.layer] += self.w;
+            return false;
+        }
+        // Move to the face, keep the rest of the optical depth.
+        self.x += u[0] * d_face;
+        self.y += u[1] * d_face;
+        self.z = face_z;
+        if m.sigma_t > 0.0 {
+            self.s_left = (self.s_left - d_face * m.sigma_t).max(0.0);
+        }
+        let last = media.len() - 1;
+        let n_t = match (down, self.layer) {
+            (false, 0) => ch.eta_above,
+            (false, j) => media[j - 1].eta,
+            (true, j) if j == last => ch.eta_below,
+            (true, j) => media[j + 1].eta,
+        };
+        let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
+        if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
+            self.u[2] = -u[2];
+            return true;
+        }
+        let ratio = m.eta / n_t;
+        self.u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
+        let exit = match (down, self.layer) {
+            (false, 0) => {
+                tally.rd += self.w;
+                &mut tally.r
+            }
+            (true, j) if j == last => {
+                tally.td += self.w;
+                &mut tally.t
+            }
+            (false, _) => {
+                self.layer -= 1;
+                return true;
+            }
+            (true, _) => {
+                self.layer += 1;
+                return true;
+            }
+        };
+        let bin = ((self.x * self.x + self.y * self.y).sqrt() * inv_bin) as usize;
+        if bin < bins {
+            exit[bin] += self.w;
+        }
+        false
+    }
+}
+
+/// Traces photons `first..first + count` of channel `ch` into `tally`, one after the other. (Tracing four photons
+/// side by side, one event each in turn, to overlap their dependency chains was measured slower: the events'
+/// branches do not predict across photons.)
+fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
+    let inv_bin = 1.0 / settings.bin_mm;
+    for k in first..first + count {
+        let mut p = Photon::launch(ch, settings.seed, k);
+        while p.event(ch, settings.bins, inv_bin, tally) {}
     }
 }
 
@@ -403,8 +483,9 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                         z_top_mm: z,
                         z_bottom_mm: z + l.thickness_mm,
                         sigma_t,
+                        inv_sigma_t: if sigma_t > 0.0 { 1.0 / sigma_t } else { 0.0 },
                         absorb_fraction: if sigma_t > 0.0 { l.sigma_a_per_mm[c] / sigma_t } else { 0.0 },
-                        g: l.g[c],
+                        hg: HenyeyGreenstein::new(l.g[c]),
                         eta: l.eta,
                     };
                     z += l.thickness_mm;
@@ -416,6 +497,7 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
 
     // Work list: (channel, batch, chunk) in a fixed order; every batch tally sums its chunks in chunk order.
     let total_chunks = 3 * batches as u64 * chunks_per_batch;
+    let exponential = ExponentialZiggurat::new();
     let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
     let mut next = 0u64;
     while next < total_chunks {
@@ -436,6 +518,7 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                     eta_below: stack.eta_below(),
                     start_weight: 1.0 - rsp,
                     index: channel as u32,
+                    exponential: &exponential,
                 };
                 trace_chunk(&ch, settings, first, count, &mut t);
                 ((channel as usize) * batches + batch as usize, t)

@@ -6,6 +6,7 @@
 //! - [`mc`]: the transport and its tallies (R(r), T(r) in mm⁻², totals, absorbed per layer, standard errors from
 //!   independent batches), deterministic for any thread count.
 //! - [`rng`]: Philox4x32-10, counter-based random numbers keyed by (seed, photon index).
+//! - [`ziggurat`]: exponential step lengths by the ziggurat method (Marsaglia & Tsang 2000).
 //! - [`compare`]: Monte Carlo against a diffusion [`RadialProfile`](crate::diffusion::RadialProfile) (total R,
 //!   r·R(r) error) and [`compare::diffusion_counterpart`], the diffusion model of a stack.
 //! - [`report`]: a result as CSV (the `rtbake profile --csv` layout) and JSON (with standard errors).
@@ -15,6 +16,7 @@ pub mod mc;
 pub mod report;
 pub mod rng;
 pub mod stack;
+pub mod ziggurat;
 
 pub use mc::{simulate, ChannelResult, Estimate, McResult, McSettings};
 pub use stack::{McLayer, McStack};
