@@ -131,6 +131,16 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, tex: &wgpu::Text
     Ok(out)
 }
 
+/// Reads a whole half-float texture (`Rgba16Float`, `R16Float`…) back as f32 values (top row first).
+pub fn read_texture_f16(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    tex: &wgpu::Texture,
+) -> Result<Vec<f32>, RuntimeError> {
+    let b = read_texture(device, queue, tex)?;
+    Ok(bytemuck::cast_slice::<u8, half::f16>(&b).iter().map(|v| v.to_f32()).collect())
+}
+
 /// Maps a `MAP_READ` buffer and copies its content out.
 pub fn map_read(device: &wgpu::Device, buf: &wgpu::Buffer) -> Result<Vec<u8>, RuntimeError> {
     let (tx, rx) = std::sync::mpsc::channel();

@@ -177,11 +177,7 @@ pub fn rasterise(
         pass.draw_indexed(0..mesh.indices.len() as u32, 0, 0..1);
     }
     queue.submit([enc.finish()]);
-    let read = |t| -> Result<Vec<f32>, RuntimeError> {
-        let b = gpu::read_texture(device, queue, t)?;
-        Ok(bytemuck::cast_slice::<u8, half::f16>(&b).iter().map(|v| v.to_f32()).collect())
-    };
-    let (a, b) = (read(&g0)?, read(&g1)?);
+    let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
     let mut g = MeshGBuffer::empty(width, height);
     for i in 0..(width * height) as usize {
         if b[4 * i + 2] > 0.5 {

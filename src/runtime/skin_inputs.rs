@@ -345,10 +345,7 @@ impl SkinInputs {
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin") });
         self.encode(&mut enc);
         queue.submit([enc.finish()]);
-        let read = |t| -> Result<Vec<f32>, RuntimeError> {
-            let b = gpu::read_texture(device, queue, t)?;
-            Ok(bytemuck::cast_slice::<u8, half::f16>(&b).iter().map(|v| v.to_f32()).collect())
-        };
+        let read = |t| gpu::read_texture_f16(device, queue, t);
         Ok((read(&self.albedo)?, read(&self.transmitted)?))
     }
 }
