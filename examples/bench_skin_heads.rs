@@ -27,7 +27,7 @@ fn main() {
     println!("adapter: {}", gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU twins".into()));
     let head = default_head();
     println!("mesh: the default head, {} triangles; 1280x720; 5 runs after one warm-up", head.triangle_count());
-    println!("{:<10} {:>22} {:>22} {:>22} {:>12}", "shader", "1 head ms", "3 heads ms", "5 heads ms", "1 -> 5");
+    println!("{:<12} {:>22} {:>22} {:>22} {:>12}", "shader", "1 head ms", "3 heads ms", "5 heads ms", "1 -> 5");
     for (name, shader) in
         [("none", SkinShader::None), ("ss-full", SkinShader::SsFull), ("separable", SkinShader::Separable)]
     {
@@ -53,7 +53,7 @@ fn main() {
         }
         let cell = |(m, lo, hi): (f64, f64, f64)| format!("{m:.1} ({lo:.1}-{hi:.1})");
         println!(
-            "{:<10} {:>22} {:>22} {:>22} {:>+11.0}%",
+            "{:<12} {:>22} {:>22} {:>22} {:>+11.0}%",
             name,
             cell(row[0]),
             cell(row[1]),

@@ -20,6 +20,8 @@ pub enum ShaderArg {
     SsFull,
     /// Separable SSS with the baked kernel (thesis ch. 6).
     Separable,
+    /// Hable et al.'s 13 jittered taps in one disk pass (TAP 2009's "SS Jittered"), derived from d'Eon's 6 Gaussians.
+    SsJittered,
 }
 
 #[derive(clap::Args)]
@@ -87,6 +89,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
             ShaderArg::None => SkinShader::None,
             ShaderArg::SsFull => SkinShader::SsFull,
             ShaderArg::Separable => SkinShader::Separable,
+            ShaderArg::SsJittered => SkinShader::SsJittered,
         },
         heads: a.heads,
         distance_m: a.distance,

@@ -53,6 +53,8 @@ pub struct DemoAssets {
     pub rig_source: String,
     /// The baked importance kernel ([`path::IMPORTANCE_KERNEL_DEFAULT`]), when the bake has it.
     pub importance: Option<ImportanceSamples>,
+    /// Scale and follow-surface settings of the importance-sampled pass (the demo's defaults).
+    pub importance_params: ImportanceSssParams,
 }
 
 impl DemoAssets {
@@ -98,6 +100,7 @@ impl DemoAssets {
             baked_rig,
             rig_source,
             importance,
+            importance_params: ImportanceSssParams::default(),
         })
     }
 }
@@ -319,7 +322,7 @@ fn shade(
     let Lit { geo, albedo, transmitted, diffuse } = lit;
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (kernel, params) = (&assets.kernel, &assets.sss);
-    let importance_params = ImportanceSssParams::default();
+    let importance_params = assets.importance_params;
     let Some(method) = method else {
         return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, aa);
     };

@@ -18,6 +18,7 @@
 use super::cpu;
 use super::demo::{back_light_view, render_geometry, DemoAssets, Geometry, SssMethod};
 use super::device::Gpu;
+use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use super::mesh_raster::{self, MeshGBuffer};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
 use super::RuntimeError;
@@ -36,6 +37,9 @@ pub enum SkinShader {
     SsFull,
     /// Separable SSS (thesis ch. 6) with the baked kernel.
     Separable,
+    /// TAP's "SS Jittered": Hable et al.'s 13 jittered taps ([`crate::sss_sampling::jittered::hable13`] of
+    /// d'Eon's 6 Gaussians) in one disk pass (the importance-sampled pass, physically scaled by depth).
+    SsJittered,
 }
 
 /// Heads side by side, centre to centre, metres.
@@ -189,6 +193,18 @@ fn geometry(
     Ok(Geometry { frame, depth, skin: g.covered })
 }
 
+/// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
+/// the widest tap.
+pub fn jittered_samples() -> Result<ImportanceSamples, InvalidInput> {
+    let taps = crate::sss_sampling::jittered::hable13(&crate::diffusion::sum_of_gaussians::deon6())?;
+    let widest = taps.iter().map(|t| t.r_mm()).fold(0.0, f64::max);
+    Ok(ImportanceSamples {
+        offsets_mm: taps.iter().map(|t| [t.x_mm as f32, t.y_mm as f32, t.r_mm() as f32, 0.0]).collect(),
+        weights: taps.iter().map(|t| [t.weight[0] as f32, t.weight[1] as f32, t.weight[2] as f32, 0.0]).collect(),
+        cutoff_mm: (1.5 * widest) as f32,
+    })
+}
+
 /// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded).
 pub fn render(
     gpu: Option<&Gpu>,
@@ -208,6 +224,15 @@ pub fn render(
         SkinShader::None => None,
         SkinShader::SsFull => Some(SssMethod::Gaussians),
         SkinShader::Separable => Some(SssMethod::Separable),
+        SkinShader::SsJittered => {
+            assets.importance = Some(jittered_samples()?);
+            assets.importance_params = ImportanceSssParams {
+                mm_per_world_unit: 1000.0 / WORLD_UNITS_PER_M,
+                fovy_deg: s.camera().fov_y_deg,
+                follow_surface: true,
+            };
+            Some(SssMethod::Importance)
+        }
     };
     let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
     render_geometry(gpu, geo, &assets, method, background, None)

@@ -14,5 +14,6 @@
 pub mod cdf;
 pub mod compare;
 pub mod disk;
+pub mod jittered;
 
 pub use disk::{ImportanceKernel, SampledProfile};

@@ -1,5 +1,5 @@
 //! Issue 14: `rtbake run skin` — heads from a mesh through the skin chain. The GPU chain agrees with its CPU twin,
-//! the SSS shaders soften the lit skin (red more than blue, as the skin profiles are widest in red), a mesh file is
+//! the SSS shaders (separable, SS Full, SS Jittered) soften the lit skin (red more than blue, as the skin profiles are widest in red), a mesh file is
 //! rendered like the built-in head, and bad meshes and settings exit 2 naming the file or flag, writing nothing.
 
 use crate::support::rtbake;
@@ -42,9 +42,13 @@ fn gpu_and_cpu_chains_agree_and_sss_softens_red_most() {
     assert!(close as f64 >= 0.99 * gpu.len() as f64, "{close} of {} channels within 2/255", gpu.len());
     let none = render(&["--shader", "none"], &p("none.png"));
     let full = render(&["--shader", "ss-full"], &p("full.png"));
+    let jittered = render(&["--shader", "ss-jittered"], &p("jittered.png"));
+    let jittered_cpu = render(&["--shader", "ss-jittered", "--cpu"], &p("jittered_cpu.png"));
+    let close = jittered.iter().zip(&jittered_cpu).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+    assert!(close as f64 >= 0.99 * jittered.len() as f64, "ss-jittered: {close} of {} within 2/255", jittered.len());
     let covered = none.chunks(4).filter(|px| px[..3] != [46, 48, 52]).count();
     assert!(covered > 5000, "{covered} head pixels");
-    for (name, img) in [("separable", &gpu), ("ss-full", &full)] {
+    for (name, img) in [("separable", &gpu), ("ss-full", &full), ("ss-jittered", &jittered)] {
         let ratio = |c| roughness(img, 320, 180, c) / roughness(&none, 320, 180, c);
         let (r, b) = (ratio(0), ratio(2));
         eprintln!("{name}: Laplacian energy vs no SSS: red {r:.3}, blue {b:.3}");
