@@ -40,6 +40,7 @@ fn main() {
                 width: 1280,
                 height: 720,
                 melanin: 0.02,
+                stretch: Default::default(),
             };
             let run = || {
                 let t = Instant::now();

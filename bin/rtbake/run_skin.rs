@@ -5,7 +5,7 @@ use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
-use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader};
+use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,6 +22,12 @@ pub enum ShaderArg {
     Separable,
     /// Hable et al.'s 13 jittered taps in one disk pass (TAP 2009's "SS Jittered"), derived from d'Eon's 6 Gaussians.
     SsJittered,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum StretchArg {
+    Thesis,
+    Tap2009,
 }
 
 #[derive(clap::Args)]
@@ -45,6 +51,10 @@ pub struct SkinArgs {
     /// Millimetres per OBJ unit (glTF is in metres).
     #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     mesh_mm_per_unit: f32,
+    /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ) or tap2009 (α = 11, β = 800, no clamp of
+    /// the depth derivative, TAP 2009 §4).
+    #[arg(long, value_enum, default_value = "thesis")]
+    stretch: StretchArg,
     /// Melanin volume fraction Cm of the skin, 0..=0.5.
     #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
     melanin: f32,
@@ -96,6 +106,10 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         width: a.width,
         height: a.height,
         melanin: a.melanin,
+        stretch: match a.stretch {
+            StretchArg::Thesis => StretchPreset::Thesis,
+            StretchArg::Tap2009 => StretchPreset::Tap2009,
+        },
     };
     settings.validate().map_err(usage)?;
     if !(a.mesh_mm_per_unit.is_finite() && a.mesh_mm_per_unit > 0.0) {

@@ -18,6 +18,7 @@
 use super::cpu;
 use super::demo::{back_light_view, render_geometry, DemoAssets, Geometry, SssMethod};
 use super::device::Gpu;
+use super::gaussian_sss::GaussianSssParams;
 use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use super::mesh_raster::{self, MeshGBuffer};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
@@ -40,6 +41,27 @@ pub enum SkinShader {
     /// TAP's "SS Jittered": Hable et al.'s 13 jittered taps ([`crate::sss_sampling::jittered::hable13`] of
     /// d'Eon's 6 Gaussians) in one disk pass (the importance-sampled pass, physically scaled by depth).
     SsJittered,
+}
+
+/// The stretch parameters of the SS Full shader (eq. 4.1–4.4 / TAP 2009 eq. 2–3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StretchPreset {
+    /// The bake's fit parameters (the thesis' α = 31.5, β = 800, γ = 0.001 unless the bake says otherwise).
+    #[default]
+    Thesis,
+    /// TAP 2009 §4: "empirically fixed values of α = 11 and β = 800", with no clamp of the depth derivative.
+    Tap2009,
+}
+
+impl StretchPreset {
+    /// The parameters for `base` (the bake's).
+    pub fn apply(self, base: GaussianSssParams) -> GaussianSssParams {
+        match self {
+            StretchPreset::Thesis => base,
+            // γ = f32::MAX: min(|∂d|, γ) = |∂d|, TAP's eq. 2–3 have no clamp.
+            StretchPreset::Tap2009 => GaussianSssParams { alpha: 11.0, beta: 800.0, gamma: f32::MAX, ..base },
+        }
+    }
 }
 
 /// Heads side by side, centre to centre, metres.
@@ -65,6 +87,8 @@ pub struct SkinRenderSettings {
     pub height: u32,
     /// Melanin volume fraction Cm (uniform over the skin).
     pub melanin: f32,
+    /// Stretch parameters of `SkinShader::SsFull`.
+    pub stretch: StretchPreset,
 }
 
 impl SkinRenderSettings {
@@ -222,7 +246,10 @@ pub fn render(
     assets.sss.fovy_deg = s.camera().fov_y_deg;
     let method = match s.shader {
         SkinShader::None => None,
-        SkinShader::SsFull => Some(SssMethod::Gaussians),
+        SkinShader::SsFull => {
+            assets.gaussian_params = s.stretch.apply(assets.gaussian_params);
+            Some(SssMethod::Gaussians)
+        }
         SkinShader::Separable => Some(SssMethod::Separable),
         SkinShader::SsJittered => {
             assets.importance = Some(jittered_samples()?);

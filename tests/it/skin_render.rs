@@ -48,7 +48,13 @@ fn gpu_and_cpu_chains_agree_and_sss_softens_red_most() {
     assert!(close as f64 >= 0.99 * jittered.len() as f64, "ss-jittered: {close} of {} within 2/255", jittered.len());
     let covered = none.chunks(4).filter(|px| px[..3] != [46, 48, 52]).count();
     assert!(covered > 5000, "{covered} head pixels");
-    for (name, img) in [("separable", &gpu), ("ss-full", &full), ("ss-jittered", &jittered)] {
+    let tap = render(&["--shader", "ss-full", "--stretch", "tap2009"], &p("tap.png"));
+    assert_ne!(tap, full, "the TAP 2009 stretch (alpha 11) must differ from the thesis' (alpha 31.5)");
+    let tap_cpu = render(&["--shader", "ss-full", "--stretch", "tap2009", "--cpu"], &p("tap_cpu.png"));
+    let close = tap.iter().zip(&tap_cpu).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+    assert!(close as f64 >= 0.99 * tap.len() as f64, "ss-full tap2009: {close} of {} within 2/255", tap.len());
+    for (name, img) in [("separable", &gpu), ("ss-full", &full), ("ss-jittered", &jittered), ("ss-full tap2009", &tap)]
+    {
         let ratio = |c| roughness(img, 320, 180, c) / roughness(&none, 320, 180, c);
         let (r, b) = (ratio(0), ratio(2));
         eprintln!("{name}: Laplacian energy vs no SSS: red {r:.3}, blue {b:.3}");
