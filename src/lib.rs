@@ -153,6 +153,7 @@ pub mod plot;
 #[cfg(feature = "runtime")]
 pub mod runtime;
 pub mod separable;
+pub mod shading;
 pub mod skin_color;
 pub mod spectral;
 pub mod sss_sampling;

@@ -153,6 +153,9 @@ pub(crate) struct Geometry {
     pub(crate) frame: SkinFrame,
     pub(crate) depth: Vec<f32>,
     pub(crate) skin: Vec<bool>,
+    /// Specular radiance per pixel under the key light (white), added after the SSS pass so it is never blurred
+    /// (TAP 2009 §4: diffuse and specular in separate render targets); None: no specular layer (the demo).
+    pub(crate) specular: Option<Vec<f32>>,
 }
 
 /// Spheres as (centre x, centre y in units of the frame height, radius, depth of the centre).
@@ -171,6 +174,7 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
         },
         depth: vec![50.0; n],
         skin: vec![false; n],
+        specular: None,
     };
     let hf = h as f32;
     let aspect = w as f32 / hf;
@@ -208,6 +212,9 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
 pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
     120 * w as u64 * h as u64 + (64 << 20)
 }
+
+/// Radiance scale of the key light (the diffuse layer's E = KEY_LIGHT_INTENSITY · N·L + ambient).
+pub(crate) const KEY_LIGHT_INTENSITY: f32 = 1.6;
 
 /// Direction to the key light (Lambert), view space, unit length.
 pub(crate) fn key_light_view() -> [f32; 3] {
@@ -259,7 +266,7 @@ fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result
         }
         let nn = geo.frame.normals[i];
         let lambert = (nn[0] * key[0] + nn[1] * key[1] + nn[2] * key[2]).max(0.0);
-        let e = 1.6 * lambert + 0.1;
+        let e = KEY_LIGHT_INTENSITY * lambert + 0.1;
         for c in 0..3 {
             diffuse[4 * i + c] = albedo[4 * i + c] * e;
         }
@@ -360,8 +367,9 @@ fn composite(
         if !geo.skin[i] {
             continue;
         }
+        let spec = geo.specular.as_ref().map_or(0.0, |s| s[i]);
         let v: [f32; 3] =
-            std::array::from_fn(|c| blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c]);
+            std::array::from_fn(|c| blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c] + spec);
         // Tone map the luminance (1 − e^−L) and keep the channel ratios, so skin keeps its hue in highlights.
         let l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         let scale = if l > 0.0 { (1.0 - (-l).exp()) / l } else { 0.0 };

@@ -16,7 +16,9 @@
 //!    tone-mapped and encoded over a grey background.
 
 use super::cpu;
-use super::demo::{back_light_view, render_geometry, DemoAssets, Geometry, SssMethod};
+use super::demo::{
+    back_light_view, key_light_view, render_geometry, DemoAssets, Geometry, SssMethod, KEY_LIGHT_INTENSITY,
+};
 use super::device::Gpu;
 use super::gaussian_sss::GaussianSssParams;
 use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
@@ -179,6 +181,30 @@ fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Cam
     out
 }
 
+/// The Kelemen/Szirmay-Kalos specular of skin under the key light per covered pixel (view space: V points from
+/// the surface to the eye at the origin), scaled like the diffuse layer's key light.
+pub fn specular_layer(g: &MeshGBuffer, cam: &Camera) -> Vec<f32> {
+    use crate::shading::kelemen::{specular, SKIN_F0, SKIN_RHO_S, SKIN_ROUGHNESS};
+    let (w, h) = (g.width, g.height);
+    let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
+    let aspect = w as f32 / h as f32;
+    let l = key_light_view();
+    (0..(w * h) as usize)
+        .map(|i| {
+            if !g.covered[i] {
+                return 0.0;
+            }
+            let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+            let (xn, yn) = (px / w as f32 * 2.0 - 1.0, 1.0 - py / h as f32 * 2.0);
+            // The view ray through the pixel, reversed: from the surface to the eye.
+            let d = [-xn * t * aspect, -yn * t, 1.0];
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let v = [d[0] / len, d[1] / len, d[2] / len];
+            KEY_LIGHT_INTENSITY * specular(g.normal_view[i], l, v, SKIN_ROUGHNESS, SKIN_RHO_S, SKIN_F0)
+        })
+        .collect()
+}
+
 /// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask.
 fn geometry(
     gpu: Option<&Gpu>,
@@ -191,6 +217,7 @@ fn geometry(
     let light = light_camera(&cam);
     let shadow = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
     let thickness = thickness_mm(&g, &cam, &shadow, &light, mesh.mm_per_unit);
+    let specular = specular_layer(&g, &cam);
     let n = (s.width * s.height) as usize;
     let mut frame = SkinFrame {
         width: s.width,
@@ -214,7 +241,7 @@ fn geometry(
         frame.normals[i] = g.normal_view[i];
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
-    Ok(Geometry { frame, depth, skin: g.covered })
+    Ok(Geometry { frame, depth, skin: g.covered, specular: Some(specular) })
 }
 
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×

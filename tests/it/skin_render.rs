@@ -140,3 +140,31 @@ fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
         assert!(!out.exists(), "{args:?} wrote the output");
     }
 }
+
+/// The specular layer (Kelemen/Szirmay-Kalos, added after the SSS pass): zero off the head, and its peak where the
+/// normal is within 8° of the half vector of the key light and the view.
+#[test]
+fn the_specular_layer_peaks_at_the_mirror_normal() {
+    use rtbake::mesh::camera::Camera;
+    use rtbake::runtime::skin_render::specular_layer;
+    let cam = Camera::facing(0.6).unwrap();
+    let g = rtbake::runtime::cpu::mesh_raster::rasterise(&default_head(), &cam, 256, 192);
+    let spec = specular_layer(&g, &cam);
+    assert!(spec.iter().zip(&g.covered).all(|(s, c)| *c || *s == 0.0));
+    let (peak_i, peak) = spec.iter().copied().enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+    assert!(peak > 0.0);
+    // Key light (view space) as the demo's, the view direction at the peak pixel ≈ +z (30° field of view).
+    let l = {
+        let v = [-0.5f32, 0.6, 0.62];
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        [v[0] / n, v[1] / n, v[2] / n]
+    };
+    let hv = {
+        let h = [l[0], l[1], l[2] + 1.0];
+        let n = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+        [h[0] / n, h[1] / n, h[2] / n]
+    };
+    let n = g.normal_view[peak_i];
+    let n_dot_h = n[0] * hv[0] + n[1] * hv[1] + n[2] * hv[2];
+    assert!(n_dot_h > 0.99, "peak normal {n:?} vs half vector {hv:?}: {n_dot_h}");
+}

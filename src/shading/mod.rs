@@ -1,0 +1,6 @@
+//! Surface shading models of the skin renderer that are not subsurface scattering.
+//!
+//! - [`kelemen`]: the Kelemen/Szirmay-Kalos specular BRDF with a Beckmann distribution and Schlick's Fresnel, as
+//!   TAP 2009 §4 and thesis ch. 4 use it for skin (kept apart from the diffuse layer that SSS blurs).
+
+pub mod kelemen;
