@@ -28,9 +28,12 @@ fn main() {
     let head = default_head();
     println!("mesh: the default head, {} triangles; 1280x720; 5 runs after one warm-up", head.triangle_count());
     println!("{:<12} {:>22} {:>22} {:>22} {:>12}", "shader", "1 head ms", "3 heads ms", "5 heads ms", "1 -> 5");
-    for (name, shader) in
-        [("none", SkinShader::None), ("ss-full", SkinShader::SsFull), ("separable", SkinShader::Separable)]
-    {
+    for (name, shader) in [
+        ("none", SkinShader::None),
+        ("ss-jittered", SkinShader::SsJittered),
+        ("ss-full", SkinShader::SsFull),
+        ("separable", SkinShader::Separable),
+    ] {
         let mut row = Vec::new();
         for heads in [1u32, 3, 5] {
             let s = SkinRenderSettings {
