@@ -116,6 +116,10 @@ fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
     let empty = write("empty.obj", b"");
     let garbage = write("bad.gltf", b"{\"asset\": 7}");
     let unknown = write("head.stl", b"solid");
+    // A huge mesh file is refused from its size, before it is read (a sparse 600 MiB file).
+    let huge = t.path().join("huge.glb");
+    std::fs::File::create(&huge).unwrap().set_len(600 << 20).unwrap();
+    let huge = huge.to_str().unwrap().to_string();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec!["--mesh", &no_vn], "vn"),
         (vec!["--mesh", &no_vt], "TEXCOORD_0"),
@@ -124,6 +128,7 @@ fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
         (vec!["--mesh", &garbage], "not a valid glTF"),
         (vec!["--mesh", &unknown], "extension"),
         (vec!["--mesh", "/nonexistent/head.glb"], "--mesh"),
+        (vec!["--mesh", &huge], "accepted at most"),
         (vec!["--heads", "0"], "--heads"),
         (vec!["--heads", "17"], "--heads"),
         (vec!["--distance", "0"], "--distance"),
