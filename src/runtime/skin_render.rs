@@ -147,11 +147,18 @@ fn light_camera(cam: &Camera) -> Camera {
 }
 
 /// Per covered pixel, the thickness (mm) the back light crosses to reach it (Listing 5.1), from a shadow map.
+/// The view-space ray through the centre of pixel `i` of a `w`×`h` image, scaled to view depth 1 (z = −1).
+fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
+    let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
+    let aspect = w as f32 / h as f32;
+    let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+    let (xn, yn) = (px / w as f32 * 2.0 - 1.0, 1.0 - py / h as f32 * 2.0);
+    [xn * t * aspect, yn * t, -1.0]
+}
+
 fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Camera, mm_per_unit: f32) -> Vec<f32> {
     let (w, h) = (g.width, g.height);
     let inv_view = cam.view().try_inverse().expect("a look-at view is invertible");
-    let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
-    let aspect = w as f32 / h as f32;
     let light_view = light.view();
     let light_vp: Matrix4<f32> = light.projection(1.0) * light_view;
     let s = SHADOW_MAP_SIZE as f32;
@@ -160,10 +167,9 @@ fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Cam
         if !g.covered[i] {
             continue;
         }
-        let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
-        let (xn, yn) = (px / w as f32 * 2.0 - 1.0, 1.0 - py / h as f32 * 2.0);
+        let ray = view_ray(cam, w, h, i);
         let depth = g.depth_mm[i] / mm_per_unit;
-        let p_view = Vector4::new(xn * t * aspect * depth, yn * t * depth, -depth, 1.0);
+        let p_view = Vector4::new(ray[0] * depth, ray[1] * depth, -depth, 1.0);
         // Listing 5.1: the position shrunk along the normal before the shadow-map lookup (5 mm), so the surface
         // facing the light does not read its own depth back as a thickness (acne).
         let n = g.normal_view[i];
@@ -186,18 +192,15 @@ fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Cam
 pub fn specular_layer(g: &MeshGBuffer, cam: &Camera) -> Vec<f32> {
     use crate::shading::kelemen::{specular, SKIN_F0, SKIN_RHO_S, SKIN_ROUGHNESS};
     let (w, h) = (g.width, g.height);
-    let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
-    let aspect = w as f32 / h as f32;
     let l = key_light_view();
     (0..(w * h) as usize)
         .map(|i| {
             if !g.covered[i] {
                 return 0.0;
             }
-            let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
-            let (xn, yn) = (px / w as f32 * 2.0 - 1.0, 1.0 - py / h as f32 * 2.0);
             // The view ray through the pixel, reversed: from the surface to the eye.
-            let d = [-xn * t * aspect, -yn * t, 1.0];
+            let ray = view_ray(cam, w, h, i);
+            let d = [-ray[0], -ray[1], 1.0];
             let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             let v = [d[0] / len, d[1] / len, d[2] / len];
             KEY_LIGHT_INTENSITY * specular(g.normal_view[i], l, v, SKIN_ROUGHNESS, SKIN_RHO_S, SKIN_F0)

@@ -64,22 +64,7 @@ fn smaa_modes_gpu_matches_cpu_4x_1080p() {
     gpu_vs_cpu(SmaaMode::X4, 1920, 1080, 2);
 }
 
-/// Mean absolute error (0..255, RGB) over the pixels of `mask` and PSNR (dB) over all pixels.
-fn errors(img: &[u8], truth: &[u8], mask: &[bool]) -> (f64, f64) {
-    let (mut sum, mut n, mut se) = (0.0f64, 0usize, 0.0f64);
-    for (i, (p, q)) in img.chunks(4).zip(truth.chunks(4)).enumerate() {
-        for k in 0..3 {
-            let d = p[k] as f64 - q[k] as f64;
-            se += d * d;
-            if mask[i] {
-                sum += d.abs();
-                n += 1;
-            }
-        }
-    }
-    let mse = se / (img.len() / 4 * 3) as f64;
-    (sum / n.max(1) as f64, 10.0 * (255.0f64 * 255.0 / mse).log10())
-}
+use crate::support::edge_error_and_psnr as errors;
 
 /// Mean absolute RGB change (0..255) between consecutive frames, over frames `from..`.
 fn mean_change(frames: &[Vec<u8>], from: usize) -> f64 {

@@ -174,3 +174,21 @@ pub fn baked_files_of_format(format: &str) -> Vec<(PathBuf, rtbake::manifest::En
     let manifest = rtbake::manifest::Manifest::load(&dir).expect("baked/manifest.json");
     manifest.files.into_iter().filter(|e| e.meta.format == format).map(|e| (dir.join(&e.path), e)).collect()
 }
+
+/// Mean absolute error (0..255 scale, RGB) of RGBA8 `img` against `truth` over the pixels selected by `mask`
+/// (the edge error of the antialiasing quality checks), and PSNR (dB) over all pixels.
+pub fn edge_error_and_psnr(img: &[u8], truth: &[u8], mask: &[bool]) -> (f64, f64) {
+    let (mut sum, mut n, mut se) = (0.0f64, 0usize, 0.0f64);
+    for (i, (p, q)) in img.chunks(4).zip(truth.chunks(4)).enumerate() {
+        for k in 0..3 {
+            let d = p[k] as f64 - q[k] as f64;
+            se += d * d;
+            if mask[i] {
+                sum += d.abs();
+                n += 1;
+            }
+        }
+    }
+    let mse = se / (img.len() / 4 * 3) as f64;
+    (sum / n as f64, 10.0 * (255.0f64 * 255.0 / mse).log10())
+}
