@@ -68,3 +68,35 @@ fn bad_counts_exit_2_naming_line_and_column_and_write_nothing() {
     let o = rtbake(&["report", "chi2", "--counts", t.path().join("missing.csv").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// The `--out` table read the way an analysis script reads it: Python's `csv` module (UTF-8, header row), every
+/// number parsed with `float`, the booleans as `true`/`false`; TAP's Zoom 110° SS Full row is χ² 4.5, significant.
+#[test]
+fn the_csv_table_loads_in_python_csv() {
+    if !crate::support::tool_available(
+        "Python csv read of report chi2",
+        "python3",
+        &["--version"],
+        "apt-get install python3",
+    ) {
+        return;
+    }
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("table.csv");
+    let o = rtbake(&["report", "chi2", "--counts", "tap2009", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let script = r#"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], encoding="utf-8", newline="")))
+assert len(rows) == 36, len(rows)
+for r in rows:
+    float(r["chi2"]); float(r["p_value"]); int(r["chosen"]); int(r["total"])
+    assert r["significant"] in ("true", "false"), r
+z = [r for r in rows if r["configuration"] == "TS - Zoom - 110\u00b0" and r["comparison"] == "TS vs SS Full"]
+assert len(z) == 1 and float(z[0]["chi2"]) == 4.5 and z[0]["significant"] == "true", z
+print("ok")
+"#;
+    let py = std::process::Command::new("python3").args(["-c", script, out.to_str().unwrap()]).output().unwrap();
+    assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
+    assert_eq!(String::from_utf8_lossy(&py.stdout).trim(), "ok");
+}

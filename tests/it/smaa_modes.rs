@@ -407,3 +407,28 @@ fn run_smaa_mode_refuses_bad_frame_sequences_naming_the_file() {
     assert!(err.contains("--mode 4x (8 frames of 640x360)") && err.contains("--max-memory"), "{err}");
     assert!(!t.path().join("o").exists());
 }
+
+/// The edge-detector flags belong to the single-image path: with --mode they are refused by name (exit 2) and
+/// nothing is written.
+#[test]
+fn run_smaa_mode_refuses_edge_detector_flags() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("frames");
+    let depth = t.path().join("depth.exr");
+    let mask = t.path().join("mask.png");
+    let (o, d, m) = (out.to_str().unwrap(), depth.to_str().unwrap(), mask.to_str().unwrap());
+    for (flags, name) in [
+        (vec!["--edges", "color"], "--edges"),
+        (vec!["--depth", d], "--depth"),
+        (vec!["--predication"], "--predication"),
+        (vec!["--mask", m], "--mask"),
+    ] {
+        let mut args = vec!["run", "smaa", "--mode", "t2x", "--cpu", "--frames", "2", "--out", o];
+        args.extend(flags);
+        let r = rtbake(&args);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("--mode") && err.contains(name), "{name}: {err}");
+        assert!(!out.exists(), "{name}: wrote {o}");
+    }
+}
