@@ -122,11 +122,12 @@ impl McSettings {
     }
 
     /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
-    /// 250 000 photons/s per thread, the slowest case measured with the release build on the project's 2-core
-    /// machine (semi-infinite, albedo 0.9, mismatched boundary: 0.28–0.32 M/s on one thread); thin or absorbing
-    /// stacks run up to ten times faster, so this is an upper estimate.
+    /// 600 000 photon histories/s per thread, below the slowest case measured with the release build on the
+    /// project's 2-core machine (semi-infinite, albedo 0.9, mismatched boundary: 0.88 M histories per CPU second on
+    /// one thread, `examples/bench_transport`, 2026-11-25); thin or absorbing stacks run up to ten times faster, so
+    /// this is an upper estimate.
     pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
-        3.0 * self.photons as f64 / (250_000.0 * threads.max(1) as f64)
+        3.0 * self.photons as f64 / (600_000.0 * threads.max(1) as f64)
     }
 
     /// Bin centres (i + ½)Δr, mm.
