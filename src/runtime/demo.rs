@@ -1,7 +1,8 @@
 //! The procedural demo frame: skin-shaded spheres (a "head" and two smaller ones) in front of hard-edged shapes,
-//! through the whole chain — skin inputs (rig → hemoglobin → albedo LUT, T(s)·E) → diffuse lighting →
-//! separable SSS (or the screen-space sum of Gaussians, or the importance-sampled kernel) → + transmittance → sRGB encode → SMAA / MLAA. Every
-//! stage runs on the GPU passes, or on their CPU references when no device is given. No input images.
+//! through the whole chain — skin inputs (rig → hemoglobin → albedo LUT, T(s)·E) → diffuse lighting with the
+//! transmitted light stored beside the reflected light (thesis §5.4) → separable SSS (or the screen-space sum of
+//! Gaussians, or the importance-sampled kernel), which blurs both → sRGB encode → SMAA / MLAA. Every stage runs on
+//! the GPU passes, or on their CPU references when no device is given. No input images.
 //!
 //! Every table comes from the bake directory through the manifest-checked [`super::loader`]: the skin colour
 //! LUT, T(s), the separable kernel, the sum-of-Gaussians fit and the example hemoglobin rig with its H0
@@ -231,12 +232,14 @@ fn normalise(v: [f32; 3]) -> [f32; 3] {
     [v[0] / l, v[1] / l, v[2] / l]
 }
 
-/// The demo frame before SSS: geometry, skin albedo and transmittance, and the lit diffuse layer.
+/// Radiance scale of the back light (the transmitted light is TRANSMITTANCE_INTENSITY · albedo · T(s) · E).
+pub(crate) const TRANSMITTANCE_INTENSITY: f32 = 1.5;
+
+/// The demo frame before SSS: geometry and the lit diffuse layer.
 struct Lit {
     geo: Geometry,
-    albedo: Vec<f32>,
-    transmitted: Vec<f32>,
-    /// Diffuse irradiance · albedo, linear RGBA (alpha = SSS strength: 1 on skin, 0 elsewhere).
+    /// Reflected plus transmitted light (albedo · (irradiance + T(s)·E), §5.4), linear RGBA (alpha = SSS
+    /// strength: 1 on skin, 0 elsewhere).
     diffuse: Vec<f32>,
 }
 
@@ -267,16 +270,19 @@ fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result
         let nn = geo.frame.normals[i];
         let lambert = (nn[0] * key[0] + nn[1] * key[1] + nn[2] * key[2]).max(0.0);
         let e = KEY_LIGHT_INTENSITY * lambert + 0.1;
+        // Thesis §5.4: "we simply store the transmittance and reflectance together. These are then blurred using
+        // the screen-space Gaussian convolutions" — the back light's T(s)·E joins the reflected light before the
+        // SSS pass, so the shadow map's depth discontinuities are blurred like the rest of the diffuse light.
         for c in 0..3 {
-            diffuse[4 * i + c] = albedo[4 * i + c] * e;
+            diffuse[4 * i + c] = albedo[4 * i + c] * (e + TRANSMITTANCE_INTENSITY * transmitted[4 * i + c]);
         }
         diffuse[4 * i + 3] = 1.0;
     }
-    Ok(Lit { geo, albedo, transmitted, diffuse })
+    Ok(Lit { geo, diffuse })
 }
 
-/// The inputs the demo hands its SSS pass, as `rtbake run sss` reads them: linear diffuse irradiance · albedo
-/// (RGBA, alpha = SSS strength, 1 on skin and 0 elsewhere) and linear view-space depth (one channel, > 0, in the
+/// The inputs the demo hands its SSS pass, as `rtbake run sss` reads them: linear diffuse light, albedo ·
+/// (irradiance + back-lit T(s)·E) (RGBA, alpha = SSS strength, 1 on skin and 0 elsewhere) and linear view-space depth (one channel, > 0, in the
 /// world units of the kernel's `sss_width`: the skin spheres sit 3.5–5 units away, the background at 50).
 pub struct SssInputs {
     pub width: u32,
@@ -305,7 +311,7 @@ pub fn render(
 }
 
 /// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
-/// `method` (None: no SSS), plus transmittance, tone-mapped and encoded, then antialiased.
+/// `method` (None: no SSS; the transmitted light is in that layer), tone-mapped and encoded, then antialiased.
 pub(crate) fn render_geometry(
     gpu: Option<&Gpu>,
     geo: Geometry,
@@ -326,12 +332,12 @@ fn shade(
     rgba: Vec<u8>,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
-    let Lit { geo, albedo, transmitted, diffuse } = lit;
+    let Lit { geo, diffuse } = lit;
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (kernel, params) = (&assets.kernel, &assets.sss);
     let importance_params = assets.importance_params;
     let Some(method) = method else {
-        return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, aa);
+        return composite(gpu, &geo, &diffuse, rgba, aa);
     };
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
@@ -347,17 +353,15 @@ fn shade(
         },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
-    composite(gpu, &geo, &blurred, &albedo, &transmitted, rgba, aa)
+    composite(gpu, &geo, &blurred, rgba, aa)
 }
 
-/// Composites the (blurred) diffuse layer plus back-lit transmittance over the background, tone-maps, encodes sRGB
-/// and antialiases.
+/// Composites the (blurred) diffuse layer (reflected and transmitted light) plus the unblurred specular layer over
+/// the background, tone-maps, encodes sRGB and antialiases.
 fn composite(
     gpu: Option<&Gpu>,
     geo: &Geometry,
     blurred: &[f32],
-    albedo: &[f32],
-    transmitted: &[f32],
     mut rgba: Vec<u8>,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
@@ -368,8 +372,7 @@ fn composite(
             continue;
         }
         let spec = geo.specular.as_ref().map_or(0.0, |s| s[i]);
-        let v: [f32; 3] =
-            std::array::from_fn(|c| blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c] + spec);
+        let v: [f32; 3] = std::array::from_fn(|c| blurred[4 * i + c] + spec);
         // Tone map the luminance (1 − e^−L) and keep the channel ratios, so skin keeps its hue in highlights.
         let l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         let scale = if l > 0.0 { (1.0 - (-l).exp()) / l } else { 0.0 };

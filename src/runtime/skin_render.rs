@@ -10,10 +10,10 @@
 //!    mesh's texture coordinates (the face maps are texture-space maps), view-space normals, thickness; the rig's
 //!    scale and bias maps are not applied (the runtime's skin-inputs pass samples them in screen space, which is
 //!    right for the screen-space demo and wrong for a mesh: a neutral rig is used).
-//! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
-//!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
-//!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
-//!    tone-mapped and encoded over a grey background.
+//! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the back light's transmittance stored with
+//!    the reflected light (thesis §5.4), the SSS pass of `shader` (none, separable or the screen-space sum of
+//!    Gaussians) on that diffuse layer, view depth in head-sized world units ([`WORLD_UNITS_PER_M`]), the
+//!    specular layer added after the SSS pass, tone-mapped and encoded over a grey background.
 
 use super::cpu;
 use super::demo::{
