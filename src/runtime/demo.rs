@@ -232,12 +232,12 @@ fn normalise(v: [f32; 3]) -> [f32; 3] {
 }
 
 /// The demo frame before SSS: geometry, skin albedo and transmittance, and the lit diffuse layer.
-struct Lit {
-    geo: Geometry,
-    albedo: Vec<f32>,
-    transmitted: Vec<f32>,
+pub(crate) struct Lit {
+    pub(crate) geo: Geometry,
+    pub(crate) albedo: Vec<f32>,
+    pub(crate) transmitted: Vec<f32>,
     /// Diffuse irradiance · albedo, linear RGBA (alpha = SSS strength: 1 on skin, 0 elsewhere).
-    diffuse: Vec<f32>,
+    pub(crate) diffuse: Vec<f32>,
 }
 
 fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
@@ -247,7 +247,7 @@ fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, Ru
 
 /// Skin inputs (albedo from the LUT through the rig, transmittance T(s)·E for the back light) and the lit diffuse
 /// layer of `geo`.
-fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
+pub(crate) fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
@@ -352,7 +352,7 @@ fn shade(
 
 /// Composites the (blurred) diffuse layer plus back-lit transmittance over the background, tone-maps, encodes sRGB
 /// and antialiases.
-fn composite(
+pub(crate) fn composite(
     gpu: Option<&Gpu>,
     geo: &Geometry,
     blurred: &[f32],

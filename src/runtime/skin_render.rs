@@ -43,6 +43,9 @@ pub enum SkinShader {
     /// TAP's "SS Jittered": Hable et al.'s 13 jittered taps ([`crate::sss_sampling::jittered::hable13`] of
     /// d'Eon's 6 Gaussians) in one disk pass (the importance-sampled pass, physically scaled by depth).
     SsJittered,
+    /// d'Eon et al.'s texture-space diffusion (TAP's "TS") with the thesis ch. 3 optimisations switchable
+    /// ([`super::texture_space`]).
+    Ts(super::texture_space::TsSettings),
 }
 
 /// The stretch parameters of the SS Full shader (eq. 4.1–4.4 / TAP 2009 eq. 2–3).
@@ -148,7 +151,7 @@ fn light_camera(cam: &Camera) -> Camera {
 
 /// Per covered pixel, the thickness (mm) the back light crosses to reach it (Listing 5.1), from a shadow map.
 /// The view-space ray through the centre of pixel `i` of a `w`×`h` image, scaled to view depth 1 (z = −1).
-fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
+pub(crate) fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
     let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
     let aspect = w as f32 / h as f32;
     let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
@@ -208,13 +211,14 @@ pub fn specular_layer(g: &MeshGBuffer, cam: &Camera) -> Vec<f32> {
         .collect()
 }
 
-/// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask.
-fn geometry(
+/// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask; and the
+/// G-buffer it came from.
+pub(crate) fn geometry(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     assets: &DemoAssets,
-) -> Result<Geometry, RuntimeError> {
+) -> Result<(Geometry, MeshGBuffer), RuntimeError> {
     let cam = s.camera();
     let g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
     let light = light_camera(&cam);
@@ -244,7 +248,8 @@ fn geometry(
         frame.normals[i] = g.normal_view[i];
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
-    Ok(Geometry { frame, depth, skin: g.covered, specular: Some(specular) })
+    let skin = g.covered.clone();
+    Ok((Geometry { frame, depth, skin, specular: Some(specular) }, g))
 }
 
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
@@ -266,9 +271,12 @@ pub fn render(
     s: &SkinRenderSettings,
     assets: &DemoAssets,
 ) -> Result<Image<u8>, RuntimeError> {
+    if let SkinShader::Ts(ts) = s.shader {
+        return super::texture_space::render(gpu, mesh, s, ts, assets).map(|(img, _)| img);
+    }
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let geo = geometry(gpu, &heads, s, assets)?;
+    let (geo, _) = geometry(gpu, &heads, s, assets)?;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
@@ -290,6 +298,7 @@ pub fn render(
             };
             Some(SssMethod::Importance)
         }
+        SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
     let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
     render_geometry(gpu, geo, &assets, method, background, None)

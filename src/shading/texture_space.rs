@@ -219,7 +219,8 @@ mod tests {
     #[test]
     fn stretch_of_a_square_and_weights_of_the_blend_constants() {
         // A 0.1 × 0.2 rectangle mapped onto the unit uv square: ∂P/∂u = 0.1, ∂P/∂v = 0.2.
-        let s = triangle_stretch([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.2, 0.0]], [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        let s =
+            triangle_stretch([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.2, 0.0]], [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
         let s = s.unwrap();
         assert!((s[0] - 0.1).abs() < 1e-6 && (s[1] - 0.2).abs() < 1e-6, "{s:?}");
         assert!(triangle_stretch([[0.0; 3]; 3], [[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]).is_none());
