@@ -2,7 +2,8 @@
 //! shadow map, skin inputs, SSS pass, composite; host read-backs between stages included, as the chain runs them
 //! today) for 1, 3 and 5 heads at 1280×720, per shader, median and min–max of 5 runs after a warm-up, and the
 //! change from 1 to 5 heads. TAP measured on a GeForce 8600M GS: SS Full 29 → 25 fps (−13 %), TS 26 → 9 fps
-//! (−65 %), No SSS 51 → 40 fps.
+//! (−65 %), No SSS 51 → 40 fps. `ts` is rtbake's texture-space diffusion at its default 1024² map, no ch. 3
+//! optimisation (d'Eon et al. 2007 as TAP ran it).
 //!
 //!     cargo run --release --example bench_skin_heads            # the adapter (WGPU_BACKEND/WGPU_ADAPTER_NAME)
 //!     cargo run --release --example bench_skin_heads -- cpu     # the CPU twins
@@ -14,6 +15,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::create_headless;
 use rtbake::runtime::skin_render::{render, SkinRenderSettings, SkinShader};
+use rtbake::runtime::texture_space::TsSettings;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -33,6 +35,7 @@ fn main() {
         ("ss-jittered", SkinShader::SsJittered),
         ("ss-full", SkinShader::SsFull),
         ("separable", SkinShader::Separable),
+        ("ts", SkinShader::Ts(TsSettings::default())),
     ] {
         let mut row = Vec::new();
         for heads in [1u32, 3, 5] {

@@ -6,6 +6,7 @@ use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
+use rtbake::runtime::texture_space::{TsSettings, DEFAULT_MAP_SIZE};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,6 +23,24 @@ pub enum ShaderArg {
     Separable,
     /// Hable et al.'s 13 jittered taps in one disk pass (TAP 2009's "SS Jittered"), derived from d'Eon's 6 Gaussians.
     SsJittered,
+    /// d'Eon et al.'s texture-space diffusion (TAP 2009's "TS"): irradiance map in UV space, stretch map, the 6
+    /// Gaussians of the baked fit, with the thesis ch. 3 optimisations of --ts-opt.
+    Ts,
+}
+
+/// A thesis ch. 3 optimisation of the texture-space shader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TsOptArg {
+    /// None of them (d'Eon et al. 2007 as published).
+    None,
+    /// Culled irradiance map: texels more than 105° from the view vector are occluded, not blurred (§3.2).
+    Cull,
+    /// Depth-based irradiance map: edge scaled by min(d_ref/d, 1) per head (eq. 3.1–3.2).
+    Depth,
+    /// Clipped irradiance map: texels outside the view frustum are clipped (eq. 3.3–3.4).
+    Clip,
+    /// All three.
+    All,
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -55,6 +74,12 @@ pub struct SkinArgs {
     /// the depth derivative, TAP 2009 §4).
     #[arg(long, value_enum, default_value = "thesis")]
     stretch: StretchArg,
+    /// Irradiance map edge of --shader ts, texels, 32..=2048 (T_max with --ts-opt depth; default 1024).
+    #[arg(long, allow_negative_numbers = true, value_name = "TEXELS")]
+    ts_map_size: Option<u32>,
+    /// Thesis ch. 3 optimisations of --shader ts, comma-separated: none, cull, depth, clip, all (default none).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    ts_opt: Vec<TsOptArg>,
     /// Melanin volume fraction Cm of the skin, 0..=0.5.
     #[arg(long, default_value_t = 0.02, allow_negative_numbers = true)]
     melanin: f32,
@@ -93,6 +118,22 @@ fn load_mesh(path: &Path, mm_per_unit: f32) -> anyhow::Result<Mesh> {
     mesh.map_err(usage)
 }
 
+/// The texture-space settings of `a` (validated: --ts-map-size in range).
+fn ts_settings(a: &SkinArgs) -> anyhow::Result<TsSettings> {
+    let has = |o| a.ts_opt.contains(&o) || a.ts_opt.contains(&TsOptArg::All);
+    if a.ts_opt.contains(&TsOptArg::None) && a.ts_opt.len() > 1 {
+        return Err(usage_msg("--ts-opt none cannot be combined with other optimisations".to_string()));
+    }
+    let ts = TsSettings {
+        map_size: a.ts_map_size.unwrap_or(DEFAULT_MAP_SIZE),
+        cull: has(TsOptArg::Cull),
+        depth_sized: has(TsOptArg::Depth),
+        clip: has(TsOptArg::Clip),
+    };
+    ts.validate().map_err(usage)?;
+    Ok(ts)
+}
+
 pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     let settings = SkinRenderSettings {
         shader: match a.shader {
@@ -100,6 +141,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
             ShaderArg::SsFull => SkinShader::SsFull,
             ShaderArg::Separable => SkinShader::Separable,
             ShaderArg::SsJittered => SkinShader::SsJittered,
+            ShaderArg::Ts => SkinShader::Ts(ts_settings(&a)?),
         },
         heads: a.heads,
         distance_m: a.distance,
@@ -111,6 +153,9 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
             StretchArg::Tap2009 => StretchPreset::Tap2009,
         },
     };
+    if !matches!(a.shader, ShaderArg::Ts) && (a.ts_map_size.is_some() || !a.ts_opt.is_empty()) {
+        return Err(usage_msg("--ts-map-size and --ts-opt apply to --shader ts only".to_string()));
+    }
     settings.validate().map_err(usage)?;
     if !(a.mesh_mm_per_unit.is_finite() && a.mesh_mm_per_unit > 0.0) {
         return Err(usage_msg(format!("--mesh-mm-per-unit must be a finite number > 0, got {}", a.mesh_mm_per_unit)));
@@ -119,7 +164,12 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     crate::run::check_output_of(&a.output, &inputs)?;
     ctx.check_budget(
         &format!("--width {} --height {}", a.width, a.height),
-        rtbake::runtime::demo::memory_estimate_bytes(a.width, a.height) + (96 << 20),
+        rtbake::runtime::demo::memory_estimate_bytes(a.width, a.height)
+            + (96 << 20)
+            + match settings.shader {
+                SkinShader::Ts(ts) => rtbake::runtime::texture_space::memory_estimate_bytes(ts.map_size),
+                _ => 0,
+            },
         rtbake::runtime::demo::time_estimate_seconds(a.width, a.height, a.common.cpu) + 0.5,
     )?;
     let mesh = match &a.mesh {

@@ -236,11 +236,11 @@ fn normalise(v: [f32; 3]) -> [f32; 3] {
 pub(crate) const TRANSMITTANCE_INTENSITY: f32 = 1.5;
 
 /// The demo frame before SSS: geometry and the lit diffuse layer.
-struct Lit {
-    geo: Geometry,
+pub(crate) struct Lit {
+    pub(crate) geo: Geometry,
     /// Reflected plus transmitted light (albedo · (irradiance + T(s)·E), §5.4), linear RGBA (alpha = SSS
     /// strength: 1 on skin, 0 elsewhere).
-    diffuse: Vec<f32>,
+    pub(crate) diffuse: Vec<f32>,
 }
 
 fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
@@ -250,7 +250,7 @@ fn lit(gpu: Option<&Gpu>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, Ru
 
 /// Skin inputs (albedo from the LUT through the rig, transmittance T(s)·E for the back light) and the lit diffuse
 /// layer of `geo`.
-fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
+pub(crate) fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
@@ -358,7 +358,7 @@ fn shade(
 
 /// Composites the (blurred) diffuse layer (reflected and transmitted light) plus the unblurred specular layer over
 /// the background, tone-maps, encodes sRGB and antialiases.
-fn composite(
+pub(crate) fn composite(
     gpu: Option<&Gpu>,
     geo: &Geometry,
     blurred: &[f32],

@@ -28,6 +28,7 @@ pub mod skin_render;
 pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;
+pub mod texture_space;
 pub mod transport_gpu;
 
 /// Errors of the runtime.

@@ -43,6 +43,9 @@ pub enum SkinShader {
     /// TAP's "SS Jittered": Hable et al.'s 13 jittered taps ([`crate::sss_sampling::jittered::hable13`] of
     /// d'Eon's 6 Gaussians) in one disk pass (the importance-sampled pass, physically scaled by depth).
     SsJittered,
+    /// d'Eon et al.'s texture-space diffusion (TAP's "TS") with the thesis ch. 3 optimisations switchable
+    /// ([`super::texture_space`]).
+    Ts(super::texture_space::TsSettings),
 }
 
 /// The stretch parameters of the SS Full shader (eq. 4.1–4.4 / TAP 2009 eq. 2–3).
@@ -146,9 +149,8 @@ fn light_camera(cam: &Camera) -> Camera {
     Camera { eye: eye.into(), target: cam.target, up: [0.0, 1.0, 0.0], fov_y_deg: 40.0, near: 0.3, far: 3.0 }
 }
 
-/// Per covered pixel, the thickness (mm) the back light crosses to reach it (Listing 5.1), from a shadow map.
 /// The view-space ray through the centre of pixel `i` of a `w`×`h` image, scaled to view depth 1 (z = −1).
-fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
+pub(crate) fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
     let t = (0.5 * cam.fov_y_deg.to_radians()).tan();
     let aspect = w as f32 / h as f32;
     let (px, py) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
@@ -156,12 +158,55 @@ fn view_ray(cam: &Camera, w: u32, h: u32, i: usize) -> [f32; 3] {
     [xn * t * aspect, yn * t, -1.0]
 }
 
-fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Camera, mm_per_unit: f32) -> Vec<f32> {
+/// The back light's shadow map (linear depth in mm from the light), and the thickness it gives (Listing 5.1).
+pub(crate) struct ShadowMap {
+    map: MeshGBuffer,
+    light_view: Matrix4<f32>,
+    light_vp: Matrix4<f32>,
+    mm_per_unit: f32,
+}
+
+impl ShadowMap {
+    /// `mesh` rasterised from the back light's camera of the frame seen by `cam`.
+    pub(crate) fn new(gpu: Option<&Gpu>, mesh: &Mesh, cam: &Camera) -> Result<Self, RuntimeError> {
+        let light = light_camera(cam);
+        let map = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
+        let light_view = light.view();
+        Ok(Self { map, light_view, light_vp: light.projection(1.0) * light_view, mm_per_unit: mesh.mm_per_unit })
+    }
+
+    /// The thickness (mm) the back light crosses to reach the surface point `p_world` with unit normal `n_world`
+    /// (mesh units): Listing 5.1's distance between the point, shrunk 5 mm along its normal so that the surface
+    /// facing the light does not read its own depth back as a thickness (acne), and the shadow map's nearest
+    /// surface along the same light ray; 0 outside the map or where it saw nothing.
+    pub(crate) fn thickness_mm(&self, p_world: [f32; 3], n_world: [f32; 3]) -> f32 {
+        let shrink = SHADOW_SHRINK_MM / self.mm_per_unit;
+        let p = Vector4::new(
+            p_world[0] - n_world[0] * shrink,
+            p_world[1] - n_world[1] * shrink,
+            p_world[2] - n_world[2] * shrink,
+            1.0,
+        );
+        let c = self.light_vp * p;
+        let s = SHADOW_MAP_SIZE as f32;
+        let (sx, sy) = ((c.x / c.w * 0.5 + 0.5) * s, (0.5 - c.y / c.w * 0.5) * s);
+        let d_light_mm = -(self.light_view * p).z * self.mm_per_unit;
+        let (ix, iy) = (sx.floor() as i64, sy.floor() as i64);
+        let inside = (0..SHADOW_MAP_SIZE as i64).contains(&ix) && (0..SHADOW_MAP_SIZE as i64).contains(&iy);
+        let j = (iy * SHADOW_MAP_SIZE as i64 + ix) as usize;
+        if inside && self.map.covered[j] {
+            (d_light_mm - self.map.depth_mm[j]).max(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Per covered pixel of `g` (seen by `cam`), the thickness (mm) the back light crosses to reach it
+/// ([`ShadowMap::thickness_mm`] of the pixel's world position and normal).
+fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &ShadowMap, mm_per_unit: f32) -> Vec<f32> {
     let (w, h) = (g.width, g.height);
     let inv_view = cam.view().try_inverse().expect("a look-at view is invertible");
-    let light_view = light.view();
-    let light_vp: Matrix4<f32> = light.projection(1.0) * light_view;
-    let s = SHADOW_MAP_SIZE as f32;
     let mut out = vec![0.0f32; (w * h) as usize];
     for (i, o) in out.iter_mut().enumerate() {
         if !g.covered[i] {
@@ -169,20 +214,10 @@ fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &MeshGBuffer, light: &Cam
         }
         let ray = view_ray(cam, w, h, i);
         let depth = g.depth_mm[i] / mm_per_unit;
-        let p_view = Vector4::new(ray[0] * depth, ray[1] * depth, -depth, 1.0);
-        // Listing 5.1: the position shrunk along the normal before the shadow-map lookup (5 mm), so the surface
-        // facing the light does not read its own depth back as a thickness (acne).
-        let n = g.normal_view[i];
-        let shrink = SHADOW_SHRINK_MM / mm_per_unit;
-        let p_view = p_view - Vector4::new(n[0], n[1], n[2], 0.0) * shrink;
-        let p = inv_view * p_view;
-        let c = light_vp * p;
-        let (sx, sy) = ((c.x / c.w * 0.5 + 0.5) * s, (0.5 - c.y / c.w * 0.5) * s);
-        let d_light_mm = -(light_view * p).z * mm_per_unit;
-        let (ix, iy) = (sx.floor() as i64, sy.floor() as i64);
-        let inside = (0..SHADOW_MAP_SIZE as i64).contains(&ix) && (0..SHADOW_MAP_SIZE as i64).contains(&iy);
-        let j = (iy * SHADOW_MAP_SIZE as i64 + ix) as usize;
-        *o = if inside && shadow.covered[j] { (d_light_mm - shadow.depth_mm[j]).max(0.0) } else { 0.0 };
+        let p = inv_view * Vector4::new(ray[0] * depth, ray[1] * depth, -depth, 1.0);
+        let nv = g.normal_view[i];
+        let n = inv_view * Vector4::new(nv[0], nv[1], nv[2], 0.0);
+        *o = shadow.thickness_mm([p.x, p.y, p.z], [n.x, n.y, n.z]);
     }
     out
 }
@@ -208,18 +243,18 @@ pub fn specular_layer(g: &MeshGBuffer, cam: &Camera) -> Vec<f32> {
         .collect()
 }
 
-/// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask.
-fn geometry(
+/// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask; the
+/// G-buffer it came from and the back light's shadow map.
+pub(crate) fn geometry(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     assets: &DemoAssets,
-) -> Result<Geometry, RuntimeError> {
+) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
     let g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
-    let light = light_camera(&cam);
-    let shadow = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
-    let thickness = thickness_mm(&g, &cam, &shadow, &light, mesh.mm_per_unit);
+    let shadow = ShadowMap::new(gpu, mesh, &cam)?;
+    let thickness = thickness_mm(&g, &cam, &shadow, mesh.mm_per_unit);
     let specular = specular_layer(&g, &cam);
     let n = (s.width * s.height) as usize;
     let mut frame = SkinFrame {
@@ -244,7 +279,8 @@ fn geometry(
         frame.normals[i] = g.normal_view[i];
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
-    Ok(Geometry { frame, depth, skin: g.covered, specular: Some(specular) })
+    let skin = g.covered.clone();
+    Ok((Geometry { frame, depth, skin, specular: Some(specular) }, g, shadow))
 }
 
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
@@ -266,9 +302,12 @@ pub fn render(
     s: &SkinRenderSettings,
     assets: &DemoAssets,
 ) -> Result<Image<u8>, RuntimeError> {
+    if let SkinShader::Ts(ts) = s.shader {
+        return super::texture_space::render(gpu, mesh, s, ts, assets).map(|(img, _)| img);
+    }
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let geo = geometry(gpu, &heads, s, assets)?;
+    let (geo, _, _) = geometry(gpu, &heads, s, assets)?;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
@@ -290,6 +329,7 @@ pub fn render(
             };
             Some(SssMethod::Importance)
         }
+        SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
     let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
     render_geometry(gpu, geo, &assets, method, background, None)

