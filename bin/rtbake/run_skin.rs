@@ -47,12 +47,13 @@ pub enum TsOptArg {
 pub enum StretchArg {
     Thesis,
     Tap2009,
+    Physical,
 }
 
 #[derive(clap::Args)]
 pub struct SkinArgs {
     /// Output PNG (RGBA8, sRGB-encoded).
-    #[arg(long, value_name = "PNG")]
+    #[arg(long, alias = "out", value_name = "PNG")]
     output: PathBuf,
     /// Skin shader.
     #[arg(long, value_enum, default_value = "separable")]
@@ -70,8 +71,9 @@ pub struct SkinArgs {
     /// Millimetres per OBJ unit (glTF is in metres).
     #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     mesh_mm_per_unit: f32,
-    /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ) or tap2009 (α = 11, β = 800, no clamp of
-    /// the depth derivative, TAP 2009 §4).
+    /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ), tap2009 (α = 11, β = 800, no clamp of
+    /// the depth derivative, TAP 2009 §4) — both stated for a 20° field of view and scaled to the camera's — or
+    /// physical (α from the camera: each Gaussian at its width in mm, as TS and SS Jittered).
     #[arg(long, value_enum, default_value = "thesis")]
     stretch: StretchArg,
     /// Irradiance map edge of --shader ts, texels, 32..=2048 (T_max with --ts-opt depth; default 1024).
@@ -151,6 +153,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         stretch: match a.stretch {
             StretchArg::Thesis => StretchPreset::Thesis,
             StretchArg::Tap2009 => StretchPreset::Tap2009,
+            StretchArg::Physical => StretchPreset::Physical,
         },
     };
     if !matches!(a.shader, ShaderArg::Ts) && (a.ts_map_size.is_some() || !a.ts_opt.is_empty()) {

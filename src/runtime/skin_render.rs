@@ -49,22 +49,46 @@ pub enum SkinShader {
 }
 
 /// The stretch parameters of the SS Full shader (eq. 4.1–4.4 / TAP 2009 eq. 2–3).
+///
+/// Thesis §4.2: "The value of α is influenced by the size of the object in 3D space, the field-of-view used to
+/// render the scene and the viewport size"; its α = 31.5 was "chosen empirically for a head 1.0 units tall, a
+/// field-of-view of 20° and a viewport height of 720 pixels". The world unit here is a head height
+/// ([`WORLD_UNITS_PER_M`]) and the chain scales α with the viewport height; [`StretchPreset::apply`] scales the
+/// printed α from the 20° field of view to the camera's ([`ALPHA_FOV_DEG`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum StretchPreset {
     /// The bake's fit parameters (the thesis' α = 31.5, β = 800, γ = 0.001 unless the bake says otherwise).
     #[default]
     Thesis,
-    /// TAP 2009 §4: "empirically fixed values of α = 11 and β = 800", with no clamp of the depth derivative.
+    /// TAP 2009 §4: "empirically fixed values of α = 11 and β = 800", with no clamp of the depth derivative (its
+    /// field of view taken as the thesis' 20°).
     Tap2009,
+    /// α from the camera, so that every Gaussian of the fit has its physical width in mm at the pixel's depth, as
+    /// in texture space and in the physically scaled SS Jittered pass: α = 720 · (world units per mm) /
+    /// (2 tan(fov/2)) (a tap step of σ pixels for a Gaussian of σ mm); β and γ as the bake's. The thesis' and
+    /// TAP's empirical α set "the global subsurface scattering level in the image" (§4.2) above this.
+    Physical,
 }
 
+/// Vertical field of view (degrees) for which the thesis states α (§4.2).
+pub const ALPHA_FOV_DEG: f32 = 20.0;
+
 impl StretchPreset {
-    /// The parameters for `base` (the bake's).
-    pub fn apply(self, base: GaussianSssParams) -> GaussianSssParams {
+    /// The parameters for `base` (the bake's) on a camera of vertical field of view `fovy_deg`, for the chain's
+    /// 720-pixel α ([`GaussianSssParams::for_viewport_height`]).
+    pub fn apply(self, base: GaussianSssParams, fovy_deg: f32) -> GaussianSssParams {
+        let half_tan = (0.5 * fovy_deg.to_radians()).tan();
+        let fov_scale = (0.5 * ALPHA_FOV_DEG.to_radians()).tan() / half_tan;
         match self {
-            StretchPreset::Thesis => base,
+            StretchPreset::Thesis => GaussianSssParams { alpha: base.alpha * fov_scale, ..base },
             // γ = f32::MAX: min(|∂d|, γ) = |∂d|, TAP's eq. 2–3 have no clamp.
-            StretchPreset::Tap2009 => GaussianSssParams { alpha: 11.0, beta: 800.0, gamma: f32::MAX, ..base },
+            StretchPreset::Tap2009 => {
+                GaussianSssParams { alpha: 11.0 * fov_scale, beta: 800.0, gamma: f32::MAX, ..base }
+            }
+            StretchPreset::Physical => {
+                let world_units_per_mm = WORLD_UNITS_PER_M / 1000.0;
+                GaussianSssParams { alpha: 720.0 * world_units_per_mm / (2.0 * half_tan), ..base }
+            }
         }
     }
 }
@@ -316,7 +340,7 @@ pub fn render(
     let method = match s.shader {
         SkinShader::None => None,
         SkinShader::SsFull => {
-            assets.gaussian_params = s.stretch.apply(assets.gaussian_params);
+            assets.gaussian_params = s.stretch.apply(assets.gaussian_params, s.camera().fov_y_deg);
             Some(SssMethod::Gaussians)
         }
         SkinShader::Separable => Some(SssMethod::Separable),
@@ -333,4 +357,30 @@ pub fn render(
     };
     let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
     render_geometry(gpu, geo, &assets, method, background, None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stretch_presets_scale_alpha_with_the_field_of_view() {
+        let base = GaussianSssParams::default();
+        // At the thesis' own 20° the printed values are unchanged.
+        assert_eq!(StretchPreset::Thesis.apply(base, 20.0), base);
+        let tap = StretchPreset::Tap2009.apply(base, 20.0);
+        assert!((tap.alpha - 11.0).abs() < 1e-5 && tap.beta == 800.0 && tap.gamma == f32::MAX);
+        // A wider field of view shows a head smaller: α shrinks by tan(10°)/tan(15°) at 30°.
+        let wide = StretchPreset::Thesis.apply(base, 30.0);
+        let expected = 31.5 * (10.0f32.to_radians().tan() / 15.0f32.to_radians().tan());
+        assert!((wide.alpha - expected).abs() < 1e-4, "{} vs {expected}", wide.alpha);
+        // Physical: a tap step of σ pixels for a Gaussian of σ mm. At depth d world units a length L mm spans
+        // L·(world units per mm)·h/(2·d·tan(fov/2)) pixels; the chain's step is α·(h/720)·σ/d.
+        let phys = StretchPreset::Physical.apply(base, 30.0);
+        let (h, d, sigma_mm) = (720.0f32, 2.0f32, 1.5f32);
+        let step_px = phys.alpha * (h / 720.0) * sigma_mm / d;
+        let projected_px = sigma_mm * (WORLD_UNITS_PER_M / 1000.0) * h / (2.0 * d * 15.0f32.to_radians().tan());
+        assert!((step_px - projected_px).abs() < 1e-4 * projected_px, "{step_px} vs {projected_px}");
+        assert_eq!((phys.beta, phys.gamma), (base.beta, base.gamma));
+    }
 }
