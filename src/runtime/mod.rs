@@ -11,6 +11,7 @@
 //! - no pass needs `FLOAT32_FILTERABLE` or an f32 render target (lavapipe and llvmpipe run everything).
 
 pub mod chain;
+pub(crate) mod compute_chain;
 pub mod cpu;
 pub mod demo;
 pub mod device;
@@ -19,11 +20,13 @@ pub mod gpu;
 pub mod importance_sss;
 pub mod loader;
 pub mod mesh_raster;
+pub mod mesh_skin_inputs;
 pub mod mlaa;
 pub mod moving_scene;
 pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
+pub mod skin_passes;
 pub mod skin_render;
 pub mod smaa;
 pub mod smaa_edges;

@@ -6,10 +6,11 @@
 //! 2. A 512² shadow map from the back light (TAP 2009 used 512²) gives the thickness the light crosses to reach
 //!    each visible point: the point's distance from the light minus the shadow map's nearest distance along the
 //!    same ray (Listing 5.1), in mm.
-//! 3. Skin inputs per pixel: melanin `melanin` (uniform), mean-free hemoglobin H0 of the baked rig read at the
-//!    mesh's texture coordinates (the face maps are texture-space maps), view-space normals, thickness; the rig's
-//!    scale and bias maps are not applied (the runtime's skin-inputs pass samples them in screen space, which is
-//!    right for the screen-space demo and wrong for a mesh: a neutral rig is used).
+//! 3. Skin inputs per pixel: melanin `melanin` (uniform), hemoglobin H of the baked rig's eq. 7.6 (weights and
+//!    the global anger/fear state of [`SkinPasses::rig_pose`]) evaluated at the mesh's texture coordinates
+//!    ([`super::mesh_skin_inputs`]: the face maps are texture-space maps), view-space normals, thickness; the
+//!    skin-inputs pass then runs with a neutral rig (scale 1, bias 0), so its hemoglobin is that H (its own rig
+//!    lookup samples screen space, right for the screen-space demo and wrong for a mesh).
 //! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
 //!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
 //!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
@@ -24,6 +25,7 @@ use super::gaussian_sss::GaussianSssParams;
 use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use super::mesh_raster::{self, MeshGBuffer};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
+use super::skin_passes::SkinPasses;
 use super::RuntimeError;
 use crate::error::{check_range, InvalidInput};
 use crate::image_buf::Image;
@@ -213,6 +215,7 @@ fn geometry(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
+    passes: &SkinPasses,
     assets: &DemoAssets,
 ) -> Result<Geometry, RuntimeError> {
     let cam = s.camera();
@@ -230,14 +233,22 @@ fn geometry(
         thickness_mm: vec![assets.luts.s_max_mm; n],
         normals: vec![[0.0, 0.0, 1.0]; n],
     };
+    let hemoglobin = match &assets.baked_rig {
+        Some(r) => {
+            let neutral = super::mesh_skin_inputs::RigPose::neutral(r.names.len());
+            let pose = passes.rig_pose.as_ref().unwrap_or(&neutral);
+            Some(super::mesh_skin_inputs::hemoglobin_for_gbuffer(gpu, &g, r, pose)?)
+        }
+        None => None,
+    };
     let mut depth = vec![100.0f32; n];
     for i in 0..n {
         if !g.covered[i] {
             continue;
         }
         frame.melanin[i] = s.melanin;
-        frame.h0[i] = match &assets.baked_rig {
-            Some(r) => r.h0_at(g.uv[i][0], g.uv[i][1]),
+        frame.h0[i] = match &hemoglobin {
+            Some(hb) => hb[i],
             None => 0.006 * ((g.uv[i][0] * 400.0).sin() * (g.uv[i][1] * 300.0).cos()),
         };
         frame.thickness_mm[i] = thickness[i].min(assets.luts.s_max_mm);
@@ -259,16 +270,28 @@ pub fn jittered_samples() -> Result<ImportanceSamples, InvalidInput> {
     })
 }
 
-/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded).
+/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded) and the default
+/// [`SkinPasses`].
 pub fn render(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     assets: &DemoAssets,
 ) -> Result<Image<u8>, RuntimeError> {
+    render_with(gpu, mesh, s, &SkinPasses::default(), assets)
+}
+
+/// [`render`] with the passes of `passes` (rig pose, …).
+pub fn render_with(
+    gpu: Option<&Gpu>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<Image<u8>, RuntimeError> {
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let geo = geometry(gpu, &heads, s, assets)?;
+    let geo = geometry(gpu, &heads, s, passes, assets)?;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };

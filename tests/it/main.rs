@@ -73,3 +73,4 @@ mod transmittance_table;
 mod transport_cli;
 mod transport_gpu;
 mod transport_physics;
+mod skin_passes;

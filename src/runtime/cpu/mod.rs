@@ -9,6 +9,7 @@
 pub mod gaussian_sss;
 pub mod importance_sss;
 pub mod mesh_raster;
+pub mod mesh_skin_inputs;
 pub mod mlaa;
 pub mod separable_sss;
 pub mod skin_inputs;
