@@ -6,7 +6,8 @@ use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
-use rtbake::runtime::skin_passes::SkinPasses;
+use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
+use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, WrinkleMaps};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -71,6 +72,10 @@ pub struct SkinArgs {
     /// 0..=1 (g = 1 + a·(1.27 − 1) + f·(0.81 − 1), thesis §7.7). Default: {"neutral": 1}.
     #[arg(long, value_name = "FILE|JSON")]
     rig_weights: Option<String>,
+    /// Wrinkle pass (thesis Listing 8.1) with the baked example PD map and zone masks: NAME=WEIGHT,... with NAME
+    /// one of Table 8.1's expressions (joy, surprise, fear, anger, disgust, sad) and WEIGHT in 0..=1.
+    #[arg(long, value_name = "WEIGHTS")]
+    wrinkles: Option<String>,
     #[command(flatten)]
     common: crate::run::Common,
 }
@@ -94,6 +99,11 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
             usage_msg("--rig-weights needs the hemoglobin rig in the bake directory (facial/hemoglobin/example)")
         })?;
         p.rig_pose = Some(RigPose::for_baked_rig(&json, rig).map_err(usage)?);
+    }
+    if let Some(v) = &a.wrinkles {
+        let zone_weights = parse_wrinkle_weights(v).map_err(usage)?;
+        let maps = WrinkleMaps::load(&a.common.baked).map_err(|e| usage_msg(format!("--wrinkles: {e}")))?;
+        p.wrinkles = Some(Wrinkles { maps, zone_weights });
     }
     Ok(p)
 }

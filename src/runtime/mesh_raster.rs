@@ -1,8 +1,9 @@
 //! The mesh G-buffer pass of the skin renderer (issue 14; TAP 2009 §5 renders heads, thesis ch. 3–5 shades them):
 //! a wgpu render pipeline with a `Depth32Float` depth buffer (less-than test, back faces culled, counter-clockwise
 //! front faces) that writes per pixel the view-space unit normal and the linear view depth in mm
-//! (`Rgba16Float`), and the texture coordinates with a coverage flag (`Rgba16Float`) — the inputs the
-//! screen-space passes and texture-space diffusion need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
+//! (`Rgba16Float`), the texture coordinates with a coverage flag (`Rgba16Float`) and the view-space tangent of
+//! [`crate::mesh::tangents`] with its handedness (`Rgba16Float`, interpolated, not renormalised) — the inputs the
+//! screen-space passes, texture-space diffusion and the wrinkle pass need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
 //! [`MeshGBuffer`].
 
 use super::gpu;
@@ -23,6 +24,9 @@ pub struct MeshGBuffer {
     pub depth_mm: Vec<f32>,
     pub uv: Vec<[f32; 2]>,
     pub covered: Vec<bool>,
+    /// View-space tangent (xyz, interpolated: not unit, not exactly perpendicular to the normal) and handedness w
+    /// ([`crate::mesh::tangents`]); zero where nothing is covered.
+    pub tangent_view: Vec<[f32; 4]>,
 }
 
 impl MeshGBuffer {
@@ -35,6 +39,7 @@ impl MeshGBuffer {
             depth_mm: vec![0.0; n],
             uv: vec![[0.0; 2]; n],
             covered: vec![false; n],
+            tangent_view: vec![[0.0; 4]; n],
         }
     }
 }
@@ -60,8 +65,8 @@ pub fn rasterise(
     height: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
     camera.validate()?;
-    super::device::check_image_fits(device, width, height, 8 + 8 + 4)?;
-    let vertex_bytes = mesh.positions.len() as u64 * 32;
+    super::device::check_image_fits(device, width, height, 8 + 8 + 8 + 4)?;
+    let vertex_bytes = mesh.positions.len() as u64 * 48;
     if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
         return Err(InvalidInput::new(
             "--mesh",
@@ -69,9 +74,10 @@ pub fn rasterise(
         )
         .into());
     }
-    let mut vertices = Vec::with_capacity(mesh.positions.len() * 8);
-    for ((p, n), t) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs) {
-        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1]]);
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    let mut vertices = Vec::with_capacity(mesh.positions.len() * 12);
+    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&tangents) {
+        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1], tg[0], tg[1], tg[2], tg[3]]);
     }
     let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("mesh vertices"),
@@ -95,9 +101,9 @@ pub fn rasterise(
             entry_point: Some("vs_mesh"),
             compilation_options: Default::default(),
             buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: 32,
+                array_stride: 48,
                 step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4],
             })],
         },
         primitive: wgpu::PrimitiveState {
@@ -121,6 +127,7 @@ pub fn rasterise(
             targets: &[
                 Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
                 Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+                Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
             ],
         }),
         multiview_mask: None,
@@ -130,6 +137,7 @@ pub fn rasterise(
         gpu::bind_group(device, "mesh camera", &pipeline.get_bind_group_layout(0), &[(0, ubuf.as_entire_binding())]);
     let g0 = gpu::texture(device, "normal+depth", width, height, gformat);
     let g1 = gpu::texture(device, "uv+cover", width, height, gformat);
+    let g2 = gpu::texture(device, "tangent", width, height, gformat);
     let depth = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("mesh depth"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -140,9 +148,10 @@ pub fn rasterise(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
         view_formats: &[],
     });
-    let (v0, v1, vd) = (
+    let (v0, v1, v2, vd) = (
         g0.create_view(&Default::default()),
         g1.create_view(&Default::default()),
+        g2.create_view(&Default::default()),
         depth.create_view(&Default::default()),
     );
     let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
@@ -160,7 +169,7 @@ pub fn rasterise(
         };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("mesh g-buffer"),
-            color_attachments: &[attach(&v0), attach(&v1)],
+            color_attachments: &[attach(&v0), attach(&v1), attach(&v2)],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &vd,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
@@ -178,6 +187,7 @@ pub fn rasterise(
     }
     queue.submit([enc.finish()]);
     let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
+    let c = gpu::read_texture_f16(device, queue, &g2)?;
     let mut g = MeshGBuffer::empty(width, height);
     for i in 0..(width * height) as usize {
         if b[4 * i + 2] > 0.5 {
@@ -185,6 +195,7 @@ pub fn rasterise(
             g.normal_view[i] = [a[4 * i], a[4 * i + 1], a[4 * i + 2]];
             g.depth_mm[i] = a[4 * i + 3];
             g.uv[i] = [b[4 * i], b[4 * i + 1]];
+            g.tangent_view[i] = [c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]];
         }
     }
     Ok(g)

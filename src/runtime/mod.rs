@@ -32,6 +32,7 @@ pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;
 pub mod transport_gpu;
+pub mod wrinkle_pass;
 
 /// Errors of the runtime.
 #[derive(Debug, thiserror::Error)]

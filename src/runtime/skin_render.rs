@@ -11,6 +11,8 @@
 //!    ([`super::mesh_skin_inputs`]: the face maps are texture-space maps), view-space normals, thickness; the
 //!    skin-inputs pass then runs with a neutral rig (scale 1, bias 0), so its hemoglobin is that H (its own rig
 //!    lookup samples screen space, right for the screen-space demo and wrong for a mesh).
+//!    With [`SkinPasses::wrinkles`], the wrinkle pass of Listing 8.1 ([`super::wrinkle_pass`]) replaces the
+//!    G-buffer's normals before any lighting.
 //! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
 //!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
 //!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
@@ -219,7 +221,10 @@ fn geometry(
     assets: &DemoAssets,
 ) -> Result<Geometry, RuntimeError> {
     let cam = s.camera();
-    let g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
+    let mut g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
+    if let Some(w) = &passes.wrinkles {
+        g.normal_view = super::wrinkle_pass::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
+    }
     let light = light_camera(&cam);
     let shadow = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
     let thickness = thickness_mm(&g, &cam, &shadow, &light, mesh.mm_per_unit);

@@ -8,7 +8,8 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::cpu::mesh_raster::rasterise;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::{hemoglobin_for_gbuffer, RigPose};
-use rtbake::runtime::skin_passes::SkinPasses;
+use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
+use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, wrinkled_normals_for, WrinkleMaps};
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset};
 use serde_json::json;
 
@@ -85,6 +86,76 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
     assert!(gr_f > gr_n + 0.003, "fear must pale: G/R {gr_f} vs neutral {gr_n}");
 }
 
+fn wrinkles(spec: &str) -> Wrinkles {
+    let maps = WrinkleMaps::load(&baked_dir()).unwrap();
+    Wrinkles { maps, zone_weights: parse_wrinkle_weights(spec).unwrap() }
+}
+
+#[test]
+fn wrinkle_pass_gpu_matches_cpu_and_bends_normals_only_under_its_masks() {
+    let g = gpu();
+    let mesh = default_head();
+    let cam = Camera::facing(0.6).unwrap();
+    let gb = rasterise(&mesh, &cam, 320, 180);
+    // The GPU G-buffer's tangents agree with the CPU raster's (f16 targets, edge pixels aside).
+    let gpu_gb = rtbake::runtime::mesh_raster::rasterise(&g.device, &g.queue, &mesh, &cam, 320, 180).unwrap();
+    let both: Vec<usize> = (0..gb.covered.len()).filter(|&i| gb.covered[i] && gpu_gb.covered[i]).collect();
+    let close = both
+        .iter()
+        .filter(|&&i| (0..4).all(|k| (gb.tangent_view[i][k] - gpu_gb.tangent_view[i][k]).abs() < 1e-2))
+        .count();
+    assert!(close as f64 >= 0.99 * both.len() as f64, "tangents: {close} of {} agree", both.len());
+    assert!(both.iter().all(|&i| gb.tangent_view[i][3].abs() == 1.0), "handedness is ±1 inside triangles");
+
+    let w = wrinkles("joy=1, anger=0.5, sad=1");
+    let on_gpu = wrinkled_normals_for(Some(&g), &gb, &w.maps, &w.zone_weights).unwrap();
+    let on_cpu = wrinkled_normals_for(None, &gb, &w.maps, &w.zone_weights).unwrap();
+    let flat = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
+    let (frac, worst) = agreement(&flat(&on_gpu), &flat(&on_cpu), 1.0 / 255.0);
+    assert!(frac >= 0.999 && worst < 1e-4, "{frac} of components within 1/255, worst {worst}");
+    let mut bent = 0;
+    for i in 0..gb.covered.len() {
+        let (n, m) = (gb.normal_view[i], on_cpu[i]);
+        let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+        let masked = gb.covered[i] && w.maps.mask_weight_at(gb.uv[i][0], gb.uv[i][1], &w.zone_weights) > 0.0;
+        if gb.covered[i] {
+            assert!((len - 1.0).abs() < 2e-3, "pixel {i}: |n| = {len}");
+        }
+        if !masked {
+            assert_eq!(n, m, "pixel {i}: no mask, no change");
+        } else if n != m {
+            bent += 1;
+        }
+    }
+    assert!(bent > 500, "{bent} normals bent under the masks");
+}
+
+#[test]
+fn zero_wrinkle_weights_leave_the_frame_byte_identical_and_a_weight_changes_only_masked_pixels() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let s = settings(SkinShader::None);
+    let frame = |passes: &SkinPasses| render_with(Some(&g), &default_head(), &s, passes, &assets).unwrap().data;
+    let plain = frame(&SkinPasses::default());
+    let zero = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=0, anger=0")), ..Default::default() });
+    assert!(plain == zero, "zero wrinkle weights must not change a byte");
+    let joy = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=1")), ..Default::default() });
+    let gb = rtbake::runtime::mesh_raster::rasterise(&g.device, &g.queue, &default_head(), &s.camera(), 320, 180)
+        .unwrap();
+    let w = wrinkles("joy=1");
+    let (mut changed, mut outside) = (0, 0);
+    for i in 0..gb.covered.len() {
+        if plain[4 * i..4 * i + 4] == joy[4 * i..4 * i + 4] {
+            continue;
+        }
+        changed += 1;
+        let masked = gb.covered[i] && w.maps.mask_weight_at(gb.uv[i][0], gb.uv[i][1], &w.zone_weights) > 0.0;
+        outside += !masked as usize;
+    }
+    assert!(changed > 100, "{changed} pixels changed by joy's wrinkles");
+    assert_eq!(outside, 0, "{outside} of {changed} changed pixels lie outside joy's masks");
+}
+
 /// Runs `run skin` with `args` into a fresh directory: exit 2, the flag named, no output file.
 fn refused(args: &[&str], flag: &str) {
     let t = tempfile::tempdir().unwrap();
@@ -107,4 +178,7 @@ fn bad_pass_flags_exit_2_naming_the_flag_and_write_nothing() {
     refused(&["--rig-weights", r#"{"neutral": 1, "global": {"joy": 0.5}}"#], "--rig-weights");
     refused(&["--rig-weights", "{not json"], "--rig-weights");
     refused(&["--rig-weights", "/nonexistent/weights.json"], "--rig-weights");
+    refused(&["--wrinkles", "smile=1"], "--wrinkles");
+    refused(&["--wrinkles", "joy=1.5"], "--wrinkles");
+    refused(&["--wrinkles", "joy"], "--wrinkles");
 }

@@ -18,6 +18,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
     let (wf, hf) = (width as f32, height as f32);
     let mut g = MeshGBuffer::empty(width, height);
     let mut zbuf = vec![1.0f32; (width * height) as usize];
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
     struct V {
         x: f32,
         y: f32,
@@ -26,6 +27,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
         n: [f32; 3],
         depth_mm: f32,
         uv: [f32; 2],
+        t: [f32; 4],
     }
     let vert = |i: u32| -> Option<V> {
         let p = mesh.positions[i as usize];
@@ -36,6 +38,8 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
         let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
         let n = mesh.normals[i as usize];
         let nv = view * Vector4::new(n[0], n[1], n[2], 0.0);
+        let tg = tangents[i as usize];
+        let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
         Some(V {
             x: (c.x / c.w * 0.5 + 0.5) * wf,
             y: (0.5 - c.y / c.w * 0.5) * hf,
@@ -44,6 +48,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
             n: [nv.x, nv.y, nv.z],
             depth_mm: -pv.z * mesh.mm_per_unit,
             uv: mesh.uvs[i as usize],
+            t: [tv.x, tv.y, tv.z, tg[3]],
         })
     };
     for t in mesh.indices.chunks_exact(3) {
@@ -82,6 +87,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
                 g.normal_view[i] = n.map(|v| f16(v / l));
                 g.depth_mm[i] = f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm));
                 g.uv[i] = [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1]))];
+                g.tangent_view[i] = std::array::from_fn(|k| f16(lerp(a.t[k], b.t[k], c.t[k])));
             }
         }
     }

@@ -16,6 +16,7 @@ pub mod skin_inputs;
 pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;
+pub mod wrinkle_pass;
 
 /// How a bilinear fetch of an 8-bit texture is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
