@@ -33,6 +33,12 @@ pub enum StretchArg {
     Tap2009,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
 #[derive(clap::Args)]
 pub struct SkinArgs {
     /// Output PNG (RGBA8, sRGB-encoded).
@@ -76,6 +82,10 @@ pub struct SkinArgs {
     /// one of Table 8.1's expressions (joy, surprise, fear, anger, disgust, sad) and WEIGHT in 0..=1.
     #[arg(long, value_name = "WEIGHTS")]
     wrinkles: Option<String>,
+    /// Bloom on the HDR frame before tone mapping (thesis ch. 4): threshold 1.0, weight 0.25, three Gaussians of
+    /// 0.25 %, 0.8 % and 2.5 % of the frame height mixed 0.5/0.3/0.2 (`rtbake::runtime::bloom`).
+    #[arg(long, value_enum, default_value = "on")]
+    bloom: OnOff,
     #[command(flatten)]
     common: crate::run::Common,
 }
@@ -99,6 +109,9 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
             usage_msg("--rig-weights needs the hemoglobin rig in the bake directory (facial/hemoglobin/example)")
         })?;
         p.rig_pose = Some(RigPose::for_baked_rig(&json, rig).map_err(usage)?);
+    }
+    if a.bloom == OnOff::Off {
+        p.bloom = None;
     }
     if let Some(v) = &a.wrinkles {
         let zone_weights = parse_wrinkle_weights(v).map_err(usage)?;

@@ -55,6 +55,8 @@ pub struct DemoAssets {
     pub importance: Option<ImportanceSamples>,
     /// Scale and follow-surface settings of the importance-sampled pass (the demo's defaults).
     pub importance_params: ImportanceSssParams,
+    /// Bloom on the final HDR frame before tone mapping ([`super::bloom`]); None (the demo's default): no bloom.
+    pub bloom: Option<super::bloom::BloomParams>,
 }
 
 impl DemoAssets {
@@ -101,6 +103,7 @@ impl DemoAssets {
             rig_source,
             importance,
             importance_params: ImportanceSssParams::default(),
+            bloom: None,
         })
     }
 }
@@ -330,8 +333,9 @@ fn shade(
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (kernel, params) = (&assets.kernel, &assets.sss);
     let importance_params = assets.importance_params;
+    let bloom = assets.bloom.as_ref();
     let Some(method) = method else {
-        return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, aa);
+        return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, bloom, aa);
     };
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
@@ -347,11 +351,13 @@ fn shade(
         },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
-    composite(gpu, &geo, &blurred, &albedo, &transmitted, rgba, aa)
+    composite(gpu, &geo, &blurred, &albedo, &transmitted, rgba, bloom, aa)
 }
 
-/// Composites the (blurred) diffuse layer plus back-lit transmittance over the background, tone-maps, encodes sRGB
+/// Composites the (blurred) diffuse layer plus back-lit transmittance and specular over the background, blooms the
+/// HDR frame when `bloom` says so (thesis ch. 4: on the final image, before tone mapping), tone-maps, encodes sRGB
 /// and antialiases.
+#[allow(clippy::too_many_arguments)]
 fn composite(
     gpu: Option<&Gpu>,
     geo: &Geometry,
@@ -359,17 +365,45 @@ fn composite(
     albedo: &[f32],
     transmitted: &[f32],
     mut rgba: Vec<u8>,
+    bloom: Option<&super::bloom::BloomParams>,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
     let (w, h) = (geo.frame.width, geo.frame.height);
     let n = (w * h) as usize;
+    // The final HDR radiance of the skin.
+    let mut hdr = vec![0.0f32; 4 * n];
     for i in 0..n {
         if !geo.skin[i] {
             continue;
         }
         let spec = geo.specular.as_ref().map_or(0.0, |s| s[i]);
-        let v: [f32; 3] =
-            std::array::from_fn(|c| blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c] + spec);
+        for c in 0..3 {
+            hdr[4 * i + c] = blurred[4 * i + c] + 1.5 * albedo[4 * i + c] * transmitted[4 * i + c] + spec;
+        }
+    }
+    if let Some(b) = bloom {
+        // The background enters as its linear radiance; where bloom adds light to it, it is re-encoded (the
+        // background is display-referred: no tone map).
+        for i in (0..n).filter(|&i| !geo.skin[i]) {
+            for c in 0..3 {
+                hdr[4 * i + c] = cpu::srgb_to_linear(rgba[4 * i + c] as f32 / 255.0);
+            }
+        }
+        let out = super::bloom::bloom_for(gpu, w, h, &hdr, b)?;
+        for i in (0..n).filter(|&i| !geo.skin[i]) {
+            if out[4 * i..4 * i + 3] != hdr[4 * i..4 * i + 3] {
+                for c in 0..3 {
+                    rgba[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb(out[4 * i + c].clamp(0.0, 1.0)));
+                }
+            }
+        }
+        hdr = out;
+    }
+    for i in 0..n {
+        if !geo.skin[i] {
+            continue;
+        }
+        let v: [f32; 3] = std::array::from_fn(|c| hdr[4 * i + c]);
         // Tone map the luminance (1 − e^−L) and keep the channel ratios, so skin keeps its hue in highlights.
         let l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         let scale = if l > 0.0 { (1.0 - (-l).exp()) / l } else { 0.0 };

@@ -10,6 +10,7 @@
 //!   `Rgba8Unorm` and the shaders decode/encode sRGB themselves where linear blending is wanted;
 //! - no pass needs `FLOAT32_FILTERABLE` or an f32 render target (lavapipe and llvmpipe run everything).
 
+pub mod bloom;
 pub mod chain;
 pub(crate) mod compute_chain;
 pub mod cpu;

@@ -1,7 +1,9 @@
 //! The passes of the thesis' skin shader that `run skin` adds around its SSS shader (issue 14, part B), chosen
 //! per frame: the rig's eq. 7.6 in texture space ([`super::mesh_skin_inputs`], thesis §7.6) and the wrinkle pass
-//! ([`super::wrinkle_pass`], thesis ch. 8 Listing 8.1).
+//! ([`super::wrinkle_pass`], thesis ch. 8 Listing 8.1) before shading, and bloom on the final HDR frame before
+//! tone mapping ([`super::bloom`], thesis ch. 4). The default is the neutral pose, no wrinkles and bloom on.
 
+use super::bloom::BloomParams;
 use super::mesh_skin_inputs::RigPose;
 use super::wrinkle_pass::WrinkleMaps;
 
@@ -13,10 +15,18 @@ pub struct Wrinkles {
 }
 
 /// What `run skin` adds to the SSS shader of [`super::skin_render::SkinRenderSettings`].
-#[derive(Clone, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SkinPasses {
     /// The rig's pose (eq. 7.6 weights and global state); None: the neutral pose (weight 1 on neutral, g = 1).
     pub rig_pose: Option<RigPose>,
     /// The wrinkle pass on the G-buffer's normals; None: no wrinkle pass.
     pub wrinkles: Option<Wrinkles>,
+    /// Bloom; None: off.
+    pub bloom: Option<BloomParams>,
+}
+
+impl Default for SkinPasses {
+    fn default() -> Self {
+        SkinPasses { rig_pose: None, wrinkles: None, bloom: Some(BloomParams::default()) }
+    }
 }

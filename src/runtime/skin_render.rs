@@ -16,7 +16,8 @@
 //! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
 //!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
 //!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
-//!    tone-mapped and encoded over a grey background.
+//!    the specular layer added after the SSS pass, bloom on the HDR frame ([`SkinPasses::bloom`], thesis ch. 4:
+//!    on the final image, before tone mapping), tone-mapped and encoded over a grey background.
 
 use super::cpu;
 use super::demo::{
@@ -302,6 +303,7 @@ pub fn render_with(
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
     assets.rig_weights = vec![1.0];
     assets.sss.fovy_deg = s.camera().fov_y_deg;
+    assets.bloom = passes.bloom;
     let method = match s.shader {
         SkinShader::None => None,
         SkinShader::SsFull => {

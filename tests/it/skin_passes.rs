@@ -136,10 +136,11 @@ fn zero_wrinkle_weights_leave_the_frame_byte_identical_and_a_weight_changes_only
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let s = settings(SkinShader::None);
     let frame = |passes: &SkinPasses| render_with(Some(&g), &default_head(), &s, passes, &assets).unwrap().data;
-    let plain = frame(&SkinPasses::default());
-    let zero = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=0, anger=0")), ..Default::default() });
+    // No bloom: it would spread a pixel's change to its neighbours.
+    let plain = frame(&SkinPasses { bloom: None, ..Default::default() });
+    let zero = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=0, anger=0")), bloom: None, ..Default::default() });
     assert!(plain == zero, "zero wrinkle weights must not change a byte");
-    let joy = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=1")), ..Default::default() });
+    let joy = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=1")), bloom: None, ..Default::default() });
     let gb = rtbake::runtime::mesh_raster::rasterise(&g.device, &g.queue, &default_head(), &s.camera(), 320, 180)
         .unwrap();
     let w = wrinkles("joy=1");
@@ -154,6 +155,60 @@ fn zero_wrinkle_weights_leave_the_frame_byte_identical_and_a_weight_changes_only
     }
     assert!(changed > 100, "{changed} pixels changed by joy's wrinkles");
     assert_eq!(outside, 0, "{outside} of {changed} changed pixels lie outside joy's masks");
+}
+
+/// A 128×96 HDR frame: dim noise below the threshold everywhere and `bright` at the given pixels.
+fn hdr_frame(bright: &[(usize, usize, f32)]) -> Vec<f32> {
+    let (w, h) = (128usize, 96usize);
+    let mut v: Vec<f32> = (0..4 * w * h).map(|i| if i % 4 == 3 { 1.0 } else { 0.3 + 0.5 * ((i * 7919) % 101) as f32 / 101.0 }).collect();
+    for &(x, y, l) in bright {
+        for c in 0..3 {
+            v[4 * (y * w + x) + c] = l * [1.0, 0.8, 0.6][c];
+        }
+    }
+    v
+}
+
+fn rgb_sum(v: &[f32]) -> f64 {
+    v.chunks(4).map(|p| (p[0] + p[1] + p[2]) as f64).sum()
+}
+
+#[test]
+fn bloom_conserves_energy_spreads_a_bright_pixel_monotonically_and_gpu_matches_cpu() {
+    use rtbake::runtime::bloom::{bloom_for, BloomParams};
+    let g = gpu();
+    let p = BloomParams::default();
+    let (w, h) = (128u32, 96u32);
+    // A bright 3×3 patch and a single bright pixel, far from the border (σ of the widest blur: 2.4 px, r = 8).
+    let mut lights = vec![(90, 30, 40.0)];
+    for y in 47..50 {
+        for x in 40..43 {
+            lights.push((x, y, 12.0));
+        }
+    }
+    let input = hdr_frame(&lights);
+    let on_cpu = bloom_for(None, w, h, &input, &p).unwrap();
+    let on_gpu = bloom_for(Some(&g), w, h, &input, &p).unwrap();
+    let (frac, worst) = agreement(&on_gpu, &on_cpu, 1.0 / 255.0);
+    assert!(frac >= 0.999 && worst < 1e-4, "GPU vs CPU: {frac} within 1/255, worst {worst}");
+    for (name, out) in [("cpu", &on_cpu), ("gpu", &on_gpu)] {
+        let (a, b) = (rgb_sum(&input), rgb_sum(out));
+        assert!(((b - a) / a).abs() < 1e-5, "{name}: energy {a} in, {b} out");
+        // Light moved out of the bright pixels into their surroundings.
+        let at = |x: usize, y: usize, v: &[f32]| v[4 * (y * w as usize + x)];
+        assert!(at(90, 30, out) < at(90, 30, &input), "{name}");
+        // Along the row from the single bright pixel, the added light decreases monotonically and is positive
+        // within the widest blur's reach, zero beyond it.
+        let added: Vec<f32> = (90..110).map(|x| at(x, 30, out) - at(x, 30, &input)).collect();
+        for k in 1..added.len() - 1 {
+            assert!(added[k + 1] <= added[k], "{name}: not monotone at +{k}: {added:?}");
+        }
+        assert!(added[1] > 0.0 && added[8] > 0.0 && added[9] == 0.0, "{name}: {added:?}");
+    }
+    // Nothing below the threshold moves.
+    let dim = hdr_frame(&[]);
+    assert_eq!(bloom_for(None, w, h, &dim, &p).unwrap(), dim);
+    assert_eq!(bloom_for(Some(&g), w, h, &dim, &p).unwrap(), dim);
 }
 
 /// Runs `run skin` with `args` into a fresh directory: exit 2, the flag named, no output file.
@@ -181,4 +236,5 @@ fn bad_pass_flags_exit_2_naming_the_flag_and_write_nothing() {
     refused(&["--wrinkles", "smile=1"], "--wrinkles");
     refused(&["--wrinkles", "joy=1.5"], "--wrinkles");
     refused(&["--wrinkles", "joy"], "--wrinkles");
+    refused(&["--bloom", "maybe"], "--bloom");
 }

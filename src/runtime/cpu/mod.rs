@@ -6,6 +6,7 @@
 //! ([`FilterPrecision`]): real GPUs filter in (nearly) full float precision, while lavapipe/llvmpipe filter 8-bit
 //! textures with 8-bit weights and return 8-bit results.
 
+pub mod bloom;
 pub mod gaussian_sss;
 pub mod importance_sss;
 pub mod mesh_raster;
