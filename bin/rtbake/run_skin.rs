@@ -86,6 +86,9 @@ pub struct SkinArgs {
     /// 0.25 %, 0.8 % and 2.5 % of the frame height mixed 0.5/0.3/0.2 (`rtbake::runtime::bloom`).
     #[arg(long, value_enum, default_value = "on")]
     bloom: OnOff,
+    /// Samples per pixel of the mesh G-buffer: 1 or 4 (MSAA, the standard 4× pattern; edges blended by coverage).
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    msaa: u32,
     #[command(flatten)]
     common: crate::run::Common,
 }
@@ -110,6 +113,8 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
         })?;
         p.rig_pose = Some(RigPose::for_baked_rig(&json, rig).map_err(usage)?);
     }
+    rtbake::runtime::mesh_raster::check_samples(a.msaa).map_err(usage)?;
+    p.msaa = a.msaa;
     if a.bloom == OnOff::Off {
         p.bloom = None;
     }

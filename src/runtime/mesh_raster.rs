@@ -5,6 +5,13 @@
 //! [`crate::mesh::tangents`] with its handedness (`Rgba16Float`, interpolated, not renormalised) — the inputs the
 //! screen-space passes, texture-space diffusion and the wrinkle pass need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
 //! [`MeshGBuffer`].
+//!
+//! MSAA ([`rasterise_samples`] with 4 samples, `run skin --msaa 4`): multisampled targets and depth buffer, the
+//! fragment shaded once per pixel at its centre and stored in the samples it covers, the hardware resolve averaging
+//! the samples; uncovered samples hold zeros, so the resolved coverage flag is the covered fraction and the
+//! attributes divided by it are the mean over the covered samples (the normal renormalised). 4× needs
+//! `MULTISAMPLE_X4` and `MULTISAMPLE_RESOLVE` for `Rgba16Float` and `Depth32Float`, checked through the formats'
+//! guaranteed `TextureFormatFeatures` for the device's features.
 
 use super::gpu;
 use super::RuntimeError;
@@ -27,6 +34,8 @@ pub struct MeshGBuffer {
     /// View-space tangent (xyz, interpolated: not unit, not exactly perpendicular to the normal) and handedness w
     /// ([`crate::mesh::tangents`]); zero where nothing is covered.
     pub tangent_view: Vec<[f32; 4]>,
+    /// Covered fraction of the pixel: 0 or 1 with one sample, k/4 with 4× MSAA.
+    pub coverage: Vec<f32>,
 }
 
 impl MeshGBuffer {
@@ -40,6 +49,7 @@ impl MeshGBuffer {
             uv: vec![[0.0; 2]; n],
             covered: vec![false; n],
             tangent_view: vec![[0.0; 4]; n],
+            coverage: vec![0.0; n],
         }
     }
 }
@@ -55,6 +65,17 @@ pub(crate) fn camera_uniform(mesh: &Mesh, camera: &Camera, width: u32, height: u
     u
 }
 
+/// Sample counts of the G-buffer raster (`--msaa`).
+pub const SAMPLE_COUNTS: [u32; 2] = [1, 4];
+
+/// Refuses a sample count other than 1 or 4 (`--msaa`).
+pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
+    if !SAMPLE_COUNTS.contains(&samples) {
+        return Err(InvalidInput::new("--msaa", format!("must be 1 or 4 samples per pixel, got {samples}")));
+    }
+    Ok(())
+}
+
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
 pub fn rasterise(
     device: &wgpu::Device,
@@ -64,6 +85,30 @@ pub fn rasterise(
     width: u32,
     height: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
+    rasterise_samples(device, queue, mesh, camera, width, height, 1)
+}
+
+/// [`rasterise`] with `samples` (1 or 4) samples per pixel (see the module doc).
+pub fn rasterise_samples(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<MeshGBuffer, RuntimeError> {
+    check_samples(samples)?;
+    if samples > 1 {
+        use wgpu::TextureFormatFeatureFlags as Fl;
+        for f in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Depth32Float] {
+            let flags = f.guaranteed_format_features(device.features()).flags;
+            let resolve = f.has_depth_aspect() || flags.contains(Fl::MULTISAMPLE_RESOLVE);
+            if !flags.sample_count_supported(samples) || !resolve {
+                return Err(InvalidInput::new("--msaa", format!("{samples}x is not supported for {f:?} here")).into());
+            }
+        }
+    }
     camera.validate()?;
     super::device::check_image_fits(device, width, height, 8 + 8 + 8 + 4)?;
     let vertex_bytes = mesh.positions.len() as u64 * 48;
@@ -119,7 +164,7 @@ pub fn rasterise(
             stencil: wgpu::StencilState::default(),
             bias: wgpu::DepthBiasState::default(),
         }),
-        multisample: wgpu::MultisampleState::default(),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs_mesh"),
@@ -138,11 +183,31 @@ pub fn rasterise(
     let g0 = gpu::texture(device, "normal+depth", width, height, gformat);
     let g1 = gpu::texture(device, "uv+cover", width, height, gformat);
     let g2 = gpu::texture(device, "tangent", width, height, gformat);
+    let multisampled = |label, format| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    let ms: Vec<wgpu::TextureView> = if samples > 1 {
+        ["normal+depth ms", "uv+cover ms", "tangent ms"]
+            .iter()
+            .map(|l| multisampled(*l, gformat).create_view(&Default::default()))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let depth = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("mesh depth"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         mip_level_count: 1,
-        sample_count: 1,
+        sample_count: samples,
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::Depth32Float,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -156,11 +221,12 @@ pub fn rasterise(
     );
     let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
     {
-        let attach = |view| {
+        let attach = |k: usize, single| {
+            let (view, resolve_target) = if samples > 1 { (&ms[k], Some(single)) } else { (single, None) };
             Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,
-                resolve_target: None,
+                resolve_target,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     store: wgpu::StoreOp::Store,
@@ -169,7 +235,7 @@ pub fn rasterise(
         };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("mesh g-buffer"),
-            color_attachments: &[attach(&v0), attach(&v1), attach(&v2)],
+            color_attachments: &[attach(0, &v0), attach(1, &v1), attach(2, &v2)],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &vd,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
@@ -189,9 +255,14 @@ pub fn rasterise(
     let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
     let c = gpu::read_texture_f16(device, queue, &g2)?;
     let mut g = MeshGBuffer::empty(width, height);
+    if samples > 1 {
+        resolve_coverage(&mut g, &a, &b, &c);
+        return Ok(g);
+    }
     for i in 0..(width * height) as usize {
         if b[4 * i + 2] > 0.5 {
             g.covered[i] = true;
+            g.coverage[i] = 1.0;
             g.normal_view[i] = [a[4 * i], a[4 * i + 1], a[4 * i + 2]];
             g.depth_mm[i] = a[4 * i + 3];
             g.uv[i] = [b[4 * i], b[4 * i + 1]];
@@ -199,4 +270,26 @@ pub fn rasterise(
         }
     }
     Ok(g)
+}
+
+/// The G-buffer from the resolved (sample-averaged) targets: coverage = the averaged flag, attributes = averaged
+/// value / coverage (the mean over the covered samples), the normal renormalised. Shared with the CPU twin.
+pub(crate) fn resolve_coverage(g: &mut MeshGBuffer, a: &[f32], b: &[f32], c: &[f32]) {
+    for i in 0..(g.width * g.height) as usize {
+        let cov = b[4 * i + 2];
+        if cov <= 0.0 {
+            continue;
+        }
+        let n = [a[4 * i] / cov, a[4 * i + 1] / cov, a[4 * i + 2] / cov];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if !(len > 0.0) {
+            continue;
+        }
+        g.covered[i] = true;
+        g.coverage[i] = cov;
+        g.normal_view[i] = n.map(|v| v / len);
+        g.depth_mm[i] = a[4 * i + 3] / cov;
+        g.uv[i] = [b[4 * i] / cov, b[4 * i + 1] / cov];
+        g.tangent_view[i] = std::array::from_fn(|k| c[4 * i + k] / cov);
+    }
 }

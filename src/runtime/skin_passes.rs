@@ -1,7 +1,8 @@
 //! The passes of the thesis' skin shader that `run skin` adds around its SSS shader (issue 14, part B), chosen
 //! per frame: the rig's eq. 7.6 in texture space ([`super::mesh_skin_inputs`], thesis §7.6) and the wrinkle pass
 //! ([`super::wrinkle_pass`], thesis ch. 8 Listing 8.1) before shading, and bloom on the final HDR frame before
-//! tone mapping ([`super::bloom`], thesis ch. 4). The default is the neutral pose, no wrinkles and bloom on.
+//! tone mapping ([`super::bloom`], thesis ch. 4), and the G-buffer's sample count (MSAA). The default is the
+//! neutral pose, no wrinkles, bloom on and one sample per pixel.
 
 use super::bloom::BloomParams;
 use super::mesh_skin_inputs::RigPose;
@@ -23,10 +24,12 @@ pub struct SkinPasses {
     pub wrinkles: Option<Wrinkles>,
     /// Bloom; None: off.
     pub bloom: Option<BloomParams>,
+    /// Samples per pixel of the G-buffer raster, 1 or 4 (MSAA, [`super::mesh_raster::rasterise_samples`]).
+    pub msaa: u32,
 }
 
 impl Default for SkinPasses {
     fn default() -> Self {
-        SkinPasses { rig_pose: None, wrinkles: None, bloom: Some(BloomParams::default()) }
+        SkinPasses { rig_pose: None, wrinkles: None, bloom: Some(BloomParams::default()), msaa: 1 }
     }
 }

@@ -13,6 +13,9 @@
 //!    lookup samples screen space, right for the screen-space demo and wrong for a mesh).
 //!    With [`SkinPasses::wrinkles`], the wrinkle pass of Listing 8.1 ([`super::wrinkle_pass`]) replaces the
 //!    G-buffer's normals before any lighting.
+//!    With `--msaa 4` ([`SkinPasses::msaa`]) the G-buffer is rasterised with 4 samples per pixel
+//!    ([`super::mesh_raster::rasterise_samples`]) and partly covered pixels are blended with the background by
+//!    their coverage after shading (the shadow map stays at 1 sample).
 //! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
 //!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
 //!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
@@ -80,6 +83,8 @@ pub const SHADOW_SHRINK_MM: f32 = 5.0;
 /// World units of the SSS passes per metre: their parameters (sssWidth, α, β) are stated for a head one world
 /// unit tall (`runtime::gaussian_sss`), and the default head is 0.21 m tall.
 pub const WORLD_UNITS_PER_M: f32 = 1.0 / 0.21;
+/// The background colour, RGBA8 sRGB.
+const BACKGROUND: [u8; 4] = [46, 48, 52, 255];
 /// Most heads per frame (TAP 2009 Table III measures 1, 3 and 5).
 pub const MAX_HEADS: u32 = 16;
 
@@ -220,9 +225,12 @@ fn geometry(
     s: &SkinRenderSettings,
     passes: &SkinPasses,
     assets: &DemoAssets,
-) -> Result<Geometry, RuntimeError> {
+) -> Result<(Geometry, Vec<f32>), RuntimeError> {
     let cam = s.camera();
-    let mut g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
+    let mut g = match gpu {
+        Some(d) => mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, s.width, s.height, passes.msaa)?,
+        None => cpu::mesh_raster::rasterise_samples(mesh, &cam, s.width, s.height, passes.msaa)?,
+    };
     if let Some(w) = &passes.wrinkles {
         g.normal_view = super::wrinkle_pass::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
     }
@@ -261,7 +269,8 @@ fn geometry(
         frame.normals[i] = g.normal_view[i];
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
-    Ok(Geometry { frame, depth, skin: g.covered, specular: Some(specular) })
+    let coverage = std::mem::take(&mut g.coverage);
+    Ok((Geometry { frame, depth, skin: g.covered, specular: Some(specular) }, coverage))
 }
 
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
@@ -297,7 +306,7 @@ pub fn render_with(
 ) -> Result<Image<u8>, RuntimeError> {
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let geo = geometry(gpu, &heads, s, passes, assets)?;
+    let (geo, coverage) = geometry(gpu, &heads, s, passes, assets)?;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
@@ -321,6 +330,15 @@ pub fn render_with(
             Some(SssMethod::Importance)
         }
     };
-    let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
-    render_geometry(gpu, geo, &assets, method, background, None)
+    let background = BACKGROUND.repeat((s.width * s.height) as usize);
+    let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
+    // MSAA: partly covered pixels blend the shaded skin with the background by their coverage, in linear light.
+    for (i, &cov) in coverage.iter().enumerate().filter(|(_, &c)| c > 0.0 && c < 1.0) {
+        for c in 0..3 {
+            let skin = cpu::srgb_to_linear(frame.data[4 * i + c] as f32 / 255.0);
+            let bg = cpu::srgb_to_linear(BACKGROUND[c] as f32 / 255.0);
+            frame.data[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb(cov * skin + (1.0 - cov) * bg));
+        }
+    }
+    Ok(frame)
 }

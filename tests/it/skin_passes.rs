@@ -81,7 +81,7 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
     };
     let (gr_n, gr_a, gr_f) = (mean_g_over_r(&render(&neutral)), mean_g_over_r(&render(&anger)), mean_g_over_r(&render(&fear)));
     eprintln!("mean G/R: neutral {gr_n:.4}, anger {gr_a:.4}, fear {gr_f:.4}");
-    // Measured: neutral 0.7820, anger 0.7787, fear 0.7873 (the LUT's G/R moves slowly with H at Cm = 0.02).
+    // Measured (bloom on): neutral 0.7822, anger 0.7789, fear 0.7878 (the LUT's G/R moves slowly with H at Cm = 0.02).
     assert!(gr_a < gr_n - 0.002, "anger must redden: G/R {gr_a} vs neutral {gr_n}");
     assert!(gr_f > gr_n + 0.003, "fear must pale: G/R {gr_f} vs neutral {gr_n}");
 }
@@ -211,6 +211,57 @@ fn bloom_conserves_energy_spreads_a_bright_pixel_monotonically_and_gpu_matches_c
     assert_eq!(bloom_for(Some(&g), w, h, &dim, &p).unwrap(), dim);
 }
 
+#[test]
+fn msaa_4x_gpu_matches_cpu_and_its_coverage_is_closer_to_16x_supersampling_than_1x() {
+    use rtbake::runtime::cpu::mesh_raster::rasterise_samples;
+    let g = gpu();
+    let mesh = default_head();
+    let cam = Camera::facing(0.6).unwrap();
+    let (w, h) = (160usize, 90usize);
+    let one = rasterise_samples(&mesh, &cam, w as u32, h as u32, 1).unwrap();
+    let four = rasterise_samples(&mesh, &cam, w as u32, h as u32, 4).unwrap();
+    let four_gpu =
+        rtbake::runtime::mesh_raster::rasterise_samples(&g.device, &g.queue, &mesh, &cam, w as u32, h as u32, 4)
+            .unwrap();
+    let same = four.coverage.iter().zip(&four_gpu.coverage).filter(|(a, b)| a == b).count();
+    assert!(same as f64 >= 0.99 * (w * h) as f64, "coverage: {same} of {} pixels agree", w * h);
+    let both: Vec<usize> = (0..w * h).filter(|&i| four.coverage[i] == 1.0 && four_gpu.coverage[i] == 1.0).collect();
+    let close = both
+        .iter()
+        .filter(|&&i| {
+            (0..3).all(|k| (four.normal_view[i][k] - four_gpu.normal_view[i][k]).abs() < 1e-2)
+                // f16 depth: 0.5 mm steps at 512–1024 mm; the resolves may round the mean differently.
+                && (four.depth_mm[i] - four_gpu.depth_mm[i]).abs() <= 1.0
+        })
+        .count();
+    assert!(close as f64 >= 0.99 * both.len() as f64, "{close} of {} interior pixels agree", both.len());
+    assert!(four.coverage.iter().any(|&c| c == 0.25 || c == 0.5 || c == 0.75), "partial coverage at the edges");
+    // Truth: 16 samples per pixel on a regular 4×4 grid (the 1× raster at 4× the resolution).
+    let fine = rasterise_samples(&mesh, &cam, 4 * w as u32, 4 * h as u32, 1).unwrap();
+    let truth: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let n = (0..16).filter(|k| fine.covered[(4 * y + k / 4) * 4 * w + 4 * x + k % 4]).count();
+            n as f32 / 16.0
+        })
+        .collect();
+    let edge: Vec<usize> = (0..w * h).filter(|&i| truth[i] > 0.0 && truth[i] < 1.0).collect();
+    assert!(edge.len() > 100, "{} edge pixels", edge.len());
+    let err = |cov: &[f32]| edge.iter().map(|&i| (cov[i] - truth[i]).abs() as f64).sum::<f64>() / edge.len() as f64;
+    let (e1, e4, e4_gpu) = (err(&one.coverage), err(&four.coverage), err(&four_gpu.coverage));
+    eprintln!("mean |coverage − 16× truth| over {} edge pixels: 1× {e1:.4}, 4× {e4:.4} (GPU {e4_gpu:.4})", edge.len());
+    assert!(e4 < 0.6 * e1 && e4_gpu < 0.6 * e1, "4× {e4} / GPU {e4_gpu} vs 1× {e1}");
+
+    // The whole frame with --msaa 4: GPU and CPU chains agree.
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let passes = SkinPasses { msaa: 4, ..Default::default() };
+    let s = settings(SkinShader::SsFull);
+    let a = render_with(Some(&g), &mesh, &s, &passes, &assets).unwrap().data;
+    let b = render_with(None, &mesh, &s, &passes, &assets).unwrap().data;
+    let close = a.iter().zip(&b).filter(|(x, y)| x.abs_diff(**y) <= 2).count();
+    assert!(close as f64 >= 0.99 * a.len() as f64, "msaa 4 frame: {close} of {} channels within 2/255", a.len());
+}
+
 /// Runs `run skin` with `args` into a fresh directory: exit 2, the flag named, no output file.
 fn refused(args: &[&str], flag: &str) {
     let t = tempfile::tempdir().unwrap();
@@ -237,4 +288,6 @@ fn bad_pass_flags_exit_2_naming_the_flag_and_write_nothing() {
     refused(&["--wrinkles", "joy=1.5"], "--wrinkles");
     refused(&["--wrinkles", "joy"], "--wrinkles");
     refused(&["--bloom", "maybe"], "--bloom");
+    refused(&["--msaa", "2"], "--msaa");
+    refused(&["--msaa", "-4"], "--msaa");
 }
