@@ -57,6 +57,10 @@ pub struct DemoAssets {
     pub importance_params: ImportanceSssParams,
     /// Bloom on the final HDR frame before tone mapping ([`super::bloom`]); None (the demo's default): no bloom.
     pub bloom: Option<super::bloom::BloomParams>,
+    /// Post-scatter texturing (thesis §7.6, after d'Eon et al. 2007): the SSS pass blurs the irradiance alone and
+    /// the albedo multiplies it afterwards, so skin colour is not blurred; false (the demo): the pass blurs
+    /// albedo · irradiance (pre-scatter texturing, as the screen-space passes of ch. 4 take a rendered image).
+    pub post_scatter_albedo: bool,
 }
 
 impl DemoAssets {
@@ -104,6 +108,7 @@ impl DemoAssets {
             importance,
             importance_params: ImportanceSssParams::default(),
             bloom: None,
+            post_scatter_albedo: false,
         })
     }
 }
@@ -271,7 +276,7 @@ fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets) -> Result
         let lambert = (nn[0] * key[0] + nn[1] * key[1] + nn[2] * key[2]).max(0.0);
         let e = KEY_LIGHT_INTENSITY * lambert + 0.1;
         for c in 0..3 {
-            diffuse[4 * i + c] = albedo[4 * i + c] * e;
+            diffuse[4 * i + c] = if assets.post_scatter_albedo { e } else { albedo[4 * i + c] * e };
         }
         diffuse[4 * i + 3] = 1.0;
     }
@@ -334,8 +339,19 @@ fn shade(
     let (kernel, params) = (&assets.kernel, &assets.sss);
     let importance_params = assets.importance_params;
     let bloom = assets.bloom.as_ref();
+    // Post-scatter texturing: the albedo multiplies the (blurred) irradiance.
+    let textured = |mut v: Vec<f32>| {
+        if assets.post_scatter_albedo {
+            for (i, px) in v.chunks_exact_mut(4).enumerate() {
+                for c in 0..3 {
+                    px[c] *= albedo[4 * i + c];
+                }
+            }
+        }
+        v
+    };
     let Some(method) = method else {
-        return composite(gpu, &geo, &diffuse, &albedo, &transmitted, rgba, bloom, aa);
+        return composite(gpu, &geo, &textured(diffuse), &albedo, &transmitted, rgba, bloom, aa);
     };
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
@@ -351,7 +367,7 @@ fn shade(
         },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
-    composite(gpu, &geo, &blurred, &albedo, &transmitted, rgba, bloom, aa)
+    composite(gpu, &geo, &textured(blurred), &albedo, &transmitted, rgba, bloom, aa)
 }
 
 /// Composites the (blurred) diffuse layer plus back-lit transmittance and specular over the background, blooms the

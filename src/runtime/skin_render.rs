@@ -16,11 +16,14 @@
 //!    With `--msaa 4` ([`SkinPasses::msaa`]) the G-buffer is rasterised with 4 samples per pixel
 //!    ([`super::mesh_raster::rasterise_samples`]) and partly covered pixels are blended with the background by
 //!    their coverage after shading (the shadow map stays at 1 sample).
-//! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the SSS pass of `shader` (none, separable or
-//!    the screen-space sum of Gaussians) on the diffuse layer, view depth in head-sized world units
-//!    ([`WORLD_UNITS_PER_M`]), back-lit transmittance added,
-//!    the specular layer added after the SSS pass, bloom on the HDR frame ([`SkinPasses::bloom`], thesis ch. 4:
-//!    on the final image, before tone mapping), tone-mapped and encoded over a grey background.
+//! 4. The demo's shading in the thesis' order: Lambert key light; the SSS pass of `shader` (none, separable or
+//!    the screen-space sum of Gaussians) on the diffuse irradiance, view depth in head-sized world units
+//!    ([`WORLD_UNITS_PER_M`]); skin colour (albedo from the skin LUT) applied **after** the SSS pass
+//!    (post-scatter texturing, thesis §7.6: "to avoid blurring the albedo twice"; the procedural demo blurs
+//!    albedo · irradiance instead); back-lit transmittance added; the Kelemen/Szirmay-Kalos specular layer added
+//!    after the SSS pass, never blurred (ch. 4, separate render targets; the demo has none); bloom on the final
+//!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
+//!    over a grey background.
 
 use super::cpu;
 use super::demo::{
@@ -313,6 +316,7 @@ pub fn render_with(
     assets.rig_weights = vec![1.0];
     assets.sss.fovy_deg = s.camera().fov_y_deg;
     assets.bloom = passes.bloom;
+    assets.post_scatter_albedo = true;
     let method = match s.shader {
         SkinShader::None => None,
         SkinShader::SsFull => {
