@@ -7,8 +7,8 @@ use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
-use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, WrinkleMaps};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
+use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, WrinkleMaps};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

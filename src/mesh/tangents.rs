@@ -62,7 +62,7 @@ pub fn vertex_tangents(mesh: &Mesh) -> Vec<[f32; 4]> {
             let t = t_sum[i].map(|v| v as f32);
             let t = sub(t, nrm.map(|c| c * dot(nrm, t)));
             let len = dot(t, t).sqrt();
-            if !(len > 1e-12) {
+            if len.is_nan() || len <= 1e-12 {
                 // No uv gradient here: any unit vector perpendicular to the normal.
                 let a = if nrm[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
                 let t = cross(cross(nrm, a), nrm);
@@ -127,7 +127,10 @@ mod tests {
         let p = |i: u32| m.positions[i as usize];
         let uv = |i: u32| m.uvs[i as usize];
         let (e1, e2) = (sub(p(tri[1]), p(tri[0])), sub(p(tri[2]), p(tri[0])));
-        let (d1, d2) = (sub([uv(tri[1])[0], uv(tri[1])[1], 0.0], [uv(tri[0])[0], uv(tri[0])[1], 0.0]), sub([uv(tri[2])[0], uv(tri[2])[1], 0.0], [uv(tri[0])[0], uv(tri[0])[1], 0.0]));
+        let (d1, d2) = (
+            sub([uv(tri[1])[0], uv(tri[1])[1], 0.0], [uv(tri[0])[0], uv(tri[0])[1], 0.0]),
+            sub([uv(tri[2])[0], uv(tri[2])[1], 0.0], [uv(tri[0])[0], uv(tri[0])[1], 0.0]),
+        );
         let r = 1.0 / (d1[0] * d2[1] - d2[0] * d1[1]);
         let dpdu: [f32; 3] = std::array::from_fn(|k| (e1[k] * d2[1] - e2[k] * d1[1]) * r);
         for &i in tri {

@@ -58,7 +58,7 @@ impl BloomParams {
             check_range("bloom sigma", s as f64, 1e-5, 0.25, "(fraction of the frame height)")?;
         }
         let sum: f32 = self.mix.iter().sum();
-        if self.mix.iter().any(|a| !(*a >= 0.0)) || (sum - 1.0).abs() > 1e-4 {
+        if self.mix.iter().any(|a| a.is_nan() || *a < 0.0) || (sum - 1.0).abs() > 1e-4 {
             return Err(InvalidInput::new("bloom mix", format!("must be >= 0 and sum to 1, got {:?}", self.mix)));
         }
         Ok(())

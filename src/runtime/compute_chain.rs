@@ -27,6 +27,7 @@ pub(crate) fn groups_8x8(w: u32, h: u32) -> [u32; 3] {
 
 /// Runs `stages` in order over `buffers` (bindings 1..=N) with `uniform` at binding 0 and returns the bytes of
 /// buffer `read` (an index into `buffers`). `what` names the pass in errors (the flag or the pass).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn run(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -37,7 +38,7 @@ pub(crate) fn run(
     stages: &[Stage<'_>],
     read: usize,
 ) -> Result<Vec<u8>, RuntimeError> {
-    let limit = device.limits().max_storage_buffer_binding_size as u64;
+    let limit = device.limits().max_storage_buffer_binding_size;
     let sizes: Vec<u64> = buffers
         .iter()
         .map(|b| match b {
@@ -79,7 +80,8 @@ pub(crate) fn run(
             count: None,
         });
     }
-    let bgl = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(what), entries: &entries });
+    let bgl =
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(what), entries: &entries });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(what),
         bind_group_layouts: &[Some(&bgl)],
@@ -108,7 +110,12 @@ pub(crate) fn run(
         .map(|(b, &size)| {
             // Bindings must not be empty and copies are 4-byte multiples: round up to 16 bytes.
             let size = size.div_ceil(16).max(1) * 16;
-            let buf = device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size, usage, mapped_at_creation: true });
+            let buf = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(what),
+                size,
+                usage,
+                mapped_at_creation: true,
+            });
             if let Buffer::Data(d) = b {
                 if !d.is_empty() {
                     let mut view = buf.slice(..d.len() as u64).get_mapped_range_mut().expect("mapped at creation");
@@ -130,7 +137,8 @@ pub(crate) fn run(
     });
     let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     for (p, s) in pipelines.iter().zip(stages) {
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.entry), timestamp_writes: None });
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.entry), timestamp_writes: None });
         pass.set_pipeline(p);
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups(s.groups[0], s.groups[1], s.groups[2]);

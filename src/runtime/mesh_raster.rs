@@ -282,7 +282,7 @@ pub(crate) fn resolve_coverage(g: &mut MeshGBuffer, a: &[f32], b: &[f32], c: &[f
         }
         let n = [a[4 * i] / cov, a[4 * i + 1] / cov, a[4 * i + 2] / cov];
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             continue;
         }
         g.covered[i] = true;

@@ -14,7 +14,7 @@
 //! thesis applies the global state factor g to the whole hemoglobin map after the blend, as
 //! [`crate::facial::hemoglobin_rig::evaluate`] does.
 //!
-//! One compute dispatch over flat f32 buffers (`shaders/mesh_skin_inputs.wgsl`, via [`super::compute_chain`]); the
+//! One compute dispatch over flat f32 buffers (`shaders/mesh_skin_inputs.wgsl`, via `compute_chain`); the
 //! CPU twin is [`super::cpu::mesh_skin_inputs`].
 
 use super::compute_chain::{self, Buffer, Stage};
@@ -109,7 +109,11 @@ impl RigAtUv<'_> {
         if self.pose.weights.len() != self.rig.targets.len() || self.rig.targets.len() > MAX_RIG_TARGETS {
             return Err(InvalidInput::new(
                 RIG_WEIGHTS_FLAG,
-                format!("needs one weight per rig target ({}), got {}", self.rig.targets.len(), self.pose.weights.len()),
+                format!(
+                    "needs one weight per rig target ({}), got {}",
+                    self.rig.targets.len(),
+                    self.pose.weights.len()
+                ),
             ));
         }
         if self.h0.channels != 1 || self.h0.width == 0 || self.h0.height == 0 {

@@ -338,10 +338,10 @@ pub fn render_with(
     let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
     // MSAA: partly covered pixels blend the shaded skin with the background by their coverage, in linear light.
     for (i, &cov) in coverage.iter().enumerate().filter(|(_, &c)| c > 0.0 && c < 1.0) {
-        for c in 0..3 {
-            let skin = cpu::srgb_to_linear(frame.data[4 * i + c] as f32 / 255.0);
-            let bg = cpu::srgb_to_linear(BACKGROUND[c] as f32 / 255.0);
-            frame.data[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb(cov * skin + (1.0 - cov) * bg));
+        for (px, &bg) in frame.data[4 * i..4 * i + 3].iter_mut().zip(&BACKGROUND) {
+            let skin = cpu::srgb_to_linear(*px as f32 / 255.0);
+            let bg = cpu::srgb_to_linear(bg as f32 / 255.0);
+            *px = cpu::unorm8(cpu::linear_to_srgb(cov * skin + (1.0 - cov) * bg));
         }
     }
     Ok(frame)

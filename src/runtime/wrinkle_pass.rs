@@ -65,7 +65,8 @@ impl WrinkleMaps {
             });
         }
         let unorm = |b: u8| b as f32 / 255.0;
-        let masks = |m: &[u8]| m.chunks_exact(4).map(|c| [unorm(c[0]), unorm(c[1]), unorm(c[2]), unorm(c[3])]).collect();
+        let masks =
+            |m: &[u8]| m.chunks_exact(4).map(|c| [unorm(c[0]), unorm(c[1]), unorm(c[2]), unorm(c[3])]).collect();
         Ok(WrinkleMaps {
             pd_size,
             pd: pd.chunks_exact(2).map(|c| [-1.0 + 2.0 * unorm(c[0]), -1.0 + 2.0 * unorm(c[1])]).collect(),
@@ -78,9 +79,16 @@ impl WrinkleMaps {
         let (pw, ph) = self.pd_size;
         let (mw, mh) = self.mask_size;
         let n = (mw * mh) as usize;
-        if pw == 0 || ph == 0 || self.pd.len() != (pw * ph) as usize || n == 0 || self.masks.iter().any(|m| m.len() != n)
+        if pw == 0
+            || ph == 0
+            || self.pd.len() != (pw * ph) as usize
+            || n == 0
+            || self.masks.iter().any(|m| m.len() != n)
         {
-            return Err(InvalidInput::new("wrinkle maps", "PD map and masks must be non-empty and of their stated size"));
+            return Err(InvalidInput::new(
+                "wrinkle maps",
+                "PD map and masks must be non-empty and of their stated size",
+            ));
         }
         Ok(())
     }

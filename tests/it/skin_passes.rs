@@ -9,8 +9,8 @@ use rtbake::runtime::cpu::mesh_raster::rasterise;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::{hemoglobin_for_gbuffer, RigPose};
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
-use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, wrinkled_normals_for, WrinkleMaps};
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset};
+use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, wrinkled_normals_for, WrinkleMaps};
 use serde_json::json;
 
 fn settings(shader: SkinShader) -> SkinRenderSettings {
@@ -46,8 +46,9 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let rig = assets.baked_rig.as_ref().expect("the bake has the example rig");
     let gb = rasterise(&default_head(), &Camera::facing(0.6).unwrap(), 320, 180);
-    let pose = RigPose::for_baked_rig(&json!({"neutral": 0.3, "joy": 0.3, "anger": 0.4, "global": {"anger": 1.0}}), rig)
-        .unwrap();
+    let pose =
+        RigPose::for_baked_rig(&json!({"neutral": 0.3, "joy": 0.3, "anger": 0.4, "global": {"anger": 1.0}}), rig)
+            .unwrap();
     assert!((pose.global_scale - 1.27).abs() < 1e-6);
     let on_gpu = hemoglobin_for_gbuffer(Some(&g), &gb, rig, &pose).unwrap();
     let on_cpu = hemoglobin_for_gbuffer(None, &gb, rig, &pose).unwrap();
@@ -62,9 +63,8 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
     // The neutral pose reproduces the neutral map: H = bias0 + H0, the mean over the head near the rig's bias0.
     let neutral = RigPose::neutral(rig.names.len());
     let h_n = hemoglobin_for_gbuffer(None, &gb, rig, &neutral).unwrap();
-    let mean = |h: &[f32]| {
-        h.iter().zip(&gb.covered).filter(|(_, &c)| c).map(|(v, _)| *v as f64).sum::<f64>() / covered as f64
-    };
+    let mean =
+        |h: &[f32]| h.iter().zip(&gb.covered).filter(|(_, &c)| c).map(|(v, _)| *v as f64).sum::<f64>() / covered as f64;
     // Full anger at its global state: more hemoglobin (×1.27 on top of the anger target).
     let anger = RigPose::for_baked_rig(&json!({"anger": 1.0, "global": {"anger": 1.0}}), rig).unwrap();
     let h_a = hemoglobin_for_gbuffer(None, &gb, rig, &anger).unwrap();
@@ -79,7 +79,8 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
         let passes = SkinPasses { rig_pose: Some(pose.clone()), ..Default::default() };
         render_with(Some(&g), &default_head(), &settings(SkinShader::None), &passes, &assets).unwrap().data
     };
-    let (gr_n, gr_a, gr_f) = (mean_g_over_r(&render(&neutral)), mean_g_over_r(&render(&anger)), mean_g_over_r(&render(&fear)));
+    let (gr_n, gr_a, gr_f) =
+        (mean_g_over_r(&render(&neutral)), mean_g_over_r(&render(&anger)), mean_g_over_r(&render(&fear)));
     eprintln!("mean G/R: neutral {gr_n:.4}, anger {gr_a:.4}, fear {gr_f:.4}");
     // Measured (bloom on): neutral 0.7822, anger 0.7789, fear 0.7878 (the LUT's G/R moves slowly with H at Cm = 0.02).
     assert!(gr_a < gr_n - 0.002, "anger must redden: G/R {gr_a} vs neutral {gr_n}");
@@ -114,8 +115,8 @@ fn wrinkle_pass_gpu_matches_cpu_and_bends_normals_only_under_its_masks() {
     let (frac, worst) = agreement(&flat(&on_gpu), &flat(&on_cpu), 1.0 / 255.0);
     assert!(frac >= 0.999 && worst < 1e-4, "{frac} of components within 1/255, worst {worst}");
     let mut bent = 0;
-    for i in 0..gb.covered.len() {
-        let (n, m) = (gb.normal_view[i], on_cpu[i]);
+    for (i, &m) in on_cpu.iter().enumerate() {
+        let n = gb.normal_view[i];
         let len = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
         let masked = gb.covered[i] && w.maps.mask_weight_at(gb.uv[i][0], gb.uv[i][1], &w.zone_weights) > 0.0;
         if gb.covered[i] {
@@ -141,8 +142,8 @@ fn zero_wrinkle_weights_leave_the_frame_byte_identical_and_a_weight_changes_only
     let zero = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=0, anger=0")), bloom: None, ..Default::default() });
     assert!(plain == zero, "zero wrinkle weights must not change a byte");
     let joy = frame(&SkinPasses { wrinkles: Some(wrinkles("joy=1")), bloom: None, ..Default::default() });
-    let gb = rtbake::runtime::mesh_raster::rasterise(&g.device, &g.queue, &default_head(), &s.camera(), 320, 180)
-        .unwrap();
+    let gb =
+        rtbake::runtime::mesh_raster::rasterise(&g.device, &g.queue, &default_head(), &s.camera(), 320, 180).unwrap();
     let w = wrinkles("joy=1");
     let (mut changed, mut outside) = (0, 0);
     for i in 0..gb.covered.len() {
@@ -160,7 +161,8 @@ fn zero_wrinkle_weights_leave_the_frame_byte_identical_and_a_weight_changes_only
 /// A 128×96 HDR frame: dim noise below the threshold everywhere and `bright` at the given pixels.
 fn hdr_frame(bright: &[(usize, usize, f32)]) -> Vec<f32> {
     let (w, h) = (128usize, 96usize);
-    let mut v: Vec<f32> = (0..4 * w * h).map(|i| if i % 4 == 3 { 1.0 } else { 0.3 + 0.5 * ((i * 7919) % 101) as f32 / 101.0 }).collect();
+    let mut v: Vec<f32> =
+        (0..4 * w * h).map(|i| if i % 4 == 3 { 1.0 } else { 0.3 + 0.5 * ((i * 7919) % 101) as f32 / 101.0 }).collect();
     for &(x, y, l) in bright {
         for c in 0..3 {
             v[4 * (y * w + x) + c] = l * [1.0, 0.8, 0.6][c];

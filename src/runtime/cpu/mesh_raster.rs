@@ -17,7 +17,7 @@ pub const STANDARD_4X: [[f32; 2]; 4] = [[0.375, 0.125], [0.875, 0.375], [0.125, 
 /// [`rasterise`] with `samples` (1 or 4) samples per pixel: with 4, the standard pattern ([`STANDARD_4X`]),
 /// coverage and depth tested per sample, attributes interpolated once at the pixel centre and stored (f16) in the
 /// covered samples, the samples averaged (f16) and resolved as the GPU path does
-/// ([`crate::runtime::mesh_raster::resolve_coverage`]).
+/// (`mesh_raster::resolve_coverage`).
 pub fn rasterise_samples(
     mesh: &Mesh,
     camera: &Camera,

@@ -12,7 +12,11 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 }
 
 /// The wrinkled view-space normals of `g` (uncovered pixels keep theirs).
-pub fn wrinkled_normals(g: &MeshGBuffer, maps: &WrinkleMaps, weights: &[f32; 8]) -> Result<Vec<[f32; 3]>, InvalidInput> {
+pub fn wrinkled_normals(
+    g: &MeshGBuffer,
+    maps: &WrinkleMaps,
+    weights: &[f32; 8],
+) -> Result<Vec<[f32; 3]>, InvalidInput> {
     maps.validate()?;
     let ((pw, ph), (mw, mh)) = (maps.pd_size, maps.mask_size);
     let mut out = g.normal_view.clone();
