@@ -80,6 +80,11 @@ pub mod path {
     pub const RIG_FILE_NAME: &str = "rig.json";
     /// Folder of the wrinkle assets.
     pub const WRINKLES_DIR: &str = "facial/wrinkles";
+    /// The example's partial-derivative wrinkle map (raw R8G8_UNORM, `pd = 2·texel − 1`, thesis §8.2).
+    pub const WRINKLE_PD_EXAMPLE: &str = "facial/wrinkles/example/wrinkle_pd.bin";
+    /// The example's zone masks (raw R8G8B8A8_UNORM: red, green, blue, brown; cyan, magenta, orange, gray).
+    pub const WRINKLE_MASKS_EXAMPLE: [&str; 2] =
+        ["facial/wrinkles/example/wrinkle_masks_0.bin", "facial/wrinkles/example/wrinkle_masks_1.bin"];
 
     /// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
     pub fn sidecar(exr_path: &str) -> String {

@@ -5,8 +5,11 @@ use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
+use rtbake::runtime::mesh_skin_inputs::RigPose;
+use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
 use rtbake::runtime::texture_space::{TsSettings, DEFAULT_MAP_SIZE};
+use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, WrinkleMaps};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -50,6 +53,12 @@ pub enum StretchArg {
     Physical,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
 #[derive(clap::Args)]
 pub struct SkinArgs {
     /// Output PNG (RGBA8, sRGB-encoded).
@@ -91,8 +100,57 @@ pub struct SkinArgs {
     /// Frame height in pixels.
     #[arg(long, default_value_t = 720, value_name = "PIXELS")]
     height: u32,
+    /// Hemoglobin rig pose (eq. 7.6) at the mesh's uv: a JSON object or a file holding one,
+    /// {"target": weight, ..., "global": {"anger": a, "fear": f}}; target weights sum to 1, global weights in
+    /// 0..=1 (g = 1 + a·(1.27 − 1) + f·(0.81 − 1), thesis §7.7). Default: {"neutral": 1}.
+    #[arg(long, value_name = "FILE|JSON")]
+    rig_weights: Option<String>,
+    /// Wrinkle pass (thesis Listing 8.1) with the baked example PD map and zone masks: NAME=WEIGHT,... with NAME
+    /// one of Table 8.1's expressions (joy, surprise, fear, anger, disgust, sad) and WEIGHT in 0..=1.
+    #[arg(long, value_name = "WEIGHTS")]
+    wrinkles: Option<String>,
+    /// Bloom on the HDR frame before tone mapping (thesis ch. 4): threshold 1.0, weight 0.25, three Gaussians of
+    /// 0.25 %, 0.8 % and 2.5 % of the frame height mixed 0.5/0.3/0.2 (`rtbake::runtime::bloom`).
+    #[arg(long, value_enum, default_value = "on")]
+    bloom: OnOff,
+    /// Samples per pixel of the mesh G-buffer: 1 or 4 (MSAA, the standard 4× pattern; edges blended by coverage).
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    msaa: u32,
     #[command(flatten)]
     common: crate::run::Common,
+}
+
+/// A JSON argument given inline (starting with `{`) or as a file name (exit 2 naming `flag`).
+fn json_arg(flag: &str, v: &str) -> anyhow::Result<serde_json::Value> {
+    let text = if v.trim_start().starts_with('{') {
+        v.to_string()
+    } else {
+        std::fs::read_to_string(v).map_err(|e| usage_msg(format!("{flag} {v}: {e}")))?
+    };
+    serde_json::from_str(&text).map_err(|e| usage_msg(format!("{flag}: not valid JSON: {e}")))
+}
+
+/// The passes around the SSS shader from the flags (exit 2 naming the flag).
+fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
+    let mut p = SkinPasses::default();
+    if let Some(v) = &a.rig_weights {
+        let json = json_arg("--rig-weights", v)?;
+        let rig = assets.baked_rig.as_ref().ok_or_else(|| {
+            usage_msg("--rig-weights needs the hemoglobin rig in the bake directory (facial/hemoglobin/example)")
+        })?;
+        p.rig_pose = Some(RigPose::for_baked_rig(&json, rig).map_err(usage)?);
+    }
+    rtbake::runtime::mesh_raster::check_samples(a.msaa).map_err(usage)?;
+    p.msaa = a.msaa;
+    if a.bloom == OnOff::Off {
+        p.bloom = None;
+    }
+    if let Some(v) = &a.wrinkles {
+        let zone_weights = parse_wrinkle_weights(v).map_err(usage)?;
+        let maps = WrinkleMaps::load(&a.common.baked).map_err(|e| usage_msg(format!("--wrinkles: {e}")))?;
+        p.wrinkles = Some(Wrinkles { maps, zone_weights });
+    }
+    Ok(p)
 }
 
 /// Reads and validates `--mesh` (exit 2 naming the file and the defect).
@@ -180,9 +238,10 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         None => default_head(),
     };
     let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
+    let passes = passes(&a, &assets)?;
     let gpu = crate::run::device(ctx, a.common.cpu)?;
     let t = Instant::now();
-    let out = skin_render::render(gpu.as_ref(), &mesh, &settings, &assets)?;
+    let out = skin_render::render_with(gpu.as_ref(), &mesh, &settings, &passes, &assets)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     write_atomic(&a.output, &io::png::encode_u8_frame(&out)?)?;
     ctx.info(format!(

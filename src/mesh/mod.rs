@@ -15,6 +15,7 @@ pub mod camera;
 pub mod gltf;
 pub mod head;
 pub mod obj;
+pub mod tangents;
 
 use crate::error::InvalidInput;
 

@@ -56,6 +56,12 @@ pub struct DemoAssets {
     pub importance: Option<ImportanceSamples>,
     /// Scale and follow-surface settings of the importance-sampled pass (the demo's defaults).
     pub importance_params: ImportanceSssParams,
+    /// Bloom on the final HDR frame before tone mapping ([`super::bloom`]); None (the demo's default): no bloom.
+    pub bloom: Option<super::bloom::BloomParams>,
+    /// Post-scatter texturing (thesis §7.6, after d'Eon et al. 2007): the SSS pass blurs the irradiance alone and
+    /// the albedo multiplies it afterwards, so skin colour is not blurred; false (the demo): the pass blurs
+    /// albedo · irradiance (pre-scatter texturing, as the screen-space passes of ch. 4 take a rendered image).
+    pub post_scatter_albedo: bool,
 }
 
 impl DemoAssets {
@@ -102,6 +108,8 @@ impl DemoAssets {
             rig_source,
             importance,
             importance_params: ImportanceSssParams::default(),
+            bloom: None,
+            post_scatter_albedo: false,
         })
     }
 }
@@ -238,7 +246,10 @@ pub(crate) const TRANSMITTANCE_INTENSITY: f32 = 1.5;
 /// The demo frame before SSS: geometry and the lit diffuse layer.
 pub(crate) struct Lit {
     pub(crate) geo: Geometry,
-    /// Reflected plus transmitted light (albedo · (irradiance + T(s)·E), §5.4), linear RGBA (alpha = SSS
+    /// Skin albedo from the LUT, linear RGBA.
+    pub(crate) albedo: Vec<f32>,
+    /// Reflected plus transmitted light (albedo · (irradiance + T(s)·E), §5.4; without the albedo under
+    /// post-scatter texturing), linear RGBA (alpha = SSS
     /// strength: 1 on skin, 0 elsewhere).
     pub(crate) diffuse: Vec<f32>,
 }
@@ -274,11 +285,12 @@ pub(crate) fn lit_geometry(gpu: Option<&Gpu>, geo: Geometry, assets: &DemoAssets
         // the screen-space Gaussian convolutions" — the back light's T(s)·E joins the reflected light before the
         // SSS pass, so the shadow map's depth discontinuities are blurred like the rest of the diffuse light.
         for c in 0..3 {
-            diffuse[4 * i + c] = albedo[4 * i + c] * (e + TRANSMITTANCE_INTENSITY * transmitted[4 * i + c]);
+            let light = e + TRANSMITTANCE_INTENSITY * transmitted[4 * i + c];
+            diffuse[4 * i + c] = if assets.post_scatter_albedo { light } else { albedo[4 * i + c] * light };
         }
         diffuse[4 * i + 3] = 1.0;
     }
-    Ok(Lit { geo, diffuse })
+    Ok(Lit { geo, albedo, diffuse })
 }
 
 /// The inputs the demo hands its SSS pass, as `rtbake run sss` reads them: linear diffuse light, albedo ·
@@ -332,12 +344,24 @@ fn shade(
     rgba: Vec<u8>,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
-    let Lit { geo, diffuse } = lit;
+    let Lit { geo, albedo, diffuse } = lit;
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (kernel, params) = (&assets.kernel, &assets.sss);
     let importance_params = assets.importance_params;
+    let bloom = assets.bloom.as_ref();
+    // Post-scatter texturing: the albedo multiplies the (blurred) irradiance.
+    let textured = |mut v: Vec<f32>| {
+        if assets.post_scatter_albedo {
+            for (i, px) in v.chunks_exact_mut(4).enumerate() {
+                for c in 0..3 {
+                    px[c] *= albedo[4 * i + c];
+                }
+            }
+        }
+        v
+    };
     let Some(method) = method else {
-        return composite(gpu, &geo, &diffuse, rgba, aa);
+        return composite(gpu, &geo, &textured(diffuse), rgba, bloom, aa);
     };
     let sss = match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
@@ -353,26 +377,56 @@ fn shade(
         },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
-    composite(gpu, &geo, &blurred, rgba, aa)
+    composite(gpu, &geo, &textured(blurred), rgba, bloom, aa)
 }
 
 /// Composites the (blurred) diffuse layer (reflected and transmitted light) plus the unblurred specular layer over
-/// the background, tone-maps, encodes sRGB and antialiases.
+/// the background, blooms the HDR frame when `bloom` says so (thesis ch. 4: on the final image, before tone
+/// mapping), tone-maps, encodes sRGB and antialiases.
 pub(crate) fn composite(
     gpu: Option<&Gpu>,
     geo: &Geometry,
     blurred: &[f32],
     mut rgba: Vec<u8>,
+    bloom: Option<&super::bloom::BloomParams>,
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
     let (w, h) = (geo.frame.width, geo.frame.height);
     let n = (w * h) as usize;
+    // The final HDR radiance of the skin.
+    let mut hdr = vec![0.0f32; 4 * n];
     for i in 0..n {
         if !geo.skin[i] {
             continue;
         }
         let spec = geo.specular.as_ref().map_or(0.0, |s| s[i]);
-        let v: [f32; 3] = std::array::from_fn(|c| blurred[4 * i + c] + spec);
+        for c in 0..3 {
+            hdr[4 * i + c] = blurred[4 * i + c] + spec;
+        }
+    }
+    if let Some(b) = bloom {
+        // The background enters as its linear radiance; where bloom adds light to it, it is re-encoded (the
+        // background is display-referred: no tone map).
+        for i in (0..n).filter(|&i| !geo.skin[i]) {
+            for c in 0..3 {
+                hdr[4 * i + c] = cpu::srgb_to_linear(rgba[4 * i + c] as f32 / 255.0);
+            }
+        }
+        let out = super::bloom::bloom_for(gpu, w, h, &hdr, b)?;
+        for i in (0..n).filter(|&i| !geo.skin[i]) {
+            if out[4 * i..4 * i + 3] != hdr[4 * i..4 * i + 3] {
+                for c in 0..3 {
+                    rgba[4 * i + c] = cpu::unorm8(cpu::linear_to_srgb(out[4 * i + c].clamp(0.0, 1.0)));
+                }
+            }
+        }
+        hdr = out;
+    }
+    for i in 0..n {
+        if !geo.skin[i] {
+            continue;
+        }
+        let v: [f32; 3] = std::array::from_fn(|c| hdr[4 * i + c]);
         // Tone map the luminance (1 − e^−L) and keep the channel ratios, so skin keeps its hue in highlights.
         let l = 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
         let scale = if l > 0.0 { (1.0 - (-l).exp()) / l } else { 0.0 };

@@ -1,9 +1,17 @@
 //! The mesh G-buffer pass of the skin renderer (issue 14; TAP 2009 §5 renders heads, thesis ch. 3–5 shades them):
 //! a wgpu render pipeline with a `Depth32Float` depth buffer (less-than test, back faces culled, counter-clockwise
 //! front faces) that writes per pixel the view-space unit normal and the linear view depth in mm
-//! (`Rgba16Float`), and the texture coordinates with a coverage flag (`Rgba16Float`) — the inputs the
-//! screen-space passes and texture-space diffusion need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
+//! (`Rgba16Float`), the texture coordinates with a coverage flag (`Rgba16Float`) and the view-space tangent of
+//! [`crate::mesh::tangents`] with its handedness (`Rgba16Float`, interpolated, not renormalised) — the inputs the
+//! screen-space passes, texture-space diffusion and the wrinkle pass need. Its CPU twin is [`super::cpu::mesh_raster`]; both return a
 //! [`MeshGBuffer`].
+//!
+//! MSAA ([`rasterise_samples`] with 4 samples, `run skin --msaa 4`): multisampled targets and depth buffer, the
+//! fragment shaded once per pixel at its centre and stored in the samples it covers, the hardware resolve averaging
+//! the samples; uncovered samples hold zeros, so the resolved coverage flag is the covered fraction and the
+//! attributes divided by it are the mean over the covered samples (the normal renormalised). 4× needs
+//! `MULTISAMPLE_X4` and `MULTISAMPLE_RESOLVE` for `Rgba16Float` and `Depth32Float`, checked through the formats'
+//! guaranteed `TextureFormatFeatures` for the device's features.
 
 use super::gpu;
 use super::RuntimeError;
@@ -23,6 +31,11 @@ pub struct MeshGBuffer {
     pub depth_mm: Vec<f32>,
     pub uv: Vec<[f32; 2]>,
     pub covered: Vec<bool>,
+    /// View-space tangent (xyz, interpolated: not unit, not exactly perpendicular to the normal) and handedness w
+    /// ([`crate::mesh::tangents`]); zero where nothing is covered.
+    pub tangent_view: Vec<[f32; 4]>,
+    /// Covered fraction of the pixel: 0 or 1 with one sample, k/4 with 4× MSAA.
+    pub coverage: Vec<f32>,
 }
 
 impl MeshGBuffer {
@@ -35,6 +48,8 @@ impl MeshGBuffer {
             depth_mm: vec![0.0; n],
             uv: vec![[0.0; 2]; n],
             covered: vec![false; n],
+            tangent_view: vec![[0.0; 4]; n],
+            coverage: vec![0.0; n],
         }
     }
 }
@@ -50,6 +65,17 @@ pub(crate) fn camera_uniform(mesh: &Mesh, camera: &Camera, width: u32, height: u
     u
 }
 
+/// Sample counts of the G-buffer raster (`--msaa`).
+pub const SAMPLE_COUNTS: [u32; 2] = [1, 4];
+
+/// Refuses a sample count other than 1 or 4 (`--msaa`).
+pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
+    if !SAMPLE_COUNTS.contains(&samples) {
+        return Err(InvalidInput::new("--msaa", format!("must be 1 or 4 samples per pixel, got {samples}")));
+    }
+    Ok(())
+}
+
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
 pub fn rasterise(
     device: &wgpu::Device,
@@ -59,9 +85,33 @@ pub fn rasterise(
     width: u32,
     height: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
+    rasterise_samples(device, queue, mesh, camera, width, height, 1)
+}
+
+/// [`rasterise`] with `samples` (1 or 4) samples per pixel (see the module doc).
+pub fn rasterise_samples(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<MeshGBuffer, RuntimeError> {
+    check_samples(samples)?;
+    if samples > 1 {
+        use wgpu::TextureFormatFeatureFlags as Fl;
+        for f in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Depth32Float] {
+            let flags = f.guaranteed_format_features(device.features()).flags;
+            let resolve = f.has_depth_aspect() || flags.contains(Fl::MULTISAMPLE_RESOLVE);
+            if !flags.sample_count_supported(samples) || !resolve {
+                return Err(InvalidInput::new("--msaa", format!("{samples}x is not supported for {f:?} here")).into());
+            }
+        }
+    }
     camera.validate()?;
-    super::device::check_image_fits(device, width, height, 8 + 8 + 4)?;
-    let vertex_bytes = mesh.positions.len() as u64 * 32;
+    super::device::check_image_fits(device, width, height, 8 + 8 + 8 + 4)?;
+    let vertex_bytes = mesh.positions.len() as u64 * 48;
     if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
         return Err(InvalidInput::new(
             "--mesh",
@@ -69,9 +119,10 @@ pub fn rasterise(
         )
         .into());
     }
-    let mut vertices = Vec::with_capacity(mesh.positions.len() * 8);
-    for ((p, n), t) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs) {
-        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1]]);
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    let mut vertices = Vec::with_capacity(mesh.positions.len() * 12);
+    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&tangents) {
+        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1], tg[0], tg[1], tg[2], tg[3]]);
     }
     let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("mesh vertices"),
@@ -95,9 +146,9 @@ pub fn rasterise(
             entry_point: Some("vs_mesh"),
             compilation_options: Default::default(),
             buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: 32,
+                array_stride: 48,
                 step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4],
             })],
         },
         primitive: wgpu::PrimitiveState {
@@ -113,12 +164,13 @@ pub fn rasterise(
             stencil: wgpu::StencilState::default(),
             bias: wgpu::DepthBiasState::default(),
         }),
-        multisample: wgpu::MultisampleState::default(),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
         fragment: Some(wgpu::FragmentState {
             module: &module,
             entry_point: Some("fs_mesh"),
             compilation_options: Default::default(),
             targets: &[
+                Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
                 Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
                 Some(wgpu::ColorTargetState { format: gformat, blend: None, write_mask: wgpu::ColorWrites::ALL }),
             ],
@@ -130,28 +182,51 @@ pub fn rasterise(
         gpu::bind_group(device, "mesh camera", &pipeline.get_bind_group_layout(0), &[(0, ubuf.as_entire_binding())]);
     let g0 = gpu::texture(device, "normal+depth", width, height, gformat);
     let g1 = gpu::texture(device, "uv+cover", width, height, gformat);
+    let g2 = gpu::texture(device, "tangent", width, height, gformat);
+    let multisampled = |label, format| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    let ms: Vec<wgpu::TextureView> = if samples > 1 {
+        ["normal+depth ms", "uv+cover ms", "tangent ms"]
+            .iter()
+            .map(|l| multisampled(*l, gformat).create_view(&Default::default()))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let depth = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("mesh depth"),
         size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
         mip_level_count: 1,
-        sample_count: 1,
+        sample_count: samples,
         dimension: wgpu::TextureDimension::D2,
         format: wgpu::TextureFormat::Depth32Float,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
         view_formats: &[],
     });
-    let (v0, v1, vd) = (
+    let (v0, v1, v2, vd) = (
         g0.create_view(&Default::default()),
         g1.create_view(&Default::default()),
+        g2.create_view(&Default::default()),
         depth.create_view(&Default::default()),
     );
     let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
     {
-        let attach = |view| {
+        let attach = |k: usize, single| {
+            let (view, resolve_target) = if samples > 1 { (&ms[k], Some(single)) } else { (single, None) };
             Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,
-                resolve_target: None,
+                resolve_target,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     store: wgpu::StoreOp::Store,
@@ -160,7 +235,7 @@ pub fn rasterise(
         };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("mesh g-buffer"),
-            color_attachments: &[attach(&v0), attach(&v1)],
+            color_attachments: &[attach(0, &v0), attach(1, &v1), attach(2, &v2)],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &vd,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
@@ -178,14 +253,43 @@ pub fn rasterise(
     }
     queue.submit([enc.finish()]);
     let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
+    let c = gpu::read_texture_f16(device, queue, &g2)?;
     let mut g = MeshGBuffer::empty(width, height);
+    if samples > 1 {
+        resolve_coverage(&mut g, &a, &b, &c);
+        return Ok(g);
+    }
     for i in 0..(width * height) as usize {
         if b[4 * i + 2] > 0.5 {
             g.covered[i] = true;
+            g.coverage[i] = 1.0;
             g.normal_view[i] = [a[4 * i], a[4 * i + 1], a[4 * i + 2]];
             g.depth_mm[i] = a[4 * i + 3];
             g.uv[i] = [b[4 * i], b[4 * i + 1]];
+            g.tangent_view[i] = [c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]];
         }
     }
     Ok(g)
+}
+
+/// The G-buffer from the resolved (sample-averaged) targets: coverage = the averaged flag, attributes = averaged
+/// value / coverage (the mean over the covered samples), the normal renormalised. Shared with the CPU twin.
+pub(crate) fn resolve_coverage(g: &mut MeshGBuffer, a: &[f32], b: &[f32], c: &[f32]) {
+    for i in 0..(g.width * g.height) as usize {
+        let cov = b[4 * i + 2];
+        if cov <= 0.0 {
+            continue;
+        }
+        let n = [a[4 * i] / cov, a[4 * i + 1] / cov, a[4 * i + 2] / cov];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if len.is_nan() || len <= 0.0 {
+            continue;
+        }
+        g.covered[i] = true;
+        g.coverage[i] = cov;
+        g.normal_view[i] = n.map(|v| v / len);
+        g.depth_mm[i] = a[4 * i + 3] / cov;
+        g.uv[i] = [b[4 * i] / cov, b[4 * i + 1] / cov];
+        g.tangent_view[i] = std::array::from_fn(|k| c[4 * i + k] / cov);
+    }
 }

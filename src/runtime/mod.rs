@@ -10,7 +10,9 @@
 //!   `Rgba8Unorm` and the shaders decode/encode sRGB themselves where linear blending is wanted;
 //! - no pass needs `FLOAT32_FILTERABLE` or an f32 render target (lavapipe and llvmpipe run everything).
 
+pub mod bloom;
 pub mod chain;
+pub(crate) mod compute_chain;
 pub mod cpu;
 pub mod demo;
 pub mod device;
@@ -19,17 +21,20 @@ pub mod gpu;
 pub mod importance_sss;
 pub mod loader;
 pub mod mesh_raster;
+pub mod mesh_skin_inputs;
 pub mod mlaa;
 pub mod moving_scene;
 pub mod scene;
 pub mod separable_sss;
 pub mod skin_inputs;
+pub mod skin_passes;
 pub mod skin_render;
 pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;
 pub mod texture_space;
 pub mod transport_gpu;
+pub mod wrinkle_pass;
 
 /// Errors of the runtime.
 #[derive(Debug, thiserror::Error)]

@@ -6,14 +6,25 @@
 //! 2. A 512² shadow map from the back light (TAP 2009 used 512²) gives the thickness the light crosses to reach
 //!    each visible point: the point's distance from the light minus the shadow map's nearest distance along the
 //!    same ray (Listing 5.1), in mm.
-//! 3. Skin inputs per pixel: melanin `melanin` (uniform), mean-free hemoglobin H0 of the baked rig read at the
-//!    mesh's texture coordinates (the face maps are texture-space maps), view-space normals, thickness; the rig's
-//!    scale and bias maps are not applied (the runtime's skin-inputs pass samples them in screen space, which is
-//!    right for the screen-space demo and wrong for a mesh: a neutral rig is used).
-//! 4. The demo's shading: Lambert key light, albedo from the skin LUT, the back light's transmittance stored with
-//!    the reflected light (thesis §5.4), the SSS pass of `shader` (none, separable or the screen-space sum of
-//!    Gaussians) on that diffuse layer, view depth in head-sized world units ([`WORLD_UNITS_PER_M`]), the
-//!    specular layer added after the SSS pass, tone-mapped and encoded over a grey background.
+//! 3. Skin inputs per pixel: melanin `melanin` (uniform), hemoglobin H of the baked rig's eq. 7.6 (weights and
+//!    the global anger/fear state of [`SkinPasses::rig_pose`]) evaluated at the mesh's texture coordinates
+//!    ([`super::mesh_skin_inputs`]: the face maps are texture-space maps), view-space normals, thickness; the
+//!    skin-inputs pass then runs with a neutral rig (scale 1, bias 0), so its hemoglobin is that H (its own rig
+//!    lookup samples screen space, right for the screen-space demo and wrong for a mesh).
+//!    With [`SkinPasses::wrinkles`], the wrinkle pass of Listing 8.1 ([`super::wrinkle_pass`]) replaces the
+//!    G-buffer's normals before any lighting.
+//!    With `--msaa 4` ([`SkinPasses::msaa`]) the G-buffer is rasterised with 4 samples per pixel
+//!    ([`super::mesh_raster::rasterise_samples`]) and partly covered pixels are blended with the background by
+//!    their coverage after shading (the shadow map stays at 1 sample).
+//! 4. The demo's shading in the thesis' order: Lambert key light; the SSS pass of `shader` (none, separable or
+//!    the screen-space sum of Gaussians) on the diffuse irradiance, view depth in head-sized world units
+//!    ([`WORLD_UNITS_PER_M`]); skin colour (albedo from the skin LUT) applied **after** the SSS pass
+//!    (post-scatter texturing, thesis §7.6: "to avoid blurring the albedo twice"; the procedural demo blurs
+//!    albedo · irradiance instead); the back light's transmittance stored with the reflected light and blurred with
+//!    it (thesis §5.4); the Kelemen/Szirmay-Kalos specular layer added
+//!    after the SSS pass, never blurred (ch. 4, separate render targets; the demo has none); bloom on the final
+//!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
+//!    over a grey background.
 
 use super::cpu;
 use super::demo::{
@@ -24,6 +35,7 @@ use super::gaussian_sss::GaussianSssParams;
 use super::importance_sss::{ImportanceSamples, ImportanceSssParams};
 use super::mesh_raster::{self, MeshGBuffer};
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
+use super::skin_passes::SkinPasses;
 use super::RuntimeError;
 use crate::error::{check_range, InvalidInput};
 use crate::image_buf::Image;
@@ -102,6 +114,8 @@ pub const SHADOW_SHRINK_MM: f32 = 5.0;
 /// World units of the SSS passes per metre: their parameters (sssWidth, α, β) are stated for a head one world
 /// unit tall (`runtime::gaussian_sss`), and the default head is 0.21 m tall.
 pub const WORLD_UNITS_PER_M: f32 = 1.0 / 0.21;
+/// The background colour, RGBA8 sRGB.
+const BACKGROUND: [u8; 4] = [46, 48, 52, 255];
 /// Most heads per frame (TAP 2009 Table III measures 1, 3 and 5).
 pub const MAX_HEADS: u32 = 16;
 
@@ -273,10 +287,17 @@ pub(crate) fn geometry(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
+    passes: &SkinPasses,
     assets: &DemoAssets,
 ) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
-    let g = rasterise(gpu, mesh, &cam, s.width, s.height)?;
+    let mut g = match gpu {
+        Some(d) => mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, s.width, s.height, passes.msaa)?,
+        None => cpu::mesh_raster::rasterise_samples(mesh, &cam, s.width, s.height, passes.msaa)?,
+    };
+    if let Some(w) = &passes.wrinkles {
+        g.normal_view = super::wrinkle_pass::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
+    }
     let shadow = ShadowMap::new(gpu, mesh, &cam)?;
     let thickness = thickness_mm(&g, &cam, &shadow, mesh.mm_per_unit);
     let specular = specular_layer(&g, &cam);
@@ -289,14 +310,22 @@ pub(crate) fn geometry(
         thickness_mm: vec![assets.luts.s_max_mm; n],
         normals: vec![[0.0, 0.0, 1.0]; n],
     };
+    let hemoglobin = match &assets.baked_rig {
+        Some(r) => {
+            let neutral = super::mesh_skin_inputs::RigPose::neutral(r.names.len());
+            let pose = passes.rig_pose.as_ref().unwrap_or(&neutral);
+            Some(super::mesh_skin_inputs::hemoglobin_for_gbuffer(gpu, &g, r, pose)?)
+        }
+        None => None,
+    };
     let mut depth = vec![100.0f32; n];
     for i in 0..n {
         if !g.covered[i] {
             continue;
         }
         frame.melanin[i] = s.melanin;
-        frame.h0[i] = match &assets.baked_rig {
-            Some(r) => r.h0_at(g.uv[i][0], g.uv[i][1]),
+        frame.h0[i] = match &hemoglobin {
+            Some(hb) => hb[i],
             None => 0.006 * ((g.uv[i][0] * 400.0).sin() * (g.uv[i][1] * 300.0).cos()),
         };
         frame.thickness_mm[i] = thickness[i].min(assets.luts.s_max_mm);
@@ -305,6 +334,18 @@ pub(crate) fn geometry(
     }
     let skin = g.covered.clone();
     Ok((Geometry { frame, depth, skin, specular: Some(specular) }, g, shadow))
+}
+
+/// MSAA: partly covered pixels of `frame` blend the shaded skin with the background by their `coverage`, in linear
+/// light.
+pub(crate) fn blend_coverage(frame: &mut Image<u8>, coverage: &[f32]) {
+    for (i, &cov) in coverage.iter().enumerate().filter(|(_, &c)| c > 0.0 && c < 1.0) {
+        for (px, &bg) in frame.data[4 * i..4 * i + 3].iter_mut().zip(&BACKGROUND) {
+            let skin = cpu::srgb_to_linear(*px as f32 / 255.0);
+            let bg = cpu::srgb_to_linear(bg as f32 / 255.0);
+            *px = cpu::unorm8(cpu::linear_to_srgb(cov * skin + (1.0 - cov) * bg));
+        }
+    }
 }
 
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
@@ -319,24 +360,39 @@ pub fn jittered_samples() -> Result<ImportanceSamples, InvalidInput> {
     })
 }
 
-/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded).
+/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded) and the default
+/// [`SkinPasses`].
 pub fn render(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     assets: &DemoAssets,
 ) -> Result<Image<u8>, RuntimeError> {
+    render_with(gpu, mesh, s, &SkinPasses::default(), assets)
+}
+
+/// [`render`] with the passes of `passes` (rig pose, …).
+pub fn render_with(
+    gpu: Option<&Gpu>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<Image<u8>, RuntimeError> {
     if let SkinShader::Ts(ts) = s.shader {
-        return super::texture_space::render(gpu, mesh, s, ts, assets).map(|(img, _)| img);
+        return super::texture_space::render_with(gpu, mesh, s, ts, passes, assets).map(|(img, _)| img);
     }
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let (geo, _, _) = geometry(gpu, &heads, s, assets)?;
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, assets)?;
+    let coverage = g.coverage;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
     assets.rig_weights = vec![1.0];
     assets.sss.fovy_deg = s.camera().fov_y_deg;
+    assets.bloom = passes.bloom;
+    assets.post_scatter_albedo = true;
     let method = match s.shader {
         SkinShader::None => None,
         SkinShader::SsFull => {
@@ -355,8 +411,10 @@ pub fn render(
         }
         SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
-    let background = [46u8, 48, 52, 255].repeat((s.width * s.height) as usize);
-    render_geometry(gpu, geo, &assets, method, background, None)
+    let background = BACKGROUND.repeat((s.width * s.height) as usize);
+    let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
+    blend_coverage(&mut frame, &coverage);
+    Ok(frame)
 }
 
 #[cfg(test)]

@@ -32,6 +32,7 @@ use super::demo::{composite, lit_geometry, DemoAssets, Geometry};
 use super::device::Gpu;
 use super::gpu;
 use super::skin_inputs::{RigScaleBiasMaps, SkinFrame};
+use super::skin_passes::SkinPasses;
 use super::skin_render::{self, row_of_heads, SkinRenderSettings, HEAD_SPACING_M};
 use super::RuntimeError;
 use crate::error::{check_range, InvalidInput};
@@ -135,7 +136,8 @@ impl TsStats {
     }
 }
 
-/// Renders `mesh` (repeated `s.heads` times) with texture-space diffusion (RGBA8, sRGB-encoded) and the work done.
+/// Renders `mesh` (repeated `s.heads` times) with texture-space diffusion (RGBA8, sRGB-encoded) and the work done,
+/// with the default [`SkinPasses`].
 pub fn render(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
@@ -143,14 +145,31 @@ pub fn render(
     ts: TsSettings,
     assets: &DemoAssets,
 ) -> Result<(Image<u8>, TsStats), RuntimeError> {
+    render_with(gpu, mesh, s, ts, &SkinPasses::default(), assets)
+}
+
+/// [`render`] with the passes of `passes` (rig pose, wrinkles and MSAA of the G-buffer, bloom), as
+/// `skin_render::render_with` applies them to the screen-space shaders. The rig pose and wrinkles shape the
+/// screen-space G-buffer whose pixels gather the blurred map (the texels use the mesh's vertex normals and H0).
+pub fn render_with(
+    gpu: Option<&Gpu>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    ts: TsSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<(Image<u8>, TsStats), RuntimeError> {
     s.validate()?;
     ts.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let (geo, g, shadow) = skin_render::geometry(gpu, &heads, s, assets)?;
-    // As `skin_render::render`: a neutral rig (scale 1, bias 0).
+    let (geo, g, shadow) = skin_render::geometry(gpu, &heads, s, passes, assets)?;
+    // As `skin_render::render_with`: a neutral rig (scale 1, bias 0), post-scatter texturing (the maps hold
+    // irradiance; each pixel's albedo multiplies what it gathers, thesis §7.6) and the passes' bloom.
     let mut assets = assets.clone();
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
     assets.rig_weights = vec![1.0];
+    assets.post_scatter_albedo = true;
+    assets.bloom = passes.bloom;
     let lit = lit_geometry(gpu, geo, &assets)?;
     let cam = s.camera();
     let (w, h) = (s.width, s.height);
@@ -261,7 +280,13 @@ pub fn render(
     }
     // The grey background of `skin_render::render`.
     let background = [46u8, 48, 52, 255].repeat((w * h) as usize);
-    let img = composite(gpu, &lit.geo, &diffuse, background, None)?;
+    for (px, a) in diffuse.chunks_exact_mut(4).zip(lit.albedo.chunks_exact(4)) {
+        for c in 0..3 {
+            px[c] *= a[c];
+        }
+    }
+    let mut img = composite(gpu, &lit.geo, &diffuse, background, assets.bloom.as_ref(), None)?;
+    skin_render::blend_coverage(&mut img, &g.coverage);
     Ok((img, stats))
 }
 

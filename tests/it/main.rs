@@ -65,6 +65,7 @@ mod separable_kernel;
 mod skin_cli;
 mod skin_color;
 mod skin_layers;
+mod skin_passes;
 mod skin_render;
 mod skin_spectral_data;
 mod skin_ts;

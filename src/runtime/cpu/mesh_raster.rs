@@ -10,14 +10,35 @@ use crate::mesh::Mesh;
 use crate::runtime::mesh_raster::{camera_uniform, MeshGBuffer};
 use nalgebra::{Matrix4, Vector4};
 
-/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer (values rounded to f16 as the GPU stores them).
-pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
+/// The standard 4× sample positions in a pixel (Vulkan's standard sample locations, D3D's standard pattern), from
+/// its top-left corner.
+pub const STANDARD_4X: [[f32; 2]; 4] = [[0.375, 0.125], [0.875, 0.375], [0.125, 0.625], [0.625, 0.875]];
+
+/// [`rasterise`] with `samples` (1 or 4) samples per pixel: with 4, the standard pattern ([`STANDARD_4X`]),
+/// coverage and depth tested per sample, attributes interpolated once at the pixel centre and stored (f16) in the
+/// covered samples, the samples averaged (f16) and resolved as the GPU path does
+/// (`mesh_raster::resolve_coverage`).
+pub fn rasterise_samples(
+    mesh: &Mesh,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<MeshGBuffer, crate::error::InvalidInput> {
+    crate::runtime::mesh_raster::check_samples(samples)?;
+    if samples == 1 {
+        return Ok(rasterise(mesh, camera, width, height));
+    }
     let u = camera_uniform(mesh, camera, width, height);
     let vp = Matrix4::from_column_slice(&u[..16]);
     let view = Matrix4::from_column_slice(&u[16..32]);
     let (wf, hf) = (width as f32, height as f32);
-    let mut g = MeshGBuffer::empty(width, height);
-    let mut zbuf = vec![1.0f32; (width * height) as usize];
+    let n = (width * height) as usize;
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+    // Per sample: depth, and the three targets' RGBA (zero where nothing covers the sample).
+    let mut zbuf = vec![1.0f32; 4 * n];
+    let mut targets = vec![[[0.0f32; 4]; 3]; 4 * n];
     struct V {
         x: f32,
         y: f32,
@@ -26,6 +47,112 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
         n: [f32; 3],
         depth_mm: f32,
         uv: [f32; 2],
+        t: [f32; 4],
+    }
+    let vert = |i: u32| -> Option<V> {
+        let p = mesh.positions[i as usize];
+        let c = vp * Vector4::new(p[0], p[1], p[2], 1.0);
+        if c.w <= camera.near * 0.5 {
+            return None;
+        }
+        let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
+        let nn = mesh.normals[i as usize];
+        let nv = view * Vector4::new(nn[0], nn[1], nn[2], 0.0);
+        let tg = tangents[i as usize];
+        let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
+        Some(V {
+            x: (c.x / c.w * 0.5 + 0.5) * wf,
+            y: (0.5 - c.y / c.w * 0.5) * hf,
+            z: c.z / c.w,
+            inv_w: 1.0 / c.w,
+            n: [nv.x, nv.y, nv.z],
+            depth_mm: -pv.z * mesh.mm_per_unit,
+            uv: mesh.uvs[i as usize],
+            t: [tv.x, tv.y, tv.z, tg[3]],
+        })
+    };
+    for t in mesh.indices.chunks_exact(3) {
+        let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
+        let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+        if area.is_nan() || area >= 0.0 {
+            continue;
+        }
+        let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
+        let x1 = (a.x.max(b.x).max(c.x).ceil() as i64).clamp(0, width as i64) as u32;
+        let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
+        let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
+        let edge = |p: &V, q: &V, x: f32, y: f32| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
+        let bary = |x: f32, y: f32| (edge(&b, &c, x, y) / area, edge(&c, &a, x, y) / area, edge(&a, &b, x, y) / area);
+        for py in y0..y1 {
+            for px in x0..x1 {
+                let i = (py * width + px) as usize;
+                let mut pass = [false; 4];
+                for (k, sp) in STANDARD_4X.iter().enumerate() {
+                    let (wa, wb, wc) = bary(px as f32 + sp[0], py as f32 + sp[1]);
+                    if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                        continue;
+                    }
+                    let z = wa * a.z + wb * b.z + wc * c.z;
+                    if z.is_nan() || z >= zbuf[4 * i + k] || z < 0.0 {
+                        continue;
+                    }
+                    zbuf[4 * i + k] = z;
+                    pass[k] = true;
+                }
+                if !pass.iter().any(|&p| p) {
+                    continue;
+                }
+                // One fragment per pixel, attributes at the pixel centre (extrapolated when it lies outside).
+                let (wa, wb, wc) = bary(px as f32 + 0.5, py as f32 + 0.5);
+                let (pa, pb, pc) = (wa * a.inv_w, wb * b.inv_w, wc * c.inv_w);
+                let s = 1.0 / (pa + pb + pc);
+                let lerp = |fa: f32, fb: f32, fc: f32| (pa * fa + pb * fb + pc * fc) * s;
+                let nrm: [f32; 3] = std::array::from_fn(|k| lerp(a.n[k], b.n[k], c.n[k]));
+                let l = (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]).sqrt();
+                let out = [
+                    [f16(nrm[0] / l), f16(nrm[1] / l), f16(nrm[2] / l), f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm))],
+                    [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1])), 1.0, 0.0],
+                    std::array::from_fn(|k| f16(lerp(a.t[k], b.t[k], c.t[k]))),
+                ];
+                for k in (0..4).filter(|&k| pass[k]) {
+                    targets[4 * i + k] = out;
+                }
+            }
+        }
+    }
+    // The resolve: the mean of the four samples, stored as f16.
+    let mut resolved = [vec![0.0f32; 4 * n], vec![0.0f32; 4 * n], vec![0.0f32; 4 * n]];
+    for i in 0..n {
+        for (t, r) in resolved.iter_mut().enumerate() {
+            for ch in 0..4 {
+                let sum: f32 = (0..4).map(|k| targets[4 * i + k][t][ch]).sum();
+                r[4 * i + ch] = f16(sum * 0.25);
+            }
+        }
+    }
+    let mut g = MeshGBuffer::empty(width, height);
+    crate::runtime::mesh_raster::resolve_coverage(&mut g, &resolved[0], &resolved[1], &resolved[2]);
+    Ok(g)
+}
+
+/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer (values rounded to f16 as the GPU stores them).
+pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
+    let u = camera_uniform(mesh, camera, width, height);
+    let vp = Matrix4::from_column_slice(&u[..16]);
+    let view = Matrix4::from_column_slice(&u[16..32]);
+    let (wf, hf) = (width as f32, height as f32);
+    let mut g = MeshGBuffer::empty(width, height);
+    let mut zbuf = vec![1.0f32; (width * height) as usize];
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    struct V {
+        x: f32,
+        y: f32,
+        z: f32,
+        inv_w: f32,
+        n: [f32; 3],
+        depth_mm: f32,
+        uv: [f32; 2],
+        t: [f32; 4],
     }
     let vert = |i: u32| -> Option<V> {
         let p = mesh.positions[i as usize];
@@ -36,6 +163,8 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
         let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
         let n = mesh.normals[i as usize];
         let nv = view * Vector4::new(n[0], n[1], n[2], 0.0);
+        let tg = tangents[i as usize];
+        let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
         Some(V {
             x: (c.x / c.w * 0.5 + 0.5) * wf,
             y: (0.5 - c.y / c.w * 0.5) * hf,
@@ -44,6 +173,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
             n: [nv.x, nv.y, nv.z],
             depth_mm: -pv.z * mesh.mm_per_unit,
             uv: mesh.uvs[i as usize],
+            t: [tv.x, tv.y, tv.z, tg[3]],
         })
     };
     for t in mesh.indices.chunks_exact(3) {
@@ -79,9 +209,11 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
                 let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
                 let f16 = |v: f32| half::f16::from_f32(v).to_f32();
                 g.covered[i] = true;
+                g.coverage[i] = 1.0;
                 g.normal_view[i] = n.map(|v| f16(v / l));
                 g.depth_mm[i] = f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm));
                 g.uv[i] = [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1]))];
+                g.tangent_view[i] = std::array::from_fn(|k| f16(lerp(a.t[k], b.t[k], c.t[k])));
             }
         }
     }

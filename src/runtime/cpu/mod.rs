@@ -6,9 +6,11 @@
 //! ([`FilterPrecision`]): real GPUs filter in (nearly) full float precision, while lavapipe/llvmpipe filter 8-bit
 //! textures with 8-bit weights and return 8-bit results.
 
+pub mod bloom;
 pub mod gaussian_sss;
 pub mod importance_sss;
 pub mod mesh_raster;
+pub mod mesh_skin_inputs;
 pub mod mlaa;
 pub mod separable_sss;
 pub mod skin_inputs;
@@ -16,6 +18,7 @@ pub mod smaa;
 pub mod smaa_edges;
 pub mod smaa_modes;
 pub mod texture_space;
+pub mod wrinkle_pass;
 
 /// How a bilinear fetch of an 8-bit texture is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -1,6 +1,7 @@
 // The mesh G-buffer pass (runtime/mesh_raster.rs): rasterises a triangle mesh with a depth buffer and writes, per
-// pixel, the view-space unit normal and the linear view depth in mm (target 0) and the texture coordinates with a
-// coverage flag (target 1). Its CPU twin is runtime/cpu/mesh_raster.rs.
+// pixel, the view-space unit normal and the linear view depth in mm (target 0), the texture coordinates with a
+// coverage flag (target 1) and the view-space tangent with its handedness (target 2, mesh/tangents.rs). Its CPU
+// twin is runtime/cpu/mesh_raster.rs.
 
 struct Camera {
     view_proj: mat4x4<f32>,
@@ -15,6 +16,7 @@ struct VsIn {
     @location(0) pos: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
 };
 
 struct VsOut {
@@ -22,6 +24,7 @@ struct VsOut {
     @location(0) n_view: vec3<f32>,
     @location(1) depth_mm: f32,
     @location(2) uv: vec2<f32>,
+    @location(3) t_view: vec4<f32>,
 };
 
 @vertex
@@ -32,12 +35,14 @@ fn vs_mesh(v: VsIn) -> VsOut {
     o.n_view = (cam.view * vec4<f32>(v.normal, 0.0)).xyz;
     o.depth_mm = -(cam.view * p).z * cam.params.x;
     o.uv = v.uv;
+    o.t_view = vec4<f32>((cam.view * vec4<f32>(v.tangent.xyz, 0.0)).xyz, v.tangent.w);
     return o;
 }
 
 struct GBuffer {
     @location(0) normal_depth: vec4<f32>,
     @location(1) uv_cover: vec4<f32>,
+    @location(2) tangent: vec4<f32>,
 };
 
 @fragment
@@ -45,5 +50,6 @@ fn fs_mesh(i: VsOut) -> GBuffer {
     var g: GBuffer;
     g.normal_depth = vec4<f32>(normalize(i.n_view), i.depth_mm);
     g.uv_cover = vec4<f32>(i.uv, 1.0, 0.0);
+    g.tangent = i.t_view;
     return g;
 }

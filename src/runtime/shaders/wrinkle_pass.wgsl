@@ -1,0 +1,110 @@
+// The wrinkle pass (runtime/wrinkle_pass.rs; thesis ch. 8, Listing 8.1): per covered pixel, the partial-derivative
+// wrinkle map and the two zone-mask maps read bilinearly at the mesh's uv, xy = base.xy + sum_z mask_z * weight_z *
+// wrinkle.xy (base: flat, the meshes carry no base normal map), n_ts = normalize(xy, 1), then n_ts taken from the
+// mesh's tangent frame (T, B = w * N x T, N) to view space. CPU twin: runtime/cpu/wrinkle_pass.rs.
+
+struct Params {
+    // frame width, height, PD map width, height
+    size: vec4<f32>,
+    // mask width, height, 0, 0
+    mask: vec4<f32>,
+    weights: array<vec4<f32>, 2>,
+};
+
+@group(0) @binding(0) var<uniform> p: Params;
+// u, v, covered, 0
+@group(0) @binding(1) var<storage, read_write> uvc: array<vec4<f32>>;
+// view normal (unit), 0
+@group(0) @binding(2) var<storage, read_write> nrm: array<vec4<f32>>;
+// view tangent (interpolated), handedness
+@group(0) @binding(3) var<storage, read_write> tng: array<vec4<f32>>;
+// decoded PD slopes (-1 + 2 * texel)
+@group(0) @binding(4) var<storage, read_write> pd: array<vec2<f32>>;
+// decoded masks: map 0 then map 1, each mask width x height
+@group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
+
+struct Taps {
+    i: vec4<u32>, // (x0, x1, y0, y1)
+    f: vec2<f32>,
+};
+
+fn taps(u: f32, v: f32, w: f32, h: f32) -> Taps {
+    let x = u * w - 0.5;
+    let y = v * h - 0.5;
+    let x0 = floor(x);
+    let y0 = floor(y);
+    var t: Taps;
+    t.f = vec2<f32>(x - x0, y - y0);
+    let xi = i32(x0);
+    let yi = i32(y0);
+    let wm = i32(w) - 1;
+    let hm = i32(h) - 1;
+    t.i = vec4<u32>(u32(clamp(xi, 0, wm)), u32(clamp(xi + 1, 0, wm)), u32(clamp(yi, 0, hm)), u32(clamp(yi + 1, 0, hm)));
+    return t;
+}
+
+fn pd_at(t: Taps) -> vec2<f32> {
+    let w = u32(p.size.z);
+    let a = pd[t.i.z * w + t.i.x];
+    let b = pd[t.i.z * w + t.i.y];
+    let c = pd[t.i.w * w + t.i.x];
+    let d = pd[t.i.w * w + t.i.y];
+    let top = a + (b - a) * t.f.x;
+    let bottom = c + (d - c) * t.f.x;
+    return top + (bottom - top) * t.f.y;
+}
+
+fn mask_at(k: u32, t: Taps) -> vec4<f32> {
+    let w = u32(p.mask.x);
+    let base = k * w * u32(p.mask.y);
+    let a = masks[base + t.i.z * w + t.i.x];
+    let b = masks[base + t.i.z * w + t.i.y];
+    let c = masks[base + t.i.w * w + t.i.x];
+    let d = masks[base + t.i.w * w + t.i.y];
+    let top = a + (b - a) * t.f.x;
+    let bottom = c + (d - c) * t.f.x;
+    return top + (bottom - top) * t.f.y;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = u32(p.size.x);
+    if (id.x >= w || id.y >= u32(p.size.y)) {
+        return;
+    }
+    let i = id.y * w + id.x;
+    let c = uvc[i];
+    let n = nrm[i].xyz;
+    if (c.z < 0.5) {
+        out_n[i] = vec4<f32>(n, 0.0);
+        return;
+    }
+    // Listing 8.1
+    let wr = pd_at(taps(c.x, c.y, p.size.z, p.size.w));
+    let tm = taps(c.x, c.y, p.mask.x, p.mask.y);
+    let m1 = mask_at(0u, tm) * p.weights[0];
+    let m2 = mask_at(1u, tm) * p.weights[1];
+    var xy = vec2<f32>(0.0, 0.0);
+    xy = xy + m1.r * wr;
+    xy = xy + m1.g * wr;
+    xy = xy + m1.b * wr;
+    xy = xy + m1.a * wr;
+    xy = xy + m2.r * wr;
+    xy = xy + m2.g * wr;
+    xy = xy + m2.b * wr;
+    xy = xy + m2.a * wr;
+    let v = vec3<f32>(xy, 1.0);
+    let nts = v / sqrt(dot(v, v));
+    // The tangent frame: Gram-Schmidt of the interpolated tangent against the normal.
+    let t4 = tng[i];
+    let to = t4.xyz - n * dot(n, t4.xyz);
+    let l = sqrt(dot(to, to));
+    if (l < 1e-6) {
+        out_n[i] = vec4<f32>(n, 0.0);
+        return;
+    }
+    let t = to / l;
+    let b = t4.w * cross(n, t);
+    out_n[i] = vec4<f32>(nts.x * t + nts.y * b + nts.z * n, 0.0);
+}

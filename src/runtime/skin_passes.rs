@@ -1,0 +1,35 @@
+//! The passes of the thesis' skin shader that `run skin` adds around its SSS shader (issue 14, part B), chosen
+//! per frame: the rig's eq. 7.6 in texture space ([`super::mesh_skin_inputs`], thesis §7.6) and the wrinkle pass
+//! ([`super::wrinkle_pass`], thesis ch. 8 Listing 8.1) before shading, and bloom on the final HDR frame before
+//! tone mapping ([`super::bloom`], thesis ch. 4), and the G-buffer's sample count (MSAA). The default is the
+//! neutral pose, no wrinkles, bloom on and one sample per pixel.
+
+use super::bloom::BloomParams;
+use super::mesh_skin_inputs::RigPose;
+use super::wrinkle_pass::WrinkleMaps;
+
+/// The wrinkle pass's maps and zone weights (Table 8.1 columns, each in `0..=1`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wrinkles {
+    pub maps: WrinkleMaps,
+    pub zone_weights: [f32; 8],
+}
+
+/// What `run skin` adds to the SSS shader of [`super::skin_render::SkinRenderSettings`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinPasses {
+    /// The rig's pose (eq. 7.6 weights and global state); None: the neutral pose (weight 1 on neutral, g = 1).
+    pub rig_pose: Option<RigPose>,
+    /// The wrinkle pass on the G-buffer's normals; None: no wrinkle pass.
+    pub wrinkles: Option<Wrinkles>,
+    /// Bloom; None: off.
+    pub bloom: Option<BloomParams>,
+    /// Samples per pixel of the G-buffer raster, 1 or 4 (MSAA, [`super::mesh_raster::rasterise_samples`]).
+    pub msaa: u32,
+}
+
+impl Default for SkinPasses {
+    fn default() -> Self {
+        SkinPasses { rig_pose: None, wrinkles: None, bloom: Some(BloomParams::default()), msaa: 1 }
+    }
+}
