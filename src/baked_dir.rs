@@ -280,6 +280,14 @@ pub fn verify_with(
     pin: Option<&str>,
     wait: &Wait,
 ) -> Result<VerifyReport, BakeDirError> {
+    // Before the lock: the lock file lives beside the directory, and verifying a directory that is not there must
+    // leave nothing behind in its parent.
+    if !dir.is_dir() {
+        return Err(BakeDirError::Unusable {
+            path: dir.display().to_string(),
+            detail: if dir.exists() { "is not a directory" } else { "does not exist" }.into(),
+        });
+    }
     let mut lock = DirLock::acquire(dir, LockMode::Shared, wait)?;
     if file_set::swap_interrupted(lock.dir()) {
         // Only a bake killed inside the two-rename fallback swap gets here; finish it first.
@@ -562,6 +570,14 @@ mod tests {
         files.extend(crate::bake::float_texture_files("test/ramp_f", &f, "lut", "test", 1e-6)?);
         files.push(json_file("test/ramp.json", params, "json", "params"));
         Ok(files)
+    }
+
+    #[test]
+    fn verify_refuses_a_missing_directory_before_taking_its_lock() {
+        let t = tempfile::tempdir().unwrap();
+        let err = verify(&t.path().join("MISSING"), &registry()).unwrap_err();
+        assert!(matches!(&err, BakeDirError::Unusable { detail, .. } if detail == "does not exist"), "{err}");
+        assert_eq!(fs::read_dir(t.path()).unwrap().count(), 0, "nothing (no .MISSING.rtbake-lock) left in the parent");
     }
 
     fn registry() -> Vec<Asset> {
