@@ -137,20 +137,12 @@ impl TextureFormats {
         Self { bin: false, dds: false, ktx2: false, png: false, c_header: false, rust_source: false };
 }
 
-/// [`unorm8_texture_files`] restricted to the binary containers selected in `formats` (the sources are the
-/// caller's).
-pub fn unorm8_texture_files_in(
-    stem: &str,
-    img: &Image<u8>,
-    kind: &str,
-    convention: &str,
-    formats: TextureFormats,
-) -> Result<Vec<BakedFile>, BakeError> {
-    let pf = PixelFormat::unorm8_for(img.channels);
-    let meta = |format: &str| FileMeta {
+/// The manifest metadata of an 8-bit UNORM texture file in `format` (`raw`, `dds`, `ktx2`, `png`).
+fn unorm8_meta(img: &Image<u8>, kind: &str, convention: &str, format: &str) -> FileMeta {
+    let mut meta = FileMeta {
         kind: kind.into(),
         format: format.into(),
-        pixel_format: pf,
+        pixel_format: PixelFormat::unorm8_for(img.channels),
         width: img.width,
         height: img.height,
         channels: img.channels,
@@ -160,12 +152,31 @@ pub fn unorm8_texture_files_in(
         verify_tolerance: None,
         supercompression: None,
     };
-    let mut png_meta = meta("png");
-    if img.channels == 2 {
-        png_meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
-        png_meta.channels = 3;
-        png_meta.pixel_format = None;
+    if format == "png" && img.channels == 2 {
+        meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
+        meta.channels = 3;
+        meta.pixel_format = None;
     }
+    meta
+}
+
+/// The raw `{stem}.bin` of an 8-bit UNORM texture, taking the texture's bytes without a copy (a large MLAA map is
+/// 52 MB: `rtbake aa … --format bin` encodes the other formats first, then moves the map into this file).
+pub fn unorm8_bin_file(stem: &str, img: Image<u8>, kind: &str, convention: &str) -> BakedFile {
+    let meta = unorm8_meta(&img, kind, convention, "raw");
+    BakedFile { path: format!("{stem}.bin"), bytes: img.data, meta }
+}
+
+/// [`unorm8_texture_files`] restricted to the binary containers selected in `formats` (the sources are the
+/// caller's).
+pub fn unorm8_texture_files_in(
+    stem: &str,
+    img: &Image<u8>,
+    kind: &str,
+    convention: &str,
+    formats: TextureFormats,
+) -> Result<Vec<BakedFile>, BakeError> {
+    let meta = |format: &str| unorm8_meta(img, kind, convention, format);
     let mut files = Vec::new();
     if formats.bin {
         files.push(BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") });
@@ -177,7 +188,7 @@ pub fn unorm8_texture_files_in(
         files.push(BakedFile { path: format!("{stem}.ktx2"), bytes: io::ktx2::encode_u8(img)?, meta: meta("ktx2") });
     }
     if formats.png {
-        files.push(BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: png_meta });
+        files.push(BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: meta("png") });
     }
     Ok(files)
 }
