@@ -133,8 +133,7 @@ pub fn bake_into_with(
         .enumerate()
         .map(|(k, (asset, params))| {
             progress(k, asset.name);
-            let files =
-                asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
+            let files = asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
             let digests = files.par_iter().map(|f| sha256_hex(&f.bytes)).collect();
             Ok((files, digests))
         })

@@ -153,13 +153,11 @@ pub fn bake_lut_with_progress(
     let mut img = Image::new(layout.width, layout.height, 3);
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let rows = rows_per_task(layout.width, layout.height, rayon::current_num_threads());
-    img.data.par_chunks_mut(row_len * rows).zip(hemoglobin.par_chunks(rows)).for_each(
-        |(out, chd)| {
-            model.linear_rgb_grid(&melanin, chd, &tables, out);
-            let done = rows_done.fetch_add(chd.len() as u32, std::sync::atomic::Ordering::Relaxed) + chd.len() as u32;
-            progress(done, layout.height);
-        },
-    );
+    img.data.par_chunks_mut(row_len * rows).zip(hemoglobin.par_chunks(rows)).for_each(|(out, chd)| {
+        model.linear_rgb_grid(&melanin, chd, &tables, out);
+        let done = rows_done.fetch_add(chd.len() as u32, std::sync::atomic::Ordering::Relaxed) + chd.len() as u32;
+        progress(done, layout.height);
+    });
     Ok(img)
 }
 
