@@ -20,6 +20,15 @@
 //! 2 threads, medians of 7 runs 0.113 / 0.134 / 0.141 s vs 0.117 / 0.157 / 0.197 s; one-thread CPU time of the
 //! table (thread CPU clock, 9 runs) 66–69 ms vs 82–112 ms, the epidermis tables 16 ms in both. Under such load the
 //! wall figures are 3–5× the idle ones; the idle figure against the 30 ms goal is still to be measured.
+//!
+//! 2026-11-25 (perf3), one task per thread (`lut::rows_per_task`: 128 rows of 256 on 2 threads instead of 8), so
+//! each band's epidermis table is streamed from L3 once per task instead of 32 times (same bits). Where the time
+//! went before (`perf record`, 1 thread): 73 % the row loop (its hottest instructions the loads of the interval
+//! cubics), 17 % glibc `expm1`/`sinh`/`exp` of the exact series in the set-up (epidermis tables and dermis rows),
+//! the rest the series' own arithmetic. Measured under load 5–7.5 (three other engineers building), 2 threads,
+//! 5 alternations of 9 runs with the previous build (same table bits): process CPU time of the table 50–54 ms
+//! (medians) vs 65–83 ms, wall medians 76–126 ms vs 115–189 ms; one thread 51–53 ms CPU. The idle wall figure
+//! against the 30 ms goal is for the lead to take (CPU/2 ≈ 25–27 ms suggests it is met).
 
 use rtbake::bake::skin::skin_color_lut_files;
 use rtbake::skin_color::lut::{bake_lut, LutEvaluation};
@@ -94,6 +103,16 @@ fn main() {
             std::hint::black_box(model.epidermis_tables(0.5, 0.32));
         });
         println!("  of which the epidermis tables (401 x 515 exact totals): wall {w:.3} s, cpu {c:.2} s");
+        let hemoglobin: Vec<f64> = (0..layout.height).map(|j| layout.hemoglobin_at_row(j)).collect();
+        let (w, c) = time(runs, || {
+            for &chd in &hemoglobin {
+                std::hint::black_box(model.dermis_reflectance(chd));
+            }
+        });
+        println!(
+            "  and the dermis reflectance ({} rows x 401 exact R, serial here): wall {w:.3} s, cpu {c:.2} s",
+            hemoglobin.len()
+        );
         let (w, c) = time(runs, || {
             skin_color_lut_files(&params).expect("bake");
         });

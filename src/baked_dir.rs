@@ -126,17 +126,24 @@ pub fn bake_into_with(
     // 1. Compute everything in memory (pure; a bad parameter writes nothing). No lock is needed for this. The assets
     //    run side by side (each is a pure function of its parameters, so the bytes do not depend on the order or the
     //    thread count); results are kept in job order and the first failing job in that order is the error reported.
-    let results: Vec<Result<Vec<BakedFile>, BakeDirError>> = jobs
+    //    Each asset's files are hashed for the manifest as soon as it is done, beside the other assets.
+    type Produced = (Vec<BakedFile>, Vec<String>);
+    let results: Vec<Result<Produced, BakeDirError>> = jobs
         .par_iter()
         .enumerate()
         .map(|(k, (asset, params))| {
             progress(k, asset.name);
-            asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })
+            let files = asset.run(params).map_err(|source| BakeDirError::Asset { asset: asset.name.into(), source })?;
+            let digests = files.par_iter().map(|f| sha256_hex(&f.bytes)).collect();
+            Ok((files, digests))
         })
         .collect();
     let mut produced: Vec<(&Asset, &Value, Vec<BakedFile>)> = Vec::with_capacity(jobs.len());
-    for ((asset, params), files) in jobs.iter().zip(results) {
-        produced.push((asset, params, files?));
+    let mut digests: Vec<Vec<String>> = Vec::with_capacity(jobs.len());
+    for ((asset, params), result) in jobs.iter().zip(results) {
+        let (files, d) = result?;
+        produced.push((asset, params, files));
+        digests.push(d);
     }
     progress(jobs.len(), "writing");
     // 2. From here to the swap, the directory is ours: the existing state read below cannot change under us.
@@ -155,8 +162,8 @@ pub fn bake_into_with(
     let mut manifest = old_manifest.clone().unwrap_or_default();
     manifest.stamp_provenance();
     let old_paths: BTreeSet<String> = manifest.files.iter().map(|f| f.path.clone()).collect();
-    for (asset, params, files) in &produced {
-        manifest.set_asset(asset.name, (*params).clone(), files);
+    for ((asset, params, files), digests) in produced.iter().zip(&digests) {
+        manifest.set_asset_with_digests(asset.name, (*params).clone(), files, digests);
     }
     let new_paths: BTreeSet<String> = manifest.files.iter().map(|f| f.path.clone()).collect();
     let mut seen = BTreeSet::new();
@@ -189,14 +196,14 @@ pub fn bake_into_with(
                 fs::copy(&src, &dst).map_err(|e| io_err(&src, e))?;
             }
         }
-        let mut written = Vec::new();
-        for (_, _, files) in &produced {
-            for f in files {
-                written.push(stage.join(&f.path));
-                write_unsynced(written.last().expect("just pushed"), &f.bytes)?;
-                bytes += f.bytes.len() as u64;
-                count += 1;
-            }
+        // The new files are independent: written side by side (the page-cache copies and file creations scale
+        // with the threads; the flush below is one).
+        let new_files: Vec<&BakedFile> = produced.iter().flat_map(|(_, _, files)| files).collect();
+        let mut written: Vec<std::path::PathBuf> = new_files.iter().map(|f| stage.join(&f.path)).collect();
+        new_files.par_iter().zip(&written).try_for_each(|(f, path)| write_unsynced(path, &f.bytes))?;
+        for f in &new_files {
+            bytes += f.bytes.len() as u64;
+            count += 1;
         }
         written.push(stage.join(MANIFEST_NAME));
         write_unsynced(&stage.join(MANIFEST_NAME), manifest.to_text().as_bytes())?;
@@ -280,6 +287,14 @@ pub fn verify_with(
     pin: Option<&str>,
     wait: &Wait,
 ) -> Result<VerifyReport, BakeDirError> {
+    // Before the lock: the lock file lives beside the directory, and verifying a directory that is not there must
+    // leave nothing behind in its parent.
+    if !dir.is_dir() {
+        return Err(BakeDirError::Unusable {
+            path: dir.display().to_string(),
+            detail: if dir.exists() { "is not a directory" } else { "does not exist" }.into(),
+        });
+    }
     let mut lock = DirLock::acquire(dir, LockMode::Shared, wait)?;
     if file_set::swap_interrupted(lock.dir()) {
         // Only a bake killed inside the two-rename fallback swap gets here; finish it first.
@@ -562,6 +577,14 @@ mod tests {
         files.extend(crate::bake::float_texture_files("test/ramp_f", &f, "lut", "test", 1e-6)?);
         files.push(json_file("test/ramp.json", params, "json", "params"));
         Ok(files)
+    }
+
+    #[test]
+    fn verify_refuses_a_missing_directory_before_taking_its_lock() {
+        let t = tempfile::tempdir().unwrap();
+        let err = verify(&t.path().join("MISSING"), &registry()).unwrap_err();
+        assert!(matches!(&err, BakeDirError::Unusable { detail, .. } if detail == "does not exist"), "{err}");
+        assert_eq!(fs::read_dir(t.path()).unwrap().count(), 0, "nothing (no .MISSING.rtbake-lock) left in the parent");
     }
 
     fn registry() -> Vec<Asset> {

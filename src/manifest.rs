@@ -174,16 +174,24 @@ impl Manifest {
 
     /// Replaces (or adds) an asset and its files; keeps assets and files sorted.
     pub fn set_asset(&mut self, name: &str, params: Value, files: &[BakedFile]) {
+        let digests: Vec<String> = files.iter().map(|f| sha256_hex(&f.bytes)).collect();
+        self.set_asset_with_digests(name, params, files, &digests);
+    }
+
+    /// [`Self::set_asset`] with the files' [`sha256_hex`] digests computed by the caller (`digests[i]` of
+    /// `files[i]`; a bake hashes each asset's files as soon as the asset is done, beside the other assets).
+    pub fn set_asset_with_digests(&mut self, name: &str, params: Value, files: &[BakedFile], digests: &[String]) {
+        assert_eq!(files.len(), digests.len(), "one digest per file");
         self.assets.retain(|a| a.name != name);
         self.files.retain(|f| f.asset != name);
         self.assets.push(AssetRecord { name: name.into(), params });
-        for f in files {
+        for (f, sha256) in files.iter().zip(digests) {
             self.files.push(Entry {
                 path: f.path.clone(),
                 asset: name.into(),
                 meta: f.meta.clone(),
                 size_bytes: f.bytes.len() as u64,
-                sha256: sha256_hex(&f.bytes),
+                sha256: sha256.clone(),
             });
         }
         self.assets.sort_by(|a, b| a.name.cmp(&b.name));

@@ -328,16 +328,21 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     a.zstd.apply(&mut files)?;
     prepare_out_dir("--out", &a.out)?;
     // The sha256 lines are hashed on a second thread while the set is written (the write mostly waits for the
-    // disk flush): same digests, printed only after the write succeeded.
+    // disk flush): same digests, printed only after the write succeeded. Under --quiet without --json nothing
+    // prints them, so they are not computed.
     let (result, shas) = std::thread::scope(|s| {
-        let hashes = s.spawn(|| {
-            let hex = |f: &BakedFile| Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
-            files.iter().map(hex).collect::<Vec<String>>()
+        let hashes = (!ctx.quiet || ctx.json).then(|| {
+            s.spawn(|| {
+                let hex =
+                    |f: &BakedFile| Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
+                files.iter().map(hex).collect::<Vec<String>>()
+            })
         });
         let result = crate::cli::write_set(ctx, "--out", &a.out, &files, &[]);
-        (result, hashes.join().expect("the sha256 thread does not panic"))
+        (result, hashes.map(|h| h.join().expect("the sha256 thread does not panic")))
     });
     result?;
+    let Some(shas) = shas else { return Ok(()) };
     let mut written = Vec::new();
     for (f, sha) in files.iter().zip(shas) {
         let path = a.out.join(&f.path);

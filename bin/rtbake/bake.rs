@@ -133,6 +133,11 @@ fn check_out_dir(dir: &Path) -> anyhow::Result<()> {
 }
 
 pub fn run_verify(a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    // Refused before the lock is taken (its file would be created beside the missing directory).
+    if !a.dir.is_dir() {
+        let what = if a.dir.exists() { "is not a directory" } else { "does not exist" };
+        return Err(usage_msg(format!("--dir {}: {what}", a.dir.display())));
+    }
     if a.dir.is_dir() && !a.dir.join(rtbake::manifest::MANIFEST_NAME).exists() {
         return Err(usage_msg(format!("--dir {}: no manifest.json (not a bake directory)", a.dir.display())));
     }

@@ -207,7 +207,14 @@ pub fn mlaa_files_with_progress(
     progress: &dyn Fn(u32, u32),
 ) -> Result<Vec<BakedFile>, BakeError> {
     let img = mlaa_area_map_with_progress(version, n, progress)?;
-    texture_with_sources(stem, &img, &mlaa_convention(version, n), formats, ("AREAMAP", "areaMapBytes"), from)
+    let convention = mlaa_convention(version, n);
+    // Every other format first, then the map itself moves into the `.bin` (no copy of up to 52 MB).
+    let others = TextureFormats { bin: false, ..formats };
+    let mut files = texture_with_sources(stem, &img, &convention, others, ("AREAMAP", "areaMapBytes"), from)?;
+    if formats.bin {
+        files.insert(0, crate::bake::unorm8_bin_file(stem, img, "lut", &convention));
+    }
+    Ok(files)
 }
 
 /// Bevy's file names for the SMAA LUTs (`bevy_anti_alias/src/smaa/`).

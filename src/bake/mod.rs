@@ -137,20 +137,12 @@ impl TextureFormats {
         Self { bin: false, dds: false, ktx2: false, png: false, c_header: false, rust_source: false };
 }
 
-/// [`unorm8_texture_files`] restricted to the binary containers selected in `formats` (the sources are the
-/// caller's).
-pub fn unorm8_texture_files_in(
-    stem: &str,
-    img: &Image<u8>,
-    kind: &str,
-    convention: &str,
-    formats: TextureFormats,
-) -> Result<Vec<BakedFile>, BakeError> {
-    let pf = PixelFormat::unorm8_for(img.channels);
-    let meta = |format: &str| FileMeta {
+/// The manifest metadata of an 8-bit UNORM texture file in `format` (`raw`, `dds`, `ktx2`, `png`).
+fn unorm8_meta(img: &Image<u8>, kind: &str, convention: &str, format: &str) -> FileMeta {
+    let mut meta = FileMeta {
         kind: kind.into(),
         format: format.into(),
-        pixel_format: pf,
+        pixel_format: PixelFormat::unorm8_for(img.channels),
         width: img.width,
         height: img.height,
         channels: img.channels,
@@ -160,24 +152,53 @@ pub fn unorm8_texture_files_in(
         verify_tolerance: None,
         supercompression: None,
     };
-    let mut png_meta = meta("png");
-    if img.channels == 2 {
-        png_meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
-        png_meta.channels = 3;
-        png_meta.pixel_format = None;
+    if format == "png" && img.channels == 2 {
+        meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
+        meta.channels = 3;
+        meta.pixel_format = None;
     }
+    meta
+}
+
+/// The raw `{stem}.bin` of an 8-bit UNORM texture, taking the texture's bytes without a copy (a large MLAA map is
+/// 52 MB: `rtbake aa … --format bin` encodes the other formats first, then moves the map into this file).
+pub fn unorm8_bin_file(stem: &str, img: Image<u8>, kind: &str, convention: &str) -> BakedFile {
+    let meta = unorm8_meta(&img, kind, convention, "raw");
+    BakedFile { path: format!("{stem}.bin"), bytes: img.data, meta }
+}
+
+/// [`unorm8_texture_files`] restricted to the binary containers selected in `formats` (the sources are the
+/// caller's).
+pub fn unorm8_texture_files_in(
+    stem: &str,
+    img: &Image<u8>,
+    kind: &str,
+    convention: &str,
+    formats: TextureFormats,
+) -> Result<Vec<BakedFile>, BakeError> {
+    let meta = |format: &str| unorm8_meta(img, kind, convention, format);
+    // The encoders are independent: PNG compression (the costly one) runs beside the containers.
+    let (png, (dds, ktx2)) = rayon::join(
+        || formats.png.then(|| io::png::encode_u8(img)).transpose(),
+        || {
+            rayon::join(
+                || formats.dds.then(|| io::dds::encode_u8(img)).transpose(),
+                || formats.ktx2.then(|| io::ktx2::encode_u8(img)).transpose(),
+            )
+        },
+    );
     let mut files = Vec::new();
     if formats.bin {
         files.push(BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") });
     }
-    if formats.dds {
-        files.push(BakedFile { path: format!("{stem}.dds"), bytes: io::dds::encode_u8(img)?, meta: meta("dds") });
+    if let Some(bytes) = dds? {
+        files.push(BakedFile { path: format!("{stem}.dds"), bytes, meta: meta("dds") });
     }
-    if formats.ktx2 {
-        files.push(BakedFile { path: format!("{stem}.ktx2"), bytes: io::ktx2::encode_u8(img)?, meta: meta("ktx2") });
+    if let Some(bytes) = ktx2? {
+        files.push(BakedFile { path: format!("{stem}.ktx2"), bytes, meta: meta("ktx2") });
     }
-    if formats.png {
-        files.push(BakedFile { path: format!("{stem}.png"), bytes: io::png::encode_u8(img)?, meta: png_meta });
+    if let Some(bytes) = png? {
+        files.push(BakedFile { path: format!("{stem}.png"), bytes, meta: meta("png") });
     }
     Ok(files)
 }
@@ -209,27 +230,28 @@ pub fn float_texture_files(
     let mut preview = meta("png", None, "u8", "srgb", Some(1.0));
     preview.kind = "preview".into();
     preview.convention = format!("{convention}; 8-bit sRGB-encoded for viewing only, do not sample as linear data");
+    // The four encoders are independent and run side by side (same bytes; errors reported in file order).
+    let ((exr_f32, exr_f16), (ktx2, png)) = rayon::join(
+        || rayon::join(|| io::exr::encode(img, ExrPrecision::F32), || io::exr::encode(img, ExrPrecision::F16)),
+        || rayon::join(|| io::ktx2::encode_f16(img), || io::png::encode_srgb_preview(img)),
+    );
     Ok(vec![
         BakedFile {
             path: format!("{stem}.exr"),
-            bytes: io::exr::encode(img, ExrPrecision::F32)?,
+            bytes: exr_f32?,
             meta: meta("exr", None, "f32", "linear", Some(tolerance)),
         },
         BakedFile {
             path: format!("{stem}_f16.exr"),
-            bytes: io::exr::encode(img, ExrPrecision::F16)?,
+            bytes: exr_f16?,
             meta: meta("exr", None, "f16", "linear", Some(half_tol)),
         },
         BakedFile {
             path: format!("{stem}.ktx2"),
-            bytes: io::ktx2::encode_f16(img)?,
+            bytes: ktx2?,
             meta: meta("ktx2", PixelFormat::f16_for(img.channels), "f16", "linear", Some(half_tol)),
         },
-        BakedFile {
-            path: format!("{stem}_preview_srgb.png"),
-            bytes: io::png::encode_srgb_preview(img)?,
-            meta: preview,
-        },
+        BakedFile { path: format!("{stem}_preview_srgb.png"), bytes: png?, meta: preview },
     ])
 }
 
@@ -237,11 +259,18 @@ pub fn float_texture_files(
 /// it in the file's metadata (`supercompression: zstd-<level>`). Other files are left as they are.
 pub fn supercompress_ktx2(files: &mut [BakedFile], level: i32) -> Result<(), BakeError> {
     crate::error::check_range("zstd level", level, 1, 22, "")?;
-    for f in files.iter_mut().filter(|f| f.meta.format == "ktx2" && f.meta.supercompression.is_none()) {
-        f.bytes = io::ktx2::supercompress(&f.bytes, &f.path, level)?;
-        f.meta.supercompression = Some(io::ktx2::Supercompression::Zstd(level).label());
-    }
-    Ok(())
+    use rayon::prelude::*;
+    // Independent files, compressed side by side (the first error in file order is reported).
+    let results: Vec<Result<(), BakeError>> = files
+        .par_iter_mut()
+        .filter(|f| f.meta.format == "ktx2" && f.meta.supercompression.is_none())
+        .map(|f| {
+            f.bytes = io::ktx2::supercompress(&f.bytes, &f.path, level)?;
+            f.meta.supercompression = Some(io::ktx2::Supercompression::Zstd(level).label());
+            Ok(())
+        })
+        .collect();
+    results.into_iter().collect()
 }
 
 /// A pretty-printed JSON file (stable key order, trailing newline).

@@ -16,7 +16,8 @@
 //!   together (one `syncfs`, [`super::atomic::sync_batch`]),
 //!   committed by atomically writing a journal that lists the renames, then renamed; a kill after the journal is
 //!   rolled forward by the next rtbake command that locks or reads the directory ([`settle`]), a kill before it
-//!   leaves the old set. No output may be one of the command's inputs.
+//!   leaves the old set. A set of one file needs no journal: its rename is the commit point, made durable by one
+//!   fsync of its directory. No output may be one of the command's inputs.
 //! - Kill points for tests: `RTBAKE_FAULT_INJECT` holds comma-separated directives checked at each named step:
 //!   `kill@STEP` exits at once (status 137, no clean-up, like SIGKILL), `hold@STEP` prints
 //!   `rtbake-fault: holding at STEP` on stderr and blocks until a line arrives on stdin, `no-exchange` forces the
@@ -539,6 +540,17 @@ pub fn write_file_set(
         return Err(e);
     }
     fault_point("staged");
+    if let [(tmp, rel)] = renames.as_slice() {
+        // One file: its rename is the commit point on its own (the path names the old or the new file at every
+        // instant), so it needs no journal; one fsync of its directory makes the rename durable.
+        let dst = root.join(rel);
+        if let Err(e) = fs::rename(root.join(tmp), &dst) {
+            let _ = fs::remove_file(root.join(tmp));
+            return Err(io_err(&dst, e));
+        }
+        sync_dir(parent_of(&dst));
+        return Ok(outputs);
+    }
     // Commit point: the journal, written atomically.
     let journal = root.join(format!("{JOURNAL_PREFIX}{}.json", std::process::id()));
     let text = serde_json::to_string(&Journal { renames: renames.clone() }).expect("journal serialises");

@@ -105,8 +105,23 @@ pub enum LutEvaluation {
     Direct,
 }
 
-/// Rows per parallel task (a multiple of nothing in particular: results do not depend on it).
-const ROWS_PER_TASK: usize = 8;
+/// Accumulator bytes of one parallel task (3 f64 per texel) that [`rows_per_task`] aims for: about three quarters of
+/// the 1 MiB L2 cache of the project's AMD EPYC, so a task's accumulators stay in L2 while every band's
+/// [`two_layer::EpidermisTable`](super::two_layer::EpidermisTable) (32 KiB) is streamed from L3 once per task.
+const TASK_ACCUMULATOR_BYTES: usize = 768 << 10;
+/// Fewest rows per task (progress granularity and the per-task set-up).
+const MIN_ROWS_PER_TASK: usize = 8;
+
+/// Rows per parallel task of a `width`-wide, `height`-high table on `threads` threads: one task per thread where
+/// the accumulators fit `TASK_ACCUMULATOR_BYTES`, fewer rows otherwise (at least `MIN_ROWS_PER_TASK`). Every band
+/// table is read once per task, so few tall tasks cut the traffic: 256² at 401 bands, one thread, CPU time 84 → 54
+/// ms from 8 to 128 rows per task (measured under load, `examples/bench_skin.rs`). The table's values do not depend
+/// on it (each texel sums its bands in the same order whichever task computes it).
+pub fn rows_per_task(width: u32, height: u32, threads: usize) -> usize {
+    let per_thread = (height as usize).div_ceil(threads.max(1));
+    let fit = TASK_ACCUMULATOR_BYTES / (3 * std::mem::size_of::<f64>() * width.max(1) as usize);
+    per_thread.min(fit).max(MIN_ROWS_PER_TASK)
+}
 
 /// Bakes the table: W × H linear sRGB (3 channels, f32), top row first, deterministic for any thread count
 /// (every texel sums its wavelengths in the same order whichever task computes it).
@@ -137,13 +152,12 @@ pub fn bake_lut_with_progress(
     let row_len = 3 * layout.width as usize;
     let mut img = Image::new(layout.width, layout.height, 3);
     let rows_done = std::sync::atomic::AtomicU32::new(0);
-    img.data.par_chunks_mut(row_len * ROWS_PER_TASK).zip(hemoglobin.par_chunks(ROWS_PER_TASK)).for_each(
-        |(out, chd)| {
-            model.linear_rgb_grid(&melanin, chd, &tables, out);
-            let done = rows_done.fetch_add(chd.len() as u32, std::sync::atomic::Ordering::Relaxed) + chd.len() as u32;
-            progress(done, layout.height);
-        },
-    );
+    let rows = rows_per_task(layout.width, layout.height, rayon::current_num_threads());
+    img.data.par_chunks_mut(row_len * rows).zip(hemoglobin.par_chunks(rows)).for_each(|(out, chd)| {
+        model.linear_rgb_grid(&melanin, chd, &tables, out);
+        let done = rows_done.fetch_add(chd.len() as u32, std::sync::atomic::Ordering::Relaxed) + chd.len() as u32;
+        progress(done, layout.height);
+    });
     Ok(img)
 }
 
@@ -183,7 +197,17 @@ mod tests {
         })
         .unwrap();
         assert_eq!(max.into_inner(), 40);
-        assert!(calls.into_inner() >= 40 / ROWS_PER_TASK as u32);
+        let tasks = 40usize.div_ceil(rows_per_task(6, 40, rayon::current_num_threads()));
+        assert!(calls.into_inner() as usize >= tasks);
         assert_eq!(with, bake_lut(&model, &layout, p.lut_evaluation).unwrap());
+    }
+
+    #[test]
+    fn tasks_fit_the_accumulator_budget_and_split_the_rows_between_threads() {
+        assert_eq!(rows_per_task(256, 256, 2), 128);
+        assert_eq!(rows_per_task(256, 256, 64), MIN_ROWS_PER_TASK);
+        // 2048 wide: 48 KiB of accumulators per row, 16 rows in 768 KiB.
+        assert_eq!(rows_per_task(2048, 2048, 1), 16);
+        assert!(rows_per_task(2, 2, 0) >= 2);
     }
 }

@@ -152,3 +152,24 @@ fn killed_bake_leaves_old_or_new_directory_never_a_mix() {
         }
     }
 }
+
+#[test]
+fn verify_refuses_a_missing_directory_and_leaves_nothing_behind() {
+    let t = tempfile::tempdir().unwrap();
+    let missing = t.path().join("MISSING");
+    let o = rtbake(&["verify", "--dir", missing.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains(missing.to_str().unwrap()) && stderr(&o).contains("does not exist"), "{}", stderr(&o));
+    // No lock file (`.MISSING.rtbake-lock`), stage or directory appears in the parent.
+    let left: Vec<_> = std::fs::read_dir(t.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+    // A file where the directory should be: refused the same way, the file untouched.
+    let file = t.path().join("f");
+    std::fs::write(&file, b"x").unwrap();
+    let o = rtbake(&["verify", "--dir", file.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("is not a directory"), "{}", stderr(&o));
+    let left: Vec<_> = std::fs::read_dir(t.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("f")]);
+    assert_eq!(std::fs::read(&file).unwrap(), b"x");
+}
