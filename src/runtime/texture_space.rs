@@ -397,7 +397,10 @@ impl TextureSpaceDiffusion {
             }
         }
         let count = uvs.len() as u32;
-        let uv_buf = storage("ts uvs", bytemuck::cast_slice(uvs));
+        // A head with no visible pixel still has its maps blurred (as d'Eon's shader); its uv list is padded to one
+        // entry because wgpu refuses empty bindings.
+        let padded: Vec<[f32; 2]> = if uvs.is_empty() { vec![[0.0; 2]] } else { uvs.to_vec() };
+        let uv_buf = storage("ts uvs", bytemuck::cast_slice(&padded));
         let out_bytes = (uvs.len() as u64 * 16).max(16);
         let out = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ts gathered"),

@@ -99,6 +99,22 @@ fn ts_chain_gpu_and_cpu_agree() {
     eprintln!("GPU vs CPU chain: {:.4} of channels within 1/255", exact as f64 / a.len() as f64);
 }
 
+/// Heads entirely outside the frame still have their maps blurred (nothing to gather: an empty uv list) on the
+/// GPU, and the frame matches the CPU twin.
+#[test]
+fn heads_outside_the_frame_render_on_both_paths() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let ts = TsSettings { map_size: 64, ..Default::default() };
+    let s = settings(SkinShader::Ts(ts), 5, 0.3, 96, 54);
+    let head = default_head();
+    let (a, stats) = texture_space::render(Some(&g), &head, &s, ts, &assets).unwrap();
+    assert!(stats.heads.iter().any(|h| h.pixels == 0) && stats.heads.iter().any(|h| h.pixels > 0), "{stats:?}");
+    let (b, _) = texture_space::render(None, &head, &s, ts, &assets).unwrap();
+    let close = a.data.iter().zip(&b.data).filter(|(x, y)| x.abs_diff(**y) <= 2).count();
+    assert!(close as f64 >= 0.99 * a.data.len() as f64, "{close} of {}", a.data.len());
+}
+
 /// Error of every shader against the converged reference (TS, 2048² map, no optimisation), 320×180, one head at
 /// 0.6 m. The reference is converged: TS at 1024² is within PSNR 55 dB of it and closer than TS at 256². TS at the
 /// default map is closer than every screen-space shader, and the screen-space shader scaled physically (SS Jittered,
