@@ -201,6 +201,7 @@ pub fn render(
             normals: vec![[0.0, 0.0, 1.0]; n],
         };
         let mut shaded = vec![false; n];
+        #[allow(clippy::needless_range_loop)] // t indexes the UV map and the texel frame alike
         for t in 0..n {
             if !uv.covered[t] {
                 continue;
@@ -342,7 +343,7 @@ impl TextureSpaceDiffusion {
         uvs: &[[f32; 2]],
     ) -> Result<Vec<[f32; 4]>, RuntimeError> {
         let map_bytes = size as u64 * size as u64 * 16;
-        let limit = device.limits().max_storage_buffer_binding_size as u64;
+        let limit = device.limits().max_storage_buffer_binding_size;
         if map_bytes > limit {
             return Err(InvalidInput::new(
                 "--ts-map-size",
