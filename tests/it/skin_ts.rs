@@ -23,9 +23,30 @@ fn srgb_to_linear(v: u8) -> f64 {
 
 /// RMSE in linear light over the reference's skin pixels (RGB), and the PSNR (peak 1).
 fn rmse_psnr(img: &[u8], reference: &[u8]) -> (f64, f64) {
+    let mask: Vec<bool> = reference.chunks(4).map(|r| r[..3] != BACKGROUND).collect();
+    rmse_psnr_over(img, reference, &mask)
+}
+
+/// Skin pixels of a `w`-wide `reference` at least `r` pixels (Chebyshev) from any background pixel.
+fn interior(reference: &[u8], w: usize, r: usize) -> Vec<bool> {
+    let h = reference.len() / 4 / w;
+    let skin = |x: usize, y: usize| reference[4 * (y * w + x)..4 * (y * w + x) + 3] != BACKGROUND;
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            x >= r
+                && y >= r
+                && x + r < w
+                && y + r < h
+                && (y - r..=y + r).all(|yy| (x - r..=x + r).all(|xx| skin(xx, yy)))
+        })
+        .collect()
+}
+
+fn rmse_psnr_over(img: &[u8], reference: &[u8], mask: &[bool]) -> (f64, f64) {
     let (mut se, mut n) = (0.0, 0usize);
-    for (p, r) in img.chunks(4).zip(reference.chunks(4)) {
-        if r[..3] == BACKGROUND {
+    for ((p, r), &m) in img.chunks(4).zip(reference.chunks(4)).zip(mask) {
+        if !m {
             continue;
         }
         for c in 0..3 {
@@ -138,8 +159,8 @@ fn ts_without_diffusion_is_the_no_sss_frame() {
 
 /// Error of every shader against the converged reference (TS, 2048² map, no optimisation), 320×180, one head at
 /// 0.6 m. The reference is converged: TS at 1024² is within PSNR 55 dB of it and closer than TS at 256². TS at the
-/// default map is closer than every screen-space shader, and the screen-space shader scaled physically (SS Jittered,
-/// taps in mm) is closer than no SSS.
+/// default map is closer than every screen-space shader, and, 3 pixels or more inside the silhouette, the
+/// screen-space shader scaled physically (SS Jittered, taps in mm) is closer than no SSS by 20 % or more.
 #[test]
 fn error_of_each_shader_against_a_converged_ts_reference() {
     let g = gpu();
@@ -148,7 +169,8 @@ fn error_of_each_shader_against_a_converged_ts_reference() {
     let img = |shader| render(Some(&g), &head, &settings(shader, 1, 0.6, 320, 180), &assets).unwrap().data;
     let ts_at = |map_size| SkinShader::Ts(TsSettings { map_size, ..Default::default() });
     let reference = img(ts_at(2048));
-    let errors: Vec<(&str, (f64, f64))> = [
+    let inner = interior(&reference, 320, 3);
+    let errors: Vec<(&str, (f64, f64), f64)> = [
         ("none", SkinShader::None),
         ("ss-jittered", SkinShader::SsJittered),
         ("ss-full", SkinShader::SsFull),
@@ -157,18 +179,26 @@ fn error_of_each_shader_against_a_converged_ts_reference() {
         ("ts 256", ts_at(256)),
     ]
     .into_iter()
-    .map(|(name, shader)| (name, rmse_psnr(&img(shader), &reference)))
+    .map(|(name, shader)| {
+        let i = img(shader);
+        (name, rmse_psnr(&i, &reference), rmse_psnr_over(&i, &reference, &inner).0)
+    })
     .collect();
-    for (name, (rmse, psnr)) in &errors {
-        eprintln!("{name:<12} RMSE {rmse:.5} (linear)  PSNR {psnr:.2} dB");
+    for (name, (rmse, psnr), inside) in &errors {
+        eprintln!("{name:<12} RMSE {rmse:.5} (linear)  PSNR {psnr:.2} dB  RMSE 3 px inside the silhouette {inside:.5}");
     }
-    let e = |name: &str| errors.iter().find(|(n, _)| *n == name).unwrap().1 .0;
+    let e = |name: &str| errors.iter().find(|(n, ..)| *n == name).unwrap().1 .0;
+    let e_inside = |name: &str| errors.iter().find(|(n, ..)| *n == name).unwrap().2;
     assert!(e("ts 1024") < e("ts 256"), "TS does not converge with the map size");
     assert!(-20.0 * e("ts 1024").log10() > 55.0, "TS 1024 vs 2048: {}", e("ts 1024"));
     for ss in ["none", "ss-jittered", "ss-full", "separable"] {
         assert!(e("ts 1024") < e(ss), "TS 1024 ({}) must be closer than {ss} ({})", e("ts 1024"), e(ss));
     }
-    assert!(e("ss-jittered") < e("none"), "SS Jittered {} vs none {}", e("ss-jittered"), e("none"));
+    // Over the whole head SS Jittered (0.00326) and no SSS (0.00332) are within the 0.0013 floor of
+    // `ts_without_diffusion_is_the_no_sss_frame`; away from the silhouette the physically scaled taps are clearly
+    // closer.
+    let (j, n) = (e_inside("ss-jittered"), e_inside("none"));
+    assert!(j < 0.8 * n, "inside the silhouette: SS Jittered {j} vs none {n}");
 }
 
 /// The requirement "SS Full closer than SS Jittered and no SSS" does not hold with rtbake's SS Full: see
