@@ -222,6 +222,7 @@ pub fn render_with(
             normals: vec![[0.0, 0.0, 1.0]; n],
         };
         let mut shaded = vec![false; n];
+        #[allow(clippy::needless_range_loop)] // t indexes the UV map and the texel frame alike
         for t in 0..n {
             if !uv.covered[t] {
                 continue;
@@ -372,7 +373,7 @@ impl TextureSpaceDiffusion {
         uvs: &[[f32; 2]],
     ) -> Result<Vec<[f32; 4]>, RuntimeError> {
         let map_bytes = size as u64 * size as u64 * 16;
-        let limit = device.limits().max_storage_buffer_binding_size as u64;
+        let limit = device.limits().max_storage_buffer_binding_size;
         if map_bytes > limit {
             return Err(InvalidInput::new(
                 "--ts-map-size",
@@ -427,7 +428,10 @@ impl TextureSpaceDiffusion {
             }
         }
         let count = uvs.len() as u32;
-        let uv_buf = storage("ts uvs", bytemuck::cast_slice(uvs));
+        // A head with no visible pixel still has its maps blurred (as d'Eon's shader); its uv list is padded to one
+        // entry because wgpu refuses empty bindings.
+        let padded: Vec<[f32; 2]> = if uvs.is_empty() { vec![[0.0; 2]] } else { uvs.to_vec() };
+        let uv_buf = storage("ts uvs", bytemuck::cast_slice(&padded));
         let out_bytes = (uvs.len() as u64 * 16).max(16);
         let out = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ts gathered"),

@@ -23,9 +23,30 @@ fn srgb_to_linear(v: u8) -> f64 {
 
 /// RMSE in linear light over the reference's skin pixels (RGB), and the PSNR (peak 1).
 fn rmse_psnr(img: &[u8], reference: &[u8]) -> (f64, f64) {
+    let mask: Vec<bool> = reference.chunks(4).map(|r| r[..3] != BACKGROUND).collect();
+    rmse_psnr_over(img, reference, &mask)
+}
+
+/// Skin pixels of a `w`-wide `reference` at least `r` pixels (Chebyshev) from any background pixel.
+fn interior(reference: &[u8], w: usize, r: usize) -> Vec<bool> {
+    let h = reference.len() / 4 / w;
+    let skin = |x: usize, y: usize| reference[4 * (y * w + x)..4 * (y * w + x) + 3] != BACKGROUND;
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            x >= r
+                && y >= r
+                && x + r < w
+                && y + r < h
+                && (y - r..=y + r).all(|yy| (x - r..=x + r).all(|xx| skin(xx, yy)))
+        })
+        .collect()
+}
+
+fn rmse_psnr_over(img: &[u8], reference: &[u8], mask: &[bool]) -> (f64, f64) {
     let (mut se, mut n) = (0.0, 0usize);
-    for (p, r) in img.chunks(4).zip(reference.chunks(4)) {
-        if r[..3] == BACKGROUND {
+    for ((p, r), &m) in img.chunks(4).zip(reference.chunks(4)).zip(mask) {
+        if !m {
             continue;
         }
         for c in 0..3 {
@@ -99,10 +120,49 @@ fn ts_chain_gpu_and_cpu_agree() {
     eprintln!("GPU vs CPU chain: {:.4} of channels within 1/255", exact as f64 / a.len() as f64);
 }
 
+/// Heads entirely outside the frame still have their maps blurred (nothing to gather: an empty uv list) on the
+/// GPU, and the frame matches the CPU twin.
+#[test]
+fn heads_outside_the_frame_render_on_both_paths() {
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let ts = TsSettings { map_size: 64, ..Default::default() };
+    let s = settings(SkinShader::Ts(ts), 5, 0.3, 96, 54);
+    let head = default_head();
+    let (a, stats) = texture_space::render(Some(&g), &head, &s, ts, &assets).unwrap();
+    assert!(stats.heads.iter().any(|h| h.pixels == 0) && stats.heads.iter().any(|h| h.pixels > 0), "{stats:?}");
+    let (b, _) = texture_space::render(None, &head, &s, ts, &assets).unwrap();
+    let close = a.data.iter().zip(&b.data).filter(|(x, y)| x.abs_diff(**y) <= 2).count();
+    assert!(close as f64 >= 0.99 * a.data.len() as f64, "{close} of {}", a.data.len());
+}
+
+/// The comparison is fair: with the Gaussians shrunk to 0.1 µm, TS (2048² map) reproduces the no-SSS frame within
+/// RMSE 0.003 — its texels are lit as the screen-space shaders' pixels, only the diffusion differs.
+#[test]
+fn ts_without_diffusion_is_the_no_sss_frame() {
+    let g = gpu();
+    let mut assets = DemoAssets::load(&baked_dir()).unwrap();
+    let head = default_head();
+    let none = render(Some(&g), &head, &settings(SkinShader::None, 1, 0.6, 320, 180), &assets).unwrap().data;
+    for s in assets.blurs.incremental_sigma_mm.iter_mut() {
+        *s = 1e-4;
+    }
+    let ts = SkinShader::Ts(TsSettings { map_size: 2048, ..Default::default() });
+    let sharp = render(Some(&g), &head, &settings(ts, 1, 0.6, 320, 180), &assets).unwrap().data;
+    let (rmse, psnr) = rmse_psnr(&sharp, &none);
+    eprintln!("TS with no diffusion vs no SSS: RMSE {rmse:.5} PSNR {psnr:.1} dB");
+    // Measured 0.0023 (52.9 dB), spread thinly over the skin: the G-buffer's f16 uv (2⁻¹¹ steps) against the texel
+    // centres where the map samples H0, bilinear gathering of the lit irradiance, and the transmitted light, which
+    // the map holds with the shadow map's thickness at each texel's surface point and the pixel at its own (the
+    // 6 mm ears change T(s) quickly). A missing light term or a different albedo would be ≥ 0.01.
+    assert!(rmse < 0.003, "RMSE {rmse}");
+}
+
 /// Error of every shader against the converged reference (TS, 2048² map, no optimisation), 320×180, one head at
 /// 0.6 m. The reference is converged: TS at 1024² is within PSNR 55 dB of it and closer than TS at 256². TS at the
-/// default map is closer than every screen-space shader, and SS Full — with TAP 2009's α = 11, β = 800 and with α
-/// at the physical scale — is closer than SS Jittered and no SSS (issue 14).
+/// default map is closer than every screen-space shader; SS Full — with TAP 2009's α = 11, β = 800 and with α at
+/// the physical scale — is closer than SS Jittered and no SSS (issue 14); and, 3 pixels or more inside the
+/// silhouette, the physically scaled SS Jittered (taps in mm) is closer than no SSS.
 #[test]
 fn error_of_each_shader_against_a_converged_ts_reference() {
     let g = gpu();
@@ -114,7 +174,8 @@ fn error_of_each_shader_against_a_converged_ts_reference() {
     };
     let ts_at = |map_size| SkinShader::Ts(TsSettings { map_size, ..Default::default() });
     let reference = img(ts_at(2048), StretchPreset::Thesis);
-    let errors: Vec<(&str, (f64, f64))> = [
+    let inner = interior(&reference, 320, 3);
+    let errors: Vec<(&str, (f64, f64), f64)> = [
         ("none", SkinShader::None, StretchPreset::Thesis),
         ("ss-jittered", SkinShader::SsJittered, StretchPreset::Thesis),
         ("ss-full", SkinShader::SsFull, StretchPreset::Thesis),
@@ -125,12 +186,16 @@ fn error_of_each_shader_against_a_converged_ts_reference() {
         ("ts 256", ts_at(256), StretchPreset::Thesis),
     ]
     .into_iter()
-    .map(|(name, shader, stretch)| (name, rmse_psnr(&img(shader, stretch), &reference)))
+    .map(|(name, shader, stretch)| {
+        let i = img(shader, stretch);
+        (name, rmse_psnr(&i, &reference), rmse_psnr_over(&i, &reference, &inner).0)
+    })
     .collect();
-    for (name, (rmse, psnr)) in &errors {
-        eprintln!("{name:<12} RMSE {rmse:.5} (linear)  PSNR {psnr:.2} dB");
+    for (name, (rmse, psnr), inside) in &errors {
+        eprintln!("{name:<12} RMSE {rmse:.5} (linear)  PSNR {psnr:.2} dB  RMSE 3 px inside the silhouette {inside:.5}");
     }
-    let e = |name: &str| errors.iter().find(|(n, _)| *n == name).unwrap().1 .0;
+    let e = |name: &str| errors.iter().find(|(n, ..)| *n == name).unwrap().1 .0;
+    let e_inside = |name: &str| errors.iter().find(|(n, ..)| *n == name).unwrap().2;
     assert!(e("ts 1024") < e("ts 256"), "TS does not converge with the map size");
     assert!(-20.0 * e("ts 1024").log10() > 55.0, "TS 1024 vs 2048: {}", e("ts 1024"));
     for ss in ["none", "ss-jittered", "ss-full", "separable"] {
@@ -145,6 +210,11 @@ fn error_of_each_shader_against_a_converged_ts_reference() {
             assert!(e(full) < e(other), "{full} ({}) must be closer than {other} ({})", e(full), e(other));
         }
     }
+    // Over the whole head SS Jittered and no SSS are close to the floor of
+    // `ts_without_diffusion_is_the_no_sss_frame`; away from the silhouette the physically scaled taps are clearly
+    // closer.
+    let (j, n) = (e_inside("ss-jittered"), e_inside("none"));
+    assert!(j < n, "inside the silhouette: SS Jittered {j} vs none {n}");
 }
 
 /// Each ch. 3 optimisation against the unoptimised TS (512² map, 320×180): three heads at 0.45 m (the outer ones
