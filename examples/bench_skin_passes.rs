@@ -86,7 +86,7 @@ fn main() {
         cell(time(|| drop(wrinkled_normals_for(g, &gb, &maps, &zones).unwrap())))
     );
     let bp = BloomParams::default();
-    println!("{:<34} {}", "bloom (3 Gaussians, 2 stages)", cell(time(|| drop(bloom_for(g, w, h, &hdr, &bp).unwrap()))));
+    println!("{:<34} {}", "bloom (3 Gaussians, 3 stages)", cell(time(|| drop(bloom_for(g, w, h, &hdr, &bp).unwrap()))));
     let frame = |p: &SkinPasses| time(|| drop(render_with(g, &head, &s, p, &assets).unwrap()));
     let none = frame(&SkinPasses { bloom: None, ..Default::default() });
     let defaults = frame(&SkinPasses::default());

@@ -110,7 +110,7 @@ pub struct SkinArgs {
     #[arg(long, value_name = "WEIGHTS")]
     wrinkles: Option<String>,
     /// Bloom on the HDR frame before tone mapping (thesis ch. 4): threshold 1.0, weight 0.25, three Gaussians of
-    /// 0.25 %, 0.8 % and 2.5 % of the frame height mixed 0.5/0.3/0.2 (`rtbake::runtime::bloom`).
+    /// 0.25 %, 0.6 % and 1.2 % of the frame height mixed 0.5/0.3/0.2 (`rtbake::runtime::bloom`).
     #[arg(long, value_enum, default_value = "on")]
     bloom: OnOff,
     /// Samples per pixel of the mesh G-buffer: 1 or 4 (MSAA, the standard 4× pattern; edges blended by coverage).

@@ -15,11 +15,13 @@
 //! normalised to 1 over its taps, so Σ out = Σ I away from the image border (taps beyond the border read 0, so
 //! light blurred off the frame leaves it). Parameters ([`BloomParams::default`], chosen here, not from the
 //! papers, for a 720-line frame of heads under a 1.6 key light; the radii scale with the frame height): threshold
-//! 1.0 (the tone map `1 − e^−L` puts L = 1 at 63 % white), weight 0.25, σ = 0.25 %, 0.8 % and 2.5 % of the frame
-//! height (1.8, 5.8 and 18 pixels at 720 lines) mixed 0.5, 0.3, 0.2; taps to ⌈3σ⌉.
+//! 1.0 (the tone map `1 − e^−L` puts L = 1 at 63 % white), weight 0.25, σ = 0.25 %, 0.6 % and 1.2 % of the frame
+//! height (1.8, 4.3 and 8.6 pixels at 720 lines) mixed 0.5, 0.3, 0.2; taps to ⌈3σ⌉ (13 + 27 + 53 taps per axis
+//! at 720 lines).
 //!
-//! Two compute stages over flat f32 buffers (`shaders/bloom.wgsl`: the three horizontal blurs, then the vertical
-//! ones summed and combined); CPU twin [`super::cpu::bloom`].
+//! Three compute stages over flat f32 buffers (`shaders/bloom.wgsl`: B, the three horizontal blurs in one walk
+//! over the widest radius, then the vertical ones summed and combined); CPU twin [`super::cpu::bloom`] (the same
+//! per-blur sums in the same order).
 
 use super::compute_chain::{self, Buffer, Stage};
 use super::RuntimeError;
@@ -43,7 +45,7 @@ pub struct BloomParams {
 
 impl Default for BloomParams {
     fn default() -> Self {
-        BloomParams { threshold: 1.0, weight: 0.25, sigma_of_height: [0.0025, 0.008, 0.025], mix: [0.5, 0.3, 0.2] }
+        BloomParams { threshold: 1.0, weight: 0.25, sigma_of_height: [0.0025, 0.006, 0.012], mix: [0.5, 0.3, 0.2] }
     }
 }
 
@@ -120,8 +122,10 @@ pub fn bloom(
             Buffer::Data(bytemuck::cast_slice(&taps)),
             Buffer::Zeroed(3 * 16 * n as u64),
             Buffer::Zeroed(16 * n as u64),
+            Buffer::Zeroed(16 * n as u64),
         ],
         &[
+            Stage { entry: "bright", groups: compute_chain::groups_8x8(width, height) },
             Stage { entry: "h_blur", groups: compute_chain::groups_8x8(width, height) },
             Stage { entry: "v_blur", groups: compute_chain::groups_8x8(width, height) },
         ],
@@ -157,8 +161,8 @@ mod tests {
             assert!((t.iter().sum::<f32>() - 1.0).abs() < 1e-5);
             assert!(t.len() % 2 == 1);
         }
-        // σ = 18 px at 720 lines: r = ⌈3σ⌉ = 54 (55 with σ's f32 rounding).
-        assert!(k[2].len() == 2 * 54 + 1 || k[2].len() == 2 * 55 + 1, "{}", k[2].len());
+        // σ = 8.64 px at 720 lines: r = ⌈25.92⌉ = 26.
+        assert_eq!(k[2].len(), 2 * 26 + 1);
         assert_eq!(p.kernels(1440)[0].len(), 2 * 11 + 1);
         assert!(BloomParams { weight: 1.5, ..p }.validate().is_err());
         assert!(BloomParams { mix: [0.5, 0.5, 0.5], ..p }.validate().is_err());

@@ -29,7 +29,16 @@ pub struct SkinPasses {
 }
 
 impl Default for SkinPasses {
+    /// `run skin`'s defaults: neutral pose, no wrinkles, bloom on, one sample.
     fn default() -> Self {
-        SkinPasses { rig_pose: None, wrinkles: None, bloom: Some(BloomParams::default()), msaa: 1 }
+        SkinPasses { bloom: Some(BloomParams::default()), ..SkinPasses::none() }
+    }
+}
+
+impl SkinPasses {
+    /// Nothing around the SSS shader: neutral pose, no wrinkles, no bloom, one sample (what
+    /// [`super::skin_render::render`] and the Table III benchmark `bench_skin_heads` measure).
+    pub fn none() -> Self {
+        SkinPasses { rig_pose: None, wrinkles: None, bloom: None, msaa: 1 }
     }
 }

@@ -360,15 +360,15 @@ pub fn jittered_samples() -> Result<ImportanceSamples, InvalidInput> {
     })
 }
 
-/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded) and the default
-/// [`SkinPasses`].
+/// Renders `mesh` as `s` says with the baked tables of `assets` (RGBA8, sRGB-encoded): the SSS shader alone,
+/// [`SkinPasses::none`] (no bloom: `run skin`'s defaults are [`SkinPasses::default`], through [`render_with`]).
 pub fn render(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     assets: &DemoAssets,
 ) -> Result<Image<u8>, RuntimeError> {
-    render_with(gpu, mesh, s, &SkinPasses::default(), assets)
+    render_with(gpu, mesh, s, &SkinPasses::none(), assets)
 }
 
 /// [`render`] with the passes of `passes` (rig pose, …).
