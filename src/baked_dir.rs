@@ -17,7 +17,9 @@
 //!   byte for byte, or within the tolerance the code (not the manifest) gives; it also checks every sha256 and
 //!   reports missing, extra, modified and stale files. Nothing the code can recompute is trusted from the
 //!   manifest: unknown, missing or duplicated asset records, duplicated entries, edited metadata or conventions
-//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps.
+//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps. Like a bake, it runs the
+//!   assets (and reads and hashes the files) side by side; the report is built in manifest order, so it does not
+//!   depend on the thread count. A directory that does not exist is refused before its lock is taken.
 
 use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
@@ -373,13 +375,22 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
             );
         }
     }
-    let mut bytes_of: BTreeMap<String, Vec<u8>> = BTreeMap::new();
-    for entry in &manifest.files {
-        let p = dir.join(&entry.path);
-        match fs::read(&p) {
-            Err(_) => set(&entry.path, FileStatus::Missing, "listed in manifest.json, not on disk".into()),
-            Ok(b) => {
+    // Files are read and hashed side by side; their statuses are set in manifest order below.
+    let read: Vec<Option<(Vec<u8>, String)>> = manifest
+        .files
+        .par_iter()
+        .map(|entry| {
+            fs::read(dir.join(&entry.path)).ok().map(|b| {
                 let sha = sha256_hex(&b);
+                (b, sha)
+            })
+        })
+        .collect();
+    let mut bytes_of: BTreeMap<String, Vec<u8>> = BTreeMap::new();
+    for (entry, read) in manifest.files.iter().zip(read) {
+        match read {
+            None => set(&entry.path, FileStatus::Missing, "listed in manifest.json, not on disk".into()),
+            Some((b, sha)) => {
                 if sha != entry.sha256 || b.len() as u64 != entry.size_bytes {
                     set(
                         &entry.path,
@@ -404,13 +415,18 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
         }
     }
     // Recompute every asset from the recorded parameters; metadata and tolerances come from the recomputation.
+    // The assets are pure and run side by side (as in a bake); their results are compared in manifest order.
     let mut recomputed = BTreeSet::new();
-    for record in &manifest.assets {
-        let Some(asset) = registry.iter().find(|a| a.name == record.name) else { continue };
-        if !recomputed.insert(record.name.as_str()) {
-            continue;
-        }
-        let files = match asset.run(&record.params) {
+    let jobs: Vec<(&crate::manifest::AssetRecord, &Asset)> = manifest
+        .assets
+        .iter()
+        .filter_map(|record| registry.iter().find(|a| a.name == record.name).map(|asset| (record, asset)))
+        .filter(|(record, _)| recomputed.insert(record.name.as_str()))
+        .collect();
+    let results: Vec<Result<Vec<BakedFile>, BakeError>> =
+        jobs.par_iter().map(|(record, asset)| asset.run(&record.params)).collect();
+    for ((record, _), result) in jobs.iter().zip(results) {
+        let files = match result {
             Ok(f) => f,
             Err(err) => {
                 for e in manifest.files.iter().filter(|e| e.asset == record.name) {
