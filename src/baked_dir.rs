@@ -693,6 +693,47 @@ mod tests {
     }
 
     #[test]
+    fn verify_report_is_the_same_for_any_thread_count() {
+        // Two assets (so they run side by side), one file missing, one modified, one stale recomputation.
+        let t = tempfile::tempdir().unwrap();
+        let dir = t.path().join("baked");
+        let mut reg = registry();
+        reg.push(Asset {
+            name: "ramp2",
+            summary: "test",
+            default_params: || serde_json::json!({"size": 5}),
+            bake: |v| {
+                let files = ramp(v)?;
+                Ok(files
+                    .into_iter()
+                    .map(|mut f| {
+                        f.path = f.path.replace("test/", "test2/");
+                        f
+                    })
+                    .collect())
+            },
+        });
+        bake_into(&dir, &[(&reg[0], (reg[0].default_params)()), (&reg[1], (reg[1].default_params)())]).unwrap();
+        fs::remove_file(dir.join("test/ramp.dds")).unwrap();
+        let p = dir.join("test2/ramp.bin");
+        let mut b = fs::read(&p).unwrap();
+        b[3] ^= 0x10;
+        fs::write(&p, b).unwrap();
+        let mut m = Manifest::load(&dir).unwrap();
+        m.assets[0].params = serde_json::json!({"size": 9});
+        fs::write(dir.join(MANIFEST_NAME), m.to_text()).unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| verify(&dir, &reg).unwrap())
+        };
+        let one = run(1);
+        assert!(one.problems >= 3, "{one:?}");
+        for threads in [2, 3] {
+            assert_eq!(run(threads), one, "{threads} threads");
+        }
+    }
+
+    #[test]
     fn corrupted_manifest_is_an_error() {
         let t = tempfile::tempdir().unwrap();
         let dir = t.path().join("baked");
