@@ -17,7 +17,9 @@
 //!   byte for byte, or within the tolerance the code (not the manifest) gives; it also checks every sha256 and
 //!   reports missing, extra, modified and stale files. Nothing the code can recompute is trusted from the
 //!   manifest: unknown, missing or duplicated asset records, duplicated entries, edited metadata or conventions
-//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps.
+//!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps. Like a bake, it runs the
+//!   assets (and reads and hashes the files) side by side; the report is built in manifest order, so it does not
+//!   depend on the thread count. A directory that does not exist is refused before its lock is taken.
 
 use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
@@ -373,13 +375,22 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
             );
         }
     }
-    let mut bytes_of: BTreeMap<String, Vec<u8>> = BTreeMap::new();
-    for entry in &manifest.files {
-        let p = dir.join(&entry.path);
-        match fs::read(&p) {
-            Err(_) => set(&entry.path, FileStatus::Missing, "listed in manifest.json, not on disk".into()),
-            Ok(b) => {
+    // Files are read and hashed side by side; their statuses are set in manifest order below.
+    let read: Vec<Option<(Vec<u8>, String)>> = manifest
+        .files
+        .par_iter()
+        .map(|entry| {
+            fs::read(dir.join(&entry.path)).ok().map(|b| {
                 let sha = sha256_hex(&b);
+                (b, sha)
+            })
+        })
+        .collect();
+    let mut bytes_of: BTreeMap<String, Vec<u8>> = BTreeMap::new();
+    for (entry, read) in manifest.files.iter().zip(read) {
+        match read {
+            None => set(&entry.path, FileStatus::Missing, "listed in manifest.json, not on disk".into()),
+            Some((b, sha)) => {
                 if sha != entry.sha256 || b.len() as u64 != entry.size_bytes {
                     set(
                         &entry.path,
@@ -404,13 +415,18 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
         }
     }
     // Recompute every asset from the recorded parameters; metadata and tolerances come from the recomputation.
+    // The assets are pure and run side by side (as in a bake); their results are compared in manifest order.
     let mut recomputed = BTreeSet::new();
-    for record in &manifest.assets {
-        let Some(asset) = registry.iter().find(|a| a.name == record.name) else { continue };
-        if !recomputed.insert(record.name.as_str()) {
-            continue;
-        }
-        let files = match asset.run(&record.params) {
+    let jobs: Vec<(&crate::manifest::AssetRecord, &Asset)> = manifest
+        .assets
+        .iter()
+        .filter_map(|record| registry.iter().find(|a| a.name == record.name).map(|asset| (record, asset)))
+        .filter(|(record, _)| recomputed.insert(record.name.as_str()))
+        .collect();
+    let results: Vec<Result<Vec<BakedFile>, BakeError>> =
+        jobs.par_iter().map(|(record, asset)| asset.run(&record.params)).collect();
+    for ((record, _), result) in jobs.iter().zip(results) {
+        let files = match result {
             Ok(f) => f,
             Err(err) => {
                 for e in manifest.files.iter().filter(|e| e.asset == record.name) {
@@ -678,6 +694,47 @@ mod tests {
         assert_eq!(status("test/stray.txt"), Some(FileStatus::Extra));
         assert_eq!(status("test/ramp.bin"), Some(FileStatus::Stale));
         assert!(!r.is_ok());
+    }
+
+    #[test]
+    fn verify_report_is_the_same_for_any_thread_count() {
+        // Two assets (so they run side by side), one file missing, one modified, one stale recomputation.
+        let t = tempfile::tempdir().unwrap();
+        let dir = t.path().join("baked");
+        let mut reg = registry();
+        reg.push(Asset {
+            name: "ramp2",
+            summary: "test",
+            default_params: || serde_json::json!({"size": 5}),
+            bake: |v| {
+                let files = ramp(v)?;
+                Ok(files
+                    .into_iter()
+                    .map(|mut f| {
+                        f.path = f.path.replace("test/", "test2/");
+                        f
+                    })
+                    .collect())
+            },
+        });
+        bake_into(&dir, &[(&reg[0], (reg[0].default_params)()), (&reg[1], (reg[1].default_params)())]).unwrap();
+        fs::remove_file(dir.join("test/ramp.dds")).unwrap();
+        let p = dir.join("test2/ramp.bin");
+        let mut b = fs::read(&p).unwrap();
+        b[3] ^= 0x10;
+        fs::write(&p, b).unwrap();
+        let mut m = Manifest::load(&dir).unwrap();
+        m.assets[0].params = serde_json::json!({"size": 9});
+        fs::write(dir.join(MANIFEST_NAME), m.to_text()).unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| verify(&dir, &reg).unwrap())
+        };
+        let one = run(1);
+        assert!(one.problems >= 3, "{one:?}");
+        for threads in [2, 3] {
+            assert_eq!(run(threads), one, "{threads} threads");
+        }
     }
 
     #[test]
