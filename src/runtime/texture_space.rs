@@ -137,7 +137,7 @@ impl TsStats {
 }
 
 /// Renders `mesh` (repeated `s.heads` times) with texture-space diffusion (RGBA8, sRGB-encoded) and the work done,
-/// with the default [`SkinPasses`].
+/// with no extra pass ([`SkinPasses::none`], as `skin_render::render`).
 pub fn render(
     gpu: Option<&Gpu>,
     mesh: &Mesh,
@@ -145,7 +145,7 @@ pub fn render(
     ts: TsSettings,
     assets: &DemoAssets,
 ) -> Result<(Image<u8>, TsStats), RuntimeError> {
-    render_with(gpu, mesh, s, ts, &SkinPasses::default(), assets)
+    render_with(gpu, mesh, s, ts, &SkinPasses::none(), assets)
 }
 
 /// [`render`] with the passes of `passes` (rig pose, wrinkles and MSAA of the G-buffer, bloom), as
