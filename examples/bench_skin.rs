@@ -27,8 +27,9 @@
 //! cubics), 17 % glibc `expm1`/`sinh`/`exp` of the exact series in the set-up (epidermis tables and dermis rows),
 //! the rest the series' own arithmetic. Measured under load 5–7.5 (three other engineers building), 2 threads,
 //! 5 alternations of 9 runs with the previous build (same table bits): process CPU time of the table 50–54 ms
-//! (medians) vs 65–83 ms, wall medians 76–126 ms vs 115–189 ms; one thread 51–53 ms CPU. The idle wall figure
-//! against the 30 ms goal is for the lead to take (CPU/2 ≈ 25–27 ms suggests it is met).
+//! (medians) vs 65–83 ms, wall medians 76–126 ms vs 115–189 ms; one thread 51–53 ms CPU. At load 1.6–2.8: wall
+//! medians 26.8–32.6 ms vs 30.9–39.1 ms; this example 29.3 ms in one run, 38.3 ms in another. The idle wall figure
+//! against the 30 ms goal is for the lead to take.
 
 use rtbake::bake::skin::skin_color_lut_files;
 use rtbake::skin_color::lut::{bake_lut, LutEvaluation};

@@ -171,6 +171,7 @@ pub fn mlaa_area_map_with_progress(
     const BAND_ROWS: usize = 64;
     let edge = validate(version, n)?;
     let mut img = Image::<u8>::new(edge, edge, 2);
+    advise_huge_pages(&img.data);
     let dist = |i: u32| if version == MlaaVersion::V2 { i * i } else { i };
     // The halves of every distance pair (i, j), row j = right distance: N² area evaluations instead of 16 N².
     let halves: Vec<(u8, u8)> = (0..n * n).into_par_iter().map(|k| half_bytes(dist(k % n), dist(k / n))).collect();
@@ -198,6 +199,26 @@ pub fn mlaa_area_map_with_progress(
         progress(((y0 + BAND_ROWS) as u32).min(edge), edge);
     }
     Ok(img)
+}
+
+/// Asks the kernel to back a large, not yet touched buffer with transparent huge pages (Linux `madvise`
+/// `MADV_HUGEPAGE`, honoured where THP is in `madvise` mode): the rows' first writes then fault in 2 MiB pages
+/// instead of 4 KiB ones (AreaMap513's 13 MB map: about 7 faults instead of 3200, which took most of the generator's
+/// time in a fresh process). A hint only: the bytes are the same whether or not it is taken.
+fn advise_huge_pages(buf: &[u8]) {
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let start = buf.as_ptr() as usize;
+        let (lo, hi) = (start.next_multiple_of(HUGE), (start + buf.len()) / HUGE * HUGE);
+        if hi > lo {
+            // SAFETY: [lo, hi) lies inside `buf`'s allocation; MADV_HUGEPAGE only changes how the kernel backs
+            // those pages (their contents stay), and a failure is ignored.
+            unsafe { libc::madvise(lo as *mut libc::c_void, hi - lo, libc::MADV_HUGEPAGE) };
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = buf;
 }
 
 #[cfg(test)]
