@@ -19,7 +19,8 @@
 //!   manifest: unknown, missing or duplicated asset records, duplicated entries, edited metadata or conventions
 //!   are `Tampered`. `--pin` compares the manifest's sha256 with one the pipeline keeps. Like a bake, it runs the
 //!   assets (and reads and hashes the files) side by side; the report is built in manifest order, so it does not
-//!   depend on the thread count. A directory that does not exist is refused before its lock is taken.
+//!   depend on the thread count. A directory that does not exist, with no bake creating it or killed swapping it,
+//!   is refused before its lock is taken.
 
 use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io::file_set::{self, DirLock, FileSetError, LockMode, Wait};
@@ -289,9 +290,9 @@ pub fn verify_with(
     pin: Option<&str>,
     wait: &Wait,
 ) -> Result<VerifyReport, BakeDirError> {
-    // Before the lock: the lock file lives beside the directory, and verifying a directory that is not there must
-    // leave nothing behind in its parent.
-    if !dir.is_dir() {
+    // Before the lock: the lock file lives beside the directory, and verifying a directory that is not there (and
+    // that no bake is creating or was killed swapping) must leave nothing behind in its parent.
+    if file_set::absent_without_trace(dir) || (dir.exists() && !dir.is_dir()) {
         return Err(BakeDirError::Unusable {
             path: dir.display().to_string(),
             detail: if dir.exists() { "is not a directory" } else { "does not exist" }.into(),

@@ -116,6 +116,25 @@ pub fn lock_path(dir: &Path) -> PathBuf {
     dir.with_file_name(format!(".{}.rtbake-lock", dir_name(dir)))
 }
 
+/// True when `dir` does not exist and nothing of rtbake's is beside it (no lock file, no staging or swapped-out
+/// directory): a command that only reads it may refuse it at once, before creating a lock file in its parent.
+/// While a bake creates `dir`, or after one was killed mid-swap, its lock or staging files are there, and the
+/// reader must take the lock to wait for it or to finish its swap.
+pub fn absent_without_trace(dir: &Path) -> bool {
+    if dir.exists() {
+        return false;
+    }
+    let prefix = format!(".{}.rtbake-", dir_name(dir));
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match std::fs::read_dir(parent) {
+        Ok(entries) => !entries.flatten().any(|e| e.file_name().to_string_lossy().starts_with(&prefix)),
+        Err(_) => true,
+    }
+}
+
 /// True for names rtbake uses for its own transient files inside a directory (never user files).
 pub fn is_internal_name(rel: &str) -> bool {
     let name = rel.rsplit('/').next().unwrap_or(rel);
