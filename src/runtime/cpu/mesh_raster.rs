@@ -10,6 +10,52 @@ use crate::mesh::Mesh;
 use crate::runtime::mesh_raster::{camera_uniform, MeshGBuffer};
 use nalgebra::{Matrix4, Vector4};
 
+/// A vertex projected to the screen (pixels, y down) with the attributes the rasterisers interpolate.
+struct V {
+    x: f32,
+    y: f32,
+    z: f32,
+    inv_w: f32,
+    n: [f32; 3],
+    depth_mm: f32,
+    uv: [f32; 2],
+    t: [f32; 4],
+}
+
+/// Every vertex of `mesh` seen by `camera` in a `width`×`height` frame, None behind half the near plane (its
+/// triangles are skipped).
+fn project(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> Vec<Option<V>> {
+    let u = camera_uniform(mesh, camera, width, height);
+    let vp = Matrix4::from_column_slice(&u[..16]);
+    let view = Matrix4::from_column_slice(&u[16..32]);
+    let (wf, hf) = (width as f32, height as f32);
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    (0..mesh.positions.len())
+        .map(|i| {
+            let p = mesh.positions[i];
+            let c = vp * Vector4::new(p[0], p[1], p[2], 1.0);
+            if c.w <= camera.near * 0.5 {
+                return None;
+            }
+            let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
+            let n = mesh.normals[i];
+            let nv = view * Vector4::new(n[0], n[1], n[2], 0.0);
+            let tg = tangents[i];
+            let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
+            Some(V {
+                x: (c.x / c.w * 0.5 + 0.5) * wf,
+                y: (0.5 - c.y / c.w * 0.5) * hf,
+                z: c.z / c.w,
+                inv_w: 1.0 / c.w,
+                n: [nv.x, nv.y, nv.z],
+                depth_mm: -pv.z * mesh.mm_per_unit,
+                uv: mesh.uvs[i],
+                t: [tv.x, tv.y, tv.z, tg[3]],
+            })
+        })
+        .collect()
+}
+
 /// The standard 4× sample positions in a pixel (Vulkan's standard sample locations, D3D's standard pattern), from
 /// its top-left corner.
 pub const STANDARD_4X: [[f32; 2]; 4] = [[0.375, 0.125], [0.875, 0.375], [0.125, 0.625], [0.625, 0.875]];
@@ -29,48 +75,13 @@ pub fn rasterise_samples(
     if samples == 1 {
         return Ok(rasterise(mesh, camera, width, height));
     }
-    let u = camera_uniform(mesh, camera, width, height);
-    let vp = Matrix4::from_column_slice(&u[..16]);
-    let view = Matrix4::from_column_slice(&u[16..32]);
-    let (wf, hf) = (width as f32, height as f32);
     let n = (width * height) as usize;
-    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
     let f16 = |v: f32| half::f16::from_f32(v).to_f32();
     // Per sample: depth, and the three targets' RGBA (zero where nothing covers the sample).
     let mut zbuf = vec![1.0f32; 4 * n];
     let mut targets = vec![[[0.0f32; 4]; 3]; 4 * n];
-    struct V {
-        x: f32,
-        y: f32,
-        z: f32,
-        inv_w: f32,
-        n: [f32; 3],
-        depth_mm: f32,
-        uv: [f32; 2],
-        t: [f32; 4],
-    }
-    let vert = |i: u32| -> Option<V> {
-        let p = mesh.positions[i as usize];
-        let c = vp * Vector4::new(p[0], p[1], p[2], 1.0);
-        if c.w <= camera.near * 0.5 {
-            return None;
-        }
-        let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
-        let nn = mesh.normals[i as usize];
-        let nv = view * Vector4::new(nn[0], nn[1], nn[2], 0.0);
-        let tg = tangents[i as usize];
-        let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
-        Some(V {
-            x: (c.x / c.w * 0.5 + 0.5) * wf,
-            y: (0.5 - c.y / c.w * 0.5) * hf,
-            z: c.z / c.w,
-            inv_w: 1.0 / c.w,
-            n: [nv.x, nv.y, nv.z],
-            depth_mm: -pv.z * mesh.mm_per_unit,
-            uv: mesh.uvs[i as usize],
-            t: [tv.x, tv.y, tv.z, tg[3]],
-        })
-    };
+    let verts = project(mesh, camera, width, height);
+    let vert = |i: u32| verts[i as usize].as_ref();
     for t in mesh.indices.chunks_exact(3) {
         let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
         let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
@@ -82,7 +93,7 @@ pub fn rasterise_samples(
         let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
         let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
         let edge = |p: &V, q: &V, x: f32, y: f32| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
-        let bary = |x: f32, y: f32| (edge(&b, &c, x, y) / area, edge(&c, &a, x, y) / area, edge(&a, &b, x, y) / area);
+        let bary = |x: f32, y: f32| (edge(b, c, x, y) / area, edge(c, a, x, y) / area, edge(a, b, x, y) / area);
         for py in y0..y1 {
             for px in x0..x1 {
                 let i = (py * width + px) as usize;
@@ -137,45 +148,10 @@ pub fn rasterise_samples(
 
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer (values rounded to f16 as the GPU stores them).
 pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
-    let u = camera_uniform(mesh, camera, width, height);
-    let vp = Matrix4::from_column_slice(&u[..16]);
-    let view = Matrix4::from_column_slice(&u[16..32]);
-    let (wf, hf) = (width as f32, height as f32);
     let mut g = MeshGBuffer::empty(width, height);
     let mut zbuf = vec![1.0f32; (width * height) as usize];
-    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
-    struct V {
-        x: f32,
-        y: f32,
-        z: f32,
-        inv_w: f32,
-        n: [f32; 3],
-        depth_mm: f32,
-        uv: [f32; 2],
-        t: [f32; 4],
-    }
-    let vert = |i: u32| -> Option<V> {
-        let p = mesh.positions[i as usize];
-        let c = vp * Vector4::new(p[0], p[1], p[2], 1.0);
-        if c.w <= camera.near * 0.5 {
-            return None;
-        }
-        let pv = view * Vector4::new(p[0], p[1], p[2], 1.0);
-        let n = mesh.normals[i as usize];
-        let nv = view * Vector4::new(n[0], n[1], n[2], 0.0);
-        let tg = tangents[i as usize];
-        let tv = view * Vector4::new(tg[0], tg[1], tg[2], 0.0);
-        Some(V {
-            x: (c.x / c.w * 0.5 + 0.5) * wf,
-            y: (0.5 - c.y / c.w * 0.5) * hf,
-            z: c.z / c.w,
-            inv_w: 1.0 / c.w,
-            n: [nv.x, nv.y, nv.z],
-            depth_mm: -pv.z * mesh.mm_per_unit,
-            uv: mesh.uvs[i as usize],
-            t: [tv.x, tv.y, tv.z, tg[3]],
-        })
-    };
+    let verts = project(mesh, camera, width, height);
+    let vert = |i: u32| verts[i as usize].as_ref();
     for t in mesh.indices.chunks_exact(3) {
         let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
         // Counter-clockwise in NDC (y up) is clockwise on screen (y down): signed area < 0 is a front face.
@@ -192,7 +168,7 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
             for px in x0..x1 {
                 let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
                 // Each weight is the signed area opposite a vertex, same sign as `area` inside.
-                let (wa, wb, wc) = (edge(&b, &c, x, y) / area, edge(&c, &a, x, y) / area, edge(&a, &b, x, y) / area);
+                let (wa, wb, wc) = (edge(b, c, x, y) / area, edge(c, a, x, y) / area, edge(a, b, x, y) / area);
                 if wa < 0.0 || wb < 0.0 || wc < 0.0 {
                     continue;
                 }
