@@ -56,6 +56,77 @@ fn project(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> Vec<Option<
         .collect()
 }
 
+/// A front-facing triangle of projected vertices with its pixel bounding box.
+struct Tri<'a> {
+    v: [&'a V; 3],
+    area: f32,
+    x: std::ops::Range<u32>,
+    y: std::ops::Range<u32>,
+}
+
+/// The attributes of a fragment, interpolated perspective-correctly, before rounding.
+struct Fragment {
+    /// Unit view-space normal.
+    normal: [f32; 3],
+    depth_mm: f32,
+    uv: [f32; 2],
+    tangent: [f32; 4],
+}
+
+impl Tri<'_> {
+    /// The triangles of `mesh` in index order whose three vertices were projected, front faces only (counter-
+    /// clockwise in NDC, y up, is clockwise on screen, y down: signed area < 0), clipped to the frame.
+    fn front_faces<'a>(
+        mesh: &'a Mesh,
+        verts: &'a [Option<V>],
+        width: u32,
+        height: u32,
+    ) -> impl Iterator<Item = Tri<'a>> {
+        mesh.indices.chunks_exact(3).filter_map(move |t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| verts[i as usize].as_ref());
+            let (a, b, c) = (a?, b?, c?);
+            let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+            if area.is_nan() || area >= 0.0 {
+                return None;
+            }
+            let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
+            let x1 = (a.x.max(b.x).max(c.x).ceil() as i64).clamp(0, width as i64) as u32;
+            let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
+            let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
+            Some(Tri { v: [a, b, c], area, x: x0..x1, y: y0..y1 })
+        })
+    }
+
+    /// Screen-space barycentrics at (x, y): each the signed area opposite a vertex, all ≥ 0 inside.
+    fn bary(&self, x: f32, y: f32) -> [f32; 3] {
+        let edge = |p: &V, q: &V| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
+        let [a, b, c] = self.v;
+        [edge(b, c) / self.area, edge(c, a) / self.area, edge(a, b) / self.area]
+    }
+
+    /// Depth (NDC z) at barycentrics `w`, linear in screen space.
+    fn z(&self, w: [f32; 3]) -> f32 {
+        let [a, b, c] = self.v;
+        w[0] * a.z + w[1] * b.z + w[2] * c.z
+    }
+
+    /// The attributes at screen barycentrics `w` (divided by clip w), the normal renormalised.
+    fn fragment(&self, w: [f32; 3]) -> Fragment {
+        let [a, b, c] = self.v;
+        let (pa, pb, pc) = (w[0] * a.inv_w, w[1] * b.inv_w, w[2] * c.inv_w);
+        let s = 1.0 / (pa + pb + pc);
+        let lerp = |fa: f32, fb: f32, fc: f32| (pa * fa + pb * fb + pc * fc) * s;
+        let n: [f32; 3] = std::array::from_fn(|k| lerp(a.n[k], b.n[k], c.n[k]));
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        Fragment {
+            normal: n.map(|v| v / l),
+            depth_mm: lerp(a.depth_mm, b.depth_mm, c.depth_mm),
+            uv: [lerp(a.uv[0], b.uv[0], c.uv[0]), lerp(a.uv[1], b.uv[1], c.uv[1])],
+            tangent: std::array::from_fn(|k| lerp(a.t[k], b.t[k], c.t[k])),
+        }
+    }
+}
+
 /// The standard 4× sample positions in a pixel (Vulkan's standard sample locations, D3D's standard pattern), from
 /// its top-left corner.
 pub const STANDARD_4X: [[f32; 2]; 4] = [[0.375, 0.125], [0.875, 0.375], [0.125, 0.625], [0.625, 0.875]];
@@ -81,29 +152,17 @@ pub fn rasterise_samples(
     let mut zbuf = vec![1.0f32; 4 * n];
     let mut targets = vec![[[0.0f32; 4]; 3]; 4 * n];
     let verts = project(mesh, camera, width, height);
-    let vert = |i: u32| verts[i as usize].as_ref();
-    for t in mesh.indices.chunks_exact(3) {
-        let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
-        let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-        if area.is_nan() || area >= 0.0 {
-            continue;
-        }
-        let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
-        let x1 = (a.x.max(b.x).max(c.x).ceil() as i64).clamp(0, width as i64) as u32;
-        let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
-        let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
-        let edge = |p: &V, q: &V, x: f32, y: f32| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
-        let bary = |x: f32, y: f32| (edge(b, c, x, y) / area, edge(c, a, x, y) / area, edge(a, b, x, y) / area);
-        for py in y0..y1 {
-            for px in x0..x1 {
+    for tri in Tri::front_faces(mesh, &verts, width, height) {
+        for py in tri.y.clone() {
+            for px in tri.x.clone() {
                 let i = (py * width + px) as usize;
                 let mut pass = [false; 4];
                 for (k, sp) in STANDARD_4X.iter().enumerate() {
-                    let (wa, wb, wc) = bary(px as f32 + sp[0], py as f32 + sp[1]);
-                    if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                    let w = tri.bary(px as f32 + sp[0], py as f32 + sp[1]);
+                    if w.iter().any(|&v| v < 0.0) {
                         continue;
                     }
-                    let z = wa * a.z + wb * b.z + wc * c.z;
+                    let z = tri.z(w);
                     if z.is_nan() || z >= zbuf[4 * i + k] || z < 0.0 {
                         continue;
                     }
@@ -114,16 +173,11 @@ pub fn rasterise_samples(
                     continue;
                 }
                 // One fragment per pixel, attributes at the pixel centre (extrapolated when it lies outside).
-                let (wa, wb, wc) = bary(px as f32 + 0.5, py as f32 + 0.5);
-                let (pa, pb, pc) = (wa * a.inv_w, wb * b.inv_w, wc * c.inv_w);
-                let s = 1.0 / (pa + pb + pc);
-                let lerp = |fa: f32, fb: f32, fc: f32| (pa * fa + pb * fb + pc * fc) * s;
-                let nrm: [f32; 3] = std::array::from_fn(|k| lerp(a.n[k], b.n[k], c.n[k]));
-                let l = (nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]).sqrt();
+                let f = tri.fragment(tri.bary(px as f32 + 0.5, py as f32 + 0.5));
                 let out = [
-                    [f16(nrm[0] / l), f16(nrm[1] / l), f16(nrm[2] / l), f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm))],
-                    [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1])), 1.0, 0.0],
-                    std::array::from_fn(|k| f16(lerp(a.t[k], b.t[k], c.t[k]))),
+                    [f16(f.normal[0]), f16(f.normal[1]), f16(f.normal[2]), f16(f.depth_mm)],
+                    [f16(f.uv[0]), f16(f.uv[1]), 1.0, 0.0],
+                    f.tangent.map(f16),
                 ];
                 for k in (0..4).filter(|&k| pass[k]) {
                     targets[4 * i + k] = out;
@@ -151,45 +205,27 @@ pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshG
     let mut g = MeshGBuffer::empty(width, height);
     let mut zbuf = vec![1.0f32; (width * height) as usize];
     let verts = project(mesh, camera, width, height);
-    let vert = |i: u32| verts[i as usize].as_ref();
-    for t in mesh.indices.chunks_exact(3) {
-        let (Some(a), Some(b), Some(c)) = (vert(t[0]), vert(t[1]), vert(t[2])) else { continue };
-        // Counter-clockwise in NDC (y up) is clockwise on screen (y down): signed area < 0 is a front face.
-        let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-        if area.is_nan() || area >= 0.0 {
-            continue;
-        }
-        let x0 = a.x.min(b.x).min(c.x).floor().max(0.0) as u32;
-        let x1 = (a.x.max(b.x).max(c.x).ceil() as i64).clamp(0, width as i64) as u32;
-        let y0 = a.y.min(b.y).min(c.y).floor().max(0.0) as u32;
-        let y1 = (a.y.max(b.y).max(c.y).ceil() as i64).clamp(0, height as i64) as u32;
-        let edge = |p: &V, q: &V, x: f32, y: f32| (q.x - p.x) * (y - p.y) - (x - p.x) * (q.y - p.y);
-        for py in y0..y1 {
-            for px in x0..x1 {
-                let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
-                // Each weight is the signed area opposite a vertex, same sign as `area` inside.
-                let (wa, wb, wc) = (edge(b, c, x, y) / area, edge(c, a, x, y) / area, edge(a, b, x, y) / area);
-                if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+    for tri in Tri::front_faces(mesh, &verts, width, height) {
+        for py in tri.y.clone() {
+            for px in tri.x.clone() {
+                let w = tri.bary(px as f32 + 0.5, py as f32 + 0.5);
+                if w.iter().any(|&v| v < 0.0) {
                     continue;
                 }
-                let z = wa * a.z + wb * b.z + wc * c.z;
+                let z = tri.z(w);
                 let i = (py * width + px) as usize;
                 if z.is_nan() || z >= zbuf[i] || z < 0.0 {
                     continue;
                 }
                 zbuf[i] = z;
-                let (pa, pb, pc) = (wa * a.inv_w, wb * b.inv_w, wc * c.inv_w);
-                let s = 1.0 / (pa + pb + pc);
-                let lerp = |fa: f32, fb: f32, fc: f32| (pa * fa + pb * fb + pc * fc) * s;
-                let n: [f32; 3] = std::array::from_fn(|k| lerp(a.n[k], b.n[k], c.n[k]));
-                let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-                let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+                let f = tri.fragment(w);
                 g.covered[i] = true;
                 g.coverage[i] = 1.0;
-                g.normal_view[i] = n.map(|v| f16(v / l));
-                g.depth_mm[i] = f16(lerp(a.depth_mm, b.depth_mm, c.depth_mm));
-                g.uv[i] = [f16(lerp(a.uv[0], b.uv[0], c.uv[0])), f16(lerp(a.uv[1], b.uv[1], c.uv[1]))];
-                g.tangent_view[i] = std::array::from_fn(|k| f16(lerp(a.t[k], b.t[k], c.t[k])));
+                g.normal_view[i] = f.normal.map(f16);
+                g.depth_mm[i] = f16(f.depth_mm);
+                g.uv[i] = f.uv.map(f16);
+                g.tangent_view[i] = f.tangent.map(f16);
             }
         }
     }
