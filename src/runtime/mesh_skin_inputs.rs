@@ -164,7 +164,7 @@ pub fn hemoglobin_at_uv(
         device,
         queue,
         "mesh skin inputs",
-        include_str!("shaders/mesh_skin_inputs.wgsl"),
+        concat!(include_str!("shaders/bilinear_taps.wgsl"), include_str!("shaders/mesh_skin_inputs.wgsl")),
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),

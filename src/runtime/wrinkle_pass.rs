@@ -96,8 +96,8 @@ impl WrinkleMaps {
     /// Σ_z mask_z(uv)·weight_z at (u, v): where it is 0 the pass leaves the normal as it is.
     pub fn mask_weight_at(&self, u: f32, v: f32, weights: &[f32; 8]) -> f32 {
         let (mw, mh) = self.mask_size;
-        let m1 = super::cpu::mesh_skin_inputs::bilinear(&self.masks[0], mw, mh, u, v);
-        let m2 = super::cpu::mesh_skin_inputs::bilinear(&self.masks[1], mw, mh, u, v);
+        let m1 = super::cpu::bilinear(&self.masks[0], mw, mh, u, v);
+        let m2 = super::cpu::bilinear(&self.masks[1], mw, mh, u, v);
         (0..4).map(|k| m1[k] * weights[k] + m2[k] * weights[4 + k]).sum()
     }
 }
@@ -160,7 +160,7 @@ pub fn wrinkled_normals(
         device,
         queue,
         "wrinkle pass",
-        include_str!("shaders/wrinkle_pass.wgsl"),
+        concat!(include_str!("shaders/bilinear_taps.wgsl"), include_str!("shaders/wrinkle_pass.wgsl")),
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),

@@ -210,6 +210,25 @@ impl Img<'_> {
     }
 }
 
+/// Bilinear, clamp-to-edge read of a row-major `w`×`h` map of `C` channels at normalised (u, v), texel centres at
+/// (i + ½)/size, in f32: the fetches of `shaders/skin_inputs.wgsl` and of `bilinear_taps.wgsl` + `rig_at`/`h0_at`/`pd_at`.
+pub(crate) fn bilinear<const C: usize>(data: &[[f32; C]], w: u32, h: u32, u: f32, v: f32) -> [f32; C] {
+    let (x, y) = (u * w as f32 - 0.5, v * h as f32 - 0.5);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (xi, yi) = (x0 as i32, y0 as i32);
+    let (wm, hm) = (w as i32 - 1, h as i32 - 1);
+    let (i0, i1) = (xi.clamp(0, wm) as usize, (xi + 1).clamp(0, wm) as usize);
+    let (j0, j1) = (yi.clamp(0, hm) as usize, (yi + 1).clamp(0, hm) as usize);
+    let w = w as usize;
+    let (a, b, c, d) = (data[j0 * w + i0], data[j0 * w + i1], data[j1 * w + i0], data[j1 * w + i1]);
+    std::array::from_fn(|k| {
+        let top = a[k] + (b[k] - a[k]) * fx;
+        let bottom = c[k] + (d[k] - c[k]) * fx;
+        top + (bottom - top) * fy
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,28 +2,9 @@
 //! [`crate::runtime::skin_inputs`]). LUTs and rig maps are rounded to f16 as on the GPU; fetches are bilinear
 //! in f32; outputs are rounded to f16.
 
-use super::f16r;
+use super::{bilinear, f16r};
 use crate::runtime::skin_inputs::{RigScaleBiasMaps, SkinFrame, SkinLuts};
 use rayon::prelude::*;
-
-/// Bilinear, clamp-to-edge fetch of `ch` channels at normalised (u, v).
-fn bilinear<const C: usize>(data: &[[f32; C]], w: u32, h: u32, u: f32, v: f32) -> [f32; C] {
-    let x = u * w as f32 - 0.5;
-    let y = v * h as f32 - 0.5;
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let (x0, y0) = (x0 as i32, y0 as i32);
-    let at =
-        |xx: i32, yy: i32| data[yy.clamp(0, h as i32 - 1) as usize * w as usize + xx.clamp(0, w as i32 - 1) as usize];
-    let (a, b, c, d) = (at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1));
-    let mut out = [0.0f32; C];
-    for k in 0..C {
-        let top = a[k] + (b[k] - a[k]) * fx;
-        let bottom = c[k] + (d[k] - c[k]) * fx;
-        out[k] = top + (bottom - top) * fy;
-    }
-    out
-}
 
 fn node(t: f32, n: f32) -> f32 {
     (t.clamp(0.0, 1.0) * (n - 1.0) + 0.5) / n

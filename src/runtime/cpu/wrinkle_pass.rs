@@ -1,7 +1,7 @@
 //! CPU twin of [`crate::runtime::wrinkle_pass`] (`shaders/wrinkle_pass.wgsl`): Listing 8.1 at the mesh's uv with
 //! the same bilinear reads, the same sums in the same order and the same tangent frame.
 
-use super::mesh_skin_inputs::bilinear;
+use super::bilinear;
 use crate::error::InvalidInput;
 use crate::runtime::mesh_raster::MeshGBuffer;
 use crate::runtime::wrinkle_pass::WrinkleMaps;

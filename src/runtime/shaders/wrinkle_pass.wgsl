@@ -24,25 +24,7 @@ struct Params {
 @group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
 
-struct Taps {
-    i: vec4<u32>, // (x0, x1, y0, y1)
-    f: vec2<f32>,
-};
-
-fn taps(u: f32, v: f32, w: f32, h: f32) -> Taps {
-    let x = u * w - 0.5;
-    let y = v * h - 0.5;
-    let x0 = floor(x);
-    let y0 = floor(y);
-    var t: Taps;
-    t.f = vec2<f32>(x - x0, y - y0);
-    let xi = i32(x0);
-    let yi = i32(y0);
-    let wm = i32(w) - 1;
-    let hm = i32(h) - 1;
-    t.i = vec4<u32>(u32(clamp(xi, 0, wm)), u32(clamp(xi + 1, 0, wm)), u32(clamp(yi, 0, hm)), u32(clamp(yi + 1, 0, hm)));
-    return t;
-}
+// `Taps` and `taps` (bilinear texel indices and weights) come from bilinear_taps.wgsl, prepended.
 
 fn pd_at(t: Taps) -> vec2<f32> {
     let w = u32(p.size.z);
