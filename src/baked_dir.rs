@@ -281,6 +281,18 @@ pub fn verify(dir: &Path, registry: &[Asset]) -> Result<VerifyReport, BakeDirErr
     verify_with(dir, registry, None, &Wait::Yes(&|_| {}))
 }
 
+/// Why `dir` cannot be verified before its lock is taken, if it cannot: it is not a directory, or it does not
+/// exist and no bake is creating it or was killed swapping it ([`file_set::absent_without_trace`]).
+pub fn unverifiable(dir: &Path) -> Option<&'static str> {
+    if dir.exists() && !dir.is_dir() {
+        Some("is not a directory")
+    } else if file_set::absent_without_trace(dir) {
+        Some("does not exist")
+    } else {
+        None
+    }
+}
+
 /// [`verify`] with an optional pinned manifest digest (`sha256sum` output or a bare hex digest; see
 /// [`check_pin`]) and a choice of waiting for the directory's lock. The directory is read under a shared lock,
 /// so no bake can swap it in the middle.
@@ -292,11 +304,8 @@ pub fn verify_with(
 ) -> Result<VerifyReport, BakeDirError> {
     // Before the lock: the lock file lives beside the directory, and verifying a directory that is not there (and
     // that no bake is creating or was killed swapping) must leave nothing behind in its parent.
-    if file_set::absent_without_trace(dir) || (dir.exists() && !dir.is_dir()) {
-        return Err(BakeDirError::Unusable {
-            path: dir.display().to_string(),
-            detail: if dir.exists() { "is not a directory" } else { "does not exist" }.into(),
-        });
+    if let Some(detail) = unverifiable(dir) {
+        return Err(BakeDirError::Unusable { path: dir.display().to_string(), detail: detail.into() });
     }
     let mut lock = DirLock::acquire(dir, LockMode::Shared, wait)?;
     if file_set::swap_interrupted(lock.dir()) {

@@ -135,8 +135,7 @@ fn check_out_dir(dir: &Path) -> anyhow::Result<()> {
 pub fn run_verify(a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
     // Refused before the lock is taken (its file would be created beside the missing directory), unless a bake is
     // creating it or was killed swapping it (then verify waits for the lock or finishes the swap).
-    if rtbake::io::file_set::absent_without_trace(&a.dir) || (a.dir.exists() && !a.dir.is_dir()) {
-        let what = if a.dir.exists() { "is not a directory" } else { "does not exist" };
+    if let Some(what) = rtbake::baked_dir::unverifiable(&a.dir) {
         return Err(usage_msg(format!("--dir {}: {what}", a.dir.display())));
     }
     if a.dir.is_dir() && !a.dir.join(rtbake::manifest::MANIFEST_NAME).exists() {
