@@ -134,6 +134,8 @@ fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
         (vec!["--distance", "0"], "--distance"),
         (vec!["--melanin", "-0.1"], "--melanin"),
         (vec!["--mesh-mm-per-unit", "0"], "--mesh-mm-per-unit"),
+        (vec!["--stretch", "wide"], "--stretch"),
+        (vec!["--stretch", ""], "--stretch"),
     ];
     for (args, needle) in cases {
         let mut a = vec!["run", "skin", "--cpu", "--width", "64", "--height", "64", "--output", o];
@@ -144,6 +146,15 @@ fn bad_meshes_and_settings_exit_2_naming_them_and_write_nothing() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!out.exists(), "{args:?} wrote the output");
     }
+    // The spelling `--out` is the same flag: a bad setting through it is refused the same way (nothing
+    // written), a good one writes the frame there.
+    let r = rtbake(&["run", "skin", "--cpu", "--width", "64", "--height", "64", "--out", o, "--heads", "0"]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--heads"));
+    assert!(!out.exists(), "a refused command wrote the output");
+    let r = rtbake(&["run", "skin", "--cpu", "--width", "64", "--height", "64", "--out", o]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert_eq!(image::open(&out).unwrap().to_rgba8().dimensions(), (64, 64));
 }
 
 /// The specular layer (Kelemen/Szirmay-Kalos, added after the SSS pass): zero off the head, and its peak where the
