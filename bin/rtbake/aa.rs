@@ -327,20 +327,16 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let mut files = files;
     a.zstd.apply(&mut files)?;
     prepare_out_dir("--out", &a.out)?;
-    // The sha256 lines are hashed on a second thread while the set is written (the write mostly waits for the
-    // disk flush): same digests, printed only after the write succeeded. Under --quiet without --json nothing
-    // prints them, so they are not computed.
-    let (result, shas) = std::thread::scope(|s| {
-        let hashes = (!ctx.quiet || ctx.json).then(|| {
-            s.spawn(|| {
-                let hex =
-                    |f: &BakedFile| Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
-                files.iter().map(hex).collect::<Vec<String>>()
-            })
-        });
-        let result = crate::cli::write_set(ctx, "--out", &a.out, &files, &[]);
-        (result, hashes.map(|h| h.join().expect("the sha256 thread does not panic")))
-    });
+    // The sha256 lines are hashed while the set is written (the write mostly waits for the page cache and the
+    // disk flush): a rayon task beside the write, so with one thread (`RAYON_NUM_THREADS=1`) the process uses one
+    // core and with two the hash overlaps the write. Same digests, printed only after the write succeeded. Under
+    // --quiet without --json nothing prints them, so they are not computed.
+    let hex = |f: &BakedFile| Sha256::digest(&f.bytes).iter().map(|b| format!("{b:02x}")).collect::<String>();
+    let want_hashes = !ctx.quiet || ctx.json;
+    let (result, shas) = rayon::join(
+        || crate::cli::write_set(ctx, "--out", &a.out, &files, &[]),
+        || want_hashes.then(|| files.iter().map(hex).collect::<Vec<String>>()),
+    );
     result?;
     let Some(shas) = shas else { return Ok(()) };
     let mut written = Vec::new();

@@ -13,12 +13,46 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.rtbake-tmp-{}", std::process::id()))
 }
 
+/// Pieces a large staged file is written in ([`write_with_early_writeback`]).
+const WRITEBACK_PIECE_BYTES: usize = 8 << 20;
+
+/// Writes `bytes` to `f`; a file larger than one [`WRITEBACK_PIECE_BYTES`] piece is written piece by piece, and on
+/// Linux each written piece is handed to the disk at once (`sync_file_range(SYNC_FILE_RANGE_WRITE)`, which starts
+/// the writeback without waiting for it), so the file system's block allocation and the device transfer of the
+/// earlier pieces overlap the copying of the later ones and the final fsync waits only for the tail. Durability is
+/// still the caller's fsync: this only moves work earlier.
+fn write_with_early_writeback(f: &mut fs::File, bytes: &[u8]) -> std::io::Result<()> {
+    if bytes.len() <= WRITEBACK_PIECE_BYTES {
+        return f.write_all(bytes);
+    }
+    let mut offset = 0usize;
+    for piece in bytes.chunks(WRITEBACK_PIECE_BYTES) {
+        f.write_all(piece)?;
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::fd::AsRawFd;
+            // SAFETY: a valid open descriptor; the call reads no memory of ours. Best effort: a file system
+            // that does not support it (EINVAL, ENOSYS, …) is synced by the caller's fsync as before.
+            let _ = unsafe {
+                libc::sync_file_range(
+                    f.as_raw_fd(),
+                    offset as libc::off64_t,
+                    piece.len() as libc::off64_t,
+                    libc::SYNC_FILE_RANGE_WRITE,
+                )
+            };
+        }
+        offset += piece.len();
+    }
+    Ok(())
+}
+
 /// Writes `bytes` to a temporary sibling of `path` and fsyncs it; returns the temp path (not yet renamed).
 pub fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf, IoError> {
     let tmp = temp_path(path);
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
+        write_with_early_writeback(&mut f, bytes)?;
         f.sync_all()
     })();
     match result {
@@ -121,6 +155,16 @@ mod tests {
         assert_eq!(fs::read(&p).unwrap(), b"second");
         let names: Vec<_> = fs::read_dir(dir.path()).unwrap().flatten().map(|e| e.file_name()).collect();
         assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn a_file_written_in_pieces_is_whole() {
+        // Two full pieces and a 1-byte tail, every byte distinct from its neighbours' position mod 251.
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.bin");
+        let bytes: Vec<u8> = (0..2 * WRITEBACK_PIECE_BYTES + 1).map(|i| (i % 251) as u8).collect();
+        write_atomic(&p, &bytes).unwrap();
+        assert!(fs::read(&p).unwrap() == bytes, "the staged pieces reassemble the bytes in order");
     }
 
     #[test]
