@@ -68,7 +68,7 @@ pub fn stage(path: &Path, bytes: &[u8]) -> Result<PathBuf, IoError> {
 /// with one [`sync_batch`] before any rename); returns the temp path.
 pub fn stage_unsynced(path: &Path, bytes: &[u8]) -> Result<PathBuf, IoError> {
     let tmp = temp_path(path);
-    match fs::File::create(&tmp).and_then(|mut f| f.write_all(bytes)) {
+    match fs::File::create(&tmp).and_then(|mut f| write_with_early_writeback(&mut f, bytes)) {
         Ok(()) => Ok(tmp),
         Err(e) => {
             let _ = fs::remove_file(&tmp);
