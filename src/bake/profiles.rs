@@ -30,6 +30,7 @@ use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
 use crate::plot::profile::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::collections::BTreeSet;
@@ -236,46 +237,59 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             .into());
         }
     }
+    // Every profile is independent: built side by side (the Hankel tables, the plots and their PNG compression),
+    // then concatenated in list order, so the files and totals.csv are the same bytes for any thread count and
+    // the first failing profile in list order is the error reported.
+    let per_profile: Vec<Result<(Vec<BakedFile>, String), BakeError>> = list
+        .par_iter()
+        .map(|(stem, title, source, extra)| -> Result<(Vec<BakedFile>, String), BakeError> {
+            let profile = source.build()?;
+            let mut provenance = source.provenance();
+            if let (Value::Object(dst), Value::Object(src)) = (&mut provenance, extra) {
+                for (k, v) in src {
+                    dst.insert(k.clone(), v.clone());
+                }
+            }
+            let t = ProfileTable::compute(profile.as_ref(), &radii, provenance)?;
+            let path = format!("profiles/{stem}");
+            let mut files = vec![
+                text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION),
+                json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION),
+            ];
+            let panels = profile_panels(&t, None, title);
+            let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
+            files.push(BakedFile {
+                path: format!("{path}.svg"),
+                bytes: svg,
+                meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+            });
+            if p.png_plots.iter().any(|s| s == stem) {
+                let mut meta = FileMeta::text("plot", "png", PLOT_CONVENTION);
+                meta.width = PLOT_WIDTH;
+                meta.height = 2 * PANEL_HEIGHT;
+                meta.channels = 3;
+                meta.sample_type = "u8".into();
+                meta.color_space = "srgb".into();
+                files.push(BakedFile {
+                    path: format!("{path}.png"),
+                    bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
+                    meta,
+                });
+            }
+            let r = t.total_reflectance;
+            let tt = t.total_transmittance.map(|v| format!("{:e},{:e},{:e}", v[0], v[1], v[2])).unwrap_or(",,".into());
+            Ok((files, format!("{stem},{:e},{:e},{:e},{tt}\n", r[0], r[1], r[2])))
+        })
+        .collect();
     let mut files = Vec::new();
     let mut totals = String::from(
         "# rtbake diffusion-profiles: totals R^(0) = int 2 pi r R(r) dr and T^(0) (empty where the model has no T)\n\
          profile,total_R_r,total_R_g,total_R_b,total_T_r,total_T_g,total_T_b\n",
     );
-    for (stem, title, source, extra) in &list {
-        let profile = source.build()?;
-        let mut provenance = source.provenance();
-        if let (Value::Object(dst), Value::Object(src)) = (&mut provenance, extra) {
-            for (k, v) in src {
-                dst.insert(k.clone(), v.clone());
-            }
-        }
-        let t = ProfileTable::compute(profile.as_ref(), &radii, provenance)?;
-        let path = format!("profiles/{stem}");
-        files.push(text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION));
-        files.push(json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION));
-        let panels = profile_panels(&t, None, title);
-        let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
-        files.push(BakedFile {
-            path: format!("{path}.svg"),
-            bytes: svg,
-            meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
-        });
-        if p.png_plots.iter().any(|s| s == stem) {
-            let mut meta = FileMeta::text("plot", "png", PLOT_CONVENTION);
-            meta.width = PLOT_WIDTH;
-            meta.height = 2 * PANEL_HEIGHT;
-            meta.channels = 3;
-            meta.sample_type = "u8".into();
-            meta.color_space = "srgb".into();
-            files.push(BakedFile {
-                path: format!("{path}.png"),
-                bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
-                meta,
-            });
-        }
-        let r = t.total_reflectance;
-        let tt = t.total_transmittance.map(|v| format!("{:e},{:e},{:e}", v[0], v[1], v[2])).unwrap_or(",,".into());
-        totals.push_str(&format!("{stem},{:e},{:e},{:e},{tt}\n", r[0], r[1], r[2]));
+    for result in per_profile {
+        let (profile_files, row) = result?;
+        files.extend(profile_files);
+        totals.push_str(&row);
     }
     files.push(text_file(
         "profiles/totals.csv",
