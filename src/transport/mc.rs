@@ -41,8 +41,11 @@
 //! CPU's and the two agree statistically) reads its tallies back and calls it too, so both report means and standard errors the
 //! same way.
 
+use super::lanes::{self, Path};
+#[cfg(test)]
 use super::rng::PhotonRng;
 use super::stack::McStack;
+#[cfg(test)]
 use super::ziggurat::ExponentialZiggurat;
 use crate::error::InvalidInput;
 use rayon::prelude::*;
@@ -62,7 +65,7 @@ pub const MIN_BIN_MM: f64 = 1e-6;
 /// Largest tallied radius (bins × Δr), mm.
 pub const MAX_RADIUS_MM: f64 = 1e4;
 /// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling).
-pub const CHUNK_PHOTONS: u64 = 256;
+pub const CHUNK_PHOTONS: u64 = 1024;
 /// Chunks traced in parallel before their tallies are summed in order.
 pub const WAVE_CHUNKS: usize = 64;
 
@@ -214,29 +217,29 @@ impl Tally {
 
 /// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug)]
-struct Medium {
-    z_top_mm: f64,
-    z_bottom_mm: f64,
-    sigma_t: f64,
+pub(super) struct Medium {
+    pub(super) z_top_mm: f64,
+    pub(super) z_bottom_mm: f64,
+    pub(super) sigma_t: f64,
     /// 1/σt (unused in a clear layer).
-    inv_sigma_t: f64,
+    pub(super) inv_sigma_t: f64,
     /// σa/σt (0 in a clear layer).
-    absorb_fraction: f64,
-    hg: HenyeyGreenstein,
-    eta: f64,
+    pub(super) absorb_fraction: f64,
+    pub(super) hg: HenyeyGreenstein,
+    pub(super) eta: f64,
 }
 
 /// Henyey–Greenstein sampling constants of one g (MCML eq. 3.28):
 /// cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g), cos θ = 2ξ − 1 for |g| < 10⁻⁶.
 #[derive(Clone, Copy, Debug)]
-struct HenyeyGreenstein {
-    isotropic: bool,
+pub(super) struct HenyeyGreenstein {
+    pub(super) isotropic: bool,
     /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
-    one_minus_g2: f64,
-    one_minus_g: f64,
-    two_g: f64,
-    one_plus_g2: f64,
-    inv_two_g: f64,
+    pub(super) one_minus_g2: f64,
+    pub(super) one_minus_g: f64,
+    pub(super) two_g: f64,
+    pub(super) one_plus_g2: f64,
+    pub(super) inv_two_g: f64,
 }
 
 impl HenyeyGreenstein {
@@ -252,6 +255,7 @@ impl HenyeyGreenstein {
     }
 
     /// cos θ from a uniform ξ.
+    #[cfg(test)]
     #[inline]
     fn cos_theta(&self, xi: f64) -> f64 {
         if self.isotropic {
@@ -264,6 +268,7 @@ impl HenyeyGreenstein {
 
 /// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ `[0, 1]`, and the cosine of
 /// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
+#[cfg(test)]
 fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     if n_i == n_t {
         return (0.0, cos_i);
@@ -281,6 +286,7 @@ fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
 /// Rotates direction `u` by polar cos θ and the azimuth (cos φ, sin φ) (MCML eq. 3.30–3.31). sin θ/√(1 − uz²) is
 /// taken as one square root of a quotient, and sin θ·√(1 − uz²) as that times 1 − uz² (the same expressions as
 /// MCML's `Spin`, one square root fewer).
+#[cfg(test)]
 #[inline]
 fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
     let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
@@ -301,18 +307,18 @@ fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
 }
 
 /// What every photon of one channel shares.
-struct Channel<'a> {
-    media: &'a [Medium],
-    eta_above: f64,
-    eta_below: f64,
+pub(super) struct Channel<'a> {
+    pub(super) media: &'a [Medium],
+    pub(super) eta_above: f64,
+    pub(super) eta_below: f64,
     /// 1 − Rsp.
-    start_weight: f64,
-    index: u32,
-    /// Step lengths −ln ξ by the ziggurat method.
-    exponential: &'a ExponentialZiggurat,
+    pub(super) start_weight: f64,
+    pub(super) index: u32,
+    pub(super) seed: u64,
 }
 
-/// One photon packet in flight.
+/// One photon packet in flight (the scalar reference engine).
+#[cfg(test)]
 struct Photon {
     x: f64,
     y: f64,
@@ -325,9 +331,10 @@ struct Photon {
     rng: PhotonRng,
 }
 
+#[cfg(test)]
 impl Photon {
     /// Photon `k` of the channel at the origin, heading down with weight 1 − Rsp.
-    fn launch(ch: &Channel<'_>, seed: u64, k: u64) -> Self {
+    fn launch(ch: &Channel<'_>, k: u64) -> Self {
         Self {
             x: 0.0,
             y: 0.0,
@@ -336,7 +343,7 @@ impl Photon {
             w: ch.start_weight,
             s_left: 0.0,
             layer: 0,
-            rng: PhotonRng::new(seed, k, ch.index),
+            rng: PhotonRng::new(ch.seed, k, ch.index),
         }
     }
 
@@ -347,12 +354,19 @@ impl Photon {
     /// z + uz·s/σt is compared with the face the packet heads for; only a packet that reaches it computes the
     /// distance to the face (and then stops there exactly, as MCML's `PathToBoundary` and `CrossOrNot`).
     #[inline(always)]
-    fn event(&mut self, ch: &Channel<'_>, bins: usize, inv_bin: f64, tally: &mut Tally) -> bool {
+    fn event(
+        &mut self,
+        ch: &Channel<'_>,
+        exponential: &ExponentialZiggurat,
+        bins: usize,
+        inv_bin: f64,
+        tally: &mut Tally,
+    ) -> bool {
         let media = ch.media;
         let m = &media[self.layer];
         let rng = &mut self.rng;
         if self.s_left == 0.0 {
-            self.s_left = ch.exponential.sample(rng);
+            self.s_left = exponential.sample(rng);
         }
         let u = self.u;
         let down = u[2] > 0.0;
@@ -440,15 +454,27 @@ impl Photon {
     }
 }
 
-/// Traces photons `first..first + count` of channel `ch` into `tally`, one after the other. (Tracing four photons
-/// side by side, one event each in turn, to overlap their dependency chains was measured slower: the events'
-/// branches do not predict across photons.)
-fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
-    let inv_bin = 1.0 / settings.bin_mm;
+/// The scalar reference engine: traces photons `first..first + count` of channel `ch` into `tally`, one after the
+/// other, with the draws of the module docs' last paragraph but one (ziggurat steps, disk azimuths). The lane
+/// engine ([`super::lanes`]) is checked against it statistically.
+#[cfg(test)]
+fn trace_chunk_scalar(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
+    let exponential = ExponentialZiggurat::new();
+    let inv_bin = 1.0 / bin_mm;
     for k in first..first + count {
-        let mut p = Photon::launch(ch, settings.seed, k);
-        while p.event(ch, settings.bins, inv_bin, tally) {}
+        let mut p = Photon::launch(ch, k);
+        while p.event(ch, &exponential, tally.r.len(), inv_bin, tally) {}
     }
+}
+
+/// Which photon loop traces the chunks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Engine {
+    /// [`super::lanes`] on the given instruction-set path (every path gives the same bytes).
+    Lanes(Path),
+    /// The scalar reference (tests only).
+    #[cfg(test)]
+    Scalar,
 }
 
 fn estimate(batch_values: impl Iterator<Item = f64> + Clone, total: f64, batches: usize) -> Estimate {
@@ -465,6 +491,10 @@ pub fn simulate(stack: &McStack, settings: &McSettings) -> McResult {
 
 /// [`simulate`], calling `progress(fraction done)` after every wave of chunks (from the calling thread).
 pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: &dyn Fn(f64)) -> McResult {
+    simulate_engine(stack, settings, Engine::Lanes(Path::detect()), progress)
+}
+
+fn simulate_engine(stack: &McStack, settings: &McSettings, engine: Engine, progress: &dyn Fn(f64)) -> McResult {
     let layers = stack.layers();
     let n_layers = layers.len();
     let batches = settings.batches as usize;
@@ -498,7 +528,6 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
 
     // Work list: (channel, batch, chunk) in a fixed order; every batch tally sums its chunks in chunk order.
     let total_chunks = 3 * batches as u64 * chunks_per_batch;
-    let exponential = ExponentialZiggurat::new();
     let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
     let mut next = 0u64;
     while next < total_chunks {
@@ -519,9 +548,13 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                     eta_below: stack.eta_below(),
                     start_weight: 1.0 - rsp,
                     index: channel as u32,
-                    exponential: &exponential,
+                    seed: settings.seed,
                 };
-                trace_chunk(&ch, settings, first, count, &mut t);
+                match engine {
+                    Engine::Lanes(path) => lanes::trace_chunk(path, &ch, settings.bin_mm, first, count, &mut t),
+                    #[cfg(test)]
+                    Engine::Scalar => trace_chunk_scalar(&ch, settings.bin_mm, first, count, &mut t),
+                }
                 ((channel as usize) * batches + batch as usize, t)
             })
             .collect();

@@ -12,6 +12,7 @@
 //! - [`report`]: a result as CSV (the `rtbake profile --csv` layout) and JSON (with standard errors).
 
 pub mod compare;
+pub mod lanes;
 pub mod mc;
 pub mod report;
 pub mod rng;
