@@ -30,9 +30,6 @@ use super::rng::{M0, M1, W0, W1};
 /// per-lane absorption sums, so it must not depend on the CPU).
 pub const LANES: usize = 8;
 
-type F = [f64; LANES];
-type U = [u32; LANES];
-
 /// The instruction set the lane loops are compiled for; every path gives the same bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Path {
@@ -105,10 +102,139 @@ mod x86 {
     }
 }
 
+/// `LANES` f64 values, one per lane. Every operation is a fixed-length loop of one IEEE operation, which the
+/// compiler turns into packed instructions of the enabled width (a long fused loop body is not vectorised).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct V([f64; LANES]);
+/// `LANES` u32 values.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct W([u32; LANES]);
+/// A per-lane condition.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct M([bool; LANES]);
+
+macro_rules! lanewise {
+    ($t:ident, $out:ident, |$($a:ident),*| $e:expr) => {{
+        let mut r = $out::default();
+        for i in 0..LANES {
+            $(let $a = $a.0[i];)*
+            r.0[i] = $e;
+        }
+        r
+    }};
+}
+
+impl Default for M {
+    fn default() -> Self {
+        M([false; LANES])
+    }
+}
+
+impl V {
+    #[inline(always)]
+    fn splat(v: f64) -> V {
+        V([v; LANES])
+    }
+    #[inline(always)]
+    fn lt(self, o: V) -> M {
+        let a = self;
+        lanewise!(V, M, |a, o| a < o)
+    }
+    #[inline(always)]
+    fn le(self, o: V) -> M {
+        let a = self;
+        lanewise!(V, M, |a, o| a <= o)
+    }
+    #[inline(always)]
+    fn eq(self, o: V) -> M {
+        let a = self;
+        lanewise!(V, M, |a, o| a == o)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> V {
+        let a = self;
+        lanewise!(V, V, |a| a.sqrt())
+    }
+    /// max(v, 0) as a select (no NaN handling needed: the arguments are finite or discarded).
+    #[inline(always)]
+    fn pos(self) -> V {
+        let a = self;
+        lanewise!(V, V, |a| if a > 0.0 { a } else { 0.0 })
+    }
+    #[inline(always)]
+    fn abs(self) -> V {
+        let a = self;
+        lanewise!(V, V, |a| a.abs())
+    }
+}
+
+impl M {
+    #[inline(always)]
+    fn select(self, a: V, b: V) -> V {
+        let m = self;
+        lanewise!(V, V, |m, a, b| if m { a } else { b })
+    }
+    #[inline(always)]
+    fn select_w(self, a: W, b: W) -> W {
+        let m = self;
+        lanewise!(W, W, |m, a, b| if m { a } else { b })
+    }
+    #[inline(always)]
+    fn and(self, o: M) -> M {
+        let a = self;
+        lanewise!(M, M, |a, o| a & o)
+    }
+    #[inline(always)]
+    fn or(self, o: M) -> M {
+        let a = self;
+        lanewise!(M, M, |a, o| a | o)
+    }
+    #[inline(always)]
+    fn not(self) -> M {
+        let a = self;
+        lanewise!(M, M, |a| !a)
+    }
+}
+
+macro_rules! binop {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl std::ops::$tr for V {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: V) -> V {
+                let a = self;
+                lanewise!(V, V, |a, o| a $op o)
+            }
+        }
+        impl std::ops::$tr<f64> for V {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: f64) -> V {
+                let a = self;
+                let o = V::splat(o);
+                lanewise!(V, V, |a, o| a $op o)
+            }
+        }
+    };
+}
+binop!(Add, add, +);
+binop!(Sub, sub, -);
+binop!(Mul, mul, *);
+binop!(Div, div, /);
+
+impl std::ops::Neg for V {
+    type Output = V;
+    #[inline(always)]
+    fn neg(self) -> V {
+        let a = self;
+        lanewise!(V, V, |a| -a)
+    }
+}
+
 /// ln 2 split for an exact k·ln 2 (fdlibm `e_log.c`).
 const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
 const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
-/// fdlibm `e_log.c` minimax coefficients of (ln(1 + f) − 2s)/s ... in z = s², s = f/(2 + f), |error| < 2⁻⁵⁸.7.
+/// fdlibm `e_log.c` minimax coefficients Lg1..Lg7 of R(z) ≈ (ln(1 + f) − 2s)/s in z = s², s = f/(2 + f).
 const LG: [f64; 7] = [
     6.666_666_666_666_735_130e-1,
     3.999_999_999_940_941_908e-1,
@@ -119,26 +245,29 @@ const LG: [f64; 7] = [
     1.479_819_860_511_658_591e-1,
 ];
 
-/// −ln x for a normal x in (0, 1], branch-free (fdlibm's `__ieee754_log`: x = 2ᵏ·(1 + f) with 1 + f in
-/// `[√2/2, √2)`, ln(1 + f) = f − (f²/2 − s·(f²/2 + R(s²))), s = f/(2 + f); within an ulp or two of the exact value).
+/// −ln x for normal x in (0, 1] per lane, branch-free (fdlibm's `__ieee754_log`: x = 2ᵏ·(1 + f) with 1 + f in
+/// `[√2/2, √2)`, ln(1 + f) = f − (f²/2 − s·(f²/2 + R(s²))), s = f/(2 + f); within an ulp or two).
 #[inline(always)]
-pub fn neg_ln(x: f64) -> f64 {
-    let bits = x.to_bits();
-    let hx = (bits >> 32) as u32;
-    let mut k = (hx >> 20) as i32 - 1023;
-    let hm = hx & 0x000f_ffff;
-    let i = (hm + 0x95f64) & 0x0010_0000;
-    let y = f64::from_bits((u64::from(hm | (i ^ 0x3ff0_0000)) << 32) | (bits & 0xffff_ffff));
-    k += (i >> 20) as i32;
+fn neg_ln(x: V) -> V {
+    let mut y = V::default();
+    let mut dk = V::default();
+    for i in 0..LANES {
+        let bits = x.0[i].to_bits();
+        let hx = (bits >> 32) as u32;
+        let hm = hx & 0x000f_ffff;
+        let t = (hm + 0x95f64) & 0x0010_0000;
+        y.0[i] = f64::from_bits((u64::from(hm | (t ^ 0x3ff0_0000)) << 32) | (bits & 0xffff_ffff));
+        // k = exponent − 1023 + (t ≠ 0), exactly as an f64.
+        dk.0[i] = f64::from(((hx >> 20) + (t >> 20)) as i32 - 1023);
+    }
     let f = y - 1.0;
-    let dk = f64::from(k);
-    let s = f / (2.0 + f);
+    let s = f / (f + 2.0);
     let z = s * s;
     let w = z * z;
-    let t1 = w * (LG[1] + w * (LG[3] + w * LG[5]));
-    let t2 = z * (LG[0] + w * (LG[2] + w * (LG[4] + w * LG[6])));
+    let t1 = w * ((w * ((w * LG[5]) + LG[3])) + LG[1]);
+    let t2 = z * ((w * ((w * ((w * LG[6]) + LG[4])) + LG[2])) + LG[0]);
     let r = t2 + t1;
-    let hfsq = 0.5 * f * f;
+    let hfsq = f * f * 0.5;
     ((hfsq - (s * (hfsq + r) + dk * LN2_LO)) - f) - dk * LN2_HI
 }
 
@@ -166,35 +295,38 @@ const COS: [f64; 9] = [
     -1.0 / 6_402_373_705_728_000.0,
 ];
 
-/// (cos φ, sin φ) of the azimuth φ = (q + ½)·π/2 + θ of a 32-bit word: q = its top two bits (the quadrant),
-/// θ = ((low 30 bits + ½)/2³⁰ − ½)·π/2 ∈ (−π/4, π/4) — φ uniform on `[0, 2π)` on a grid of 2π/2³², by polynomials
-/// and selects (no table, no branch): cos(π/4 + θ) = (cos θ − sin θ)/√2, sin(π/4 + θ) = (cos θ + sin θ)/√2, then q
-/// quarter turns.
+/// (cos φ, sin φ) per lane of the azimuth φ = (q + ½)·π/2 + θ of a 32-bit word: q = its top two bits (the
+/// quadrant), θ = ((low 30 bits + ½)/2³⁰ − ½)·π/2 ∈ (−π/4, π/4) — φ uniform on `[0, 2π)` on a grid of 2π/2³², by
+/// polynomials and selects (no table, no branch): cos(π/4 + θ) = (cos θ − sin θ)/√2,
+/// sin(π/4 + θ) = (cos θ + sin θ)/√2, then q quarter turns.
 #[inline(always)]
-pub fn azimuth_cos_sin(word: u32) -> (f64, f64) {
-    let q = word >> 30;
-    let frac = (f64::from((word & 0x3fff_ffff) as i32) + 0.5) * (1.0 / 1_073_741_824.0);
-    let t = (frac - 0.5) * std::f64::consts::FRAC_PI_2;
+fn azimuth_cos_sin(word: W) -> (V, V) {
+    let low = lanewise!(W, V, |word| f64::from((word & 0x3fff_ffff) as i32));
+    let t = ((low + 0.5) * (1.0 / 1_073_741_824.0) - 0.5) * std::f64::consts::FRAC_PI_2;
     let z = t * t;
-    let mut ps = SIN[7];
+    let mut ps = V::splat(SIN[7]);
     for c in SIN[..7].iter().rev() {
-        ps = ps * z + c;
+        ps = ps * z + *c;
     }
     let sin_t = t + t * z * ps;
-    let mut pc = COS[8];
+    let mut pc = V::splat(COS[8]);
     for c in COS[..8].iter().rev() {
-        pc = pc * z + c;
+        pc = pc * z + *c;
     }
-    let cos_t = 1.0 + z * pc;
+    let cos_t = z * pc + 1.0;
     let c = (cos_t - sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     let s = (cos_t + sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     // Quarter turns: q = 1: (−s, c); q = 2: (−c, −s); q = 3: (s, −c).
-    let (c1, s1) = if q & 1 != 0 { (-s, c) } else { (c, s) };
-    if q & 2 != 0 {
-        (-c1, -s1)
-    } else {
-        (c1, s1)
-    }
+    let odd = lanewise!(W, M, |word| word & 0x4000_0000 != 0);
+    let half = lanewise!(W, M, |word| word & 0x8000_0000 != 0);
+    let (c1, s1) = (odd.select(-s, c), odd.select(c, s));
+    (half.select(-c1, c1), half.select(-s1, s1))
+}
+
+/// Per lane a uniform in (0, 1] on the grid k/2³² (k = 1..=2³²) from a word, by an exact signed conversion.
+#[inline(always)]
+fn unit(word: W) -> V {
+    lanewise!(W, V, |word| (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0))
 }
 
 /// The ten round keys of Philox4x32-10 under `seed` (the key bumped by the Weyl constants between rounds).
@@ -210,32 +342,27 @@ fn round_keys(seed: u64) -> [[u32; 2]; 10] {
     keys
 }
 
-/// Philox4x32-10 of `c` under the round keys `keys` ([`super::rng::philox4x32_10`], written for one lane of a
-/// vectorised loop: the 32×32 → 64-bit products become packed multiplies).
+/// Philox4x32-10 of the counters `c` per lane under the round keys `keys` ([`super::rng::philox4x32_10`]; the
+/// 32×32 → 64-bit products become packed multiplies).
 #[inline(always)]
-fn block(mut c: [u32; 4], keys: &[[u32; 2]; 10]) -> [u32; 4] {
+fn block(mut c: [W; 4], keys: &[[u32; 2]; 10]) -> [W; 4] {
     for k in keys {
-        let p0 = u64::from(M0) * u64::from(c[0]);
-        let p1 = u64::from(M1) * u64::from(c[2]);
-        c = [(p1 >> 32) as u32 ^ c[1] ^ k[0], p1 as u32, (p0 >> 32) as u32 ^ c[3] ^ k[1], p0 as u32];
+        let (c0, c1, c2, c3) = (c[0], c[1], c[2], c[3]);
+        let p0 = lanewise!(W, P, |c0| u64::from(M0) * u64::from(c0));
+        let p1 = lanewise!(W, P, |c2| u64::from(M1) * u64::from(c2));
+        c = [
+            lanewise!(W, W, |p1, c1| (p1 >> 32) as u32 ^ c1 ^ k[0]),
+            lanewise!(W, W, |p1| p1 as u32),
+            lanewise!(W, W, |p0, c3| (p0 >> 32) as u32 ^ c3 ^ k[1]),
+            lanewise!(W, W, |p0| p0 as u32),
+        ];
     }
     c
 }
 
-/// A uniform in (0, 1] on the grid k/2³² (k = 1..=2³²) from a word, by an exact signed conversion.
-#[inline(always)]
-fn unit(word: u32) -> f64 {
-    (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0)
-}
-
-#[inline(always)]
-fn pos(v: f64) -> f64 {
-    if v > 0.0 {
-        v
-    } else {
-        0.0
-    }
-}
+/// 64-bit products per lane.
+#[derive(Clone, Copy, Debug, Default)]
+struct P([u64; LANES]);
 
 /// The per-lane copy of one layer's constants (reloaded when a packet changes layer).
 #[derive(Clone, Copy, Debug, Default)]
@@ -245,51 +372,51 @@ struct LayerConsts {
     sigma_t: f64,
     inv_sigma_t: f64,
     absorb: f64,
-    /// 1 for an isotropic layer (cos θ = 2ξ − 1), else 0.
-    iso: f64,
+    isotropic: bool,
     /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
     hg: [f64; 5],
     eta: f64,
     n_above: f64,
     n_below: f64,
-    /// 1 in the first layer, 1 in the last (leaving through that face ends the packet).
-    top: f64,
-    bottom: f64,
+    /// The first layer, the last (leaving through that face ends the packet).
+    top: bool,
+    bottom: bool,
 }
 
 /// Structure-of-arrays state of the lanes.
 #[derive(Clone, Debug, Default)]
 struct Lanes {
-    x: F,
-    y: F,
-    z: F,
-    ux: F,
-    uy: F,
-    uz: F,
-    w: F,
+    x: V,
+    y: V,
+    z: V,
+    ux: V,
+    uy: V,
+    uz: V,
+    w: V,
     /// Optical depth left of the current step (0: draw a new one).
-    s: F,
-    z_top: F,
-    z_bottom: F,
-    sigma_t: F,
-    inv_sigma_t: F,
-    absorb: F,
-    iso: F,
-    hg: [F; 5],
-    eta: F,
-    n_above: F,
-    n_below: F,
-    top: F,
-    bottom: F,
-    photon_lo: U,
-    photon_hi: U,
-    event: U,
-    /// 1 while the lane traces a photon of the chunk, 0 once the chunk has none left for it.
-    live: F,
-    /// Per lane: weight absorbed in this step (0 elsewhere) and the outcome code (`END_*`, 0 = continues).
-    dw: F,
-    code: U,
-    interacted: U,
+    s: V,
+    z_top: V,
+    z_bottom: V,
+    sigma_t: V,
+    inv_sigma_t: V,
+    absorb: V,
+    isotropic: M,
+    hg: [V; 5],
+    eta: V,
+    n_above: V,
+    n_below: V,
+    top: M,
+    bottom: M,
+    photon_lo: W,
+    photon_hi: W,
+    event: W,
+    /// Whether the lane traces a photon of the chunk (false once the chunk has none left for it).
+    live: M,
+    /// Per lane: weight absorbed in this step (0 elsewhere), the outcome code (`END_*`, 0 = continues) and 1 where
+    /// a live packet interacted.
+    dw: V,
+    code: W,
+    interacted: W,
 }
 
 const END_TOP: u32 = 1;
@@ -300,161 +427,129 @@ const CROSSED: u32 = 5;
 
 impl Lanes {
     fn load_layer(&mut self, i: usize, m: &LayerConsts) {
-        self.z_top[i] = m.z_top;
-        self.z_bottom[i] = m.z_bottom;
-        self.sigma_t[i] = m.sigma_t;
-        self.inv_sigma_t[i] = m.inv_sigma_t;
-        self.absorb[i] = m.absorb;
-        self.iso[i] = m.iso;
+        self.z_top.0[i] = m.z_top;
+        self.z_bottom.0[i] = m.z_bottom;
+        self.sigma_t.0[i] = m.sigma_t;
+        self.inv_sigma_t.0[i] = m.inv_sigma_t;
+        self.absorb.0[i] = m.absorb;
+        self.isotropic.0[i] = m.isotropic;
         for (h, v) in self.hg.iter_mut().zip(m.hg) {
-            h[i] = v;
+            h.0[i] = v;
         }
-        self.eta[i] = m.eta;
-        self.n_above[i] = m.n_above;
-        self.n_below[i] = m.n_below;
-        self.top[i] = m.top;
-        self.bottom[i] = m.bottom;
+        self.eta.0[i] = m.eta;
+        self.n_above.0[i] = m.n_above;
+        self.n_below.0[i] = m.n_below;
+        self.top.0[i] = m.top;
+        self.bottom.0[i] = m.bottom;
     }
 
     /// Lane `i` starts photon `k` (or, with `live` false, a placeholder whose tallies are masked out).
     fn launch(&mut self, i: usize, k: u64, live: bool, start_weight: f64, first_layer: &LayerConsts) {
-        self.x[i] = 0.0;
-        self.y[i] = 0.0;
-        self.z[i] = 0.0;
-        self.ux[i] = 0.0;
-        self.uy[i] = 0.0;
-        self.uz[i] = 1.0;
-        self.w[i] = start_weight;
-        self.s[i] = 0.0;
-        self.photon_lo[i] = k as u32;
-        self.photon_hi[i] = (k >> 32) as u32;
-        self.event[i] = 0;
-        self.live[i] = if live { 1.0 } else { 0.0 };
+        self.x.0[i] = 0.0;
+        self.y.0[i] = 0.0;
+        self.z.0[i] = 0.0;
+        self.ux.0[i] = 0.0;
+        self.uy.0[i] = 0.0;
+        self.uz.0[i] = 1.0;
+        self.w.0[i] = start_weight;
+        self.s.0[i] = 0.0;
+        self.photon_lo.0[i] = k as u32;
+        self.photon_hi.0[i] = (k >> 32) as u32;
+        self.event.0[i] = 0;
+        self.live.0[i] = live;
         self.load_layer(i, first_layer);
     }
 
     /// One event of every lane (module docs). Writes `dw`, `code` and `interacted`; no branch on lane data.
     #[inline(always)]
     fn step(&mut self, channel: u32, keys: &[[u32; 2]; 10]) {
-        for i in 0..LANES {
-            // One Philox4x32-10 block: counter (photon lo, photon hi, channel, event).
-            let c = block([self.photon_lo[i], self.photon_hi[i], channel, self.event[i]], keys);
-            self.event[i] = self.event[i].wrapping_add(1);
-            let xi1 = unit(c[1]);
+        let [r0, r1, r2, r3] = block([self.photon_lo, self.photon_hi, W([channel; LANES]), self.event], keys);
+        let event = self.event;
+        self.event = lanewise!(W, W, |event| event.wrapping_add(1));
+        let xi1 = unit(r1);
+        let zero = V::splat(0.0);
 
-            let (x, y, z) = (self.x[i], self.y[i], self.z[i]);
-            let (ux, uy, uz) = (self.ux[i], self.uy[i], self.uz[i]);
-            let w = self.w[i];
-            let s = if self.s[i] == 0.0 { neg_ln(unit(c[0])) } else { self.s[i] };
-            let sigma_t = self.sigma_t[i];
-            let down = uz > 0.0;
-            let face_z = if down { self.z_bottom[i] } else { self.z_top[i] };
-            let d_step = s * self.inv_sigma_t[i];
-            let z_step = z + uz * d_step;
-            // Strictly short of the face it heads for (always for uz = 0, which meets no face).
-            let interact = sigma_t > 0.0 && (uz == 0.0 || (z_step - face_z) * uz < 0.0);
-            let d_face = (face_z - z) / uz;
-            let glide = !interact && !(d_face.abs() < f64::INFINITY);
-            let d = if interact { d_step } else { d_face };
+        let (x, y, z, ux, uy, uz, w) = (self.x, self.y, self.z, self.ux, self.uy, self.uz, self.w);
+        let s = self.s.eq(zero).select(neg_ln(unit(r0)), self.s);
+        let sigma_t = self.sigma_t;
+        let down = zero.lt(uz);
+        let face_z = down.select(self.z_bottom, self.z_top);
+        let d_step = s * self.inv_sigma_t;
+        let z_step = z + uz * d_step;
+        // Strictly short of the face it heads for (always for uz = 0, which meets no face).
+        let interact = zero.lt(sigma_t).and(uz.eq(zero).or(((z_step - face_z) * uz).lt(zero)));
+        let d_face = (face_z - z) / uz;
+        let glide = interact.or(d_face.abs().lt(V::splat(f64::INFINITY))).not();
+        let d = interact.select(d_step, d_face);
 
-            // Interaction: implicit capture, HG polar angle, azimuth, spin, roulette.
-            let dw = w * self.absorb[i];
-            let w_int = w - dw;
-            let [a, b, c2, d2, e] = [self.hg[0][i], self.hg[1][i], self.hg[2][i], self.hg[3][i], self.hg[4][i]];
-            let f = a / (b + c2 * xi1);
-            let hg = (d2 - f * f) * e;
-            let hg = if hg < -1.0 {
-                -1.0
-            } else if hg > 1.0 {
-                1.0
-            } else {
-                hg
-            };
-            let cos_t = if self.iso[i] != 0.0 { 2.0 * xi1 - 1.0 } else { hg };
-            let (cos_p, sin_p) = azimuth_cos_sin(c[2]);
-            let sin2_t = pos(1.0 - cos_t * cos_t);
-            let sin_t = sin2_t.sqrt();
-            let one_minus_uz2 = 1.0 - uz * uz;
-            let q = (sin2_t / one_minus_uz2).sqrt();
-            let polar = uz.abs() > 0.99999;
-            let sx = if polar { sin_t * cos_p } else { q * (ux * uz * cos_p - uy * sin_p) + ux * cos_t };
-            let sy = if polar { sin_t * sin_p } else { q * (uy * uz * cos_p + ux * sin_p) + uy * cos_t };
-            let sz = if polar {
-                if uz < 0.0 {
-                    -cos_t
-                } else {
-                    cos_t
-                }
-            } else {
-                -q * one_minus_uz2 * cos_p + uz * cos_t
-            };
-            let low = w_int < ROULETTE_THRESHOLD;
-            let survive = unit(c[3]) <= 1.0 / ROULETTE_CHANCE && w_int != 0.0;
-            let w_int = if low && survive { w_int * ROULETTE_CHANCE } else { w_int };
-            let lost = low && !survive;
+        // Interaction: implicit capture, HG polar angle, azimuth, spin, roulette.
+        let dw = w * self.absorb;
+        let w_int = w - dw;
+        let [a, b, c, e, f] = self.hg;
+        let q = a / (b + c * xi1);
+        let hg = (e - q * q) * f;
+        let hg = hg.lt(V::splat(-1.0)).select(V::splat(-1.0), V::splat(1.0).lt(hg).select(V::splat(1.0), hg));
+        let cos_t = self.isotropic.select(xi1 * 2.0 - 1.0, hg);
+        let (cos_p, sin_p) = azimuth_cos_sin(r2);
+        let sin2_t = (-(cos_t * cos_t) + 1.0).pos();
+        let sin_t = sin2_t.sqrt();
+        let one_minus_uz2 = -(uz * uz) + 1.0;
+        let a = (sin2_t / one_minus_uz2).sqrt();
+        let polar = V::splat(0.99999).lt(uz.abs());
+        let sx = polar.select(sin_t * cos_p, a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t);
+        let sy = polar.select(sin_t * sin_p, a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t);
+        let sz = polar.select(uz.lt(zero).select(-cos_t, cos_t), -a * one_minus_uz2 * cos_p + uz * cos_t);
+        let low = w_int.lt(V::splat(ROULETTE_THRESHOLD));
+        let survive = unit(r3).le(V::splat(1.0 / ROULETTE_CHANCE)).and(w_int.eq(zero).not());
+        let w_int = low.and(survive).select(w_int * ROULETTE_CHANCE, w_int);
+        let lost = low.and(survive.not());
 
-            // Face: Fresnel reflection or refraction into the neighbour.
-            let n_i = self.eta[i];
-            let n_t = if down { self.n_below[i] } else { self.n_above[i] };
-            let cos_i = uz.abs();
-            let ratio = n_i / n_t;
-            let sin_t2 = ratio * ratio * pos(1.0 - cos_i * cos_i);
-            let cos_tr = pos(1.0 - sin_t2).sqrt();
-            let rs = (n_i * cos_i - n_t * cos_tr) / (n_i * cos_i + n_t * cos_tr);
-            let rp = (n_i * cos_tr - n_t * cos_i) / (n_i * cos_tr + n_t * cos_i);
-            let same = n_i == n_t;
-            let refl = if same {
-                0.0
-            } else if sin_t2 >= 1.0 {
-                1.0
-            } else {
-                0.5 * (rs * rs + rp * rp)
-            };
-            let reflect = refl > 0.0 && (refl >= 1.0 || xi1 <= refl);
-            let cos_tr = if same { cos_i } else { cos_tr };
-            let fx = if reflect { ux } else { ux * ratio };
-            let fy = if reflect { uy } else { uy * ratio };
-            let fz = if reflect {
-                -uz
-            } else if down {
-                cos_tr
-            } else {
-                -cos_tr
-            };
-            let s_face = if sigma_t > 0.0 { pos(s - d_face * sigma_t) } else { s };
-            let leaves = !reflect && (if down { self.bottom[i] != 0.0 } else { self.top[i] != 0.0 });
+        // Face: Fresnel reflection or refraction into the neighbour.
+        let n_i = self.eta;
+        let n_t = down.select(self.n_below, self.n_above);
+        let cos_i = uz.abs();
+        let ratio = n_i / n_t;
+        let sin_t2 = ratio * ratio * (-(cos_i * cos_i) + 1.0).pos();
+        let cos_tr = (-sin_t2 + 1.0).pos().sqrt();
+        let rs = (n_i * cos_i - n_t * cos_tr) / (n_i * cos_i + n_t * cos_tr);
+        let rp = (n_i * cos_tr - n_t * cos_i) / (n_i * cos_tr + n_t * cos_i);
+        let same = n_i.eq(n_t);
+        let refl = same.select(zero, V::splat(1.0).le(sin_t2).select(V::splat(1.0), (rs * rs + rp * rp) * 0.5));
+        let reflect = zero.lt(refl).and(V::splat(1.0).le(refl).or(xi1.le(refl)));
+        let cos_tr = same.select(cos_i, cos_tr);
+        let fx = reflect.select(ux, ux * ratio);
+        let fy = reflect.select(uy, uy * ratio);
+        let fz = reflect.select(-uz, down.select(cos_tr, -cos_tr));
+        let s_face = zero.lt(sigma_t).select((s - d_face * sigma_t).pos(), s);
+        let crossing = reflect.not();
 
-            self.x[i] = x + ux * d;
-            self.y[i] = y + uy * d;
-            self.z[i] = if interact { z_step } else { face_z };
-            self.ux[i] = if interact { sx } else { fx };
-            self.uy[i] = if interact { sy } else { fy };
-            self.uz[i] = if interact { sz } else { fz };
-            self.w[i] = if interact { w_int } else { w };
-            self.s[i] = if interact { 0.0 } else { s_face };
-            let live = self.live[i] != 0.0;
-            self.dw[i] = if interact && live { dw } else { 0.0 };
-            self.interacted[i] = u32::from(interact && live);
-            self.code[i] = if interact {
-                if lost {
-                    END_ROULETTE
-                } else {
-                    0
-                }
-            } else if glide {
-                END_GLIDE
-            } else if leaves {
-                if down {
-                    END_BOTTOM
-                } else {
-                    END_TOP
-                }
-            } else if reflect {
-                0
-            } else {
-                CROSSED
-            };
-        }
+        self.x = x + ux * d;
+        self.y = y + uy * d;
+        self.z = interact.select(z_step, face_z);
+        self.ux = interact.select(sx, fx);
+        self.uy = interact.select(sy, fy);
+        self.uz = interact.select(sz, fz);
+        self.w = interact.select(w_int, w);
+        self.s = interact.select(zero, s_face);
+        let live = self.live;
+        self.dw = interact.and(live).select(dw, zero);
+        self.interacted = lanewise!(M, W, |interact, live| u32::from(interact & live));
+        let splat = |v: u32| W([v; LANES]);
+        let leaves = crossing.and(down.select_m(self.bottom, self.top));
+        let face_code = leaves.select_w(
+            down.select_w(splat(END_BOTTOM), splat(END_TOP)),
+            crossing.select_w(splat(CROSSED), splat(0)),
+        );
+        let face_code = glide.select_w(splat(END_GLIDE), face_code);
+        self.code = interact.select_w(lost.select_w(splat(END_ROULETTE), splat(0)), face_code);
+    }
+}
+
+impl M {
+    #[inline(always)]
+    fn select_m(self, a: M, b: M) -> M {
+        let m = self;
+        lanewise!(M, M, |m, a, b| if m { a } else { b })
     }
 }
 
@@ -472,13 +567,13 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
             sigma_t: m.sigma_t,
             inv_sigma_t: m.inv_sigma_t,
             absorb: m.absorb_fraction,
-            iso: if m.hg.isotropic { 1.0 } else { 0.0 },
+            isotropic: m.hg.isotropic,
             hg: [m.hg.one_minus_g2, m.hg.one_minus_g, m.hg.two_g, m.hg.one_plus_g2, m.hg.inv_two_g],
             eta: m.eta,
             n_above: if j == 0 { ch.eta_above } else { media[j - 1].eta },
             n_below: if j == last { ch.eta_below } else { media[j + 1].eta },
-            top: if j == 0 { 1.0 } else { 0.0 },
-            bottom: if j == last { 1.0 } else { 0.0 },
+            top: j == 0,
+            bottom: j == last,
         })
         .collect();
     let keys = round_keys(ch.seed);
@@ -498,37 +593,38 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
     while live_count > 0 {
         lanes.step(ch.index, &keys);
         if media.len() == 1 {
-            for (a, dw) in absorbed[0].iter_mut().zip(&lanes.dw) {
+            for (a, dw) in absorbed[0].iter_mut().zip(&lanes.dw.0) {
                 *a += dw;
             }
         } else {
             for (j, acc) in absorbed.iter_mut().enumerate() {
                 for i in 0..LANES {
-                    acc[i] += if layer[i] == j { lanes.dw[i] } else { 0.0 };
+                    acc[i] += if layer[i] == j { lanes.dw.0[i] } else { 0.0 };
                 }
             }
         }
         let mut interactions = 0u32;
         let mut special = 0u32;
         for i in 0..LANES {
-            interactions += lanes.interacted[i];
-            special |= u32::from(lanes.code[i] != 0) << i;
+            interactions += lanes.interacted.0[i];
+            special |= u32::from(lanes.code.0[i] != 0) << i;
         }
         tally.interactions += u64::from(interactions);
         while special != 0 {
             let i = special.trailing_zeros() as usize;
             special &= special - 1;
-            let live = lanes.live[i] != 0.0;
-            let w = lanes.w[i];
-            match lanes.code[i] {
+            let live = lanes.live.0[i];
+            let w = lanes.w.0[i];
+            match lanes.code.0[i] {
                 CROSSED => {
-                    layer[i] = if lanes.uz[i] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
+                    layer[i] = if lanes.uz.0[i] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
                     lanes.load_layer(i, &consts[layer[i]]);
                     continue;
                 }
                 END_GLIDE if live => absorbed[layer[i]][i] += w,
                 code @ (END_TOP | END_BOTTOM) if live => {
-                    let r = (lanes.x[i] * lanes.x[i] + lanes.y[i] * lanes.y[i]).sqrt();
+                    let (x, y) = (lanes.x.0[i], lanes.y.0[i]);
+                    let r = (x * x + y * y).sqrt();
                     let (total, bins_of) = if code == END_TOP {
                         (&mut tally.rd, &mut tally.r)
                     } else {
@@ -568,51 +664,76 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
 mod tests {
     use super::*;
 
-    /// The branch-free −ln x against the library logarithm: within 2 ulp over the whole (0, 1] grid of the draws.
+    /// Words spread over the whole u32 range, `LANES` at a time.
+    fn words(j: u64) -> W {
+        let mut w = W::default();
+        for (i, v) in w.0.iter_mut().enumerate() {
+            let n = j * LANES as u64 + i as u64;
+            *v = match n % 3 {
+                0 => (n.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as u32,
+                1 => n as u32,
+                _ => u32::MAX - n as u32,
+            };
+        }
+        w
+    }
+
+    /// The branch-free −ln ξ against the library logarithm over the draws' grid (0, 1]: within 4.5·10⁻¹⁶ relative.
     #[test]
     fn neg_ln_matches_the_library() {
         let mut worst = 0.0f64;
-        for j in 0..200_000u64 {
-            let word = (j.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as u32;
-            for x in [unit(word), unit(j as u32), unit(u32::MAX - j as u32)] {
-                let exact = -x.ln();
-                let got = neg_ln(x);
-                if exact != 0.0 {
-                    worst = worst.max(((got - exact) / exact).abs());
+        for j in 0..60_000 {
+            let x = unit(words(j));
+            let got = neg_ln(x);
+            for i in 0..LANES {
+                let exact = -x.0[i].ln();
+                if exact == 0.0 {
+                    assert_eq!(got.0[i], 0.0);
                 } else {
-                    assert_eq!(got, 0.0);
+                    worst = worst.max(((got.0[i] - exact) / exact).abs());
                 }
             }
         }
         assert!(worst < 4.5e-16, "worst relative error {worst:e}");
     }
 
-    /// The polynomial azimuth against the library sin/cos of (q + ½)π/2 + θ, and unit length.
+    /// The polynomial azimuth against the library sin/cos of 2π(word + ½)/2³², and unit length: within 10⁻¹⁵.
     #[test]
     fn azimuth_matches_the_library() {
         let mut worst = 0.0f64;
-        for j in 0..200_000u64 {
-            let word = (j.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32) as u32;
-            let (c, s) = azimuth_cos_sin(word);
-            let phi = ((f64::from(word) + 0.5) / 4_294_967_296.0) * std::f64::consts::TAU;
-            let (es, ec) = phi.sin_cos();
-            worst = worst.max((c - ec).abs()).max((s - es).abs()).max((c * c + s * s - 1.0).abs());
+        for j in 0..60_000 {
+            let w = words(j);
+            let (c, s) = azimuth_cos_sin(w);
+            for i in 0..LANES {
+                let phi = ((f64::from(w.0[i]) + 0.5) / 4_294_967_296.0) * std::f64::consts::TAU;
+                let (es, ec) = phi.sin_cos();
+                let (c, s) = (c.0[i], s.0[i]);
+                worst = worst.max((c - ec).abs()).max((s - es).abs()).max((c * c + s * s - 1.0).abs());
+            }
         }
         assert!(worst < 1e-15, "worst error {worst:e}");
     }
 
-    /// The lane loop's Philox block is the reference Philox4x32-10 of its counter, and its uniform is (w + 1)/2³².
+    /// The lanes' Philox block is the reference Philox4x32-10 of each lane's counter, and the uniform is
+    /// (w + 1)/2³².
     #[test]
     fn lane_draws_are_the_philox_blocks() {
         let seed = 0x0123_4567_89ab_cdef_u64;
         let keys = round_keys(seed);
-        for (photon, event) in [(0u64, 0u32), (0x1_0000_0005, 7), (u64::MAX, u32::MAX)] {
-            let c = [photon as u32, (photon >> 32) as u32, 2, event];
+        let photons: [u64; LANES] = [0, 1, 5, 0x1_0000_0005, 77, u64::MAX, 1 << 40, 12345];
+        let lo = W(photons.map(|k| k as u32));
+        let hi = W(photons.map(|k| (k >> 32) as u32));
+        let event = W([0, 1, 2, 3, 7, u32::MAX, 100, 9]);
+        let got = block([lo, hi, W([2; LANES]), event], &keys);
+        for i in 0..LANES {
+            let c = [lo.0[i], hi.0[i], 2, event.0[i]];
             let expected = super::super::rng::philox4x32_10(c, [seed as u32, (seed >> 32) as u32]);
-            assert_eq!(block(c, &keys), expected);
+            assert_eq!(got.map(|w| w.0[i]), expected, "lane {i}");
         }
-        for w in [0u32, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX] {
-            assert_eq!(unit(w), (f64::from(w) + 1.0) / 4_294_967_296.0);
+        let w = W([0, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX, 3, 4, 5]);
+        let u = unit(w);
+        for i in 0..LANES {
+            assert_eq!(u.0[i], (f64::from(w.0[i]) + 1.0) / 4_294_967_296.0);
         }
     }
 }
