@@ -194,6 +194,10 @@ impl M {
         let a = self;
         lanewise!(M, M, |a| !a)
     }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0.iter().fold(false, |a, &b| a | b)
+    }
 }
 
 macro_rules! binop {
@@ -375,9 +379,9 @@ struct LayerConsts {
     isotropic: bool,
     /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
     hg: [f64; 5],
-    eta: f64,
-    n_above: f64,
-    n_below: f64,
+    /// η of the layer over η of the medium above and below (the neighbour layer or the ambient medium).
+    ratio_above: f64,
+    ratio_below: f64,
     /// The first layer, the last (leaving through that face ends the packet).
     top: bool,
     bottom: bool,
@@ -402,9 +406,8 @@ struct Lanes {
     absorb: V,
     isotropic: M,
     hg: [V; 5],
-    eta: V,
-    n_above: V,
-    n_below: V,
+    ratio_above: V,
+    ratio_below: V,
     top: M,
     bottom: M,
     photon_lo: W,
@@ -436,9 +439,8 @@ impl Lanes {
         for (h, v) in self.hg.iter_mut().zip(m.hg) {
             h.0[i] = v;
         }
-        self.eta.0[i] = m.eta;
-        self.n_above.0[i] = m.n_above;
-        self.n_below.0[i] = m.n_below;
+        self.ratio_above.0[i] = m.ratio_above;
+        self.ratio_below.0[i] = m.ratio_below;
         self.top.0[i] = m.top;
         self.bottom.0[i] = m.bottom;
     }
@@ -478,9 +480,6 @@ impl Lanes {
         let z_step = z + uz * d_step;
         // Strictly short of the face it heads for (always for uz = 0, which meets no face).
         let interact = zero.lt(sigma_t).and(uz.eq(zero).or(((z_step - face_z) * uz).lt(zero)));
-        let d_face = (face_z - z) / uz;
-        let glide = interact.or(d_face.abs().lt(V::splat(f64::INFINITY))).not();
-        let d = interact.select(d_step, d_face);
 
         // Interaction: implicit capture, HG polar angle, azimuth, spin, roulette.
         let dw = w * self.absorb;
@@ -504,24 +503,43 @@ impl Lanes {
         let w_int = low.and(survive).select(w_int * ROULETTE_CHANCE, w_int);
         let lost = low.and(survive.not());
 
-        // Face: Fresnel reflection or refraction into the neighbour.
-        let n_i = self.eta;
-        let n_t = down.select(self.n_below, self.n_above);
-        let cos_i = uz.abs();
-        let ratio = n_i / n_t;
-        let sin_t2 = ratio * ratio * (-(cos_i * cos_i) + 1.0).pos();
-        let cos_tr = (-sin_t2 + 1.0).pos().sqrt();
-        let rs = (n_i * cos_i - n_t * cos_tr) / (n_i * cos_i + n_t * cos_tr);
-        let rp = (n_i * cos_tr - n_t * cos_i) / (n_i * cos_tr + n_t * cos_i);
-        let same = n_i.eq(n_t);
-        let refl = same.select(zero, V::splat(1.0).le(sin_t2).select(V::splat(1.0), (rs * rs + rp * rp) * 0.5));
-        let reflect = zero.lt(refl).and(V::splat(1.0).le(refl).or(xi1.le(refl)));
-        let cos_tr = same.select(cos_i, cos_tr);
-        let fx = reflect.select(ux, ux * ratio);
-        let fy = reflect.select(uy, uy * ratio);
-        let fz = reflect.select(-uz, down.select(cos_tr, -cos_tr));
-        let s_face = zero.lt(sigma_t).select((s - d_face * sigma_t).pos(), s);
-        let crossing = reflect.not();
+        // Face (only when some lane is at one): Fresnel reflection or refraction into the neighbour.
+        let at_face = interact.not();
+        let splat = |v: u32| W([v; LANES]);
+        let (d, fx, fy, fz, s_face, face_code) = if at_face.any() {
+            let d_face = (face_z - z) / uz;
+            let glide = interact.or(d_face.abs().lt(V::splat(f64::INFINITY))).not();
+            // n_i/n_t, and R = ½(rs² + rp²) with rs = (ρ cos_i − cos_t)/(ρ cos_i + cos_t),
+            // rp = (ρ cos_t − cos_i)/(ρ cos_t + cos_i), ρ = n_i/n_t, over one common denominator.
+            let ratio = down.select(self.ratio_below, self.ratio_above);
+            let cos_i = uz.abs();
+            let sin_t2 = ratio * ratio * (-(cos_i * cos_i) + 1.0).pos();
+            let cos_tr = (-sin_t2 + 1.0).pos().sqrt();
+            let (a, b) = (ratio * cos_i - cos_tr, ratio * cos_i + cos_tr);
+            let (c, e) = (ratio * cos_tr - cos_i, ratio * cos_tr + cos_i);
+            let (ae, cb, be) = (a * e, c * b, b * e);
+            let same = ratio.eq(V::splat(1.0));
+            let refl = same.select(
+                zero,
+                V::splat(1.0).le(sin_t2).select(V::splat(1.0), (ae * ae + cb * cb) / (be * be) * 0.5),
+            );
+            let reflect = zero.lt(refl).and(V::splat(1.0).le(refl).or(xi1.le(refl)));
+            let cos_tr = same.select(cos_i, cos_tr);
+            let fx = reflect.select(ux, ux * ratio);
+            let fy = reflect.select(uy, uy * ratio);
+            let fz = reflect.select(-uz, down.select(cos_tr, -cos_tr));
+            let s_face = zero.lt(sigma_t).select((s - d_face * sigma_t).pos(), s);
+            let crossing = reflect.not();
+            let leaves = crossing.and(down.select_m(self.bottom, self.top));
+            let code = leaves.select_w(
+                down.select_w(splat(END_BOTTOM), splat(END_TOP)),
+                crossing.select_w(splat(CROSSED), splat(0)),
+            );
+            let code = glide.select_w(splat(END_GLIDE), code);
+            (interact.select(d_step, d_face), fx, fy, fz, s_face, code)
+        } else {
+            (d_step, ux, uy, uz, s, splat(0))
+        };
 
         self.x = x + ux * d;
         self.y = y + uy * d;
@@ -534,13 +552,6 @@ impl Lanes {
         let live = self.live;
         self.dw = interact.and(live).select(dw, zero);
         self.interacted = lanewise!(M, W, |interact, live| u32::from(interact & live));
-        let splat = |v: u32| W([v; LANES]);
-        let leaves = crossing.and(down.select_m(self.bottom, self.top));
-        let face_code = leaves.select_w(
-            down.select_w(splat(END_BOTTOM), splat(END_TOP)),
-            crossing.select_w(splat(CROSSED), splat(0)),
-        );
-        let face_code = glide.select_w(splat(END_GLIDE), face_code);
         self.code = interact.select_w(lost.select_w(splat(END_ROULETTE), splat(0)), face_code);
     }
 }
@@ -569,9 +580,8 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
             absorb: m.absorb_fraction,
             isotropic: m.hg.isotropic,
             hg: [m.hg.one_minus_g2, m.hg.one_minus_g, m.hg.two_g, m.hg.one_plus_g2, m.hg.inv_two_g],
-            eta: m.eta,
-            n_above: if j == 0 { ch.eta_above } else { media[j - 1].eta },
-            n_below: if j == last { ch.eta_below } else { media[j + 1].eta },
+            ratio_above: m.eta / if j == 0 { ch.eta_above } else { media[j - 1].eta },
+            ratio_below: m.eta / if j == last { ch.eta_below } else { media[j + 1].eta },
             top: j == 0,
             bottom: j == last,
         })
