@@ -195,6 +195,10 @@ impl M {
         lanewise!(M, M, |a| !a)
     }
     #[inline(always)]
+    fn all(self) -> bool {
+        self.0.iter().fold(true, |a, &b| a & b)
+    }
+    #[inline(always)]
     fn any(self) -> bool {
         self.0.iter().fold(false, |a, &b| a | b)
     }
@@ -485,10 +489,15 @@ impl Lanes {
         let dw = w * self.absorb;
         let w_int = w - dw;
         let [a, b, c, e, f] = self.hg;
-        let q = a / (b + c * xi1);
-        let hg = (e - q * q) * f;
-        let hg = hg.lt(V::splat(-1.0)).select(V::splat(-1.0), V::splat(1.0).lt(hg).select(V::splat(1.0), hg));
-        let cos_t = self.isotropic.select(xi1 * 2.0 - 1.0, hg);
+        let iso = xi1 * 2.0 - 1.0;
+        let cos_t = if self.isotropic.all() {
+            iso
+        } else {
+            let q = a / (b + c * xi1);
+            let hg = (e - q * q) * f;
+            let hg = hg.lt(V::splat(-1.0)).select(V::splat(-1.0), V::splat(1.0).lt(hg).select(V::splat(1.0), hg));
+            self.isotropic.select(iso, hg)
+        };
         let (cos_p, sin_p) = azimuth_cos_sin(r2);
         let sin2_t = (-(cos_t * cos_t) + 1.0).pos();
         let sin_t = sin2_t.sqrt();
