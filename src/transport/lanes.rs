@@ -28,7 +28,7 @@ use super::rng::{M0, M1, W0, W1};
 
 /// Photon packets traced side by side (the same on every path: the lane a photon gets decides the order of the
 /// per-lane absorption sums, so it must not depend on the CPU).
-pub const LANES: usize = 8;
+pub const LANES: usize = 32;
 
 /// The instruction set the lane loops are compiled for; every path gives the same bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -350,22 +350,23 @@ fn round_keys(seed: u64) -> [[u32; 2]; 10] {
     keys
 }
 
-/// Philox4x32-10 of the counters `c` per lane under the round keys `keys` ([`super::rng::philox4x32_10`]; the
-/// 32×32 → 64-bit products become packed multiplies).
+/// Philox4x32-10 of the counters `c` per lane under the round keys `keys` ([`super::rng::philox4x32_10`]). The
+/// words are carried in 64-bit lanes so that the 32×32 → 64-bit products are packed multiplies of the low halves
+/// with no repacking: a product's low half is the next round's word as it stands (the high bits it carries along
+/// are masked off before the next multiply and at the end).
 #[inline(always)]
-fn block(mut c: [W; 4], keys: &[[u32; 2]; 10]) -> [W; 4] {
+fn block(c: [W; 4], keys: &[[u32; 2]; 10]) -> [W; 4] {
+    let [mut c0, mut c1, mut c2, mut c3] = c.map(|w| lanewise!(W, P, |w| u64::from(w)));
     for k in keys {
-        let (c0, c1, c2, c3) = (c[0], c[1], c[2], c[3]);
-        let p0 = lanewise!(W, P, |c0| u64::from(M0) * u64::from(c0));
-        let p1 = lanewise!(W, P, |c2| u64::from(M1) * u64::from(c2));
-        c = [
-            lanewise!(W, W, |p1, c1| (p1 >> 32) as u32 ^ c1 ^ k[0]),
-            lanewise!(W, W, |p1| p1 as u32),
-            lanewise!(W, W, |p0, c3| (p0 >> 32) as u32 ^ c3 ^ k[1]),
-            lanewise!(W, W, |p0| p0 as u32),
-        ];
+        let (k0, k1) = (u64::from(k[0]), u64::from(k[1]));
+        let p0 = lanewise!(P, P, |c0| (c0 & 0xffff_ffff) * u64::from(M0));
+        let p1 = lanewise!(P, P, |c2| (c2 & 0xffff_ffff) * u64::from(M1));
+        c0 = lanewise!(P, P, |p1, c1| (p1 >> 32) ^ c1 ^ k0);
+        c1 = p1;
+        c2 = lanewise!(P, P, |p0, c3| (p0 >> 32) ^ c3 ^ k1);
+        c3 = p0;
     }
-    c
+    [c0, c1, c2, c3].map(|p| lanewise!(P, W, |p| p as u32))
 }
 
 /// 64-bit products per lane.
@@ -424,6 +425,8 @@ struct Lanes {
     dw: V,
     code: W,
     interacted: W,
+    /// 1 − Rsp.
+    start_weight: f64,
 }
 
 const END_TOP: u32 = 1;
@@ -449,21 +452,21 @@ impl Lanes {
         self.bottom.0[i] = m.bottom;
     }
 
-    /// Lane `i` starts photon `k` (or, with `live` false, a placeholder whose tallies are masked out).
-    fn launch(&mut self, i: usize, k: u64, live: bool, start_weight: f64, first_layer: &LayerConsts) {
+    /// Lane `i` starts photon `k` (or, with `live` false, a placeholder whose tallies are masked out) with weight
+    /// `start_weight`; its layer constants are the caller's (those of the first layer).
+    fn launch(&mut self, i: usize, k: u64, live: bool) {
         self.x.0[i] = 0.0;
         self.y.0[i] = 0.0;
         self.z.0[i] = 0.0;
         self.ux.0[i] = 0.0;
         self.uy.0[i] = 0.0;
         self.uz.0[i] = 1.0;
-        self.w.0[i] = start_weight;
+        self.w.0[i] = self.start_weight;
         self.s.0[i] = 0.0;
         self.photon_lo.0[i] = k as u32;
         self.photon_hi.0[i] = (k >> 32) as u32;
         self.event.0[i] = 0;
         self.live.0[i] = live;
-        self.load_layer(i, first_layer);
     }
 
     /// One event of every lane (module docs). Writes `dw`, `code` and `interacted`; no branch on lane data.
@@ -500,12 +503,13 @@ impl Lanes {
         };
         let (cos_p, sin_p) = azimuth_cos_sin(r2);
         let sin2_t = (-(cos_t * cos_t) + 1.0).pos();
-        let sin_t = sin2_t.sqrt();
         let one_minus_uz2 = -(uz * uz) + 1.0;
-        let a = (sin2_t / one_minus_uz2).sqrt();
+        // Along the z axis (|uz| > 0.99999, e.g. a packet's first interaction) the frame is the lab frame: there
+        // the one square root gives sin θ itself.
         let polar = V::splat(0.99999).lt(uz.abs());
-        let sx = polar.select(sin_t * cos_p, a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t);
-        let sy = polar.select(sin_t * sin_p, a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t);
+        let a = (sin2_t / polar.select(V::splat(1.0), one_minus_uz2)).sqrt();
+        let sx = polar.select(a * cos_p, a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t);
+        let sy = polar.select(a * sin_p, a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t);
         let sz = polar.select(uz.lt(zero).select(-cos_t, cos_t), -a * one_minus_uz2 * cos_p + uz * cos_t);
         let low = w_int.lt(V::splat(ROULETTE_THRESHOLD));
         let survive = unit(r3).le(V::splat(1.0 / ROULETTE_CHANCE)).and(w_int.eq(zero).not());
@@ -600,12 +604,16 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
     let bins = tally.r.len();
     let end = first + count;
     let mut next = first;
-    let mut lanes = Lanes::default();
+    let mut lanes = Lanes { start_weight: ch.start_weight, ..Lanes::default() };
     let mut layer = [0usize; LANES];
     for i in 0..LANES {
-        lanes.launch(i, next, next < end, ch.start_weight, &consts[0]);
+        lanes.load_layer(i, &consts[0]);
+        lanes.launch(i, next, next < end);
         next = (next + 1).min(end);
     }
+    // Exit weights (R then T, module docs of the loop below) and the totals Rd, Td.
+    let mut exits = vec![0.0f64; 2 * (bins + 1)];
+    let mut totals = [0.0f64; 2];
     // Absorbed weight per layer and lane.
     let mut absorbed = vec![[0.0f64; LANES]; media.len()];
     let mut live_count = LANES.min(count as usize);
@@ -634,43 +642,44 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
             special &= special - 1;
             let live = lanes.live.0[i];
             let w = lanes.w.0[i];
-            match lanes.code.0[i] {
-                CROSSED => {
-                    layer[i] = if lanes.uz.0[i] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
-                    lanes.load_layer(i, &consts[layer[i]]);
-                    continue;
-                }
-                END_GLIDE if live => absorbed[layer[i]][i] += w,
-                code @ (END_TOP | END_BOTTOM) if live => {
-                    let (x, y) = (lanes.x.0[i], lanes.y.0[i]);
-                    let r = (x * x + y * y).sqrt();
-                    let (total, bins_of) = if code == END_TOP {
-                        (&mut tally.rd, &mut tally.r)
-                    } else {
-                        (&mut tally.td, &mut tally.t)
-                    };
-                    *total += w;
-                    let bin = (r * inv_bin) as usize;
-                    if bin < bins {
-                        bins_of[bin] += w;
-                    }
-                }
-                _ => {}
+            let code = lanes.code.0[i];
+            if code == CROSSED {
+                layer[i] = if lanes.uz.0[i] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
+                lanes.load_layer(i, &consts[layer[i]]);
+                continue;
             }
-            // The packet has ended: the lane takes the chunk's next photon, or idles once there is none.
-            if live {
+            if code == END_GLIDE && live {
+                absorbed[layer[i]][i] += w;
+            }
+            // Exits (and, adding zero, roulette losses and placeholders) scored without a branch: R bins at
+            // 0..bins, T bins at bins + 1.., each followed by an overflow slot for radii beyond the last bin.
+            let (x, y) = (lanes.x.0[i], lanes.y.0[i]);
+            let bin = (((x * x + y * y).sqrt() * inv_bin) as usize).min(bins);
+            let w_exit = if live && code <= END_BOTTOM { w } else { 0.0 };
+            let bottom = code == END_BOTTOM;
+            exits[bin + usize::from(bottom) * (bins + 1)] += w_exit;
+            totals[usize::from(bottom)] += w_exit;
+            // The packet has ended: the lane takes the chunk's next photon, or idles (a placeholder whose tallies
+            // are masked out) once there is none.
+            let more = live && next < end;
+            if live && !more {
                 live_count -= 1;
             }
-            let more = live && next < end;
-            if more {
-                live_count += 1;
+            if layer[i] != 0 {
+                layer[i] = 0;
+                lanes.load_layer(i, &consts[0]);
             }
-            layer[i] = 0;
-            lanes.launch(i, next, more, ch.start_weight, &consts[0]);
-            if more {
-                next += 1;
-            }
+            lanes.launch(i, next, more);
+            next += u64::from(more);
         }
+    }
+    tally.rd += totals[0];
+    tally.td += totals[1];
+    for (t, e) in tally.r.iter_mut().zip(&exits[..bins]) {
+        *t += e;
+    }
+    for (t, e) in tally.t.iter_mut().zip(&exits[bins + 1..2 * bins + 1]) {
+        *t += e;
     }
     for (t, acc) in tally.absorbed.iter_mut().zip(&absorbed) {
         for a in acc {

@@ -65,7 +65,7 @@ pub const MIN_BIN_MM: f64 = 1e-6;
 /// Largest tallied radius (bins × Δr), mm.
 pub const MAX_RADIUS_MM: f64 = 1e4;
 /// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling).
-pub const CHUNK_PHOTONS: u64 = 1024;
+pub const CHUNK_PHOTONS: u64 = 4096;
 /// Chunks traced in parallel before their tallies are summed in order.
 pub const WAVE_CHUNKS: usize = 64;
 
