@@ -748,17 +748,18 @@ mod tests {
     fn lane_draws_are_the_philox_blocks() {
         let seed = 0x0123_4567_89ab_cdef_u64;
         let keys = round_keys(seed);
-        let photons: [u64; LANES] = [0, 1, 5, 0x1_0000_0005, 77, u64::MAX, 1 << 40, 12345];
+        let special: [u64; 8] = [0, 1, 5, 0x1_0000_0005, 77, u64::MAX, 1 << 40, 12345];
+        let photons: [u64; LANES] = std::array::from_fn(|i| special[i % 8] ^ (i as u64 / 8) << 20);
         let lo = W(photons.map(|k| k as u32));
         let hi = W(photons.map(|k| (k >> 32) as u32));
-        let event = W([0, 1, 2, 3, 7, u32::MAX, 100, 9]);
+        let event = W(std::array::from_fn(|i| [0, 1, 2, 3, 7, u32::MAX, 100, 9][i % 8] ^ (i as u32 / 8)));
         let got = block([lo, hi, W([2; LANES]), event], &keys);
         for i in 0..LANES {
             let c = [lo.0[i], hi.0[i], 2, event.0[i]];
             let expected = super::super::rng::philox4x32_10(c, [seed as u32, (seed >> 32) as u32]);
             assert_eq!(got.map(|w| w.0[i]), expected, "lane {i}");
         }
-        let w = W([0, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX, 3, 4, 5]);
+        let w = W(std::array::from_fn(|i| [0, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX, 3, 4, 5][i % 8]));
         let u = unit(w);
         for i in 0..LANES {
             assert_eq!(u.0[i], (f64::from(w.0[i]) + 1.0) / 4_294_967_296.0);
