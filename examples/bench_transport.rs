@@ -13,9 +13,12 @@
 //! of the per-round ratios. CPU time, not wall time, is the per-core measure on a machine whose cores other
 //! processes share (wall time there counts their turns). It also checks that every run and pool gave the same bytes.
 //!
-//! Measured 2026-11-25 (commit f6b35a3, 5 rounds, shared 2-core machine): (a) 8.4 M histories per CPU second vs
-//! MCML's 6.95 M photons → 1.20× per core (per round 1.18–1.24); (b) 0.90 M vs 0.62 M → 1.43× (1.42–1.45). The
-//! photon loop before this work gave 0.91× and 0.90× with the same method in the same session. Goal 2×: not reached.
+//! Measured 2026-11-25 (commit 49cf6cc, the photon-lane engine `transport::lanes` on its AVX-512F path, 5 rounds,
+//! shared 2-core machine, `RTBAKE_MCML=/tmp/mcml/mcml RTBAKE_BENCH_ROUNDS=5`): (a) CPU median 0.112 s
+//! (0.112–0.112) = 26.8 M histories per CPU second vs MCML's 7.20 M photons → 3.71× per core (per round
+//! 3.67–3.81); (b) 0.218 s (0.217–0.234) = 2.75 M vs 0.64 M → 4.29× (4.09–4.43). Goal 2×: met. The scalar engine
+//! before it (b64e702), same session and method: 1.20× (1.19–1.23) and 1.42× (1.40–1.46); the lane engine with the
+//! AVX2 path forced: 1.87× (1.78–1.87) and 2.14× (2.13–2.15); the portable path: 0.49× and 0.49×.
 //!
 //! When an adapter is found (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME` as for the runtime) the GPU path
 //! (`runtime::transport_gpu`, pipeline compiled once, one warm-up run) is timed the same way: median and min–max

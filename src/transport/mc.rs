@@ -5,8 +5,8 @@
 //! Rsp = ((n₀ − n₁)/(n₀ + n₁))² is the specular reflection of the top surface (§3.1; MCML's special case of a
 //! clear first layer is not made: a clear layer is simply traced). Then, repeatedly (§3.2–3.8):
 //!
-//! * **Step**: a dimensionless optical depth s, exponential of mean 1 (distributed as −ln ξ; drawn by the ziggurat
-//!   method, [`super::ziggurat`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
+//! * **Step**: a dimensionless optical depth s = −ln ξ, exponential of mean 1 (a branch-free logarithm,
+//!   [`super::lanes`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
 //!   unless it reaches the layer's face first, in which case it stops there and keeps the rest of s for the next
 //!   layer (§3.3.2, with σt = 0 in a clear layer).
 //! * **Face**: unpolarised Fresnel reflectance R(θi) = ½(rs² + rp²) between the layer's index and the neighbour's
@@ -16,8 +16,7 @@
 //! * **Interaction**: implicit capture — the weight w·σa/σt is scored as absorbed in the layer and w keeps the rest
 //!   (§3.4); the direction is scattered by the Henyey–Greenstein phase function
 //!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ uniform on `[0, 2π)`
-//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ from a point uniform in the unit disk, [`PhotonRng::azimuth_cos_sin`],
-//!   instead of MCML's cos(2πξ)).
+//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ by polynomials of the angle within a quadrant, [`super::lanes`]).
 //! * **Russian roulette** below w = [`ROULETTE_THRESHOLD`]: the packet survives with chance 1/[`ROULETTE_CHANCE`]
 //!   with weight w·`ROULETTE_CHANCE`, else ends (§3.6; energy is conserved in expectation).
 //!
@@ -27,14 +26,24 @@
 //! Standard errors come from [`McSettings::batches`] independent batches of equal size:
 //! SE = √(Σ_b (x_b − x̄)²/(B(B − 1))).
 //!
-//! Each event draws, in order: the step (one word, more in the ziggurat's rare slow cases) when none is pending;
-//! then either the Fresnel ξ at a face (only where 0 < R < 1) or, at an interaction, the HG ξ, the azimuth (two
-//! words per disk try, 2.55 on average) and the roulette ξ (only below the threshold).
+//! Each event draws one Philox block (four 32-bit words) of its photon, block e at the photon's event e, and uses
+//! them in fixed roles: word 0 the step (when none is pending), word 1 the HG ξ at an interaction or the Fresnel ξ
+//! at a face, word 2 the azimuth, word 3 the roulette ξ; the words an event does not need are skipped. (Before the
+//! lane engine, an event drew only what it used, in order: the step by the ziggurat method, [`super::ziggurat`],
+//! the Fresnel or HG ξ, the azimuth from a point uniform in the unit disk, [`super::rng::PhotonRng::azimuth_cos_sin`], the
+//! roulette ξ. That scalar engine is kept as the reference the lane engine is tested against; the histories of the
+//! two differ, their results agree within the standard errors.)
 //!
-//! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, block)
-//! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
-//! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
-//! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
+//! **Engine**: photons are traced [`super::lanes::LANES`] at a time by [`super::lanes`], every step computing both the
+//! interaction and the face for all lanes in packed arithmetic and keeping one per lane (AVX-512F, AVX2 or
+//! portable code, chosen at run time; all give the same bytes).
+//!
+//! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, event)
+//! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`] (within a chunk a lane whose packet ends
+//! takes the next photon index, so which lane traces which photon depends only on the histories), chunks in
+//! parallel waves of [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same
+//! bytes for any rayon thread count and any instruction-set path, and memory is bounded by (WAVE_CHUNKS + batches)
+//! tallies, not by N.
 //!
 //! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
 //! the same Philox streams but consumed MCML's way: −ln ξ, φ = 2πξ, 24-bit uniforms, so its histories are not the
@@ -64,7 +73,8 @@ pub const MAX_BINS: usize = 100_000;
 pub const MIN_BIN_MM: f64 = 1e-6;
 /// Largest tallied radius (bins × Δr), mm.
 pub const MAX_RADIUS_MM: f64 = 1e4;
-/// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling).
+/// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling; large enough
+/// that the lanes seldom idle at a chunk's end).
 pub const CHUNK_PHOTONS: u64 = 4096;
 /// Chunks traced in parallel before their tallies are summed in order.
 pub const WAVE_CHUNKS: usize = 64;
@@ -125,12 +135,15 @@ impl McSettings {
     }
 
     /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
-    /// 600 000 photon histories/s per thread, below the slowest case measured with the release build on the
-    /// project's 2-core machine (semi-infinite, albedo 0.9, mismatched boundary: 0.88 M histories per CPU second on
-    /// one thread, `examples/bench_transport`, 2026-11-25); thin or absorbing stacks run up to ten times faster, so
-    /// this is an upper estimate.
+    /// 600 000 photon histories/s per thread (150 000 where the lane engine runs its portable path, no AVX2), below
+    /// the slowest case measured with the release build on the project's 2-core machine (semi-infinite, albedo 0.9,
+    /// mismatched boundary, `examples/bench_transport`, 2026-11-25, one thread: 2.75 M histories per CPU second on
+    /// the AVX-512F path, 1.40 M on the AVX2 path, 0.31 M on the portable path); thin or absorbing stacks run up to
+    /// ten times faster, so this is an upper estimate. (The rate is not raised with the lane engine: the same figure
+    /// bounds a software GPU adapter, `runtime::chain::transport_estimate`.)
     pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
-        3.0 * self.photons as f64 / (600_000.0 * threads.max(1) as f64)
+        let per_thread = if Path::detect() == Path::Portable { 150_000.0 } else { 600_000.0 };
+        3.0 * self.photons as f64 / (per_thread * threads.max(1) as f64)
     }
 
     /// Bin centres (i + ½)Δr, mm.
@@ -631,7 +644,11 @@ mod tests {
         McStack::new(
             1.0,
             1.2,
-            vec![layer(0.05, 1.5, 0.0, 0.0, 0.0), layer(0.2, 1.4, 0.3, 15.0, 0.8), layer(f64::INFINITY, 1.33, 0.1, 5.0, 0.0)],
+            vec![
+                layer(0.05, 1.5, 0.0, 0.0, 0.0),
+                layer(0.2, 1.4, 0.3, 15.0, 0.8),
+                layer(f64::INFINITY, 1.33, 0.1, 5.0, 0.0),
+            ],
         )
         .unwrap()
     }
@@ -681,7 +698,9 @@ mod tests {
             }
             // Everything that enters is reflected or absorbed (semi-infinite): energy closes in both.
             for r in [l, s] {
-                let total = r.specular_reflectance + r.diffuse_reflectance.mean + r.absorbed.iter().map(|a| a.mean).sum::<f64>();
+                let total = r.specular_reflectance
+                    + r.diffuse_reflectance.mean
+                    + r.absorbed.iter().map(|a| a.mean).sum::<f64>();
                 let se = r.diffuse_reflectance.se + r.absorbed.iter().map(|a| a.se).sum::<f64>();
                 assert!((total - 1.0).abs() <= 4.0 * se + 1e-12, "channel {c}: {total} ± {se}");
             }
