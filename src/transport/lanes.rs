@@ -113,9 +113,16 @@ struct V([f64; LANES]);
 /// `LANES` u32 values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct W([u32; LANES]);
-/// A per-lane condition.
+/// A per-lane condition: all ones (true) or zero (false) in 64 bits, the form of a packed comparison's result, so
+/// that selects are bitwise on every instruction set.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct M([bool; LANES]);
+struct M([u64; LANES]);
+
+/// The mask lane of a condition.
+#[inline(always)]
+fn mask(b: bool) -> u64 {
+    u64::from(b).wrapping_neg()
+}
 
 macro_rules! lanewise {
     ($t:ident, $out:ident, |$($a:ident),*| $e:expr) => {{
@@ -130,7 +137,7 @@ macro_rules! lanewise {
 
 impl Default for M {
     fn default() -> Self {
-        M([false; LANES])
+        M([0; LANES])
     }
 }
 
@@ -142,17 +149,17 @@ impl V {
     #[inline(always)]
     fn lt(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| a < o)
+        lanewise!(V, M, |a, o| mask(a < o))
     }
     #[inline(always)]
     fn le(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| a <= o)
+        lanewise!(V, M, |a, o| mask(a <= o))
     }
     #[inline(always)]
     fn eq(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| a == o)
+        lanewise!(V, M, |a, o| mask(a == o))
     }
     #[inline(always)]
     fn sqrt(self) -> V {
@@ -176,12 +183,12 @@ impl M {
     #[inline(always)]
     fn select(self, a: V, b: V) -> V {
         let m = self;
-        lanewise!(V, V, |m, a, b| if m { a } else { b })
+        lanewise!(V, V, |m, a, b| f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m)))
     }
     #[inline(always)]
     fn select_w(self, a: W, b: W) -> W {
         let m = self;
-        lanewise!(W, W, |m, a, b| if m { a } else { b })
+        lanewise!(W, W, |m, a, b| (a & m as u32) | (b & !(m as u32)))
     }
     #[inline(always)]
     fn and(self, o: M) -> M {
@@ -200,11 +207,11 @@ impl M {
     }
     #[inline(always)]
     fn all(self) -> bool {
-        self.0.iter().fold(true, |a, &b| a & b)
+        self.0.iter().fold(!0, |a, &b| a & b) != 0
     }
     #[inline(always)]
     fn any(self) -> bool {
-        self.0.iter().fold(false, |a, &b| a | b)
+        self.0.iter().fold(0, |a, &b| a | b) != 0
     }
 }
 
@@ -332,8 +339,8 @@ fn azimuth_cos_sin(word: W) -> (V, V) {
     let c = (cos_t - sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     let s = (cos_t + sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     // Quarter turns: q = 1: (−s, c); q = 2: (−c, −s); q = 3: (s, −c).
-    let odd = lanewise!(W, M, |word| word & 0x4000_0000 != 0);
-    let half = lanewise!(W, M, |word| word & 0x8000_0000 != 0);
+    let odd = lanewise!(W, M, |word| mask(word & 0x4000_0000 != 0));
+    let half = lanewise!(W, M, |word| mask(word & 0x8000_0000 != 0));
     let (c1, s1) = (odd.select(-s, c), odd.select(c, s));
     (half.select(-c1, c1), half.select(-s1, s1))
 }
@@ -449,14 +456,14 @@ impl Lanes {
         self.sigma_t.0[i] = m.sigma_t;
         self.inv_sigma_t.0[i] = m.inv_sigma_t;
         self.absorb.0[i] = m.absorb;
-        self.isotropic.0[i] = m.isotropic;
+        self.isotropic.0[i] = mask(m.isotropic);
         for (h, v) in self.hg.iter_mut().zip(m.hg) {
             h.0[i] = v;
         }
         self.ratio_above.0[i] = m.ratio_above;
         self.ratio_below.0[i] = m.ratio_below;
-        self.top.0[i] = m.top;
-        self.bottom.0[i] = m.bottom;
+        self.top.0[i] = mask(m.top);
+        self.bottom.0[i] = mask(m.bottom);
     }
 
     /// Lane `i` starts photon `k` (or, with `live` false, a placeholder whose tallies are masked out) with weight
@@ -473,7 +480,7 @@ impl Lanes {
         self.photon_lo.0[i] = k as u32;
         self.photon_hi.0[i] = (k >> 32) as u32;
         self.event.0[i] = 0;
-        self.live.0[i] = live;
+        self.live.0[i] = mask(live);
     }
 
     /// One event of every lane (module docs). Writes `dw`, `code` and `interacted`; no branch on lane data.
@@ -569,7 +576,7 @@ impl Lanes {
         self.s = interact.select(zero, s_face);
         let live = self.live;
         self.dw = interact.and(live).select(dw, zero);
-        self.interacted = lanewise!(M, W, |interact, live| u32::from(interact & live));
+        self.interacted = lanewise!(M, W, |interact, live| (interact & live) as u32 & 1);
         self.code = interact.select_w(lost.select_w(splat(END_ROULETTE), splat(0)), face_code);
     }
 }
@@ -578,7 +585,7 @@ impl M {
     #[inline(always)]
     fn select_m(self, a: M, b: M) -> M {
         let m = self;
-        lanewise!(M, M, |m, a, b| if m { a } else { b })
+        lanewise!(M, M, |m, a, b| (a & m) | (b & !m))
     }
 }
 
@@ -645,7 +652,7 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
         while special != 0 {
             let i = special.trailing_zeros() as usize;
             special &= special - 1;
-            let live = lanes.live.0[i];
+            let live = lanes.live.0[i] != 0;
             let w = lanes.w.0[i];
             let code = lanes.code.0[i];
             if code == CROSSED {
