@@ -137,8 +137,8 @@ impl McSettings {
     /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
     /// 600 000 photon histories/s per thread (150 000 where the lane engine runs its portable path, no AVX2), below
     /// the slowest case measured with the release build on the project's 2-core machine (semi-infinite, albedo 0.9,
-    /// mismatched boundary, `examples/bench_transport`, 2026-11-25, one thread: 2.75 M histories per CPU second on
-    /// the AVX-512F path, 1.40 M on the AVX2 path, 0.31 M on the portable path); thin or absorbing stacks run up to
+    /// mismatched boundary, `examples/bench_transport`, 2026-11-25, one thread: 2.72 M histories per CPU second on
+    /// the AVX-512F path, 1.59 M on the AVX2 path, 0.26 M on the portable path); thin or absorbing stacks run up to
     /// ten times faster, so this is an upper estimate. (The rate is not raised with the lane engine: the same figure
     /// bounds a software GPU adapter, `runtime::chain::transport_estimate`.)
     pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
