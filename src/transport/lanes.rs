@@ -33,6 +33,7 @@ use super::rng::{M0, M1, W0, W1};
 /// Photon packets traced side by side (the same on every path: the lane a photon gets decides the order of the
 /// per-lane absorption sums, so it must not depend on the CPU; at most 32, the width of the step's outcome mask).
 pub const LANES: usize = 32;
+const _: () = assert!(LANES <= 32, "the outcome mask of a step is a u32");
 
 /// The instruction set the lane loops are compiled for; every path gives the same bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -125,7 +126,7 @@ fn mask(b: bool) -> u64 {
 }
 
 macro_rules! lanewise {
-    ($t:ident, $out:ident, |$($a:ident),*| $e:expr) => {{
+    ($out:ident, |$($a:ident),*| $e:expr) => {{
         let mut r = $out::default();
         for i in 0..LANES {
             $(let $a = $a.0[i];)*
@@ -149,33 +150,33 @@ impl V {
     #[inline(always)]
     fn lt(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| mask(a < o))
+        lanewise!(M, |a, o| mask(a < o))
     }
     #[inline(always)]
     fn le(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| mask(a <= o))
+        lanewise!(M, |a, o| mask(a <= o))
     }
     #[inline(always)]
     fn eq(self, o: V) -> M {
         let a = self;
-        lanewise!(V, M, |a, o| mask(a == o))
+        lanewise!(M, |a, o| mask(a == o))
     }
     #[inline(always)]
     fn sqrt(self) -> V {
         let a = self;
-        lanewise!(V, V, |a| a.sqrt())
+        lanewise!(V, |a| a.sqrt())
     }
     /// max(v, 0) as a select (no NaN handling needed: the arguments are finite or discarded).
     #[inline(always)]
     fn pos(self) -> V {
         let a = self;
-        lanewise!(V, V, |a| if a > 0.0 { a } else { 0.0 })
+        lanewise!(V, |a| if a > 0.0 { a } else { 0.0 })
     }
     #[inline(always)]
     fn abs(self) -> V {
         let a = self;
-        lanewise!(V, V, |a| a.abs())
+        lanewise!(V, |a| a.abs())
     }
 }
 
@@ -183,27 +184,27 @@ impl M {
     #[inline(always)]
     fn select(self, a: V, b: V) -> V {
         let m = self;
-        lanewise!(V, V, |m, a, b| f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m)))
+        lanewise!(V, |m, a, b| f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m)))
     }
     #[inline(always)]
     fn select_w(self, a: W, b: W) -> W {
         let m = self;
-        lanewise!(W, W, |m, a, b| (a & m as u32) | (b & !(m as u32)))
+        lanewise!(W, |m, a, b| (a & m as u32) | (b & !(m as u32)))
     }
     #[inline(always)]
     fn and(self, o: M) -> M {
         let a = self;
-        lanewise!(M, M, |a, o| a & o)
+        lanewise!(M, |a, o| a & o)
     }
     #[inline(always)]
     fn or(self, o: M) -> M {
         let a = self;
-        lanewise!(M, M, |a, o| a | o)
+        lanewise!(M, |a, o| a | o)
     }
     #[inline(always)]
     fn not(self) -> M {
         let a = self;
-        lanewise!(M, M, |a| !a)
+        lanewise!(M, |a| !a)
     }
     #[inline(always)]
     fn all(self) -> bool {
@@ -222,7 +223,7 @@ macro_rules! binop {
             #[inline(always)]
             fn $f(self, o: V) -> V {
                 let a = self;
-                lanewise!(V, V, |a, o| a $op o)
+                lanewise!(V, |a, o| a $op o)
             }
         }
         impl std::ops::$tr<f64> for V {
@@ -231,7 +232,7 @@ macro_rules! binop {
             fn $f(self, o: f64) -> V {
                 let a = self;
                 let o = V::splat(o);
-                lanewise!(V, V, |a, o| a $op o)
+                lanewise!(V, |a, o| a $op o)
             }
         }
     };
@@ -246,7 +247,7 @@ impl std::ops::Neg for V {
     #[inline(always)]
     fn neg(self) -> V {
         let a = self;
-        lanewise!(V, V, |a| -a)
+        lanewise!(V, |a| -a)
     }
 }
 
@@ -323,7 +324,7 @@ const COS: [f64; 9] = [
 /// sin(π/4 + θ) = (cos θ + sin θ)/√2, then q quarter turns.
 #[inline(always)]
 fn azimuth_cos_sin(word: W) -> (V, V) {
-    let low = lanewise!(W, V, |word| f64::from((word & 0x3fff_ffff) as i32));
+    let low = lanewise!(V, |word| f64::from((word & 0x3fff_ffff) as i32));
     let t = ((low + 0.5) * (1.0 / 1_073_741_824.0) - 0.5) * std::f64::consts::FRAC_PI_2;
     let z = t * t;
     let mut ps = V::splat(SIN[7]);
@@ -339,8 +340,8 @@ fn azimuth_cos_sin(word: W) -> (V, V) {
     let c = (cos_t - sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     let s = (cos_t + sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     // Quarter turns: q = 1: (−s, c); q = 2: (−c, −s); q = 3: (s, −c).
-    let odd = lanewise!(W, M, |word| mask(word & 0x4000_0000 != 0));
-    let half = lanewise!(W, M, |word| mask(word & 0x8000_0000 != 0));
+    let odd = lanewise!(M, |word| mask(word & 0x4000_0000 != 0));
+    let half = lanewise!(M, |word| mask(word & 0x8000_0000 != 0));
     let (c1, s1) = (odd.select(-s, c), odd.select(c, s));
     (half.select(-c1, c1), half.select(-s1, s1))
 }
@@ -348,7 +349,7 @@ fn azimuth_cos_sin(word: W) -> (V, V) {
 /// Per lane a uniform in (0, 1] on the grid k/2³² (k = 1..=2³²) from a word, by an exact signed conversion.
 #[inline(always)]
 fn unit(word: W) -> V {
-    lanewise!(W, V, |word| (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0))
+    lanewise!(V, |word| (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0))
 }
 
 /// The ten round keys of Philox4x32-10 under `seed` (the key bumped by the Weyl constants between rounds).
@@ -370,17 +371,17 @@ fn round_keys(seed: u64) -> [[u32; 2]; 10] {
 /// are masked off before the next multiply and at the end).
 #[inline(always)]
 fn block(c: [W; 4], keys: &[[u32; 2]; 10]) -> [W; 4] {
-    let [mut c0, mut c1, mut c2, mut c3] = c.map(|w| lanewise!(W, P, |w| u64::from(w)));
+    let [mut c0, mut c1, mut c2, mut c3] = c.map(|w| lanewise!(P, |w| u64::from(w)));
     for k in keys {
         let (k0, k1) = (u64::from(k[0]), u64::from(k[1]));
-        let p0 = lanewise!(P, P, |c0| (c0 & 0xffff_ffff) * u64::from(M0));
-        let p1 = lanewise!(P, P, |c2| (c2 & 0xffff_ffff) * u64::from(M1));
-        c0 = lanewise!(P, P, |p1, c1| (p1 >> 32) ^ c1 ^ k0);
+        let p0 = lanewise!(P, |c0| (c0 & 0xffff_ffff) * u64::from(M0));
+        let p1 = lanewise!(P, |c2| (c2 & 0xffff_ffff) * u64::from(M1));
+        c0 = lanewise!(P, |p1, c1| (p1 >> 32) ^ c1 ^ k0);
         c1 = p1;
-        c2 = lanewise!(P, P, |p0, c3| (p0 >> 32) ^ c3 ^ k1);
+        c2 = lanewise!(P, |p0, c3| (p0 >> 32) ^ c3 ^ k1);
         c3 = p0;
     }
-    [c0, c1, c2, c3].map(|p| lanewise!(P, W, |p| p as u32))
+    [c0, c1, c2, c3].map(|p| lanewise!(W, |p| p as u32))
 }
 
 /// 64-bit products per lane.
@@ -488,7 +489,7 @@ impl Lanes {
     fn step(&mut self, channel: u32, keys: &[[u32; 2]; 10]) {
         let [r0, r1, r2, r3] = block([self.photon_lo, self.photon_hi, W([channel; LANES]), self.event], keys);
         let event = self.event;
-        self.event = lanewise!(W, W, |event| event.wrapping_add(1));
+        self.event = lanewise!(W, |event| event.wrapping_add(1));
         let xi1 = unit(r1);
         let zero = V::splat(0.0);
 
@@ -576,7 +577,7 @@ impl Lanes {
         self.s = interact.select(zero, s_face);
         let live = self.live;
         self.dw = interact.and(live).select(dw, zero);
-        self.interacted = lanewise!(M, W, |interact, live| (interact & live) as u32 & 1);
+        self.interacted = lanewise!(W, |interact, live| (interact & live) as u32 & 1);
         self.code = interact.select_w(lost.select_w(splat(END_ROULETTE), splat(0)), face_code);
     }
 }
@@ -585,7 +586,7 @@ impl M {
     #[inline(always)]
     fn select_m(self, a: M, b: M) -> M {
         let m = self;
-        lanewise!(M, M, |m, a, b| (a & m) | (b & !m))
+        lanewise!(M, |m, a, b| (a & m) | (b & !m))
     }
 }
 

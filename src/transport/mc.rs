@@ -30,12 +30,12 @@
 //! them in fixed roles: word 0 the step (when none is pending), word 1 the HG ξ at an interaction or the Fresnel ξ
 //! at a face, word 2 the azimuth, word 3 the roulette ξ; the words an event does not need are skipped. (Before the
 //! lane engine, an event drew only what it used, in order: the step by the ziggurat method, [`super::ziggurat`],
-//! the Fresnel or HG ξ, the azimuth from a point uniform in the unit disk, [`super::rng::PhotonRng::azimuth_cos_sin`], the
-//! roulette ξ. That scalar engine is kept as the reference the lane engine is tested against; the histories of the
-//! two differ, their results agree within the standard errors.)
+//! the Fresnel or HG ξ, the azimuth from a point uniform in the unit disk,
+//! [`super::rng::PhotonRng::azimuth_cos_sin`], the roulette ξ. That scalar engine is kept as the reference the lane
+//! engine is tested against; the histories of the two differ, their results agree within the standard errors.)
 //!
-//! **Engine**: photons are traced [`super::lanes::LANES`] at a time by [`super::lanes`], every step computing both the
-//! interaction and the face for all lanes in packed arithmetic and keeping one per lane (AVX-512F, AVX2 or
+//! **Engine**: photons are traced [`super::lanes::LANES`] at a time by [`super::lanes`], every step computing both
+//! the interaction and the face for all lanes in packed arithmetic and keeping one per lane (AVX-512F, AVX2 or
 //! portable code, chosen at run time; all give the same bytes).
 //!
 //! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, event)
