@@ -13,9 +13,12 @@
 //! of the per-round ratios. CPU time, not wall time, is the per-core measure on a machine whose cores other
 //! processes share (wall time there counts their turns). It also checks that every run and pool gave the same bytes.
 //!
-//! Measured 2026-11-25 (commit f6b35a3, 5 rounds, shared 2-core machine): (a) 8.4 M histories per CPU second vs
-//! MCML's 6.95 M photons → 1.20× per core (per round 1.18–1.24); (b) 0.90 M vs 0.62 M → 1.43× (1.42–1.45). The
-//! photon loop before this work gave 0.91× and 0.90× with the same method in the same session. Goal 2×: not reached.
+//! Measured 2026-11-25 (commit e288609, the photon-lane engine `transport::lanes` on its AVX-512F path, 5 rounds,
+//! shared 2-core machine at load 2, `RTBAKE_MCML=/tmp/mcml/mcml RTBAKE_BENCH_ROUNDS=5`): (a) CPU median 0.117 s
+//! (0.111–0.118) = 25.6 M histories per CPU second vs MCML's 7.0 M photons → 3.67× per core (per round
+//! 3.63–3.85); (b) 0.221 s (0.220–0.222) = 2.72 M vs 0.61 M → 4.42× (4.35–4.65). Goal 2×: met. The scalar engine
+//! before it (b64e702), same session and method: 1.20× (1.19–1.23) and 1.42× (1.40–1.46). The same code with the
+//! AVX2 path forced (2 runs of 3 rounds): 2.21–2.39× and 2.52–2.57×; the portable path (SSE2): 0.39× and 0.41×.
 //!
 //! When an adapter is found (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME` as for the runtime) the GPU path
 //! (`runtime::transport_gpu`, pipeline compiled once, one warm-up run) is timed the same way: median and min–max

@@ -5,8 +5,8 @@
 //! Rsp = ((n₀ − n₁)/(n₀ + n₁))² is the specular reflection of the top surface (§3.1; MCML's special case of a
 //! clear first layer is not made: a clear layer is simply traced). Then, repeatedly (§3.2–3.8):
 //!
-//! * **Step**: a dimensionless optical depth s, exponential of mean 1 (distributed as −ln ξ; drawn by the ziggurat
-//!   method, [`super::ziggurat`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
+//! * **Step**: a dimensionless optical depth s = −ln ξ, exponential of mean 1 (a branch-free logarithm,
+//!   [`super::lanes`]), is drawn; in a layer of σt = σa + σs the packet moves s/σt
 //!   unless it reaches the layer's face first, in which case it stops there and keeps the rest of s for the next
 //!   layer (§3.3.2, with σt = 0 in a clear layer).
 //! * **Face**: unpolarised Fresnel reflectance R(θi) = ½(rs² + rp²) between the layer's index and the neighbour's
@@ -16,8 +16,7 @@
 //! * **Interaction**: implicit capture — the weight w·σa/σt is scored as absorbed in the layer and w keeps the rest
 //!   (§3.4); the direction is scattered by the Henyey–Greenstein phase function
 //!   cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (cos θ = 2ξ − 1 for g = 0), φ uniform on `[0, 2π)`
-//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ from a point uniform in the unit disk, [`PhotonRng::azimuth_cos_sin`],
-//!   instead of MCML's cos(2πξ)).
+//!   (§3.5, eq. 3.28–3.30; cos φ and sin φ by polynomials of the angle within a quadrant, [`super::lanes`]).
 //! * **Russian roulette** below w = [`ROULETTE_THRESHOLD`]: the packet survives with chance 1/[`ROULETTE_CHANCE`]
 //!   with weight w·`ROULETTE_CHANCE`, else ends (§3.6; energy is conserved in expectation).
 //!
@@ -27,22 +26,35 @@
 //! Standard errors come from [`McSettings::batches`] independent batches of equal size:
 //! SE = √(Σ_b (x_b − x̄)²/(B(B − 1))).
 //!
-//! Each event draws, in order: the step (one word, more in the ziggurat's rare slow cases) when none is pending;
-//! then either the Fresnel ξ at a face (only where 0 < R < 1) or, at an interaction, the HG ξ, the azimuth (two
-//! words per disk try, 2.55 on average) and the roulette ξ (only below the threshold).
+//! Each event draws one Philox block (four 32-bit words) of its photon, block e at the photon's event e, and uses
+//! them in fixed roles: word 0 the step (when none is pending), word 1 the HG ξ at an interaction or the Fresnel ξ
+//! at a face, word 2 the azimuth, word 3 the roulette ξ; the words an event does not need are skipped. (Before the
+//! lane engine, an event drew only what it used, in order: the step by the ziggurat method, [`super::ziggurat`],
+//! the Fresnel or HG ξ, the azimuth from a point uniform in the unit disk,
+//! [`super::rng::PhotonRng::azimuth_cos_sin`], the roulette ξ. That scalar engine is kept as the reference the lane
+//! engine is tested against; the histories of the two differ, their results agree within the standard errors.)
 //!
-//! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, block)
-//! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`], chunks in parallel waves of
-//! [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same bytes for any
-//! rayon thread count, and memory is bounded by (WAVE_CHUNKS + batches) tallies, not by N.
+//! **Engine**: photons are traced [`super::lanes::LANES`] at a time by [`super::lanes`], every step computing both
+//! the interaction and the face for all lanes in packed arithmetic and keeping one per lane (AVX-512F, AVX2 or
+//! portable code, chosen at run time; all give the same bytes).
+//!
+//! **Determinism**: photon k of channel c draws from Philox keyed with the seed at counter (k, c, event)
+//! ([`super::rng`]); photons are traced in chunks of [`CHUNK_PHOTONS`] (within a chunk a lane whose packet ends
+//! takes the next photon index, so which lane traces which photon depends only on the histories), chunks in
+//! parallel waves of [`WAVE_CHUNKS`], and each batch sums its chunks' tallies in chunk order. The result is the same
+//! bytes for any rayon thread count and any instruction-set path, and memory is bounded by (WAVE_CHUNKS + batches)
+//! tallies, not by N.
 //!
 //! [`assemble`] turns raw per-batch [`Tally`]s into the result; the GPU path (`runtime::transport_gpu`, f32,
 //! the same Philox streams but consumed MCML's way: −ln ξ, φ = 2πξ, 24-bit uniforms, so its histories are not the
 //! CPU's and the two agree statistically) reads its tallies back and calls it too, so both report means and standard errors the
 //! same way.
 
+use super::lanes::{self, Path};
+#[cfg(test)]
 use super::rng::PhotonRng;
 use super::stack::McStack;
+#[cfg(test)]
 use super::ziggurat::ExponentialZiggurat;
 use crate::error::InvalidInput;
 use rayon::prelude::*;
@@ -61,8 +73,9 @@ pub const MAX_BINS: usize = 100_000;
 pub const MIN_BIN_MM: f64 = 1e-6;
 /// Largest tallied radius (bins × Δr), mm.
 pub const MAX_RADIUS_MM: f64 = 1e4;
-/// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling).
-pub const CHUNK_PHOTONS: u64 = 256;
+/// Photons per chunk (the unit of parallel work; fixed so the result does not depend on scheduling; large enough
+/// that the lanes seldom idle at a chunk's end).
+pub const CHUNK_PHOTONS: u64 = 4096;
 /// Chunks traced in parallel before their tallies are summed in order.
 pub const WAVE_CHUNKS: usize = 64;
 
@@ -122,12 +135,15 @@ impl McSettings {
     }
 
     /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
-    /// 600 000 photon histories/s per thread, below the slowest case measured with the release build on the
-    /// project's 2-core machine (semi-infinite, albedo 0.9, mismatched boundary: 0.88 M histories per CPU second on
-    /// one thread, `examples/bench_transport`, 2026-11-25); thin or absorbing stacks run up to ten times faster, so
-    /// this is an upper estimate.
+    /// 600 000 photon histories/s per thread (150 000 where the lane engine runs its portable path, no AVX2), below
+    /// the slowest case measured with the release build on the project's 2-core machine (semi-infinite, albedo 0.9,
+    /// mismatched boundary, `examples/bench_transport`, 2026-11-25, one thread: 2.72 M histories per CPU second on
+    /// the AVX-512F path, 1.59 M on the AVX2 path, 0.26 M on the portable path); thin or absorbing stacks run up to
+    /// ten times faster, so this is an upper estimate. (The rate is not raised with the lane engine: the same figure
+    /// bounds a software GPU adapter, `runtime::chain::transport_estimate`.)
     pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
-        3.0 * self.photons as f64 / (600_000.0 * threads.max(1) as f64)
+        let per_thread = if Path::detect() == Path::Portable { 150_000.0 } else { 600_000.0 };
+        3.0 * self.photons as f64 / (per_thread * threads.max(1) as f64)
     }
 
     /// Bin centres (i + ½)Δr, mm.
@@ -214,29 +230,29 @@ impl Tally {
 
 /// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug)]
-struct Medium {
-    z_top_mm: f64,
-    z_bottom_mm: f64,
-    sigma_t: f64,
+pub(super) struct Medium {
+    pub(super) z_top_mm: f64,
+    pub(super) z_bottom_mm: f64,
+    pub(super) sigma_t: f64,
     /// 1/σt (unused in a clear layer).
-    inv_sigma_t: f64,
+    pub(super) inv_sigma_t: f64,
     /// σa/σt (0 in a clear layer).
-    absorb_fraction: f64,
-    hg: HenyeyGreenstein,
-    eta: f64,
+    pub(super) absorb_fraction: f64,
+    pub(super) hg: HenyeyGreenstein,
+    pub(super) eta: f64,
 }
 
 /// Henyey–Greenstein sampling constants of one g (MCML eq. 3.28):
 /// cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g), cos θ = 2ξ − 1 for |g| < 10⁻⁶.
 #[derive(Clone, Copy, Debug)]
-struct HenyeyGreenstein {
-    isotropic: bool,
+pub(super) struct HenyeyGreenstein {
+    pub(super) isotropic: bool,
     /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g).
-    one_minus_g2: f64,
-    one_minus_g: f64,
-    two_g: f64,
-    one_plus_g2: f64,
-    inv_two_g: f64,
+    pub(super) one_minus_g2: f64,
+    pub(super) one_minus_g: f64,
+    pub(super) two_g: f64,
+    pub(super) one_plus_g2: f64,
+    pub(super) inv_two_g: f64,
 }
 
 impl HenyeyGreenstein {
@@ -252,6 +268,7 @@ impl HenyeyGreenstein {
     }
 
     /// cos θ from a uniform ξ.
+    #[cfg(test)]
     #[inline]
     fn cos_theta(&self, xi: f64) -> f64 {
         if self.isotropic {
@@ -264,6 +281,7 @@ impl HenyeyGreenstein {
 
 /// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ `[0, 1]`, and the cosine of
 /// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
+#[cfg(test)]
 fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
     if n_i == n_t {
         return (0.0, cos_i);
@@ -281,6 +299,7 @@ fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
 /// Rotates direction `u` by polar cos θ and the azimuth (cos φ, sin φ) (MCML eq. 3.30–3.31). sin θ/√(1 − uz²) is
 /// taken as one square root of a quotient, and sin θ·√(1 − uz²) as that times 1 − uz² (the same expressions as
 /// MCML's `Spin`, one square root fewer).
+#[cfg(test)]
 #[inline]
 fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
     let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
@@ -301,18 +320,18 @@ fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
 }
 
 /// What every photon of one channel shares.
-struct Channel<'a> {
-    media: &'a [Medium],
-    eta_above: f64,
-    eta_below: f64,
+pub(super) struct Channel<'a> {
+    pub(super) media: &'a [Medium],
+    pub(super) eta_above: f64,
+    pub(super) eta_below: f64,
     /// 1 − Rsp.
-    start_weight: f64,
-    index: u32,
-    /// Step lengths −ln ξ by the ziggurat method.
-    exponential: &'a ExponentialZiggurat,
+    pub(super) start_weight: f64,
+    pub(super) index: u32,
+    pub(super) seed: u64,
 }
 
-/// One photon packet in flight.
+/// One photon packet in flight (the scalar reference engine).
+#[cfg(test)]
 struct Photon {
     x: f64,
     y: f64,
@@ -325,9 +344,10 @@ struct Photon {
     rng: PhotonRng,
 }
 
+#[cfg(test)]
 impl Photon {
     /// Photon `k` of the channel at the origin, heading down with weight 1 − Rsp.
-    fn launch(ch: &Channel<'_>, seed: u64, k: u64) -> Self {
+    fn launch(ch: &Channel<'_>, k: u64) -> Self {
         Self {
             x: 0.0,
             y: 0.0,
@@ -336,7 +356,7 @@ impl Photon {
             w: ch.start_weight,
             s_left: 0.0,
             layer: 0,
-            rng: PhotonRng::new(seed, k, ch.index),
+            rng: PhotonRng::new(ch.seed, k, ch.index),
         }
     }
 
@@ -347,12 +367,19 @@ impl Photon {
     /// z + uz·s/σt is compared with the face the packet heads for; only a packet that reaches it computes the
     /// distance to the face (and then stops there exactly, as MCML's `PathToBoundary` and `CrossOrNot`).
     #[inline(always)]
-    fn event(&mut self, ch: &Channel<'_>, bins: usize, inv_bin: f64, tally: &mut Tally) -> bool {
+    fn event(
+        &mut self,
+        ch: &Channel<'_>,
+        exponential: &ExponentialZiggurat,
+        bins: usize,
+        inv_bin: f64,
+        tally: &mut Tally,
+    ) -> bool {
         let media = ch.media;
         let m = &media[self.layer];
         let rng = &mut self.rng;
         if self.s_left == 0.0 {
-            self.s_left = ch.exponential.sample(rng);
+            self.s_left = exponential.sample(rng);
         }
         let u = self.u;
         let down = u[2] > 0.0;
@@ -440,15 +467,27 @@ impl Photon {
     }
 }
 
-/// Traces photons `first..first + count` of channel `ch` into `tally`, one after the other. (Tracing four photons
-/// side by side, one event each in turn, to overlap their dependency chains was measured slower: the events'
-/// branches do not predict across photons.)
-fn trace_chunk(ch: &Channel<'_>, settings: &McSettings, first: u64, count: u64, tally: &mut Tally) {
-    let inv_bin = 1.0 / settings.bin_mm;
+/// The scalar reference engine: traces photons `first..first + count` of channel `ch` into `tally`, one after the
+/// other, with the draws of the module docs' last paragraph but one (ziggurat steps, disk azimuths). The lane
+/// engine ([`super::lanes`]) is checked against it statistically.
+#[cfg(test)]
+fn trace_chunk_scalar(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
+    let exponential = ExponentialZiggurat::new();
+    let inv_bin = 1.0 / bin_mm;
     for k in first..first + count {
-        let mut p = Photon::launch(ch, settings.seed, k);
-        while p.event(ch, settings.bins, inv_bin, tally) {}
+        let mut p = Photon::launch(ch, k);
+        while p.event(ch, &exponential, tally.r.len(), inv_bin, tally) {}
     }
+}
+
+/// Which photon loop traces the chunks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Engine {
+    /// [`super::lanes`] on the given instruction-set path (every path gives the same bytes).
+    Lanes(Path),
+    /// The scalar reference (tests only).
+    #[cfg(test)]
+    Scalar,
 }
 
 fn estimate(batch_values: impl Iterator<Item = f64> + Clone, total: f64, batches: usize) -> Estimate {
@@ -465,6 +504,10 @@ pub fn simulate(stack: &McStack, settings: &McSettings) -> McResult {
 
 /// [`simulate`], calling `progress(fraction done)` after every wave of chunks (from the calling thread).
 pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: &dyn Fn(f64)) -> McResult {
+    simulate_engine(stack, settings, Engine::Lanes(Path::detect()), progress)
+}
+
+fn simulate_engine(stack: &McStack, settings: &McSettings, engine: Engine, progress: &dyn Fn(f64)) -> McResult {
     let layers = stack.layers();
     let n_layers = layers.len();
     let batches = settings.batches as usize;
@@ -498,7 +541,6 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
 
     // Work list: (channel, batch, chunk) in a fixed order; every batch tally sums its chunks in chunk order.
     let total_chunks = 3 * batches as u64 * chunks_per_batch;
-    let exponential = ExponentialZiggurat::new();
     let mut batch_tallies: Vec<Tally> = (0..3 * batches).map(|_| Tally::new(settings.bins, n_layers)).collect();
     let mut next = 0u64;
     while next < total_chunks {
@@ -519,9 +561,13 @@ pub fn simulate_with_progress(stack: &McStack, settings: &McSettings, progress: 
                     eta_below: stack.eta_below(),
                     start_weight: 1.0 - rsp,
                     index: channel as u32,
-                    exponential: &exponential,
+                    seed: settings.seed,
                 };
-                trace_chunk(&ch, settings, first, count, &mut t);
+                match engine {
+                    Engine::Lanes(path) => lanes::trace_chunk(path, &ch, settings.bin_mm, first, count, &mut t),
+                    #[cfg(test)]
+                    Engine::Scalar => trace_chunk_scalar(&ch, settings.bin_mm, first, count, &mut t),
+                }
                 ((channel as usize) * batches + batch as usize, t)
             })
             .collect();
@@ -577,4 +623,87 @@ pub fn assemble(stack: &McStack, settings: &McSettings, batch_tallies: &[Tally])
         }
     });
     McResult { settings: *settings, photons, channels }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transport::stack::McLayer;
+
+    /// A mismatched three-layer stack: a clear layer (gliding, refraction only), an anisotropic layer and an
+    /// isotropic semi-infinite one, so that every branch of the lane engine (faces, total internal reflection,
+    /// layer changes, roulette) is taken.
+    fn stack() -> McStack {
+        let layer = |t: f64, eta: f64, sa: f64, ss: f64, g: f64| McLayer {
+            thickness_mm: t,
+            eta,
+            sigma_a_per_mm: [sa, 2.0 * sa, 4.0 * sa],
+            sigma_s_per_mm: [ss; 3],
+            g: [g; 3],
+        };
+        McStack::new(
+            1.0,
+            1.2,
+            vec![
+                layer(0.05, 1.5, 0.0, 0.0, 0.0),
+                layer(0.2, 1.4, 0.3, 15.0, 0.8),
+                layer(f64::INFINITY, 1.33, 0.1, 5.0, 0.0),
+            ],
+        )
+        .unwrap()
+    }
+
+    /// The AVX-512F, AVX2 and portable lane loops give the same bytes (those this CPU supports), on 1 and 2
+    /// threads.
+    #[test]
+    fn every_dispatch_path_gives_the_same_bytes() {
+        let (stack, settings) = (stack(), McSettings::new(3000, 5, 4, 0.05, 30).unwrap());
+        let run = |path: Path, threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| simulate_engine(&stack, &settings, Engine::Lanes(path), &|_| {}))
+        };
+        let portable = run(Path::Portable, 1);
+        assert!(portable.channels[0].diffuse_reflectance.mean > 0.0);
+        assert_eq!(run(Path::Portable, 2), portable);
+        for path in [Path::Avx512, Path::Avx2] {
+            if path.supported() {
+                assert_eq!(run(path, 2), portable, "{path:?}");
+            }
+        }
+        assert_eq!(simulate(&stack, &settings), portable, "the detected path");
+    }
+
+    /// The lane engine (its own draw order) against the scalar reference engine: total R, absorbed per layer and
+    /// R(r) of the first bins agree within 4 combined standard errors in every channel.
+    #[test]
+    fn the_lane_engine_agrees_with_the_scalar_reference() {
+        let (stack, settings) = (stack(), McSettings::new(20_000, 9, 10, 0.1, 10).unwrap());
+        let lanes = simulate_engine(&stack, &settings, Engine::Lanes(Path::detect()), &|_| {});
+        let scalar = simulate_engine(&stack, &settings, Engine::Scalar, &|_| {});
+        let agree = |what: &str, a: Estimate, b: Estimate| {
+            let se = (a.se * a.se + b.se * b.se).sqrt();
+            assert!(se > 0.0 && (a.mean - b.mean).abs() <= 4.0 * se, "{what}: lanes {a:?}, scalar {b:?}");
+        };
+        for (c, (l, s)) in lanes.channels.iter().zip(&scalar.channels).enumerate() {
+            agree(&format!("channel {c} Rd"), l.diffuse_reflectance, s.diffuse_reflectance);
+            for j in 1..3 {
+                agree(&format!("channel {c} A{j}"), l.absorbed[j], s.absorbed[j]);
+            }
+            assert_eq!((l.absorbed[0].mean, s.absorbed[0].mean), (0.0, 0.0), "the clear layer absorbs nothing");
+            for i in 0..4 {
+                agree(&format!("channel {c} R bin {i}"), l.reflectance_mm2[i], s.reflectance_mm2[i]);
+            }
+            // Everything that enters is reflected or absorbed (semi-infinite): energy closes in both.
+            for r in [l, s] {
+                let total = r.specular_reflectance
+                    + r.diffuse_reflectance.mean
+                    + r.absorbed.iter().map(|a| a.mean).sum::<f64>();
+                let se = r.diffuse_reflectance.se + r.absorbed.iter().map(|a| a.se).sum::<f64>();
+                assert!((total - 1.0).abs() <= 4.0 * se + 1e-12, "channel {c}: {total} ± {se}");
+            }
+        }
+    }
 }

@@ -5,13 +5,17 @@
 //! - [`stack`]: [`stack::McStack`], layers with σa, σs, HG g and η per channel (JSON, validated).
 //! - [`mc`]: the transport and its tallies (R(r), T(r) in mm⁻², totals, absorbed per layer, standard errors from
 //!   independent batches), deterministic for any thread count.
+//! - [`lanes`]: the photon-lane engine [`mc`] runs: 32 packets per step in packed arithmetic, AVX-512F / AVX2 /
+//!   portable paths chosen at run time, the same bytes on each.
 //! - [`rng`]: Philox4x32-10, counter-based random numbers keyed by (seed, photon index).
-//! - [`ziggurat`]: exponential step lengths by the ziggurat method (Marsaglia & Tsang 2000).
+//! - [`ziggurat`]: exponential step lengths by the ziggurat method (Marsaglia & Tsang 2000), used by the scalar
+//!   reference engine the lane engine is tested against.
 //! - [`compare`]: Monte Carlo against a diffusion [`RadialProfile`](crate::diffusion::RadialProfile) (total R,
 //!   r·R(r) error) and [`compare::diffusion_counterpart`], the diffusion model of a stack.
 //! - [`report`]: a result as CSV (the `rtbake profile --csv` layout) and JSON (with standard errors).
 
 pub mod compare;
+pub mod lanes;
 pub mod mc;
 pub mod report;
 pub mod rng;
