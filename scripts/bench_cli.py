@@ -6,7 +6,8 @@ usage: scripts/bench_cli.py [--anchor OLD_RTBAKE] [--runs N] [RTBAKE]
 Times whole commands (process start to exit, output written to a scratch directory) as a user's pipeline runs
 them: MLAA AreaMap513 with `--format bin` and with every format, the MLAA generator with 1 and 2 rayon threads,
 the default bake of the assets both binaries know, and its verify. Every job runs RUNS times (default 7, at least 3) alternating between the
-binary under test and the anchor, so both see the same machine load; it prints the median with min-max and the
+binary under test and the anchor, so both see the same machine load; the 1- and 2-thread runs of a pair alternate
+in the same rounds, each binary's on their own (each run starts after an untimed `sync`); it prints the median with min-max and the
 anchor/new ratio of wall and of CPU time (user + sys; the wall time of large outputs is bound by the disk
 flush). RTBAKE defaults to target/release/rtbake. Nothing here is a test: figures are for the README
 and the issue notes.
@@ -54,6 +55,9 @@ def run_once(binary, argv, env, scratch):
         shutil.rmtree(out, ignore_errors=True)
         argv = argv + ["--out", out]
     e = dict(os.environ, **env)
+    # Untimed: flush what earlier runs left dirty (the other binary's files, the removed outputs), so no command
+    # waits in its own fsync for another run's data (ext4's ordered journal commits every dirty file it touches).
+    os.sync()
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     r = subprocess.run([binary] + argv, env=e, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -93,23 +97,42 @@ def main():
     with tempfile.TemporaryDirectory(dir=os.environ.get("BENCH_DIR")) as scratch:
         # verify needs a bake of the same binary: each binary verifies its own.
         results = {}
-        for name, argv, env in JOBS:
-            times = {n: [] for n, _ in bins}
-            for _ in range(runs):
-                for n, b in bins:
-                    s = os.path.join(scratch, n)
-                    os.makedirs(s, exist_ok=True)
-                    if argv[0] == "verify" and not os.path.exists(os.path.join(s, "baked")):
-                        subprocess.run([b, "bake", "--quiet", *COMMON_ASSETS, "--out", os.path.join(s, "baked")],
-                                       check=True)
-                    times[n].append(run_once(b, argv, env, s))
-            results[name] = times
-            line = f"{name:<38} new {fmt(times['new'])}"
-            if args.anchor:
-                ratio = med(times["anchor"]) / med(times["new"])
-                cpu_ratio = med(times["anchor"], 1) / max(med(times["new"], 1), 1e-9)
-                line += f" | anchor {fmt(times['anchor'])} | anchor/new wall {ratio:5.2f}x cpu {cpu_ratio:5.2f}x"
-            print(line, flush=True)
+        # The 1- and 2-thread jobs of a pair run in the same rounds (round k: 1 thread, 2 threads, for each binary),
+        # so a drift of the shared machine's speed during the benchmark falls on both sides of the ratio alike.
+        groups = []
+        for job in JOBS:
+            pair = groups and job[0].split(", ")[0] == groups[-1][0][0].split(", ")[0] and "thread" in job[0]
+            if pair:
+                groups[-1].append(job)
+            else:
+                groups.append([job])
+        for group in groups:
+            times = {name: {n: [] for n, _ in bins} for name, _, _ in group}
+            # A single job alternates the binaries in every round. A thread pair runs each binary's rounds on their
+            # own (1 thread, 2 threads, 1 thread, …), so neither side of a 1 → 2 ratio follows the other binary's
+            # run (whose large frees and flushes leave the kernel more work for whichever run comes next).
+            order = [[n_b] for n_b in bins] if len(group) > 1 else [bins]
+            for binaries in order:
+                for _ in range(runs):
+                    for name, argv, env in group:
+                        for n, b in binaries:
+                            s = os.path.join(scratch, n)
+                            os.makedirs(s, exist_ok=True)
+                            if argv[0] == "verify" and not os.path.exists(os.path.join(s, "baked")):
+                                subprocess.run(
+                                    [b, "bake", "--quiet", *COMMON_ASSETS, "--out", os.path.join(s, "baked")],
+                                    check=True,
+                                )
+                            times[name][n].append(run_once(b, argv, env, s))
+            for name, _, _ in group:
+                t = times[name]
+                results[name] = t
+                line = f"{name:<38} new {fmt(t['new'])}"
+                if args.anchor:
+                    ratio = med(t["anchor"]) / med(t["new"])
+                    cpu_ratio = med(t["anchor"], 1) / max(med(t["new"], 1), 1e-9)
+                    line += f" | anchor {fmt(t['anchor'])} | anchor/new wall {ratio:5.2f}x cpu {cpu_ratio:5.2f}x"
+                print(line, flush=True)
         for n, _ in bins:
             one = med(results["aa mlaa-v1.4 N=1023 bin, 1 thread"][n])
             two = med(results["aa mlaa-v1.4 N=1023 bin, 2 threads"][n])

@@ -167,8 +167,25 @@ pub fn mlaa_area_map_with_progress(
     n: u32,
     progress: &dyn Fn(u32, u32),
 ) -> Result<Image<u8>, MlaaAreaError> {
+    let row_bytes = 2 * 5 * n as usize;
+    area_map_in_bands(version, n, BAND_BYTES.div_ceil(row_bytes.max(1)), progress)
+}
+
+/// Bytes of image rows filled per parallel band: several 2 MiB huge pages ([`advise_huge_pages`]), so the threads
+/// of a band first-touch (and the kernel zeroes) different pages instead of queueing on the same one, as they did
+/// with 64-row bands (650 KB at N = 1023: both threads of a band inside one huge page, the fresh-process generator
+/// no faster on 2 threads than on 1).
+const BAND_BYTES: usize = 4 << 20;
+
+/// [`mlaa_area_map_with_progress`] with `band_rows` rows per band (progress is reported after each band).
+fn area_map_in_bands(
+    version: MlaaVersion,
+    n: u32,
+    band_rows: usize,
+    progress: &dyn Fn(u32, u32),
+) -> Result<Image<u8>, MlaaAreaError> {
     use rayon::prelude::*;
-    const BAND_ROWS: usize = 64;
+    let band_rows = band_rows.max(1);
     let edge = validate(version, n)?;
     let mut img = Image::<u8>::new(edge, edge, 2);
     advise_huge_pages(&img.data);
@@ -193,10 +210,10 @@ pub fn mlaa_area_map_with_progress(
         }
     };
     let row_bytes = 2 * edge as usize;
-    for (b, band) in img.data.chunks_mut(row_bytes * BAND_ROWS).enumerate() {
-        let y0 = b * BAND_ROWS;
+    for (b, band) in img.data.chunks_mut(row_bytes * band_rows).enumerate() {
+        let y0 = b * band_rows;
         band.par_chunks_mut(row_bytes).enumerate().for_each(|(r, row)| fill_row((y0 + r) as u32, row));
-        progress(((y0 + BAND_ROWS) as u32).min(edge), edge);
+        progress(((y0 + band_rows) as u32).min(edge), edge);
     }
     Ok(img)
 }
@@ -227,9 +244,9 @@ mod tests {
 
     #[test]
     fn progress_reaches_every_row_and_the_map_is_the_serial_definition_for_any_thread_count() {
-        let n = 65; // 325 rows: several bands, the last one partial
+        let n = 65; // 325 rows: with 64-row bands several bands, the last one partial
         let last = std::cell::Cell::new(0);
-        let with = mlaa_area_map_with_progress(MlaaVersion::V1_4, n, &|done, rows| {
+        let with = area_map_in_bands(MlaaVersion::V1_4, n, 64, &|done, rows| {
             assert!(done > last.get(), "progress only grows");
             assert_eq!(rows, 5 * n);
             last.set(done);
