@@ -22,19 +22,21 @@ import sys
 import tempfile
 import time
 
-JOBS = [
-    # (name, argv after the binary, env overrides)
-    ("aa mlaa-v1.4 N=513 --format bin", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin"], {}),
-    ("aa mlaa-v1.4 N=513 all formats", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin,dds,ktx2,png"], {}),
-    ("aa mlaa-v1.4 N=1023 bin, 1 thread", ["aa", "mlaa-v1.4", "--max-distance", "1023", "--format", "bin"],
-     {"RAYON_NUM_THREADS": "1"}),
-    ("aa mlaa-v1.4 N=1023 bin, 2 threads", ["aa", "mlaa-v1.4", "--max-distance", "1023", "--format", "bin"],
-     {"RAYON_NUM_THREADS": "2"}),
-    ("bake (common assets), 1 thread", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "1"}),
-    ("bake (common assets), 2 threads", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "2"}),
-    ("verify", ["verify"], {}),
+MLAA_1023 = ["aa", "mlaa-v1.4", "--max-distance", "1023", "--format", "bin"]
+# Groups of (name, argv after the binary, env overrides). A group of one job alternates the binaries in every round;
+# a thread pair runs each binary's rounds on their own (1 thread, 2 threads, 1 thread, …), so drift of the shared
+# machine falls on both sides of a 1 -> 2 ratio and neither side follows the other binary's run (whose large frees
+# and flushes leave the kernel more work for whichever run comes next).
+JOB_GROUPS = [
+    [("aa mlaa-v1.4 N=513 --format bin", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin"], {})],
+    [("aa mlaa-v1.4 N=513 all formats", ["aa", "mlaa-v1.4", "--max-distance", "513", "--format", "bin,dds,ktx2,png"],
+      {})],
+    [("aa mlaa-v1.4 N=1023 bin, 1 thread", MLAA_1023, {"RAYON_NUM_THREADS": "1"}),
+     ("aa mlaa-v1.4 N=1023 bin, 2 threads", MLAA_1023, {"RAYON_NUM_THREADS": "2"})],
+    [("bake (common assets), 1 thread", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "1"}),
+     ("bake (common assets), 2 threads", ["bake", "--quiet"], {"RAYON_NUM_THREADS": "2"})],
+    [("verify", ["verify"], {})],
 ]
-
 
 COMMON_ASSETS = []
 
@@ -97,20 +99,8 @@ def main():
     with tempfile.TemporaryDirectory(dir=os.environ.get("BENCH_DIR")) as scratch:
         # verify needs a bake of the same binary: each binary verifies its own.
         results = {}
-        # The 1- and 2-thread jobs of a pair run in the same rounds (round k: 1 thread, 2 threads, for each binary),
-        # so a drift of the shared machine's speed during the benchmark falls on both sides of the ratio alike.
-        groups = []
-        for job in JOBS:
-            pair = groups and job[0].split(", ")[0] == groups[-1][0][0].split(", ")[0] and "thread" in job[0]
-            if pair:
-                groups[-1].append(job)
-            else:
-                groups.append([job])
-        for group in groups:
+        for group in JOB_GROUPS:
             times = {name: {n: [] for n, _ in bins} for name, _, _ in group}
-            # A single job alternates the binaries in every round. A thread pair runs each binary's rounds on their
-            # own (1 thread, 2 threads, 1 thread, …), so neither side of a 1 → 2 ratio follows the other binary's
-            # run (whose large frees and flushes leave the kernel more work for whichever run comes next).
             order = [[n_b] for n_b in bins] if len(group) > 1 else [bins]
             for binaries in order:
                 for _ in range(runs):
