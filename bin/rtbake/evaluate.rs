@@ -83,7 +83,13 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
             return Ok((Box::new(p), json!({"model": "tabulated", "file": text}), text.to_string()));
         }
         let stack = LayerStack::from_json_str(&body).map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))?;
-        let src = ProfileSource::Layers { stack, adding: Adding::Symmetric, series: Series::Exact, fdr: FdrForm::Dj05 };
+        let src = ProfileSource::Layers {
+            stack,
+            adding: Adding::Symmetric,
+            series: Series::Exact,
+            fdr: FdrForm::Dj05,
+            transport: Default::default(),
+        };
         let p = src.build().map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))?;
         return Ok((p, src.provenance(), text.to_string()));
     }
@@ -92,7 +98,15 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
         if v.len() != 2 {
             return Err(usage_msg(format!("--against skin:CM,CHD needs two numbers, got '{rest}'")));
         }
-        let (src, _) = physiological_skin(v[0], v[1], Adding::Symmetric, Series::Exact, FdrForm::Dj05)?;
+        let (src, _) = physiological_skin(
+            v[0],
+            v[1],
+            Adding::Symmetric,
+            Series::Exact,
+            FdrForm::Dj05,
+            Default::default(),
+            Default::default(),
+        )?;
         let p = src.build().map_err(usage)?;
         return Ok((p, src.provenance(), format!("skin Cm {} Chd {}", v[0], v[1])));
     }

@@ -20,13 +20,13 @@ pub struct FitBurleyArgs {
     pub layered: crate::profile_source::LayeredArgs,
 }
 
-fn target(a: &FitBurleyArgs) -> anyhow::Result<(Box<dyn RadialProfile>, Value)> {
+fn target(a: &FitBurleyArgs, ctx: &Ctx) -> anyhow::Result<(Box<dyn RadialProfile>, Value)> {
     if a.layered.is_set() && (a.material.is_some() || a.profile_preset.is_some()) {
         return Err(usage_msg(
             "give one target: --material, --profile-preset, --layers, --skin-melanin or --profile-csv",
         ));
     }
-    if let Some((p, provenance, _)) = a.layered.resolve()? {
+    if let Some((p, provenance, _)) = a.layered.resolve(ctx)? {
         return Ok((p, provenance));
     }
     let named = match (&a.material, &a.profile_preset) {
@@ -43,7 +43,7 @@ fn target(a: &FitBurleyArgs) -> anyhow::Result<(Box<dyn RadialProfile>, Value)> 
 }
 
 pub fn run(a: FitBurleyArgs, ctx: &Ctx) -> anyhow::Result<()> {
-    let (profile, source) = target(&a)?;
+    let (profile, source) = target(&a, ctx)?;
     let fit = fit_burley(profile.as_ref()).map_err(usage)?;
     let albedo = fit.channels.map(|b| b.albedo);
     let d_mm = fit.channels.map(|b| b.d_mm);

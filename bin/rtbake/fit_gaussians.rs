@@ -62,13 +62,13 @@ pub fn fit_error(e: GaussianFitError) -> anyhow::Error {
 }
 
 /// The profile to fit, its provenance and a file stem.
-fn profile_from_args(a: &FitGaussiansArgs) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
+fn profile_from_args(a: &FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
     if a.layered.is_set() && (a.material.is_some() || a.profile_preset.is_some()) {
         return Err(usage_msg(
             "give one target: --material, --profile-preset, --layers or --skin-melanin/--skin-hemoglobin",
         ));
     }
-    if let Some(resolved) = a.layered.resolve()? {
+    if let Some(resolved) = a.layered.resolve(ctx)? {
         return Ok(resolved);
     }
     let named = match (&a.material, &a.profile_preset) {
@@ -117,7 +117,7 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
     settings.validate().map_err(usage)?;
     let stretch = StretchParams { alpha: a.alpha, beta: a.beta, gamma: a.gamma };
     stretch.validate().map_err(usage)?;
-    let (profile, source, stem) = profile_from_args(&a)?;
+    let (profile, source, stem) = profile_from_args(&a, ctx)?;
     let fit = fit_sum_of_gaussians(profile.as_ref(), &settings).map_err(fit_error)?;
     let ss = ScreenSpaceParams::new(&fit.sum, stretch)?;
     let mut obj = ss.to_json();

@@ -85,7 +85,7 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if args.layered.is_set() && (args.material.is_some() || args.profile.is_some()) {
         return Err(usage_msg("give one target: --profile, --material, --layers or --skin-melanin/--skin-hemoglobin"));
     }
-    let layered = args.layered.resolve()?;
+    let layered = args.layered.resolve(ctx)?;
     let (profile, name, description): (Box<dyn RadialProfile>, String, String) = match (&args.material, &args.profile) {
         _ if layered.is_some() => {
             let (profile, provenance, stem) = layered.expect("checked");

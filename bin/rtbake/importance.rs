@@ -47,7 +47,7 @@ impl ImportanceProfileArgs {
     }
 
     /// Resolves exactly one profile source (exit 2 naming the flags otherwise).
-    pub fn resolve(&self) -> anyhow::Result<ResolvedProfile> {
+    pub fn resolve(&self, ctx: &crate::cli::Ctx) -> anyhow::Result<ResolvedProfile> {
         let given =
             [self.material.is_some(), self.profile_preset.is_some(), self.layered.is_set(), self.burley.is_set()];
         let count = given.iter().filter(|g| **g).count();
@@ -64,7 +64,7 @@ impl ImportanceProfileArgs {
                 stem: "burley".into(),
             });
         }
-        if let Some((profile, provenance, stem)) = self.layered.resolve()? {
+        if let Some((profile, provenance, stem)) = self.layered.resolve(ctx)? {
             return Ok(ResolvedProfile { burley: None, profile: Some(profile), provenance, stem });
         }
         let kind = match (&self.material, &self.profile_preset) {
@@ -119,7 +119,7 @@ pub struct ImportanceKernelArgs {
 
 pub fn run(args: ImportanceKernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let n = parse_samples(args.samples)?;
-    let resolved = args.profile.resolve()?;
+    let resolved = args.profile.resolve(ctx)?;
     let k = resolved.kernel(n)?;
     if let Some(dir) = &args.out {
         prepare_out_dir("--out", dir)?;

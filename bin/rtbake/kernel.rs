@@ -58,7 +58,7 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
             args.samples
         ))
     })?;
-    let fitted = fitted_params(&args)?;
+    let fitted = fitted_params(&args, ctx)?;
     let (strength, falloff) = match &fitted {
         Some((p, _)) => (p.strength, p.falloff),
         None => (
@@ -132,7 +132,7 @@ pub fn run(args: KernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
 
 /// Strength and falloff fitted to the layered / CSV profile, if one was given (width: --sss-width or the fit's
 /// default), with a description of the target.
-fn fitted_params(args: &KernelArgs) -> anyhow::Result<Option<(SeparableParams, String)>> {
+fn fitted_params(args: &KernelArgs, ctx: &Ctx) -> anyhow::Result<Option<(SeparableParams, String)>> {
     if let Some(w) = args.sss_width {
         rtbake::error::check_positive("--sss-width", w, "world units").map_err(usage)?;
     }
@@ -144,7 +144,7 @@ fn fitted_params(args: &KernelArgs) -> anyhow::Result<Option<(SeparableParams, S
             "--strength/--falloff and a profile (--profile-csv, --layers, --skin-*) are exclusive: the profile's are fitted",
         ));
     }
-    let (profile, provenance, stem) = args.layered.resolve()?.expect("is_set");
+    let (profile, provenance, stem) = args.layered.resolve(ctx)?.expect("is_set");
     let spec = ObjectiveSpec { width: args.sss_width.unwrap_or(ObjectiveSpec::default().width), ..Default::default() };
     let target = fit::TargetKernel::from_profile(profile.as_ref(), &spec, &stem).map_err(usage)?;
     let result = fit::fit(&target)?;

@@ -18,8 +18,11 @@ use std::path::{Path, PathBuf};
 pub enum ModelArg {
     /// Semi-infinite medium (Jensen et al. 2001).
     Dipole,
-    /// Slab of --thickness-mm in air (Donner & Jensen 2005); also prints T(r).
+    /// Slab of --thickness-mm in air (Donner & Jensen 2005); also prints T(r). With --layers / --skin-*: the
+    /// layered multipole (the default there).
     Multipole,
+    /// Monte Carlo photon transport (MCML-style) for --layers and --skin-* (--g, --photons, --seed).
+    Mc,
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -37,9 +40,16 @@ pub struct ProfileArgs {
     /// skin2, wholemilk); eta = 1.3.
     #[arg(long, value_name = "NAME")]
     material: Option<String>,
-    /// Model for --material.
+    /// Model: for --material dipole (default) or multipole; for --layers / --skin-* multipole (diffusion) or mc
+    /// (Monte Carlo transport).
     #[arg(long, value_enum, default_value = "dipole")]
     model: ModelArg,
+    #[command(flatten)]
+    mc: crate::profile_source::McArgs,
+    /// How --skin-* spectra become RGB: spectral (per-wavelength profiles projected to linear sRGB under D65,
+    /// default) or band-averaged (one RGB stack of averaged coefficients).
+    #[arg(long, value_enum, default_value = "spectral")]
+    skin_projection: crate::profile_source::SkinProjectionArg,
     /// Slab thickness for --model multipole, mm (must exceed 1/sigma_t' of every channel).
     #[arg(long, value_name = "MM")]
     thickness_mm: Option<f64>,
@@ -157,9 +167,18 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         return Err(usage_msg("--thickness-mm applies only to --material with --model multipole"));
     }
 
+    let transport = args.mc.transport(if matches!(args.model, ModelArg::Mc) {
+        crate::profile_source::TransportArg::Mc
+    } else {
+        crate::profile_source::TransportArg::Multipole
+    })?;
+    if matches!(args.model, ModelArg::Mc) && !layered {
+        return Err(usage_msg("--model mc applies to --layers and --skin-melanin/--skin-hemoglobin"));
+    }
+    let mut extra = serde_json::Value::Null;
     let source = if let Some(name) = &args.material {
         let model = match args.model {
-            ModelArg::Dipole => MaterialModel::Dipole,
+            ModelArg::Dipole | ModelArg::Mc => MaterialModel::Dipole,
             ModelArg::Multipole => MaterialModel::Multipole {
                 thickness_mm: args
                     .thickness_mm
@@ -173,11 +192,21 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| usage(anyhow::anyhow!("--layers {}: cannot read: {e}", path.display())))?;
         let stack = LayerStack::from_json_str(&text).map_err(|e| flag_error(e, Some(path)))?;
-        ProfileSource::Layers { stack, adding: args.adding.into(), series, fdr }
+        ProfileSource::Layers { stack, adding: args.adding.into(), series, fdr, transport }
     } else if let Some((_, src)) = args.burley.resolve()? {
         src
     } else if let (Some(cm), Some(chd)) = (args.skin_melanin, args.skin_hemoglobin) {
-        crate::profile_source::physiological_skin(cm, chd, args.adding.into(), series, fdr)?.0
+        let (src, skin) = crate::profile_source::physiological_skin(
+            cm,
+            chd,
+            args.adding.into(),
+            series,
+            fdr,
+            transport,
+            args.skin_projection.into(),
+        )?;
+        extra = skin;
+        src
     } else {
         return Err(usage_msg("one of --material, --profile-preset or --layers is required"));
     };
@@ -191,7 +220,9 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => table::log_radii(args.r_min_mm, args.r_max_mm, args.count).map_err(|e| flag_error(e, None))?,
     };
 
-    for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
+    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
+    crate::profile_source::check_distinct_outputs(&outputs)?;
+    for (flag, path) in outputs {
         if let Some(p) = path {
             check_output_file(flag, p)?;
             let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
@@ -209,24 +240,30 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         s.validate().map_err(|e| flag_error(e, None))?;
     }
 
-    if let ProfileSource::Layers { stack, series, .. } = &source {
-        let layers = stack.layers().len();
-        let estimate = rtbake::diffusion::layered::profile_time_estimate_seconds(
-            layers,
-            radii.len(),
-            *series,
-            rayon::current_num_threads(),
-        );
-        let pairs = match series {
-            Series::Exact => "exact series".to_string(),
-            Series::Truncated { pairs } => format!("--dipole-pairs {pairs}"),
-        };
+    if layered {
         let grid = if args.radii.is_some() { "--radii" } else { "--count" };
-        ctx.check_time(&format!("{grid} ({} radii), {layers} layers, {pairs}", radii.len()), estimate)?;
+        let estimate = source.time_estimate_seconds(radii.len(), rayon::current_num_threads());
+        let what = match source.transport() {
+            Some(rtbake::diffusion::source::TransportModel::MonteCarlo { g, photons, .. }) => {
+                format!("--model mc --photons {photons} --g {g}")
+            }
+            _ => {
+                let pairs = match series {
+                    Series::Exact => "exact series".to_string(),
+                    Series::Truncated { pairs } => format!("--dipole-pairs {pairs}"),
+                };
+                format!("{grid} ({} radii), {pairs}", radii.len())
+            }
+        };
+        ctx.check_time(&what, estimate)?;
     }
     let profile = source.build().map_err(|e| flag_error(e, args.layers.as_ref()))?;
-    let table =
-        ProfileTable::compute(profile.as_ref(), &radii, source.provenance()).map_err(|e| non_finite_error(e, &args))?;
+    let mut provenance = source.provenance();
+    if let (serde_json::Value::Object(p), serde_json::Value::Object(e)) = (&mut provenance, extra) {
+        p.extend(e);
+    }
+    crate::profile_source::add_standard_errors(&mut provenance, profile.as_ref());
+    let table = ProfileTable::compute(profile.as_ref(), &radii, provenance).map_err(|e| non_finite_error(e, &args))?;
     let json = table.to_json();
     let plot_bytes = match plot_format {
         Some(format) => {
@@ -313,8 +350,21 @@ fn plot_title(source: &ProfileSource) -> String {
         }
         ProfileSource::Preset(name) => format!("{name} (sum of Gaussians)"),
         ProfileSource::Burley { fit, .. } => format!("Burley normalized diffusion ({} fit)", fit.name()),
-        ProfileSource::Layers { stack, adding, .. } => {
-            format!("{}-layer stack ({} adding)", stack.layers().len(), adding.name())
-        }
+        ProfileSource::Layers { stack, adding, transport, .. } => match transport {
+            rtbake::diffusion::source::TransportModel::Multipole => {
+                format!("{}-layer stack ({} adding)", stack.layers().len(), adding.name())
+            }
+            rtbake::diffusion::source::TransportModel::MonteCarlo { g, .. } => {
+                format!("{}-layer stack (Monte Carlo, g {g})", stack.layers().len())
+            }
+        },
+        ProfileSource::Spectral { transport, adding, .. } => match transport {
+            rtbake::diffusion::source::TransportModel::Multipole => {
+                format!("spectral skin ({} adding, projected to linear sRGB)", adding.name())
+            }
+            rtbake::diffusion::source::TransportModel::MonteCarlo { g, .. } => {
+                format!("spectral skin (Monte Carlo, g {g}, projected to linear sRGB)")
+            }
+        },
     }
 }

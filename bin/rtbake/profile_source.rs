@@ -1,16 +1,127 @@
 //! Profile inputs shared by `fit gaussians` and `fit separable` beyond the named materials and presets:
 //! a user layer stack (`--layers FILE`) or the physiological two-layer skin (`--skin-melanin`, `--skin-hemoglobin`).
 
-use crate::cli::{parse_f64_list, usage, usage_msg, AddingArg};
+use crate::cli::{parse_f64_list, usage, usage_msg, AddingArg, Ctx};
 use rtbake::diffusion::burley::{RgbBurley, ShapeFit};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
-use rtbake::diffusion::source::{MaterialModel, ProfileSource};
+use rtbake::diffusion::source::{MaterialModel, ProfileSource, TransportModel};
 use rtbake::diffusion::{FdrForm, RadialProfile};
 use rtbake::error::InvalidInput;
-use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology, SkinProjection};
+use rtbake::transport::profile::{DEFAULT_PROFILE_PHOTONS, DEFAULT_TISSUE_G};
 use serde_json::{json, Value};
 use std::path::PathBuf;
+
+/// `--model` for layer stacks and skins: the transport model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum TransportArg {
+    /// Diffusion: multipole slabs combined by adding (Donner & Jensen 2005; the thesis' model).
+    #[default]
+    Multipole,
+    /// Monte Carlo photon transport (MCML-style; --g, --photons, --seed).
+    Mc,
+}
+
+/// `--skin-projection`: how a physiological skin's spectrum becomes RGB.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum SkinProjectionArg {
+    /// Profiles per wavelength (380-780 nm, 10 nm), projected linearly to linear sRGB under D65 (the skin-colour
+    /// LUT's colour is the profile's integral).
+    #[default]
+    Spectral,
+    /// One RGB stack with band-averaged coefficients (D65 x sRGB-sensitivity weighted means; the earlier reduction).
+    BandAveraged,
+}
+
+impl From<SkinProjectionArg> for SkinProjection {
+    fn from(a: SkinProjectionArg) -> Self {
+        match a {
+            SkinProjectionArg::Spectral => SkinProjection::default(),
+            SkinProjectionArg::BandAveraged => SkinProjection::BandAveraged { reduction: RgbReduction::default() },
+        }
+    }
+}
+
+/// Monte Carlo flags of `--model mc` (shared by every profile command).
+#[derive(clap::Args, Debug, Default, Clone)]
+pub struct McArgs {
+    /// Henyey-Greenstein anisotropy for --model mc, in the open interval (-1, 1); sigma_s = sigma_s' / (1 - g) keeps
+    /// the layers' reduced scattering. Default 0.8 (tissue-like: van Gemert et al. 1989, "Skin optics").
+    #[arg(long, value_name = "G", allow_hyphen_values = true)]
+    pub g: Option<f64>,
+    /// Photons per channel (per wavelength for spectral skins) for --model mc, 1..=1e10 (default 100000).
+    #[arg(long, value_name = "N")]
+    pub photons: Option<u64>,
+    /// Seed of the Monte Carlo random numbers for --model mc (the same seed gives the same bytes on any thread
+    /// count; default 1).
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+}
+
+impl McArgs {
+    /// The transport model for `--model`; --g/--photons/--seed without `--model mc` are refused (exit 2).
+    pub fn transport(&self, model: TransportArg) -> anyhow::Result<TransportModel> {
+        if model != TransportArg::Mc {
+            if self.g.is_some() || self.photons.is_some() || self.seed.is_some() {
+                return Err(usage_msg("--g, --photons and --seed apply only to --model mc"));
+            }
+            return Ok(TransportModel::Multipole);
+        }
+        TransportModel::monte_carlo(
+            self.g.unwrap_or(DEFAULT_TISSUE_G),
+            self.photons.unwrap_or(DEFAULT_PROFILE_PHOTONS),
+            self.seed.unwrap_or(1),
+        )
+        .map_err(|e| {
+            let flag = match e.param.as_str() {
+                "g" => "--g",
+                "photons" => "--photons",
+                _ => "--model mc",
+            };
+            usage(anyhow::anyhow!("{flag}: {}", e.message))
+        })
+    }
+}
+
+/// Refuses (exit 2) a source whose time estimate exceeds `--max-seconds`; the message names the flags that set it.
+pub fn check_source_time(ctx: &Ctx, source: &ProfileSource, radii: usize) -> anyhow::Result<()> {
+    let estimate = source.time_estimate_seconds(radii, rayon::current_num_threads());
+    let flags = match source.transport() {
+        Some(TransportModel::MonteCarlo { g, photons, .. }) => format!("--model mc --photons {photons} --g {g}"),
+        _ => format!("{radii} radii of a layered profile"),
+    };
+    ctx.check_time(&flags, estimate)
+}
+
+/// Adds what only the built profile knows to its provenance: the Monte Carlo standard errors of the totals
+/// (`total_R_se`) and the negative mass a spectral projection clipped (`clipped_negative_mass`).
+pub fn add_standard_errors(provenance: &mut Value, profile: &dyn RadialProfile) {
+    rtbake::diffusion::source::add_built_provenance(provenance, profile);
+}
+
+/// Refuses (exit 2) two output flags naming the same file (`--csv X --out X` would leave only the last write).
+/// Paths are compared after resolving their directories, so `./x` and `x` collide.
+pub fn check_distinct_outputs(outputs: &[(&str, &Option<PathBuf>)]) -> anyhow::Result<()> {
+    let key = |p: &PathBuf| {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+        dir.join(p.file_name().unwrap_or_default())
+    };
+    for (i, (flag_a, a)) in outputs.iter().enumerate() {
+        for (flag_b, b) in &outputs[i + 1..] {
+            if let (Some(a), Some(b)) = (a, b) {
+                if key(a) == key(b) {
+                    return Err(usage_msg(format!(
+                        "{flag_a} and {flag_b} name the same file {}: give each output its own path",
+                        a.display()
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
 
 /// A resolved target: the profile, its provenance JSON and a file stem.
 pub type ResolvedProfile = (Box<dyn RadialProfile>, Value, String);
@@ -36,6 +147,15 @@ pub struct LayeredArgs {
     /// Truncate the multipole image series to i = -N..N (default: exact infinite series)
     #[arg(long, value_name = "N")]
     pub dipole_pairs: Option<u32>,
+    /// Model for --layers / --skin-*: multipole (diffusion, default) or mc (Monte Carlo transport)
+    #[arg(long, value_enum, default_value = "multipole")]
+    pub model: TransportArg,
+    #[command(flatten)]
+    pub mc: McArgs,
+    /// How --skin-* spectra become RGB: spectral (per-wavelength profiles projected to linear sRGB, default) or
+    /// band-averaged (one RGB stack of averaged coefficients)
+    #[arg(long, value_enum, default_value = "spectral")]
+    pub skin_projection: SkinProjectionArg,
     /// Target: your own profile as CSV, the layout `rtbake profile --csv` and `rtbake transport --csv` write (`#`
     /// comments, header r_mm,R_r,R_g,R_b or r_mm,R, rows of r in mm strictly increasing and R in mm^-2 >= 0, any
     /// spacing, >= 2 rows); interpolated linearly in log r, 0 beyond the last radius
@@ -49,15 +169,24 @@ impl LayeredArgs {
     }
 
     /// Resolves the layered source, if one was given: (profile, provenance, file stem).
-    pub fn resolve(&self) -> anyhow::Result<Option<ResolvedProfile>> {
+    pub fn resolve(&self, ctx: &Ctx) -> anyhow::Result<Option<ResolvedProfile>> {
         if !self.is_set() {
+            if self.model == TransportArg::Mc {
+                return Err(usage_msg("--model mc applies to --layers and --skin-melanin/--skin-hemoglobin"));
+            }
             return Ok(None);
         }
         let given = [self.layers.is_some(), self.skin_melanin.is_some(), self.profile_csv.is_some()];
         if given.iter().filter(|&&g| g).count() > 1 {
             return Err(usage_msg("--layers, --skin-melanin/--skin-hemoglobin and --profile-csv are exclusive"));
         }
+        let transport = self.mc.transport(self.model)?;
         if let Some(path) = &self.profile_csv {
+            if self.model == TransportArg::Mc {
+                return Err(usage_msg(
+                    "--model mc applies to --layers and --skin-melanin/--skin-hemoglobin, not --profile-csv",
+                ));
+            }
             let text = std::fs::read_to_string(path)
                 .map_err(|e| usage(anyhow::anyhow!("--profile-csv {}: cannot read: {e}", path.display())))?;
             let profile =
@@ -85,19 +214,22 @@ impl LayeredArgs {
             let stack = LayerStack::from_json_str(&text)
                 .map_err(|e| usage(anyhow::anyhow!("--layers {}: {e}", path.display())))?;
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "layers".into());
-            let src = ProfileSource::Layers { stack, adding, series, fdr: FdrForm::Dj05 };
+            let src = ProfileSource::Layers { stack, adding, series, fdr: FdrForm::Dj05, transport };
             (src, json!({"file": path.display().to_string()}), stem)
         } else {
             let cm = self.skin_melanin.expect("checked");
             let chd = self.skin_hemoglobin.expect("required by clap");
-            let (src, extra) = physiological_skin(cm, chd, adding, series, FdrForm::Dj05)?;
+            let (src, extra) =
+                physiological_skin(cm, chd, adding, series, FdrForm::Dj05, transport, self.skin_projection.into())?;
             (src, extra, format!("skin_cm{cm}_chd{chd}"))
         };
+        check_source_time(ctx, &src, rtbake::diffusion::table::DEFAULT_COUNT)?;
         let profile = src.build().map_err(usage)?;
         let mut provenance = src.provenance();
         if let (Value::Object(p), Value::Object(e)) = (&mut provenance, extra) {
             p.extend(e);
         }
+        add_standard_errors(&mut provenance, profile.as_ref());
         Ok(Some((profile, provenance, stem)))
     }
 }
@@ -110,16 +242,19 @@ pub fn physiological_skin(
     adding: Adding,
     series: Series,
     fdr: FdrForm,
+    transport: TransportModel,
+    projection: SkinProjection,
 ) -> anyhow::Result<(ProfileSource, Value)> {
-    physiological_skin_source(&SkinPhysiology::default(), &RgbReduction::default(), cm, chd, adding, series, fdr)
-        .map_err(|e| {
+    physiological_skin_source(&SkinPhysiology::default(), &projection, cm, chd, adding, series, fdr, transport).map_err(
+        |e| {
             let flag = match e.param.as_str() {
                 "melanin_fraction" => "--skin-melanin",
                 "hemoglobin_fraction" => "--skin-hemoglobin",
                 _ => "--skin-melanin/--skin-hemoglobin",
             };
             usage(anyhow::anyhow!("{flag}: {e}"))
-        })
+        },
+    )
 }
 
 /// A Jensen 2001 material as a dipole (η = 1.3, DJ05 Fdr) or a sum-of-Gaussians preset, through

@@ -381,7 +381,7 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
         }
         (SssMethodArg::Importance, None) => {
             let n = crate::importance::parse_samples(a.samples.unwrap_or(40))?;
-            let resolved = a.profile.resolve()?;
+            let resolved = a.profile.resolve(ctx)?;
             let k = resolved.kernel(n)?;
             ctx.info(format!("importance kernel: {} samples of {} (cut-off {:.4} mm)", n, resolved.stem, k.cutoff_mm));
             importance_params.validate()?;

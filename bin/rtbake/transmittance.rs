@@ -56,7 +56,7 @@ pub struct TransmittanceArgs {
     pub zstd: crate::cli::ZstdArg,
 }
 
-fn source_model(a: &TransmittanceArgs) -> anyhow::Result<(TransmittanceModel, Value, String)> {
+fn source_model(a: &TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<(TransmittanceModel, Value, String)> {
     let sources = [a.profile_preset.is_some(), a.material.is_some(), a.layered.is_set(), a.burley.is_set()];
     if sources.iter().filter(|&&s| s).count() > 1 {
         return Err(usage_msg(
@@ -79,7 +79,7 @@ fn source_model(a: &TransmittanceArgs) -> anyhow::Result<(TransmittanceModel, Va
             let (src, profile, _) = named(Named::Material { flag: "--material", name })?;
             Some((profile as Box<dyn RadialProfile>, src.provenance(), name.to_ascii_lowercase()))
         }
-        None => a.layered.resolve()?,
+        None => a.layered.resolve(ctx)?,
     };
     if let Some((profile, provenance, stem)) = target {
         let settings = FitSettings {
@@ -126,7 +126,7 @@ pub fn run(a: TransmittanceArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if s_mm.is_none() && a.out.is_none() {
         return Err(usage_msg("nothing to do: give --s MM,... to evaluate and/or --out DIR to write the table"));
     }
-    let (model, source, stem) = source_model(&a)?;
+    let (model, source, stem) = source_model(&a, ctx)?;
     let form_name = if form == TransmittanceForm::Physical { "physical" } else { "published" };
     let formula = model.formula(form);
     let mut result = json!({"form": form_name, "formula": formula, "source": source});

@@ -14,7 +14,7 @@ use rtbake::runtime::chain;
 use rtbake::runtime::device::create_headless;
 use rtbake::runtime::RuntimeError;
 use rtbake::transport::compare::{bin_averaged, compare, diffusion_counterpart};
-use rtbake::transport::{report, McLayer, McSettings, McStack};
+use rtbake::transport::{report, McSettings, McStack};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -125,17 +125,7 @@ fn resolve(args: &TransportArgs) -> anyhow::Result<(McStack, Value, String)> {
                 if !(t.is_finite() && t > 0.0) {
                     return Err(usage_msg(format!("--thickness-mm must be a finite number > 0 mm, got {t}")));
                 }
-                if !(-1.0 < g && g < 1.0) {
-                    return Err(usage_msg(format!("--g must be in the open interval (-1, 1), got {g}")));
-                }
-                let layer = McLayer {
-                    thickness_mm: t,
-                    eta: JENSEN_2001_ETA,
-                    sigma_a_per_mm: m.sigma_a_per_mm,
-                    sigma_s_per_mm: m.sigma_s_prime_per_mm.map(|s| s / (1.0 - g)),
-                    g: [g; 3],
-                };
-                McStack::new(1.0, 1.0, vec![layer])
+                McStack::slab(t, m.sigma_a_per_mm, m.sigma_s_prime_per_mm, g, JENSEN_2001_ETA)
             }
         }
         .map_err(|e| flag_error(e, None))?;
@@ -146,8 +136,15 @@ fn resolve(args: &TransportArgs) -> anyhow::Result<(McStack, Value, String)> {
         return Ok((stack.clone(), json!({"material": m.name, "g": g, "stack": stack.to_json()}), title));
     }
     let (cm, chd) = (args.skin_melanin.expect("clap group"), args.skin_hemoglobin.expect("clap requires"));
-    let (src, extra) =
-        crate::profile_source::physiological_skin(cm, chd, Default::default(), Series::Exact, FdrForm::Dj05)?;
+    let (src, extra) = crate::profile_source::physiological_skin(
+        cm,
+        chd,
+        Default::default(),
+        Series::Exact,
+        FdrForm::Dj05,
+        Default::default(),
+        rtbake::spectral::skin_layers::SkinProjection::BandAveraged { reduction: Default::default() },
+    )?;
     let ProfileSource::Layers { stack, .. } = &src else { unreachable!("physiological skin is a layer stack") };
     let stack = McStack::from_layer_stack(stack, args.g).map_err(|e| flag_error(e, None))?;
     let mut prov = extra;
@@ -163,8 +160,13 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let (bytes, seconds) =
         chain::transport_estimate(&settings, stack.layers().len(), args.gpu, rayon::current_num_threads());
     ctx.check_memory("--bins/--batches", bytes)?;
-    ctx.check_time(&format!("--photons {}", args.photons), seconds)?;
-    for (flag, path) in [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)] {
+    // The per-photon figure ignores how many times each photon scatters; the stack's optics bound that (albedo,
+    // g: `McSettings::time_estimate_for_stack`), on either path.
+    let seconds = seconds.max(settings.time_estimate_for_stack(&stack, rayon::current_num_threads()));
+    ctx.check_time(&format!("--photons {} in this stack (its albedo and g)", args.photons), seconds)?;
+    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
+    crate::profile_source::check_distinct_outputs(&outputs)?;
+    for (flag, path) in outputs {
         if let Some(p) = path {
             check_output_file(flag, p)?;
             let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();

@@ -32,7 +32,7 @@ use crate::fitting::evaluate::{compare_profiles, ProfileErrors};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings};
 use crate::plot::profile::{overlay_plot, render, PlotFormat, CHANNEL_COLORS, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::plot::{Curve, LinePlot};
-use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};
 use crate::sss_sampling::disk::{ImportanceKernel, SampledProfile};
 use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
 use rayon::prelude::*;
@@ -131,12 +131,13 @@ fn cases(p: &Params) -> Result<Vec<Case>, BakeError> {
         let (cm, chd) = (s.melanin_fraction, s.hemoglobin_fraction);
         let (source, _) = physiological_skin_source(
             &SkinPhysiology::default(),
-            &RgbReduction::default(),
+            &SkinProjection::default(),
             cm,
             chd,
             Default::default(),
             Default::default(),
             FdrForm::Dj05,
+            Default::default(),
         )
         .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
         v.push(Case { name: format!("skin/two_layer_cm{cm}_chd{chd}"), source, artist: None });

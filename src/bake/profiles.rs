@@ -24,12 +24,12 @@
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::diffusion::layered::{Adding, LayerStack};
 use crate::diffusion::multipole::Series;
-use crate::diffusion::source::{MaterialModel, ProfileSource};
+use crate::diffusion::source::{MaterialModel, ProfileSource, TransportModel};
 use crate::diffusion::table::{self, ProfileTable};
 use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
 use crate::plot::profile::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
-use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -52,6 +52,39 @@ struct SkinPoint {
     melanin_fraction: f64,
     /// Chd, 0..=0.32.
     hemoglobin_fraction: f64,
+}
+
+/// The transport model of the skins' profiles: `{"model": "multipole"}` (default) or
+/// `{"model": "mc", "g": 0.8, "photons": 100000, "seed": 1}` (Monte Carlo, `transport::profile`; each wavelength
+/// group its own stream).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkinModel {
+    model: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    g: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    photons: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    seed: Option<u64>,
+}
+
+impl SkinModel {
+    fn transport(&self) -> Result<TransportModel, InvalidInput> {
+        match self.model.as_str() {
+            "multipole" if self.g.is_none() && self.photons.is_none() && self.seed.is_none() => {
+                Ok(TransportModel::Multipole)
+            }
+            "multipole" => Err(InvalidInput::new("skin_model", "g, photons and seed apply only to model mc")),
+            "mc" => TransportModel::monte_carlo(
+                self.g.unwrap_or(crate::transport::profile::DEFAULT_TISSUE_G),
+                self.photons.unwrap_or(crate::transport::profile::DEFAULT_PROFILE_PHOTONS),
+                self.seed.unwrap_or(1),
+            )
+            .map_err(|e| InvalidInput::new(format!("skin_model.{}", e.param), e.message)),
+            other => Err(InvalidInput::new("skin_model.model", format!("must be multipole or mc, got '{other}'"))),
+        }
+    }
 }
 
 /// A named layer stack (`stack` in the `--layers` JSON schema).
@@ -80,6 +113,10 @@ struct ProfilesParams {
     skin: Vec<SkinPoint>,
     /// How the skin layers are combined.
     skin_adding: Adding,
+    /// How a skin's spectrum becomes RGB (spectral projection by default, or band-averaged coefficients).
+    skin_projection: SkinProjection,
+    /// The skins' transport model (multipole by default; Monte Carlo with `{"model": "mc", ...}`).
+    skin_model: SkinModel,
     /// User layer stacks.
     stacks: Vec<NamedStack>,
     /// Profiles (stems below `profiles/`, e.g. `dipole/skin1`) that also get a PNG plot.
@@ -101,6 +138,8 @@ fn default_params() -> ProfilesParams {
             .map(|(cm, chd)| SkinPoint { melanin_fraction: cm, hemoglobin_fraction: chd })
             .to_vec(),
         skin_adding: Adding::Symmetric,
+        skin_projection: SkinProjection::default(),
+        skin_model: SkinModel { model: "multipole".into(), g: None, photons: None, seed: None },
         stacks: vec![NamedStack {
             name: "skin3_example".into(),
             description: "illustrative thin skin fold in air (not a measured material): epidermis 0.25 mm, blood-rich \
@@ -189,12 +228,19 @@ fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Val
         ));
     }
     let physiology = SkinPhysiology::default();
-    let reduction = RgbReduction::default();
     for (i, s) in p.skin.iter().enumerate() {
         let (cm, chd) = (s.melanin_fraction, s.hemoglobin_fraction);
-        let (source, provenance) =
-            physiological_skin_source(&physiology, &reduction, cm, chd, p.skin_adding, Series::Exact, p.fdr)
-                .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
+        let (source, provenance) = physiological_skin_source(
+            &physiology,
+            &p.skin_projection,
+            cm,
+            chd,
+            p.skin_adding,
+            Series::Exact,
+            p.fdr,
+            p.skin_model.transport()?,
+        )
+        .map_err(|e| InvalidInput::new(format!("skin[{i}].{}", e.param), e.message))?;
         out.push((
             format!("skin/two_layer_cm{cm}_chd{chd}"),
             format!("two-layer skin, Cm {cm}, Chd {chd}"),
@@ -209,7 +255,13 @@ fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Val
         out.push((
             format!("layered/{}", s.name),
             format!("{} ({}-layer stack)", s.name, stack.layers().len()),
-            ProfileSource::Layers { stack, adding: s.adding, series: Series::Exact, fdr: p.fdr },
+            ProfileSource::Layers {
+                stack,
+                adding: s.adding,
+                series: Series::Exact,
+                fdr: p.fdr,
+                transport: TransportModel::Multipole,
+            },
             json!({"name": s.name, "description": s.description}),
         ));
     }
@@ -245,6 +297,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         .map(|(stem, title, source, extra)| -> Result<(Vec<BakedFile>, String), BakeError> {
             let profile = source.build()?;
             let mut provenance = source.provenance();
+            crate::diffusion::source::add_built_provenance(&mut provenance, profile.as_ref());
             if let (Value::Object(dst), Value::Object(src)) = (&mut provenance, extra) {
                 for (k, v) in src {
                     dst.insert(k.clone(), v.clone());

@@ -19,7 +19,7 @@ use crate::diffusion::materials;
 use crate::error::InvalidInput;
 use crate::plot::profile::{render, PlotFormat, CHANNEL_COLORS};
 use crate::plot::{Curve, LinePlot};
-use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology, SkinProjection};
 use crate::transport::compare::{bin_averaged, compare, diffusion_counterpart};
 use crate::transport::{simulate, McSettings, McStack};
 use serde::{Deserialize, Serialize};
@@ -100,9 +100,10 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         let (cm, chd) = (s.melanin_fraction, s.hemoglobin_fraction);
         let (src, _) = physiological_skin_source(
             &SkinPhysiology::default(),
-            &RgbReduction::default(),
+            &SkinProjection::BandAveraged { reduction: RgbReduction::default() },
             cm,
             chd,
+            Default::default(),
             Default::default(),
             Default::default(),
             Default::default(),

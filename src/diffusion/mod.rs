@@ -13,6 +13,7 @@
 //! - [`source::ProfileSource`]: the one way commands resolve "material / preset / layer stack" into a
 //!   `Box<dyn RadialProfile>` plus provenance; [`table::ProfileTable`]: R, T on a radius grid as CSV / JSON;
 //!   `crate::plot::profile`: a table as a two-panel plot (r·R(r) over log r, R(r) log–log) in PNG or SVG.
+//! - [`projected`]: per-wavelength profiles projected linearly onto linear-sRGB channels (spectral skins).
 //! - [`quadrature`]: Gauss–Legendre rules and ∫2πr R(r) dr on a log grid (used by tests and fitting).
 
 pub mod albedo_inversion;
@@ -23,6 +24,7 @@ pub mod hankel;
 pub mod layered;
 pub mod materials;
 pub mod multipole;
+pub mod projected;
 pub mod quadrature;
 pub mod source;
 pub mod sum_of_gaussians;
@@ -50,6 +52,19 @@ pub trait RadialProfile: Sync {
     /// The radii (mm) over which the profile is known, where it is not defined everywhere (a tabulated profile:
     /// its first and last rows); comparisons are restricted to it. `None`: all r ≥ 0.
     fn support_mm(&self) -> Option<(f64, f64)> {
+        None
+    }
+    /// Standard error of R(r) per channel, mm⁻², for a profile estimated by Monte Carlo (`None`: exact model).
+    fn reflectance_se_mm2(&self, _r_mm: f64) -> Option<[f64; 3]> {
+        None
+    }
+    /// Standard error of the total reflectance per channel, for a Monte Carlo profile (`None`: exact model).
+    fn total_reflectance_se(&self) -> Option<[f64; 3]> {
+        None
+    }
+    /// ∫2πr max(0, −R_c) dr per channel where the model clips negative values of an exact linear map to 0 (a
+    /// spectral projection, [`projected`]); `None`: nothing is clipped by the model.
+    fn clipped_negative_mass(&self) -> Option<[f64; 3]> {
         None
     }
     /// R at many radii (implementations may parallelise; results must not depend on the thread count).

@@ -7,6 +7,7 @@ use super::dipole::Dipole;
 use super::layered::{Adding, LayerStack, LayeredProfile};
 use super::materials::{self, JENSEN_2001_ETA};
 use super::multipole::{Series, Slab, SlabRgb};
+use super::projected::{ProjectedPart, ProjectedProfile};
 use super::{sum_of_gaussians, FdrForm, RadialProfile};
 use crate::error::InvalidInput;
 use serde_json::{json, Value};
@@ -20,6 +21,116 @@ pub enum MaterialModel {
     Multipole { thickness_mm: f64 },
 }
 
+/// The transport model that turns a layer stack into a profile.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum TransportModel {
+    /// Diffusion: multipole slabs combined by adding (Donner & Jensen 2005), the thesis' model.
+    #[default]
+    Multipole,
+    /// Monte Carlo photon transport (MCML, Wang, Jacques & Zheng 1995; `crate::transport`) with Henyey–Greenstein
+    /// anisotropy `g` (σs = σs′/(1 − g), σs′ preserved), `photons` per channel (per wavelength for spectral
+    /// skins) and the seed of the counter-based random numbers.
+    MonteCarlo { g: f64, photons: u64, seed: u64 },
+}
+
+impl TransportModel {
+    /// A validated Monte Carlo model: `g` in the open interval (−1, 1) (errors name `g`), `photons` in
+    /// 1..=`transport::mc::MAX_PHOTONS` (errors name `photons`).
+    pub fn monte_carlo(g: f64, photons: u64, seed: u64) -> Result<Self, InvalidInput> {
+        if !(g.is_finite() && g > -1.0 && g < 1.0) {
+            return Err(InvalidInput::new("g", format!("must be in the open interval (-1, 1), got {g}")));
+        }
+        crate::transport::profile::profile_settings(photons, seed)?;
+        Ok(Self::MonteCarlo { g, photons, seed })
+    }
+
+    /// `{"transport_model": "multipole"}` or `{"transport_model": "monte-carlo", "g", "photons", "seed", ...}`.
+    pub fn provenance(&self) -> Value {
+        match self {
+            Self::Multipole => json!({"transport_model": "multipole"}),
+            Self::MonteCarlo { g, photons, seed } => json!({
+                "transport_model": "monte-carlo",
+                "g": g,
+                "photons": photons,
+                "seed": seed,
+                "mc_bin_mm": crate::transport::profile::PROFILE_BIN_MM,
+                "mc_bins": crate::transport::profile::PROFILE_BINS,
+                "mc_batches": crate::transport::profile::PROFILE_BATCHES,
+                "mc_reference": "MCML, Wang, Jacques & Zheng 1995; Henyey-Greenstein phase function, \
+                                 sigma_s = sigma_s' / (1 - g); R(r) = annulus means at the bin centres",
+            }),
+        }
+    }
+
+    fn parse(v: &Value) -> Result<Self, InvalidInput> {
+        match v.get("transport_model").and_then(Value::as_str) {
+            None | Some("multipole") => Ok(Self::Multipole),
+            Some("monte-carlo") => {
+                let num = |k: &str| {
+                    v.get(k).ok_or_else(|| InvalidInput::new(k, "is required for transport_model monte-carlo"))
+                };
+                let g = num("g")?.as_f64().ok_or_else(|| InvalidInput::new("g", "must be a number"))?;
+                let photons =
+                    num("photons")?.as_u64().ok_or_else(|| InvalidInput::new("photons", "must be an integer >= 1"))?;
+                let seed = num("seed")?.as_u64().ok_or_else(|| InvalidInput::new("seed", "must be an integer >= 0"))?;
+                Self::monte_carlo(g, photons, seed)
+            }
+            Some(other) => {
+                Err(InvalidInput::new("transport_model", format!("must be multipole or monte-carlo, got '{other}'")))
+            }
+        }
+    }
+
+    /// Builds the profile of one layer stack (channels as the stack's).
+    pub fn build_stack(
+        &self,
+        stack: &LayerStack,
+        adding: Adding,
+        series: Series,
+        fdr: FdrForm,
+        seed_offset: u64,
+    ) -> Result<Box<dyn RadialProfile + Send>, InvalidInput> {
+        match *self {
+            Self::Multipole => Ok(Box::new(LayeredProfile::new(stack, adding, series, fdr)?)),
+            Self::MonteCarlo { g, photons, seed } => {
+                let mc = crate::transport::McStack::from_layer_stack(stack, g)?;
+                let settings = crate::transport::profile::profile_settings(photons, seed.wrapping_add(seed_offset))?;
+                Ok(Box::new(crate::transport::profile::McProfile::simulate(&mc, &settings)))
+            }
+        }
+    }
+
+    /// Upper estimate of the wall time of [`Self::build_stack`] tabulated at `radii` radii, seconds.
+    pub fn time_estimate_seconds(&self, stack: &LayerStack, series: Series, radii: usize, threads: usize) -> f64 {
+        match *self {
+            Self::Multipole => {
+                super::layered::profile_time_estimate_seconds(stack.layers().len(), radii, series, threads)
+            }
+            Self::MonteCarlo { g, photons, seed } => {
+                match (
+                    crate::transport::McStack::from_layer_stack(stack, g),
+                    crate::transport::profile::profile_settings(photons, seed),
+                ) {
+                    (Ok(mc), Ok(settings)) => settings.time_estimate_for_stack(&mc, threads),
+                    _ => 0.0,
+                }
+            }
+        }
+    }
+}
+
+/// A spectral material as per-wavelength layer stacks, three wavelengths per stack (channel k of stack j is
+/// wavelength `wavelengths_nm[j][k]`), projected onto linear sRGB with `weights[j][k][c]`
+/// ([`super::projected`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectralStacks {
+    pub wavelengths_nm: Vec<[f64; 3]>,
+    pub stacks: Vec<LayerStack>,
+    pub weights: Vec<[[f64; 3]; 3]>,
+    /// What the projection is, recorded in the provenance (illuminant, observer, matrix, normalisation).
+    pub projection: Value,
+}
+
 /// A resolvable profile description.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ProfileSource {
@@ -28,7 +139,9 @@ pub enum ProfileSource {
     /// A sum-of-Gaussians preset by name (`deon6`, `deon4`).
     Preset(String),
     /// A user layer stack.
-    Layers { stack: LayerStack, adding: Adding, series: Series, fdr: FdrForm },
+    Layers { stack: LayerStack, adding: Adding, series: Series, fdr: FdrForm, transport: TransportModel },
+    /// A spectral material (physiological skin): per-wavelength stacks projected onto RGB.
+    Spectral { stacks: Box<SpectralStacks>, adding: Adding, series: Series, fdr: FdrForm, transport: TransportModel },
     /// Burley's normalized diffusion from per-channel surface albedo and mean free path (mm) with one shape fit.
     Burley { albedo: [f64; 3], mean_free_path_mm: [f64; 3], fit: ShapeFit },
 }
@@ -129,8 +242,14 @@ impl ProfileSource {
                     adding,
                     series: parse_series(v)?,
                     fdr: parse_fdr(v)?,
+                    transport: TransportModel::parse(v)?,
                 })
             }
+            "spectral-layered" => Err(InvalidInput::new(
+                "model",
+                "spectral-layered profiles are rebuilt from their skin parameters (skin.melanin_fraction, \
+                 skin.hemoglobin_fraction) through spectral::skin_layers::physiological_skin_source, not from JSON",
+            )),
             other => Err(InvalidInput::new(
                 "model",
                 format!("must be one of dipole, multipole, sum-of-gaussians, layered, burley, got '{other}'"),
@@ -183,12 +302,55 @@ impl ProfileSource {
                     )
                 })
             }
-            ProfileSource::Layers { stack, adding, series, fdr } => {
-                Ok(Box::new(LayeredProfile::new(stack, *adding, *series, *fdr)?))
+            ProfileSource::Layers { stack, adding, series, fdr, transport } => {
+                transport.build_stack(stack, *adding, *series, *fdr, 0)
+            }
+            ProfileSource::Spectral { stacks, adding, series, fdr, transport } => {
+                use rayon::prelude::*;
+                let build =
+                    |(j, s): (usize, &LayerStack)| transport.build_stack(s, *adding, *series, *fdr, (j as u64) << 32);
+                // Multipole groups are cheap and independent: built side by side; Monte Carlo runs are parallel
+                // inside, so they go one after the other. Either way the parts keep the wavelength order.
+                let profiles: Vec<Box<dyn RadialProfile + Send>> = match transport {
+                    TransportModel::Multipole => {
+                        stacks.stacks.par_iter().enumerate().map(build).collect::<Result<_, _>>()?
+                    }
+                    TransportModel::MonteCarlo { .. } => {
+                        stacks.stacks.iter().enumerate().map(build).collect::<Result<_, _>>()?
+                    }
+                };
+                let parts = profiles
+                    .into_iter()
+                    .zip(&stacks.weights)
+                    .map(|(profile, w)| ProjectedPart { profile, weights: *w })
+                    .collect();
+                Ok(Box::new(ProjectedProfile::new(parts, true)))
             }
             ProfileSource::Burley { albedo, mean_free_path_mm, fit } => {
                 Ok(Box::new(RgbBurley::from_mean_free_path(*albedo, *mean_free_path_mm, *fit)?))
             }
+        }
+    }
+
+    /// Upper estimate of the wall time of [`Self::build`] plus tabulating `radii` radii on `threads` threads, seconds
+    /// (layer stacks and spectral stacks; 0 for the closed-form models).
+    pub fn time_estimate_seconds(&self, radii: usize, threads: usize) -> f64 {
+        match self {
+            ProfileSource::Layers { stack, series, transport, .. } => {
+                transport.time_estimate_seconds(stack, *series, radii, threads)
+            }
+            ProfileSource::Spectral { stacks, series, transport, .. } => {
+                stacks.stacks.iter().map(|s| transport.time_estimate_seconds(s, *series, radii, threads)).sum()
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The transport model of a layer or spectral stack (`None` for the closed-form models).
+    pub fn transport(&self) -> Option<TransportModel> {
+        match self {
+            ProfileSource::Layers { transport, .. } | ProfileSource::Spectral { transport, .. } => Some(*transport),
+            _ => None,
         }
     }
 
@@ -219,14 +381,37 @@ impl ProfileSource {
                 "profile_preset": name.to_ascii_lowercase(),
                 "units": "r in mm, R in mm^-2",
             }),
-            ProfileSource::Layers { stack, adding, series, fdr } => json!({
-                "model": "layered",
-                "adding": adding.name(),
-                "series": series_json(*series),
-                "fdr": fdr_name(*fdr),
-                "layers": stack.to_json(),
-                "units": "r in mm, R and T in mm^-2",
-            }),
+            ProfileSource::Layers { stack, adding, series, fdr, transport } => {
+                let mut v = json!({
+                    "model": "layered",
+                    "adding": adding.name(),
+                    "series": series_json(*series),
+                    "fdr": fdr_name(*fdr),
+                    "layers": stack.to_json(),
+                    "rgb": "per-channel coefficients as given (band-averaged where they come from spectra)",
+                    "units": "r in mm, R and T in mm^-2",
+                });
+                merge(&mut v, transport.provenance());
+                v
+            }
+            ProfileSource::Spectral { stacks, adding, series, fdr, transport } => {
+                let all: Vec<f64> = stacks.wavelengths_nm.iter().flatten().copied().collect();
+                let mut v = json!({
+                    "model": "spectral-layered",
+                    "adding": adding.name(),
+                    "series": series_json(*series),
+                    "fdr": fdr_name(*fdr),
+                    "wavelengths_nm": {
+                        "first": all.iter().copied().fold(f64::INFINITY, f64::min),
+                        "last": all.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                        "count": stacks.stacks.len() * 3,
+                    },
+                    "rgb": stacks.projection,
+                    "units": "r in mm, R and T in mm^-2",
+                });
+                merge(&mut v, transport.provenance());
+                v
+            }
             ProfileSource::Burley { albedo, mean_free_path_mm, fit } => json!({
                 "model": "burley",
                 "albedo": albedo,
@@ -236,6 +421,27 @@ impl ProfileSource {
                 "units": "r in mm, R in mm^-2",
             }),
         }
+    }
+}
+
+/// Adds what only a built profile knows to its provenance: `total_R_se` (Monte Carlo standard errors of the
+/// totals) and `clipped_negative_mass` (∫2πr max(0, −R_c) dr a spectral projection set to 0, with why).
+pub fn add_built_provenance(provenance: &mut Value, profile: &dyn RadialProfile) {
+    if let Some(se) = profile.total_reflectance_se() {
+        provenance["total_R_se"] = json!(se);
+    }
+    if let Some(m) = profile.clipped_negative_mass() {
+        provenance["clipped_negative_mass"] = json!({
+            "per_channel": m,
+            "reason": "the exact linear-sRGB projection turns negative where only deep red light is left (outside \
+                       the sRGB gamut); R(r) and T(r) hold 0 there, so their integral exceeds total_R by this mass",
+        });
+    }
+}
+
+fn merge(dst: &mut Value, src: Value) {
+    if let (Value::Object(d), Value::Object(s)) = (dst, src) {
+        d.extend(s);
     }
 }
 
@@ -277,7 +483,20 @@ mod tests {
                 series: Series::Truncated { pairs: 5 },
             },
             ProfileSource::Preset("deon6".into()),
-            ProfileSource::Layers { stack, adding: Adding::Directional, series: Series::Exact, fdr: FdrForm::Dj05 },
+            ProfileSource::Layers {
+                stack: stack.clone(),
+                adding: Adding::Directional,
+                series: Series::Exact,
+                fdr: FdrForm::Dj05,
+                transport: TransportModel::Multipole,
+            },
+            ProfileSource::Layers {
+                stack,
+                adding: Adding::Symmetric,
+                series: Series::Exact,
+                fdr: FdrForm::Dj05,
+                transport: TransportModel::monte_carlo(0.8, 300, 7).unwrap(),
+            },
         ];
         for src in sources {
             let back = ProfileSource::from_json(&src.provenance()).unwrap();
@@ -289,5 +508,8 @@ mod tests {
         let e = ProfileSource::from_json(&json!({"model": "dipole", "material": "unobtainium"})).unwrap().build();
         assert_eq!(e.err().unwrap().param, "material");
         assert_eq!(ProfileSource::from_json(&json!({"model": "plasma"})).unwrap_err().param, "model");
+        assert_eq!(TransportModel::monte_carlo(1.0, 10, 1).unwrap_err().param, "g");
+        assert_eq!(TransportModel::monte_carlo(-1.0, 10, 1).unwrap_err().param, "g");
+        assert_eq!(TransportModel::monte_carlo(0.5, 0, 1).unwrap_err().param, "photons");
     }
 }

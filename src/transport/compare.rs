@@ -60,7 +60,9 @@ pub fn bin_averaged(profile: &dyn RadialProfile, bin_mm: f64, bins: usize) -> Ve
         .collect()
 }
 
-/// Compares `mc` with `profile` over bin centres in `r_window_mm` (inclusive).
+/// Compares `mc` with `profile` over bin centres in `r_window_mm` (inclusive). The window recorded in the result is
+/// clipped to the tallied range [0, bins·Δr] (so an open window `[a, ∞)` is written as the finite radius it
+/// covered, never as a JSON `null`).
 pub fn compare(mc: &McResult, profile: &dyn RadialProfile, r_window_mm: [f64; 2]) -> Comparison {
     let s = &mc.settings;
     let diffusion = bin_averaged(profile, s.bin_mm, s.bins);
@@ -90,7 +92,8 @@ pub fn compare(mc: &McResult, profile: &dyn RadialProfile, r_window_mm: [f64; 2]
             max_z,
         }
     });
-    Comparison { r_window_mm, channels }
+    let covered_mm = s.bins as f64 * s.bin_mm;
+    Comparison { r_window_mm: [r_window_mm[0].min(covered_mm), r_window_mm[1].min(covered_mm)], channels }
 }
 
 /// The diffusion model rtbake has for `stack` (σs′ = σs(1 − g) per channel, DJ05 Fdr, exact image series):

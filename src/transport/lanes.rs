@@ -294,29 +294,8 @@ fn neg_ln(x: V) -> V {
     ((hfsq - (s * (hfsq + r) + dk * LN2_LO)) - f) - dk * LN2_HI
 }
 
-/// Taylor coefficients (−1)ⁿ/(2n + 1)! and (−1)ⁿ/(2n)!, n = 1.., of sin and cos on |θ| ≤ π/4 (the first omitted
-/// terms are below 10⁻¹⁶).
-const SIN: [f64; 8] = [
-    -1.0 / 6.0,
-    1.0 / 120.0,
-    -1.0 / 5040.0,
-    1.0 / 362_880.0,
-    -1.0 / 39_916_800.0,
-    1.0 / 6_227_020_800.0,
-    -1.0 / 1_307_674_368_000.0,
-    1.0 / 355_687_428_096_000.0,
-];
-const COS: [f64; 9] = [
-    -1.0 / 2.0,
-    1.0 / 24.0,
-    -1.0 / 720.0,
-    1.0 / 40_320.0,
-    -1.0 / 3_628_800.0,
-    1.0 / 479_001_600.0,
-    -1.0 / 87_178_291_200.0,
-    1.0 / 20_922_789_888_000.0,
-    -1.0 / 6_402_373_705_728_000.0,
-];
+// The Taylor coefficients of sin and cos on |θ| ≤ π/4, shared with the Bessel functions' reduction.
+use crate::diffusion::bessel::{COS_TAYLOR as COS, SIN_TAYLOR as SIN};
 
 /// (cos φ, sin φ) per lane of the azimuth φ = (q + ½)·π/2 + θ of a 32-bit word: q = its top two bits (the
 /// quadrant), θ = ((low 30 bits + ½)/2³⁰ − ½)·π/2 ∈ (−π/4, π/4) — φ uniform on `[0, 2π)` on a grid of 2π/2³², by

@@ -51,11 +51,7 @@
 //! same way.
 
 use super::lanes::{self, Path};
-#[cfg(test)]
-use super::rng::PhotonRng;
 use super::stack::McStack;
-#[cfg(test)]
-use super::ziggurat::ExponentialZiggurat;
 use crate::error::InvalidInput;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -146,10 +142,77 @@ impl McSettings {
         3.0 * self.photons as f64 / (per_thread * threads.max(1) as f64)
     }
 
+    /// Wall time of [`simulate`] in `stack`, an upper estimate from the stack's optics (before any work): three
+    /// channels × `photons` × [`interactions_per_photon_estimate`] interactions at [`INTERACTIONS_PER_SECOND`] per
+    /// thread ([`PORTABLE_INTERACTIONS_PER_SECOND`] on the portable path), never below
+    /// [`Self::time_estimate_seconds`]. Unlike the per-photon figure, it grows with the albedo and with g (a
+    /// high-albedo slab or g → 1 with σs′ kept makes every photon scatter many more times).
+    pub fn time_estimate_for_stack(&self, stack: &McStack, threads: usize) -> f64 {
+        let rate =
+            if Path::detect() == Path::Portable { PORTABLE_INTERACTIONS_PER_SECOND } else { INTERACTIONS_PER_SECOND };
+        let per_photon = interactions_per_photon_estimate(stack);
+        let t = 3.0 * self.photons as f64 * per_photon / (rate * threads.max(1) as f64);
+        t.max(self.time_estimate_seconds(threads))
+    }
+
     /// Bin centres (i + ½)Δr, mm.
     pub fn radii_mm(&self) -> Vec<f64> {
         (0..self.bins).map(|i| (i as f64 + 0.5) * self.bin_mm).collect()
     }
+}
+
+/// Interactions per thread and second assumed by [`McSettings::time_estimate_for_stack`] (AVX2 / AVX-512F paths):
+/// a third of the rate measured on the project's 2-core machine with the release build (`examples/bench_transport`
+/// case (b), 2026-11-25: 1.59 M histories per CPU second on the AVX2 path × 46.5 interactions per history, the
+/// count `interaction_estimate_bounds_the_traced_counts` traces = 74 M interactions/s).
+pub const INTERACTIONS_PER_SECOND: f64 = 25.0e6;
+/// The same on the portable lane path (no AVX2): half of 0.26 M histories/s × 46.5 = 12 M interactions/s.
+pub const PORTABLE_INTERACTIONS_PER_SECOND: f64 = 6.0e6;
+/// The constant K of [`interactions_per_photon_estimate`] (the survival law's prefactor with margin, calibrated
+/// against the interaction counts of the stacks in its test).
+pub const SURVIVAL_FACTOR: f64 = 8.0;
+
+/// Interactions per photon history, an upper estimate from the optics (the worst channel):
+///
+/// * implicit capture multiplies the weight by the single-scattering albedo a = σs/σt at every interaction, so a
+///   packet reaches the roulette threshold after n_w = ln(1/[`ROULETTE_THRESHOLD`])/ln(1/a) interactions, and
+///   roulette adds (ln m/(m − 1))/ln(1/a) on average (m = [`ROULETTE_CHANCE`]);
+/// * a photon entering a half-space through its surface is still inside after n interactions with a chance that
+///   falls like √(n_t/n) (the first-passage law of a random walk, n_t = 1/(1 − g) interactions per transport mean
+///   free path), so the expected count up to n_w is about n_t + K·√(n_t n_w), K = [`SURVIVAL_FACTOR`];
+/// * in a stack of finite reduced optical depth τ′ = Σ σs′ d every photon has left after about n_t(τ′ + 2)²
+///   interactions (the diffusive escape time).
+///
+/// The estimate is the smaller of the bounds, taking for each the worst layer.
+pub fn interactions_per_photon_estimate(stack: &McStack) -> f64 {
+    let layers = stack.layers();
+    let finite = layers.iter().all(|l| l.thickness_mm.is_finite());
+    let m = ROULETTE_CHANCE;
+    (0..3)
+        .map(|c| {
+            let (mut n_w, mut n_t, mut tau) = (0.0f64, 1.0f64, 0.0);
+            for l in layers {
+                let (sa, ss, g) = (l.sigma_a_per_mm[c], l.sigma_s_per_mm[c], l.g[c]);
+                if sa + ss <= 0.0 {
+                    continue;
+                }
+                let a = ss / (sa + ss);
+                let w = if a < 1.0 {
+                    ((1.0 / ROULETTE_THRESHOLD).ln() + m.ln() / (m - 1.0)) / -a.ln() + 1.0
+                } else {
+                    f64::INFINITY
+                };
+                n_w = n_w.max(w);
+                n_t = n_t.max(1.0 / (1.0 - g.max(0.0)));
+                if finite {
+                    tau += ss * (1.0 - g) * l.thickness_mm;
+                }
+            }
+            let walk = n_t + SURVIVAL_FACTOR * (n_t * n_w).sqrt();
+            let escape = if finite { n_t * (tau + 2.0).powi(2) } else { f64::INFINITY };
+            n_w.min(walk).min(escape).max(1.0)
+        })
+        .fold(1.0, f64::max)
 }
 
 /// A Monte Carlo estimate and its standard error.
@@ -266,57 +329,6 @@ impl HenyeyGreenstein {
             inv_two_g: 0.5 / g,
         }
     }
-
-    /// cos θ from a uniform ξ.
-    #[cfg(test)]
-    #[inline]
-    fn cos_theta(&self, xi: f64) -> f64 {
-        if self.isotropic {
-            return 2.0 * xi - 1.0;
-        }
-        let f = self.one_minus_g2 / (self.one_minus_g + self.two_g * xi);
-        ((self.one_plus_g2 - f * f) * self.inv_two_g).clamp(-1.0, 1.0)
-    }
-}
-
-/// Unpolarised Fresnel reflectance from index `n_i` into `n_t` at incidence cosine `cos_i` ∈ `[0, 1]`, and the cosine of
-/// the refracted ray (MCML eq. 3.36–3.38 in the cosine form; 1 and 0 past the critical angle).
-#[cfg(test)]
-fn fresnel(n_i: f64, n_t: f64, cos_i: f64) -> (f64, f64) {
-    if n_i == n_t {
-        return (0.0, cos_i);
-    }
-    let sin_t2 = (n_i / n_t).powi(2) * (1.0 - cos_i * cos_i).max(0.0);
-    if sin_t2 >= 1.0 {
-        return (1.0, 0.0);
-    }
-    let cos_t = (1.0 - sin_t2).sqrt();
-    let rs = (n_i * cos_i - n_t * cos_t) / (n_i * cos_i + n_t * cos_t);
-    let rp = (n_i * cos_t - n_t * cos_i) / (n_i * cos_t + n_t * cos_i);
-    (0.5 * (rs * rs + rp * rp), cos_t)
-}
-
-/// Rotates direction `u` by polar cos θ and the azimuth (cos φ, sin φ) (MCML eq. 3.30–3.31). sin θ/√(1 − uz²) is
-/// taken as one square root of a quotient, and sin θ·√(1 − uz²) as that times 1 − uz² (the same expressions as
-/// MCML's `Spin`, one square root fewer).
-#[cfg(test)]
-#[inline]
-fn spin(u: [f64; 3], cos_t: f64, cos_p: f64, sin_p: f64) -> [f64; 3] {
-    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
-    let [ux, uy, uz] = u;
-    if uz.abs() > 0.99999 {
-        let sin_t = sin2_t.sqrt();
-        [sin_t * cos_p, sin_t * sin_p, cos_t * uz.signum()]
-    } else {
-        let one_minus_uz2 = 1.0 - uz * uz;
-        // sin θ / √(1 − uz²)
-        let a = (sin2_t / one_minus_uz2).sqrt();
-        [
-            a * (ux * uz * cos_p - uy * sin_p) + ux * cos_t,
-            a * (uy * uz * cos_p + ux * sin_p) + uy * cos_t,
-            -a * one_minus_uz2 * cos_p + uz * cos_t,
-        ]
-    }
 }
 
 /// What every photon of one channel shares.
@@ -328,156 +340,6 @@ pub(super) struct Channel<'a> {
     pub(super) start_weight: f64,
     pub(super) index: u32,
     pub(super) seed: u64,
-}
-
-/// One photon packet in flight (the scalar reference engine).
-#[cfg(test)]
-struct Photon {
-    x: f64,
-    y: f64,
-    z: f64,
-    u: [f64; 3],
-    w: f64,
-    /// Optical depth left of the current step (0: draw a new one).
-    s_left: f64,
-    layer: usize,
-    rng: PhotonRng,
-}
-
-#[cfg(test)]
-impl Photon {
-    /// Photon `k` of the channel at the origin, heading down with weight 1 − Rsp.
-    fn launch(ch: &Channel<'_>, k: u64) -> Self {
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            u: [0.0, 0.0, 1.0],
-            w: ch.start_weight,
-            s_left: 0.0,
-            layer: 0,
-            rng: PhotonRng::new(ch.seed, k, ch.index),
-        }
-    }
-
-    /// One event: an interaction inside the layer or the arrival at a face. Returns false when the packet has
-    /// ended (left the stack, lost the roulette, or glides in a clear layer forever).
-    ///
-    /// The common case — an interaction inside the layer — is decided without a division: the new depth
-    /// z + uz·s/σt is compared with the face the packet heads for; only a packet that reaches it computes the
-    /// distance to the face (and then stops there exactly, as MCML's `PathToBoundary` and `CrossOrNot`).
-    #[inline(always)]
-    fn event(
-        &mut self,
-        ch: &Channel<'_>,
-        exponential: &ExponentialZiggurat,
-        bins: usize,
-        inv_bin: f64,
-        tally: &mut Tally,
-    ) -> bool {
-        let media = ch.media;
-        let m = &media[self.layer];
-        let rng = &mut self.rng;
-        if self.s_left == 0.0 {
-            self.s_left = exponential.sample(rng);
-        }
-        let u = self.u;
-        let down = u[2] > 0.0;
-        let face_z = if down { m.z_bottom_mm } else { m.z_top_mm };
-        if m.sigma_t > 0.0 {
-            let d_step = self.s_left * m.inv_sigma_t;
-            let z_new = self.z + u[2] * d_step;
-            // Strictly short of the face it heads for (always for uz = 0, which meets no face).
-            if u[2] == 0.0 || (z_new - face_z) * u[2] < 0.0 {
-                self.x += u[0] * d_step;
-                self.y += u[1] * d_step;
-                self.z = z_new;
-                self.s_left = 0.0;
-                tally.interactions += 1;
-                let dw = self.w * m.absorb_fraction;
-                tally.absorbed[self.layer] += dw;
-                self.w -= dw;
-                let cos_t = m.hg.cos_theta(rng.uniform());
-                let (cos_p, sin_p) = rng.azimuth_cos_sin();
-                self.u = spin(u, cos_t, cos_p, sin_p);
-                if self.w < ROULETTE_THRESHOLD {
-                    if self.w == 0.0 {
-                        return false;
-                    }
-                    if rng.uniform() <= 1.0 / ROULETTE_CHANCE {
-                        self.w *= ROULETTE_CHANCE;
-                    } else {
-                        return false;
-                    }
-                }
-                return true;
-            }
-        }
-        let d_face = if u[2] != 0.0 { (face_z - self.z) / u[2] } else { f64::INFINITY };
-        if d_face.is_infinite() {
-            // Gliding parallel to the faces of a clear layer (or down a clear semi-infinite one): it never leaves;
-            // score it as absorbed there.
-            tally.absorbed[self.layer] += self.w;
-            return false;
-        }
-        // Move to the face, keep the rest of the optical depth.
-        self.x += u[0] * d_face;
-        self.y += u[1] * d_face;
-        self.z = face_z;
-        if m.sigma_t > 0.0 {
-            self.s_left = (self.s_left - d_face * m.sigma_t).max(0.0);
-        }
-        let last = media.len() - 1;
-        let n_t = match (down, self.layer) {
-            (false, 0) => ch.eta_above,
-            (false, j) => media[j - 1].eta,
-            (true, j) if j == last => ch.eta_below,
-            (true, j) => media[j + 1].eta,
-        };
-        let (refl, cos_t) = fresnel(m.eta, n_t, u[2].abs());
-        if refl > 0.0 && (refl >= 1.0 || rng.uniform() <= refl) {
-            self.u[2] = -u[2];
-            return true;
-        }
-        let ratio = m.eta / n_t;
-        self.u = [u[0] * ratio, u[1] * ratio, if down { cos_t } else { -cos_t }];
-        let exit = match (down, self.layer) {
-            (false, 0) => {
-                tally.rd += self.w;
-                &mut tally.r
-            }
-            (true, j) if j == last => {
-                tally.td += self.w;
-                &mut tally.t
-            }
-            (false, _) => {
-                self.layer -= 1;
-                return true;
-            }
-            (true, _) => {
-                self.layer += 1;
-                return true;
-            }
-        };
-        let bin = ((self.x * self.x + self.y * self.y).sqrt() * inv_bin) as usize;
-        if bin < bins {
-            exit[bin] += self.w;
-        }
-        false
-    }
-}
-
-/// The scalar reference engine: traces photons `first..first + count` of channel `ch` into `tally`, one after the
-/// other, with the draws of the module docs' last paragraph but one (ziggurat steps, disk azimuths). The lane
-/// engine ([`super::lanes`]) is checked against it statistically.
-#[cfg(test)]
-fn trace_chunk_scalar(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
-    let exponential = ExponentialZiggurat::new();
-    let inv_bin = 1.0 / bin_mm;
-    for k in first..first + count {
-        let mut p = Photon::launch(ch, k);
-        while p.event(ch, &exponential, tally.r.len(), inv_bin, tally) {}
-    }
 }
 
 /// Which photon loop traces the chunks.
@@ -566,7 +428,9 @@ fn simulate_engine(stack: &McStack, settings: &McSettings, engine: Engine, progr
                 match engine {
                     Engine::Lanes(path) => lanes::trace_chunk(path, &ch, settings.bin_mm, first, count, &mut t),
                     #[cfg(test)]
-                    Engine::Scalar => trace_chunk_scalar(&ch, settings.bin_mm, first, count, &mut t),
+                    Engine::Scalar => {
+                        super::reference_engine::trace_chunk_scalar(&ch, settings.bin_mm, first, count, &mut t)
+                    }
                 }
                 ((channel as usize) * batches + batch as usize, t)
             })
@@ -651,6 +515,46 @@ mod tests {
             ],
         )
         .unwrap()
+    }
+
+    /// The interaction estimate of the time budget bounds the counts traced (skin-like stacks at g = 0 and 0.8,
+    /// a thin high-albedo slab, a semi-infinite high-albedo medium) without being absurdly pessimistic (≤ 10×; traced 107, 577, 47, 226, 46 against estimates 203, 1011, 144,
+    /// 350, 77), and
+    /// it grows without bound for the stacks that used to run forever (albedo → 1 in a thick slab, g → 1 with σs′
+    /// kept), so `--max-seconds` refuses them before any work.
+    #[test]
+    fn interaction_estimate_bounds_the_traced_counts() {
+        use crate::diffusion::layered::{Layer, LayerStack};
+        let skin = LayerStack::new(
+            1.0,
+            1.4,
+            vec![
+                Layer { thickness_mm: 0.25, eta: 1.4, sigma_a: [0.5, 1.0, 2.0], sigma_s_prime: [4.0, 5.0, 6.0] },
+                Layer { thickness_mm: 20.0, eta: 1.4, sigma_a: [0.03, 0.2, 0.4], sigma_s_prime: [2.0, 2.5, 3.0] },
+            ],
+        )
+        .unwrap();
+        let cases = [
+            McStack::from_layer_stack(&skin, 0.0).unwrap(),
+            McStack::from_layer_stack(&skin, 0.8).unwrap(),
+            McStack::slab(1.0, [0.001; 3], [10.0; 3], 0.0, 1.4).unwrap(),
+            McStack::semi_infinite([0.005; 3], [1.0; 3], 0.0, 1.3).unwrap(),
+            // `examples/bench_transport` case (b): semi-infinite, albedo 0.9, n 1.5.
+            McStack::semi_infinite([1.0; 3], [9.0; 3], 0.0, 1.5).unwrap(),
+        ];
+        let settings = McSettings::new(600, 2, 2, 0.1, 10).unwrap();
+        for (i, stack) in cases.iter().enumerate() {
+            let r = simulate(stack, &settings);
+            let traced = r.channels.iter().map(|c| c.interactions as f64 / r.photons as f64).fold(0.0, f64::max);
+            let est = interactions_per_photon_estimate(stack);
+            assert!(est >= traced && est <= 10.0 * traced, "case {i}: estimate {est} vs traced {traced}");
+        }
+        let thick_white = McStack::slab(100.0, [1e-6; 3], [10.0; 3], 0.0, 1.4).unwrap();
+        let forward = McStack::slab(1.0, [0.01; 3], [1.0; 3], 0.99999, 1.4).unwrap();
+        for stack in [thick_white, forward] {
+            let s = McSettings::new(1_000_000, 1, 10, 0.1, 10).unwrap();
+            assert!(s.time_estimate_for_stack(&stack, 2) > 600.0, "{:?}", interactions_per_photon_estimate(&stack));
+        }
     }
 
     /// The AVX-512F, AVX2 and portable lane loops give the same bytes (those this CPU supports), on 1 and 2

@@ -70,6 +70,33 @@ fn check_g(param: &str, g: f64) -> Result<(), InvalidInput> {
     Ok(())
 }
 
+/// σs = σs′/(1 − g): the scattering coefficient that keeps the reduced coefficient σs′ = σs(1 − g) of a diffusion
+/// layer for a Henyey–Greenstein anisotropy g (so transport and diffusion see the same σs′).
+pub fn sigma_s_from_reduced(sigma_s_prime_per_mm: f64, g: f64) -> f64 {
+    sigma_s_prime_per_mm / (1.0 - g)
+}
+
+impl McLayer {
+    /// A layer from diffusion coefficients (σa, σs′ in mm⁻¹) and one anisotropy g ∈ (−1, 1), σs = σs′/(1 − g)
+    /// ([`sigma_s_from_reduced`]). Errors name `g`; the rest is checked by [`McStack::new`].
+    pub fn from_reduced(
+        thickness_mm: f64,
+        eta: f64,
+        sigma_a_per_mm: [f64; 3],
+        sigma_s_prime_per_mm: [f64; 3],
+        g: f64,
+    ) -> Result<Self, InvalidInput> {
+        check_g("g", g)?;
+        Ok(Self {
+            thickness_mm,
+            eta,
+            sigma_a_per_mm,
+            sigma_s_per_mm: sigma_s_prime_per_mm.map(|s| sigma_s_from_reduced(s, g)),
+            g: [g; 3],
+        })
+    }
+}
+
 impl McStack {
     /// Validates: indices in 1..=[`MAX_ETA`], 1..=[`MAX_LAYERS`] layers, σa, σs finite in 0..=1e6 mm⁻¹, g ∈ (−1, 1),
     /// thickness finite > 0 except a semi-infinite (`INFINITY`) last layer, which needs σa > 0 in every channel
@@ -183,7 +210,7 @@ impl McStack {
                 (Some(s), None) => rgb(Some(s), &p("sigma_s"), None)?,
                 (None, Some(s)) => {
                     let sp = rgb(Some(s), &p("sigma_s_prime"), None)?;
-                    [0, 1, 2].map(|c| sp[c] / (1.0 - g[c]))
+                    [0, 1, 2].map(|c| sigma_s_from_reduced(sp[c], g[c]))
                 }
                 _ => {
                     return Err(InvalidInput::new(
@@ -206,18 +233,11 @@ impl McStack {
     /// A diffusion layer stack (σa, σs′) as transport layers with anisotropy `g` (σs = σs′/(1 − g)), so the
     /// transport and the diffusion model see the same reduced coefficients.
     pub fn from_layer_stack(stack: &LayerStack, g: f64) -> Result<Self, InvalidInput> {
-        check_g("g", g)?;
         let layers = stack
             .layers()
             .iter()
-            .map(|l| McLayer {
-                thickness_mm: l.thickness_mm,
-                eta: l.eta,
-                sigma_a_per_mm: l.sigma_a,
-                sigma_s_per_mm: l.sigma_s_prime.map(|s| s / (1.0 - g)),
-                g: [g; 3],
-            })
-            .collect();
+            .map(|l| McLayer::from_reduced(l.thickness_mm, l.eta, l.sigma_a, l.sigma_s_prime, g))
+            .collect::<Result<Vec<_>, _>>()?;
         Self::new(stack.eta_above(), stack.eta_below(), layers)
     }
 
@@ -228,15 +248,20 @@ impl McStack {
         g: f64,
         eta: f64,
     ) -> Result<Self, InvalidInput> {
-        check_g("g", g)?;
-        let layer = McLayer {
-            thickness_mm: f64::INFINITY,
-            eta,
-            sigma_a_per_mm,
-            sigma_s_per_mm: sigma_s_prime_per_mm.map(|s| s / (1.0 - g)),
-            g: [g; 3],
-        };
+        let layer = McLayer::from_reduced(f64::INFINITY, eta, sigma_a_per_mm, sigma_s_prime_per_mm, g)?;
         Self::new(1.0, eta, vec![layer])
+    }
+
+    /// A slab of `thickness_mm` and index `eta` in air on both sides (σs = σs′/(1 − g)); the multipole's geometry.
+    pub fn slab(
+        thickness_mm: f64,
+        sigma_a_per_mm: [f64; 3],
+        sigma_s_prime_per_mm: [f64; 3],
+        g: f64,
+        eta: f64,
+    ) -> Result<Self, InvalidInput> {
+        let layer = McLayer::from_reduced(thickness_mm, eta, sigma_a_per_mm, sigma_s_prime_per_mm, g)?;
+        Self::new(1.0, 1.0, vec![layer])
     }
 
     pub fn eta_above(&self) -> f64 {

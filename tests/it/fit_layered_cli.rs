@@ -28,6 +28,7 @@ fn sum_of_gaussians_fits_a_layer_stack_and_physiological_skin() {
         adding: Default::default(),
         series: Default::default(),
         fdr: Default::default(),
+        transport: Default::default(),
     }
     .build()
     .unwrap();

@@ -5,18 +5,19 @@ use rtbake::diffusion::layered::Adding;
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::table::{log_radii, ProfileTable};
 use rtbake::diffusion::FdrForm;
-use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology};
+use rtbake::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology, SkinProjection};
 
 #[test]
 fn negative_layered_values_are_clamped_reported_and_tiny() {
     let (src, _) = physiological_skin_source(
         &SkinPhysiology::default(),
-        &RgbReduction::default(),
+        &SkinProjection::BandAveraged { reduction: RgbReduction::default() },
         0.3,
         0.05,
         Adding::Symmetric,
         Series::Exact,
         FdrForm::Dj05,
+        Default::default(),
     )
     .unwrap();
     let profile = src.build().unwrap();
