@@ -9,8 +9,11 @@
 //! - `profiles/presets/deon6`, `deon4`: d'Eon, Luebke, Enderton, "Efficient Rendering of Human Skin", EGSR 2007
 //!   (6 Gaussians) and thesis Table 4.2 (4 Gaussians);
 //! - `profiles/skin/two_layer_cm<Cm>_chd<Chd>`: the physiological two-layer skin (Donner & Jensen 2006 coefficients
-//!   as in `spectral::skin_layers`; epidermis 0.25 mm over dermis 20 mm, η = 1.4; D65 × linear-sRGB-sensitivity weighted
-//!   per-channel coefficients) at (Cm, Chd) = (0.02, 0.05), (0.1, 0.1), (0.3, 0.05), symmetric adding (DJ05);
+//!   as in `spectral::skin_layers`; epidermis 0.25 mm over dermis 20 mm, η = 1.4) at (Cm, Chd) = (0.02, 0.05),
+//!   (0.1, 0.1), (0.3, 0.05), symmetric adding (DJ05): by default per wavelength (380–780 nm, 10 nm) and projected
+//!   linearly to linear sRGB under D65 (`skin_projection`; `{"kind": "band-averaged", ...}` keeps the earlier
+//!   per-channel coefficients), with the multipole (`skin_model`; `{"model": "mc", "g", "photons", "seed"}` for
+//!   Monte Carlo transport);
 //! - `profiles/layered/skin3_example`: an illustrative three-layer stack, **not a measured material** (DJ05's
 //!   three-layer skin coefficients are not public): a thin, translucent skin fold (ear rim, nostril) with air on both
 //!   sides — epidermis 0.25 mm, blood-rich upper dermis 0.5 mm, lower dermis 1.5 mm, η = 1.4 throughout. The

@@ -7,6 +7,11 @@
 //! the Monte Carlo diffuse reflectance (every exit through the top, also beyond the last bin); its standard error
 //! and the per-bin standard errors come from the independent batches ([`super::mc`]).
 //!
+//! Normalisation (the same for both models): per unit flux *entering* the top face. MCML launches each packet
+//! with weight 1 − Rsp (the specular loss at normal incidence); the diffusion totals (and the skin-colour LUT) have
+//! no entry loss, the renderer applies the entry Fresnel term itself. So R(r), T(r), the totals and their standard
+//! errors are divided by 1 − Rsp here (+2.9 % at η = 1.4 against the raw tallies).
+//!
 //! Anisotropy: a diffusion layer gives σs′; the transport gets σs = σs′/(1 − g) with Henyey–Greenstein g, so both
 //! models see the same reduced coefficients ([`super::stack::McStack::from_layer_stack`]).
 
@@ -55,13 +60,18 @@ impl McProfile {
             (0..bins).map(|i| [f(0, i), f(1, i), f(2, i)]).collect()
         };
         let ch = &result.channels;
+        // Per unit entering flux (module docs): ÷ (1 − Rsp).
+        let k = [0, 1, 2].map(|c| 1.0 / (1.0 - ch[c].specular_reflectance));
         Self {
             bin_mm: result.settings.bin_mm,
-            r: col(&|c, i| ch[c].reflectance_mm2[i].mean),
-            r_se: col(&|c, i| ch[c].reflectance_mm2[i].se),
-            t: finite.then(|| col(&|c, i| ch[c].transmittance_mm2[i].mean)),
-            total_r: [0, 1, 2].map(|c| ch[c].diffuse_reflectance),
-            total_t: finite.then(|| [0, 1, 2].map(|c| ch[c].transmittance.mean)),
+            r: col(&|c, i| k[c] * ch[c].reflectance_mm2[i].mean),
+            r_se: col(&|c, i| k[c] * ch[c].reflectance_mm2[i].se),
+            t: finite.then(|| col(&|c, i| k[c] * ch[c].transmittance_mm2[i].mean)),
+            total_r: [0, 1, 2].map(|c| {
+                let e = ch[c].diffuse_reflectance;
+                Estimate { mean: k[c] * e.mean, se: k[c] * e.se }
+            }),
+            total_t: finite.then(|| [0, 1, 2].map(|c| k[c] * ch[c].transmittance.mean)),
             photons: result.photons,
         }
     }
@@ -125,21 +135,25 @@ mod tests {
     use crate::transport::stack::McLayer;
 
     #[test]
-    fn profile_interpolates_bin_centres_and_keeps_the_totals() {
+    fn profile_interpolates_bin_centres_and_counts_entering_light() {
         let layer = McLayer::from_reduced(1.0, 1.4, [0.1, 0.2, 0.4], [2.0, 2.0, 2.0], 0.0).unwrap();
         let stack = McStack::new(1.0, 1.0, vec![layer]).unwrap();
         let settings = McSettings::new(4000, 3, 4, 0.1, 20).unwrap();
         let result = simulate(&stack, &settings);
         let p = McProfile::from_result(&result, true);
+        // Rsp at η = 1.4 under air: ((1.4 − 1)/(1.4 + 1))² = 1/36.
+        let k = 1.0 / (1.0 - 1.0 / 36.0);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
         for c in 0..3 {
-            assert_eq!(p.total_reflectance()[c], result.channels[c].diffuse_reflectance.mean);
-            assert_eq!(p.total_reflectance_se().unwrap()[c], result.channels[c].diffuse_reflectance.se);
+            let ch = &result.channels[c];
+            assert!((ch.specular_reflectance - 1.0 / 36.0).abs() < 1e-15);
+            assert!(close(p.total_reflectance()[c], k * ch.diffuse_reflectance.mean));
+            assert!(close(p.total_reflectance_se().unwrap()[c], k * ch.diffuse_reflectance.se));
             // At a bin centre the profile is that bin's annulus mean; halfway, the mean of the two neighbours.
-            let at = result.channels[c].reflectance_mm2[3].mean;
-            assert!((p.reflectance_mm2(0.35)[c] - at).abs() <= 1e-12 * at, "{c}");
-            let mid = 0.5 * (result.channels[c].reflectance_mm2[3].mean + result.channels[c].reflectance_mm2[4].mean);
-            assert!((p.reflectance_mm2(0.4)[c] - mid).abs() <= 1e-12 * mid.abs().max(1e-300));
-            assert_eq!(p.reflectance_mm2(0.0)[c], result.channels[c].reflectance_mm2[0].mean);
+            assert!(close(p.reflectance_mm2(0.35)[c], k * ch.reflectance_mm2[3].mean), "{c}");
+            let mid = 0.5 * k * (ch.reflectance_mm2[3].mean + ch.reflectance_mm2[4].mean);
+            assert!(close(p.reflectance_mm2(0.4)[c], mid));
+            assert!(close(p.reflectance_mm2(0.0)[c], k * ch.reflectance_mm2[0].mean));
             assert_eq!(p.reflectance_mm2(2.5)[c], 0.0);
         }
         assert!(p.total_transmittance().unwrap().iter().all(|&t| t > 0.0));

@@ -40,6 +40,7 @@ mod newcomer_cli;
 mod newcomer_profile_floor;
 mod newcomer_provenance;
 mod newcomer_readme;
+mod profile_models_cli;
 mod profiles_bake;
 mod profiles_cli;
 mod reliability_budget;
