@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=bench-out
 mkdir -p "$OUT"
-ALL=(bench_aa bench_layered bench_fitting bench_separable bench_skin bench_facial bench_runtime bench_transport bench_profiles)
+ALL=(bench_aa bench_layered bench_fitting bench_separable bench_skin bench_facial bench_runtime bench_transport bench_profiles bench_spectral_mc)
 BENCHES=("${@:-${ALL[@]}}")
 cargo build --release --examples --quiet
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), \

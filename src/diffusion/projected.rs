@@ -90,9 +90,9 @@ impl ProjectedProfile {
     pub fn project_values(&self, per_part: &[[f64; 3]]) -> [f64; 3] {
         let mut out = [0.0; 3];
         for (p, v) in self.parts.iter().zip(per_part) {
-            for k in 0..3 {
+            for (wk, vk) in p.weights.iter().zip(v) {
                 for (c, o) in out.iter_mut().enumerate() {
-                    *o += p.weights[k][c] * v[k];
+                    *o += wk[c] * vk;
                 }
             }
         }
@@ -103,9 +103,9 @@ impl ProjectedProfile {
     pub fn project_variance(&self, se_per_part: &[[f64; 3]]) -> [f64; 3] {
         let mut out = [0.0; 3];
         for (p, v) in self.parts.iter().zip(se_per_part) {
-            for k in 0..3 {
+            for (wk, vk) in p.weights.iter().zip(v) {
                 for (c, o) in out.iter_mut().enumerate() {
-                    *o += p.weights[k][c] * p.weights[k][c] * v[k] * v[k];
+                    *o += wk[c] * wk[c] * vk * vk;
                 }
             }
         }

@@ -573,14 +573,13 @@ mod tests {
                 let stack = McStack::from_layer_stack(&stacks.stacks[j], g).unwrap();
                 let l = simulate_engine(&stack, &settings, Engine::Lanes(Path::detect()), &|_| {});
                 let s = simulate_engine(&stack, &settings, Engine::Scalar, &|_| {});
-                let w = stacks.weights[j];
-                for k in 0..3 {
+                for (k, wk) in stacks.weights[j].iter().enumerate() {
                     let (el, es) = (l.channels[k].diffuse_reflectance, s.channels[k].diffuse_reflectance);
                     for c in 0..3 {
-                        lanes[c] += w[k][c] * el.mean;
-                        scalar[c] += w[k][c] * es.mean;
-                        var_l[c] += (w[k][c] * el.se).powi(2);
-                        var_s[c] += (w[k][c] * es.se).powi(2);
+                        lanes[c] += wk[c] * el.mean;
+                        scalar[c] += wk[c] * es.mean;
+                        var_l[c] += (wk[c] * el.se).powi(2);
+                        var_s[c] += (wk[c] * es.se).powi(2);
                     }
                 }
             }

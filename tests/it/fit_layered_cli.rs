@@ -51,6 +51,23 @@ fn sum_of_gaussians_fits_a_layer_stack_and_physiological_skin() {
     ]));
     assert_eq!(v["source"]["skin"]["melanin_fraction"], 0.05);
     let err: Vec<f64> = serde_json::from_value(v["error_percent"].clone()).unwrap();
+    // The spectral profile (the default) carries the far-reaching red of every wavelength, which four Gaussians
+    // follow a little less closely (2.9 % in R) than the band-averaged stack (< 2 %).
+    assert!(err.iter().all(|e| *e < 4.0), "{err:?}");
+    let v = json(&rtbake(&[
+        "fit",
+        "gaussians",
+        "--skin-melanin",
+        "0.05",
+        "--skin-hemoglobin",
+        "0.1",
+        "--skin-projection",
+        "band-averaged",
+        "--count",
+        "4",
+        "--json",
+    ]));
+    let err: Vec<f64> = serde_json::from_value(v["error_percent"].clone()).unwrap();
     assert!(err.iter().all(|e| *e < 2.0), "{err:?}");
 }
 
