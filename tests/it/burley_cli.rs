@@ -73,7 +73,9 @@ fn profile_csv_of_a_built_in_profile_reproduces_its_gaussian_fit() {
     let t = tempfile::tempdir().unwrap();
     for (name, source, count) in [
         ("skin1", &["--material", "skin1"][..], "6"),
-        ("skin", &["--skin-melanin", "0.1", "--skin-hemoglobin", "0.1"][..], "4"),
+        // The band-averaged skin: its 4-Gaussian fit is well conditioned enough for these tolerances (the spectral
+        // default's smallest weights move by a few % with the CSV's interpolation).
+        ("skin", &["--skin-melanin", "0.1", "--skin-hemoglobin", "0.1", "--skin-projection", "band-averaged"][..], "4"),
     ] {
         let csv = t.path().join(format!("{name}.csv"));
         let mut a = vec!["profile", "--csv", csv.to_str().unwrap(), "-q"];
