@@ -235,9 +235,95 @@ pub fn json_requested(argv: &[OsString]) -> bool {
     argv.iter().skip(1).take_while(|a| *a != "--").any(|a| a == "--json")
 }
 
-/// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
-pub fn exit_clap(e: clap::Error, json: bool) -> ! {
+/// Every long flag of `cmd` and its subcommands that takes a value, as typed (`--burley-d-mm`).
+fn value_flags(cmd: &clap::Command, out: &mut std::collections::HashSet<String>) {
+    for a in cmd.get_arguments().filter(|a| a.get_action().takes_values()) {
+        for l in a.get_long().into_iter().chain(a.get_all_aliases().unwrap_or_default()) {
+            out.insert(format!("--{l}"));
+        }
+    }
+    for s in cmd.get_subcommands() {
+        value_flags(s, out);
+    }
+}
+
+/// Joins a value-taking flag and a following value that starts with a minus sign and a digit (`--burley-d-mm
+/// -1,1,1`, `--max-memory -1G`) into one token (`--burley-d-mm=-1,1,1`), so clap hands the value to the flag's
+/// range check instead of reading it as an unknown option. Plain negative numbers already reach the checks.
+pub fn join_negative_values(argv: Vec<OsString>, cmd: &clap::Command) -> Vec<OsString> {
+    let mut flags = std::collections::HashSet::new();
+    value_flags(cmd, &mut flags);
+    let negative = |t: &str| {
+        let b = t.as_bytes();
+        b.len() >= 2
+            && b[0] == b'-'
+            && (b[1].is_ascii_digit() || (b[1] == b'.' && b.get(2).is_some_and(u8::is_ascii_digit)))
+    };
+    let mut out: Vec<OsString> = Vec::with_capacity(argv.len());
+    let mut after_separator = false;
+    for a in argv {
+        let text = a.to_string_lossy().into_owned();
+        if !after_separator && negative(&text) {
+            if let Some(prev) = out.last().map(|p| p.to_string_lossy().into_owned()) {
+                if !prev.contains('=') && flags.contains(&prev) {
+                    out.pop();
+                    out.push(format!("{prev}={text}").into());
+                    continue;
+                }
+            }
+        }
+        after_separator |= text == "--";
+        out.push(a);
+    }
+    out
+}
+
+/// clap's "invalid digit found in string" for a negative number given to an unsigned flag, said with the range:
+/// the one the flag's help states (`1..=1e10`), else the type's (`0..=18446744073709551615`).
+fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command) -> Option<(String, String)> {
     use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::ValueValidation {
+        return None;
+    }
+    let source = std::error::Error::source(e)?;
+    let int = source.downcast_ref::<std::num::ParseIntError>()?;
+    if *int.kind() != std::num::IntErrorKind::InvalidDigit {
+        return None;
+    }
+    let (Some(ContextValue::String(arg)), Some(ContextValue::String(value))) =
+        (e.get(ContextKind::InvalidArg), e.get(ContextKind::InvalidValue))
+    else {
+        return None;
+    };
+    let value = value.trim();
+    let flag = arg.split_whitespace().next().unwrap_or(arg).to_string();
+    fn find(cmd: &clap::Command, long: &str) -> Option<String> {
+        cmd.get_arguments()
+            .find(|a| a.get_long() == Some(long))
+            .map(|a| a.get_help().map(|h| h.to_string()).unwrap_or_default())
+            .or_else(|| cmd.get_subcommands().find_map(|s| find(s, long)))
+    }
+    let help = find(cmd, flag.trim_start_matches('-')).unwrap_or_default();
+    // A range the help text states, e.g. "Photons per channel, 1..=1e10 (rounded …)".
+    let stated = help
+        .split(|c: char| c.is_whitespace() || c == ',' || c == '(' || c == ')')
+        .find(|w| w.contains("..=") && w.chars().next().is_some_and(|c| c.is_ascii_digit()));
+    let range = stated.map(str::to_string).unwrap_or_else(|| format!("0..={}", u64::MAX));
+    let what = if value.starts_with('-') { "a negative number" } else { "not a whole number" };
+    Some((flag.clone(), format!("{flag}: must be a whole number in {range}, got {value} ({what})")))
+}
+
+/// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
+/// An unsigned flag given a negative number is reported with its range (exit 2).
+pub fn exit_clap(e: clap::Error, json: bool, cmd: &clap::Command) -> ! {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if let Some((flag, msg)) = negative_unsigned_message(&e, cmd) {
+        eprintln!("error: {msg}");
+        if json {
+            emit_json_error(&msg, Some(&flag), 2);
+        }
+        std::process::exit(2);
+    }
     let code = e.exit_code();
     if !json || matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) || code == 0 {
         e.exit();
@@ -424,7 +510,10 @@ pub fn fmt_bytes(b: u64) -> String {
     }
 }
 
-/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`.
+/// The largest `--max-memory`: 1024 TiB (a larger value would wrap or read as "unlimited").
+pub const MAX_MEMORY_BYTES: u64 = 1 << 50;
+
+/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`, at most 1024T.
 pub fn parse_bytes(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
@@ -435,10 +524,11 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
         _ => (t, 0),
     };
     let v: f64 = num.trim().parse().map_err(|_| format!("expected a size like 512M or 12G, got {s:?}"))?;
-    if !(v.is_finite() && v > 0.0) {
-        return Err(format!("must be a size > 0, got {s:?}"));
+    let bytes = v * (1u64 << shift) as f64;
+    if !(v.is_finite() && v > 0.0 && bytes <= MAX_MEMORY_BYTES as f64) {
+        return Err(format!("must be a size in 1..=1024T (bytes, K, M, G or T), got {s:?}"));
     }
-    Ok((v * (1u64 << shift) as f64) as u64)
+    Ok(bytes as u64)
 }
 
 /// Physical memory of this machine, if the platform says.

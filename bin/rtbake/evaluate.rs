@@ -80,6 +80,7 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
         if ext.as_deref() == Some("csv") {
             let p = rtbake::diffusion::tabulated::TabulatedProfile::from_csv_str(&body, text)
                 .map_err(|e| usage(anyhow::anyhow!("--against {e}")))?;
+            crate::profile_source::checked("--against", path, &p)?;
             return Ok((Box::new(p), json!({"model": "tabulated", "file": text}), text.to_string()));
         }
         let stack = LayerStack::from_json_str(&body).map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))?;

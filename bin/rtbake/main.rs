@@ -123,10 +123,12 @@ fn main() {
         Ok(a) => a,
         Err(e) => cli::exit_with(&e, json),
     };
-    let parsed = match command().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
+    let cmd = command();
+    let argv = cli::join_negative_values(argv, &cmd);
+    let parsed = match cmd.clone().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
-        Err(e) => cli::exit_clap(e, json),
+        Err(e) => cli::exit_clap(e, json, &cmd),
     };
     let ctx = Ctx {
         json: parsed.json,
