@@ -425,6 +425,7 @@ pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
 /// written to probe it (a kill cannot leave a probe file among the user's files).
 #[allow(dead_code)]
 pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    check_dir_name(flag, dir)?;
     std::fs::create_dir_all(dir)
         .map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
     rtbake::io::file_set::check_dir_writable(dir)
@@ -463,6 +464,26 @@ impl ZstdArg {
     }
 }
 
+/// File extensions that make a new output directory's name look like a file (`--out t.png`).
+const FILE_EXTENSIONS: [&str; 14] =
+    ["png", "exr", "json", "csv", "svg", "dds", "ktx2", "bin", "h", "hlsl", "glsl", "wgsl", "txt", "jpg"];
+
+/// Refuses a directory output named like a file that does not exist yet (`--out t.png` would silently create a
+/// directory `t.png`); an existing directory of that name is accepted.
+pub fn check_dir_name(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    let ext = dir.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if let Some(ext) = ext.filter(|e| FILE_EXTENSIONS.contains(&e.as_str())) {
+        if !dir.is_dir() {
+            return Err(usage_msg(format!(
+                "{flag} {}: this command writes several files into a directory, and this name ends in .{ext} like a \
+                 file; give a directory (e.g. {flag} out/)",
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 pub fn write_set(
     ctx: &Ctx,
     flag: &str,
@@ -470,6 +491,7 @@ pub fn write_set(
     files: &[rtbake::bake::BakedFile],
     inputs: &[&Path],
 ) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    check_dir_name(flag, dir)?;
     let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
     ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))

@@ -273,6 +273,25 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 num("total_difference")
             );
         }
+        if worst > 100.0 {
+            // Errors of several hundred percent alarm without saying why: they mean two different profiles.
+            let totals: Vec<f64> =
+                (0..3).filter_map(|c| report["total_difference"][c].as_f64()).map(f64::abs).collect();
+            let biggest_total = totals.iter().cloned().fold(0.0, f64::max);
+            let why = if !a.normalize && biggest_total > 0.05 {
+                format!(
+                    "the totals differ by up to {biggest_total:.3} (e.g. a kernel normalised to total 1 against a \
+                     material's reflectance), and the shapes differ; --normalize compares shapes only"
+                )
+            } else {
+                "their shapes differ (the candidate's radii are not the target's)".to_string()
+            };
+            println!(
+                "note: errors above 100 % mean the candidate is a different profile from the target, not a \
+                 numerical problem: {why}. A fit of this target (rtbake fit gaussians / fit burley with the same \
+                 target) evaluated back gives its fit error, typically a few percent."
+            );
+        }
     }
     match (pass, a.max_error) {
         (Some(false), Some(m)) => {

@@ -302,7 +302,10 @@ pub(crate) fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
         ctx.info("backend: CPU reference");
         return Ok(None);
     }
-    let g = create_headless(&Default::default())?;
+    let g = create_headless(&Default::default()).map_err(|e| {
+        anyhow::Error::new(e)
+            .context("could not open a GPU adapter; add --cpu to run the CPU reference of the same passes")
+    })?;
     ctx.info(format!("adapter: {}", g.describe()));
     Ok(Some(g))
 }
@@ -339,6 +342,16 @@ fn report(ctx: &Ctx, pass: &str, output: &Path, img: &Image<u8>, gpu: Option<&Gp
 
 fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
     let bytes = std::fs::read(path).map_err(|e| usage(anyhow::anyhow!("{flag} {}: {e}", path.display())))?;
+    // OpenEXR files start with the magic number 76 2f 31 01; say what the file is instead of the decoder's
+    // "file identifier missing".
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        let what = if bytes.starts_with(b"\x89PNG") { "a PNG image" } else { "not an OpenEXR file" };
+        return Err(usage_msg(format!(
+            "{flag} {}: is {what}; {flag} takes an OpenEXR image (linear, half or float; `rtbake run demo \
+             --sss-inputs DIR` writes a matching colour/depth pair)",
+            path.display()
+        )));
+    }
     Ok(io::exr::decode(&bytes, &path.display().to_string()).map_err(usage)?.0)
 }
 

@@ -262,6 +262,13 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
         ctx.info(line);
     }
+    if comparison.as_ref().is_some_and(|cmp| cmp.channels.iter().any(|k| k.total_r_difference_percent.abs() > 20.0)) {
+        ctx.info(
+            "note: large differences mean the diffusion model is outside its validity here (it assumes scattering \
+             dominates absorption and layers many transport mean free paths thick); the Monte Carlo result is the \
+             reference, within the ± standard errors printed",
+        );
+    }
     if ctx.json {
         ctx.emit_json(&json);
     } else if args.csv.is_none() && args.out.is_none() && args.plot.is_none() {

@@ -239,7 +239,10 @@ pub fn check_target_weight(param: &str, target: &str, w: f64) -> Result<f64, Inv
     if !(w.is_finite() && w.abs() <= MAX_TARGET_WEIGHT) {
         return Err(InvalidInput::new(
             param,
-            format!("weight of '{target}' must be in -{MAX_TARGET_WEIGHT}..={MAX_TARGET_WEIGHT} (the weights sum to 1, eq. 7.6), got {w}"),
+            format!(
+                "weight of '{target}' must be in -{MAX_TARGET_WEIGHT}..={MAX_TARGET_WEIGHT} (the weights sum to 1, \
+                 eq. 7.6), got {w:e}"
+            ),
         ));
     }
     Ok(w)
