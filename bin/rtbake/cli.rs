@@ -497,6 +497,38 @@ pub fn write_set(
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
 }
 
+/// Writes a command's separate output files (`--csv`, `--out`, `--plot`, …): two or more in one directory as one
+/// locked set (`write_file_set`: all or nothing, never seen mixed, refused when two flags name the same file), a
+/// single file or files in different directories each atomically. Prints `wrote PATH` per file.
+pub fn write_outputs(ctx: &Ctx, outputs: &[(&str, &Path, Vec<u8>)], inputs: &[&Path]) -> anyhow::Result<()> {
+    let parent = |p: &Path| -> std::path::PathBuf {
+        let d = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf())
+    };
+    let flags: Vec<&str> = outputs.iter().map(|o| o.0).collect();
+    let one_dir = outputs.len() > 1 && outputs.iter().all(|o| parent(o.1) == parent(outputs[0].1));
+    if one_dir {
+        let dir = parent(outputs[0].1);
+        let list: Vec<(String, &[u8])> = outputs
+            .iter()
+            .map(|(_, p, b)| {
+                (p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b.as_slice())
+            })
+            .collect();
+        let refs: Vec<(&str, &[u8])> = list.iter().map(|(n, b)| (n.as_str(), *b)).collect();
+        ctx.with_wait(|w| rtbake::io::file_set::write_file_set(&dir, &refs, inputs, w))
+            .map_err(|e| file_set_err(e).context(flags.join("/")))?;
+    } else {
+        for (_, path, bytes) in outputs {
+            rtbake::io::atomic::write_atomic(path, bytes)?;
+        }
+    }
+    for (_, path, _) in outputs {
+        ctx.info(format!("wrote {}", path.display()));
+    }
+    Ok(())
+}
+
 /// `42 s`, `7.5 min` or `3.2 h`.
 pub fn fmt_seconds(s: f64) -> String {
     if s < 120.0 {

@@ -698,6 +698,14 @@ pub fn write_file_set(
         }
     }
     let outputs: Vec<PathBuf> = files.iter().map(|(rel, _)| dir.join(rel)).collect();
+    for (k, (rel, _)) in files.iter().enumerate() {
+        if files[..k].iter().any(|(r, _)| r == rel) {
+            return Err(FileSetError::Unusable {
+                path: dir.join(rel).display().to_string(),
+                detail: "is given for two outputs of one command; give each output its own file".into(),
+            });
+        }
+    }
     check_outputs_not_inputs(&outputs, inputs)?;
     fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
     let lock = DirLock::acquire(dir, LockMode::Exclusive, wait)?;

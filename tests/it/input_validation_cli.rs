@@ -131,3 +131,36 @@ fn accepted_but_wrong_inputs_are_refused() {
         dir,
     );
 }
+
+#[test]
+fn the_rig_reader_refuses_a_rig_without_the_neutral_map_first() {
+    let t = tempfile::tempdir().unwrap();
+    let fixture = |n: &str| crate_dir().join(format!("tests/fixtures/facial/hemoglobin_{n}.png"));
+    let rig = t.path().join("rig");
+    let anger = format!("anger={}", s(&fixture("anger")));
+    let o = rtbake(&[
+        "maps",
+        "hemoglobin",
+        "--neutral",
+        s(&fixture("neutral")),
+        "--target",
+        &anger,
+        "--radius",
+        "4",
+        "--rig-size",
+        "16",
+        "--out",
+        s(&rig),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = rig.join("rig.json");
+    let mut desc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    desc["maps"].as_array_mut().unwrap().reverse();
+    std::fs::write(&json, serde_json::to_string_pretty(&desc).unwrap()).unwrap();
+    let out = t.path().join("h.exr");
+    let o = rtbake(&["maps", "rig-eval", "--rig", s(&json), "--weights", "neutral=1", "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--rig") && stderr(&o).contains("neutral map first"), "{}", stderr(&o));
+    assert!(!out.exists());
+}

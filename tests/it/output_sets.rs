@@ -129,3 +129,28 @@ fn a_listed_file_replaced_by_a_symlink_fails_verify_with_and_without_pin() {
         );
     }
 }
+
+#[test]
+fn transport_csv_json_and_plot_in_one_directory_are_one_set() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path().join("mc");
+    std::fs::create_dir(&d).unwrap();
+    let run = |seed: &str, fault: &str| {
+        Command::new(env!("CARGO_BIN_EXE_rtbake"))
+            .args(["transport", "--material", "skin1", "--photons", "2000", "--seed", seed, "-q"])
+            .args(["--csv", s(&d.join("r.csv")), "--out", s(&d.join("r.json")), "--plot", s(&d.join("r.svg"))])
+            .env("RTBAKE_FAULT_INJECT", fault)
+            .output()
+            .unwrap()
+    };
+    assert!(run("1", "").status.success());
+    let first = tree(&d);
+    assert_eq!(first.len(), 3);
+    let o = run("2", "kill@before-swap");
+    assert_eq!(o.status.code(), Some(137), "{}", stderr(&o));
+    assert_eq!(tree(&d), first, "a kill before the swap left the first run's trio");
+    let o = run("2", "kill@after-swap");
+    assert_eq!(o.status.code(), Some(137), "{}", stderr(&o));
+    let second = tree(&d);
+    assert!(second.iter().zip(&first).all(|(a, b)| a.0 == b.0 && a.1 != b.1), "all three files are the new run's");
+}
