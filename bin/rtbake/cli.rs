@@ -280,14 +280,9 @@ pub fn join_negative_values(argv: Vec<OsString>, cmd: &clap::Command) -> Vec<OsS
 
 /// clap's "invalid digit found in string" for a negative number given to an unsigned flag, said with the range:
 /// the one the flag's help states (`1..=1e10`), else the type's (`0..=18446744073709551615`).
-fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command) -> Option<(String, String)> {
+fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Option<(String, String)> {
     use clap::error::{ContextKind, ContextValue, ErrorKind};
     if e.kind() != ErrorKind::ValueValidation {
-        return None;
-    }
-    let source = std::error::Error::source(e)?;
-    let int = source.downcast_ref::<std::num::ParseIntError>()?;
-    if *int.kind() != std::num::IntErrorKind::InvalidDigit {
         return None;
     }
     let (Some(ContextValue::String(arg)), Some(ContextValue::String(value))) =
@@ -296,6 +291,14 @@ fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command) -> Option<(St
         return None;
     };
     let value = value.trim();
+    // u64/usize flags fail in the integer parser; u32 flags in clap's own range check ("-5 is not in 0..=4294967295",
+    // the type's range, not the flag's).
+    let invalid_digit = std::error::Error::source(e)
+        .and_then(|s| s.downcast_ref::<std::num::ParseIntError>())
+        .is_some_and(|i| *i.kind() == std::num::IntErrorKind::InvalidDigit);
+    if !(invalid_digit || value.parse::<i64>().is_ok_and(|v| v < 0)) {
+        return None;
+    }
     let flag = arg.split_whitespace().next().unwrap_or(arg).to_string();
     fn find(cmd: &clap::Command, long: &str) -> Option<String> {
         cmd.get_arguments()
@@ -303,21 +306,31 @@ fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command) -> Option<(St
             .map(|a| a.get_help().map(|h| h.to_string()).unwrap_or_default())
             .or_else(|| cmd.get_subcommands().find_map(|s| find(s, long)))
     }
-    let help = find(cmd, flag.trim_start_matches('-')).unwrap_or_default();
+    // The subcommand the user typed (its --width, not another command's).
+    let mut sub = cmd;
+    for a in argv.iter().skip(1) {
+        if let Some(next) = sub.find_subcommand(a.to_string_lossy().as_ref()) {
+            sub = next;
+        }
+    }
+    let help = find(sub, flag.trim_start_matches('-')).or_else(|| find(cmd, flag.trim_start_matches('-')));
+    let help = help.unwrap_or_default();
     // A range the help text states, e.g. "Photons per channel, 1..=1e10 (rounded …)".
     let stated = help
         .split(|c: char| c.is_whitespace() || c == ',' || c == '(' || c == ')')
+        .map(|w| w.trim_end_matches(['.', ';', ':']))
         .find(|w| w.contains("..=") && w.chars().next().is_some_and(|c| c.is_ascii_digit()));
-    let range = stated.map(str::to_string).unwrap_or_else(|| format!("0..={}", u64::MAX));
+    let type_max = if invalid_digit { u64::MAX } else { u64::from(u32::MAX) };
+    let range = stated.map(str::to_string).unwrap_or_else(|| format!("0..={type_max}"));
     let what = if value.starts_with('-') { "a negative number" } else { "not a whole number" };
     Some((flag.clone(), format!("{flag}: must be a whole number in {range}, got {value} ({what})")))
 }
 
 /// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
 /// An unsigned flag given a negative number is reported with its range (exit 2).
-pub fn exit_clap(e: clap::Error, json: bool, cmd: &clap::Command) -> ! {
+pub fn exit_clap(e: clap::Error, json: bool, cmd: &clap::Command, argv: &[OsString]) -> ! {
     use clap::error::{ContextKind, ContextValue, ErrorKind};
-    if let Some((flag, msg)) = negative_unsigned_message(&e, cmd) {
+    if let Some((flag, msg)) = negative_unsigned_message(&e, cmd, argv) {
         eprintln!("error: {msg}");
         if json {
             emit_json_error(&msg, Some(&flag), 2);

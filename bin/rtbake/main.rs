@@ -152,10 +152,10 @@ fn main() {
     };
     let cmd = command();
     let argv = cli::join_negative_values(argv, &cmd);
-    let parsed = match cmd.clone().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
+    let parsed = match cmd.clone().try_get_matches_from(argv.clone()).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
-        Err(e) => cli::exit_clap(e, json, &cmd),
+        Err(e) => cli::exit_clap(e, json, &cmd, &argv),
     };
     let ctx = Ctx {
         json: parsed.json,

@@ -86,6 +86,8 @@ fn negative_and_huge_numbers_are_reported_with_the_flag_and_range() {
     let dir = t.path();
     refused(&["transport", "--material", "skin1", "--photons", "-5"], &["--photons", "1..=1e10", "-5"], dir);
     refused(&["transport", "--material", "skin1", "--seed", "-1"], &["--seed", "0..=18446744073709551615"], dir);
+    // A u32 flag: the range its help states, not the type's.
+    refused(&["run", "demo", "--cpu", "--width", "-5", "--output", "x.png"], &["--width", "1..=16384", "-5"], dir);
     refused(
         &["evaluate", "--burley-albedo", "0.5,0.5,0.5", "--burley-d-mm", "-1,1,1", "--against", "skin1"],
         &["--burley-d-mm", "> 0", "-1"],
