@@ -97,14 +97,10 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
         let p = src.build().map_err(usage)?;
         return Ok((p, src.provenance(), format!("skin Cm {} Chd {}", v[0], v[1])));
     }
-    let kind = if rtbake::diffusion::sum_of_gaussians::preset(text).is_some() {
-        Named::Preset { flag: "--against", name: text }
-    } else if rtbake::diffusion::materials::find(text).is_some() {
-        Named::Material { flag: "--against", name: text }
-    } else {
-        return Err(usage_msg(format!("--against must be {TARGET_FORMS}; got '{text}'")));
-    };
-    let (src, p, _) = named(kind)?;
+    // Names resolve only through the library's `ProfileSource`: a preset, else a Jensen material.
+    let (src, p, _) = named(Named::Preset { flag: "--against", name: text })
+        .or_else(|_| named(Named::Material { flag: "--against", name: text }))
+        .map_err(|_| usage_msg(format!("--against must be {TARGET_FORMS}; got '{text}'")))?;
     let label = match src {
         ProfileSource::Material { ref name, .. } => format!("{name} (dipole)"),
         _ => text.to_string(),
