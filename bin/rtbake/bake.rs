@@ -54,6 +54,7 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     let zstd = a.zstd.level()?;
+    crate::cli::check_dir_name("--out", &a.out)?;
     let overrides: Value = match &a.asset_params {
         None => Value::Object(Default::default()),
         Some(p) => {

@@ -38,10 +38,12 @@ fn out_and_output_and_both_profile_spellings_work_everywhere() {
 fn a_directory_output_named_like_a_file_is_refused() {
     let t = tempfile::tempdir().unwrap();
     let out = t.path().join("t.png");
-    let o = rtbake(&["aa", "smaa-search", "--out", s(&out)]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("--out") && stderr(&o).contains("t.png") && stderr(&o).contains("directory"));
-    assert!(!out.exists(), "a directory named t.png was created");
+    for cmd in [&["aa", "smaa-search"][..], &["bake", "smaa-search"]] {
+        let o = rtbake(&[cmd, &["--out", s(&out)]].concat());
+        assert_eq!(o.status.code(), Some(2), "{cmd:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("--out") && stderr(&o).contains("t.png") && stderr(&o).contains("directory"));
+        assert!(!out.exists(), "{cmd:?}: a directory named t.png was created");
+    }
 }
 
 #[test]
