@@ -401,6 +401,9 @@ fn verify_locked(dir: &Path, registry: &[Asset], pin: Option<&str>) -> Result<Ve
         match read {
             None => set(&entry.path, FileStatus::Missing, "listed in manifest.json, not on disk".into()),
             Some((b, sha)) => {
+                if let Some(link) = crate::io::file_set::symlink_on_path(dir, &entry.path) {
+                    set(&entry.path, FileStatus::Tampered, format!("{link}; a baked file must be a regular file"));
+                }
                 if sha != entry.sha256 || b.len() as u64 != entry.size_bytes {
                     set(
                         &entry.path,

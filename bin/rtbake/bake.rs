@@ -25,6 +25,9 @@ pub struct VerifyArgs {
     /// Bake directory holding manifest.json.
     #[arg(long, default_value = "baked", value_name = "DIR")]
     pub dir: PathBuf,
+    /// The bake directory given without --dir (`rtbake verify baked`).
+    #[arg(value_name = "DIR", conflicts_with = "dir")]
+    pub dir_positional: Option<PathBuf>,
     /// File holding the expected sha256 of manifest.json (e.g. `sha256sum baked/manifest.json > baked.pin`, kept
     /// in version control): any edit of the manifest, however consistent, fails verification.
     #[arg(long, value_name = "FILE")]
@@ -51,6 +54,7 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     let zstd = a.zstd.level()?;
+    crate::cli::check_dir_name("--out", &a.out)?;
     let overrides: Value = match &a.asset_params {
         None => Value::Object(Default::default()),
         Some(p) => {
@@ -132,7 +136,10 @@ fn check_out_dir(dir: &Path) -> anyhow::Result<()> {
         .map_err(|e| usage(anyhow::anyhow!("--out {}: not writable: {e}", dir.display())))
 }
 
-pub fn run_verify(a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
+pub fn run_verify(mut a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
+    if let Some(d) = a.dir_positional.take() {
+        a.dir = d;
+    }
     // Refused before the lock is taken (its file would be created beside the missing directory), unless a bake is
     // creating it or was killed swapping it (then verify waits for the lock or finishes the swap).
     if let Some(what) = rtbake::baked_dir::unverifiable(&a.dir) {

@@ -235,9 +235,108 @@ pub fn json_requested(argv: &[OsString]) -> bool {
     argv.iter().skip(1).take_while(|a| *a != "--").any(|a| a == "--json")
 }
 
-/// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
-pub fn exit_clap(e: clap::Error, json: bool) -> ! {
+/// Every long flag of `cmd` and its subcommands that takes a value, as typed (`--burley-d-mm`).
+fn value_flags(cmd: &clap::Command, out: &mut std::collections::HashSet<String>) {
+    for a in cmd.get_arguments().filter(|a| a.get_action().takes_values()) {
+        for l in a.get_long().into_iter().chain(a.get_all_aliases().unwrap_or_default()) {
+            out.insert(format!("--{l}"));
+        }
+    }
+    for s in cmd.get_subcommands() {
+        value_flags(s, out);
+    }
+}
+
+/// Joins a value-taking flag and a following value that starts with a minus sign and a digit (`--burley-d-mm
+/// -1,1,1`, `--max-memory -1G`) into one token (`--burley-d-mm=-1,1,1`), so clap hands the value to the flag's
+/// range check instead of reading it as an unknown option. Plain negative numbers already reach the checks.
+pub fn join_negative_values(argv: Vec<OsString>, cmd: &clap::Command) -> Vec<OsString> {
+    let mut flags = std::collections::HashSet::new();
+    value_flags(cmd, &mut flags);
+    let negative = |t: &str| {
+        let b = t.as_bytes();
+        b.len() >= 2
+            && b[0] == b'-'
+            && (b[1].is_ascii_digit() || (b[1] == b'.' && b.get(2).is_some_and(u8::is_ascii_digit)))
+    };
+    let mut out: Vec<OsString> = Vec::with_capacity(argv.len());
+    let mut after_separator = false;
+    for a in argv {
+        let text = a.to_string_lossy().into_owned();
+        if !after_separator && negative(&text) {
+            if let Some(prev) = out.last().map(|p| p.to_string_lossy().into_owned()) {
+                if !prev.contains('=') && flags.contains(&prev) {
+                    out.pop();
+                    out.push(format!("{prev}={text}").into());
+                    continue;
+                }
+            }
+        }
+        after_separator |= text == "--";
+        out.push(a);
+    }
+    out
+}
+
+/// clap's "invalid digit found in string" for a negative number given to an unsigned flag, said with the range:
+/// the one the flag's help states (`1..=1e10`), else the type's (`0..=18446744073709551615`).
+fn negative_unsigned_message(e: &clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Option<(String, String)> {
     use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::ValueValidation {
+        return None;
+    }
+    let (Some(ContextValue::String(arg)), Some(ContextValue::String(value))) =
+        (e.get(ContextKind::InvalidArg), e.get(ContextKind::InvalidValue))
+    else {
+        return None;
+    };
+    let value = value.trim();
+    // u64/usize flags fail in the integer parser; u32 flags in clap's own range check ("-5 is not in 0..=4294967295",
+    // the type's range, not the flag's).
+    let invalid_digit = std::error::Error::source(e)
+        .and_then(|s| s.downcast_ref::<std::num::ParseIntError>())
+        .is_some_and(|i| *i.kind() == std::num::IntErrorKind::InvalidDigit);
+    if !(invalid_digit || value.parse::<i64>().is_ok_and(|v| v < 0)) {
+        return None;
+    }
+    let flag = arg.split_whitespace().next().unwrap_or(arg).to_string();
+    fn find(cmd: &clap::Command, long: &str) -> Option<String> {
+        cmd.get_arguments()
+            .find(|a| a.get_long() == Some(long))
+            .map(|a| a.get_help().map(|h| h.to_string()).unwrap_or_default())
+            .or_else(|| cmd.get_subcommands().find_map(|s| find(s, long)))
+    }
+    // The subcommand the user typed (its --width, not another command's).
+    let mut sub = cmd;
+    for a in argv.iter().skip(1) {
+        if let Some(next) = sub.find_subcommand(a.to_string_lossy().as_ref()) {
+            sub = next;
+        }
+    }
+    let help = find(sub, flag.trim_start_matches('-')).or_else(|| find(cmd, flag.trim_start_matches('-')));
+    let help = help.unwrap_or_default();
+    // A range the help text states, e.g. "Photons per channel, 1..=1e10 (rounded …)".
+    let stated = help
+        .split(|c: char| c.is_whitespace() || c == ',' || c == '(' || c == ')')
+        .map(|w| w.trim_end_matches(['.', ';', ':']))
+        .find(|w| w.contains("..=") && w.chars().next().is_some_and(|c| c.is_ascii_digit()));
+    let type_max = if invalid_digit { u64::MAX } else { u64::from(u32::MAX) };
+    let range = stated.map(str::to_string).unwrap_or_else(|| format!("0..={type_max}"));
+    let what = if value.starts_with('-') { "a negative number" } else { "not a whole number" };
+    Some((flag.clone(), format!("{flag}: must be a whole number in {range}, got {value} ({what})")))
+}
+
+/// A clap parse error: with `--json`, the error object on stdout and clap's text on stderr; else clap's usual output.
+/// An unsigned flag given a negative number is reported with its range (exit 2).
+pub fn exit_clap(e: clap::Error, json: bool, cmd: &clap::Command, argv: &[OsString]) -> ! {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if let Some((flag, msg)) = negative_unsigned_message(&e, cmd, argv) {
+        eprintln!("error: {msg}");
+        if json {
+            emit_json_error(&msg, Some(&flag), 2);
+        }
+        std::process::exit(2);
+    }
     let code = e.exit_code();
     if !json || matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) || code == 0 {
         e.exit();
@@ -339,6 +438,7 @@ pub fn parse_rgb(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
 /// written to probe it (a kill cannot leave a probe file among the user's files).
 #[allow(dead_code)]
 pub fn prepare_out_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    check_dir_name(flag, dir)?;
     std::fs::create_dir_all(dir)
         .map_err(|e| usage(anyhow::anyhow!("{flag} {}: cannot create directory: {e}", dir.display())))?;
     rtbake::io::file_set::check_dir_writable(dir)
@@ -377,6 +477,26 @@ impl ZstdArg {
     }
 }
 
+/// File extensions that make a new output directory's name look like a file (`--out t.png`).
+const FILE_EXTENSIONS: [&str; 14] =
+    ["png", "exr", "json", "csv", "svg", "dds", "ktx2", "bin", "h", "hlsl", "glsl", "wgsl", "txt", "jpg"];
+
+/// Refuses a directory output named like a file that does not exist yet (`--out t.png` would silently create a
+/// directory `t.png`); an existing directory of that name is accepted.
+pub fn check_dir_name(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    let ext = dir.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if let Some(ext) = ext.filter(|e| FILE_EXTENSIONS.contains(&e.as_str())) {
+        if !dir.is_dir() {
+            return Err(usage_msg(format!(
+                "{flag} {}: this command writes several files into a directory, and this name ends in .{ext} like a \
+                 file; give a directory (e.g. {flag} out/)",
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 pub fn write_set(
     ctx: &Ctx,
     flag: &str,
@@ -384,9 +504,42 @@ pub fn write_set(
     files: &[rtbake::bake::BakedFile],
     inputs: &[&Path],
 ) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    check_dir_name(flag, dir)?;
     let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
     ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
+}
+
+/// Writes a command's separate output files (`--csv`, `--out`, `--plot`, …): two or more in one directory as one
+/// locked set (`write_file_set`: all or nothing, never seen mixed, refused when two flags name the same file), a
+/// single file or files in different directories each atomically. Prints `wrote PATH` per file.
+pub fn write_outputs(ctx: &Ctx, outputs: &[(&str, &Path, Vec<u8>)], inputs: &[&Path]) -> anyhow::Result<()> {
+    let parent = |p: &Path| -> std::path::PathBuf {
+        let d = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf())
+    };
+    let flags: Vec<&str> = outputs.iter().map(|o| o.0).collect();
+    let one_dir = outputs.len() > 1 && outputs.iter().all(|o| parent(o.1) == parent(outputs[0].1));
+    if one_dir {
+        let dir = parent(outputs[0].1);
+        let list: Vec<(String, &[u8])> = outputs
+            .iter()
+            .map(|(_, p, b)| {
+                (p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b.as_slice())
+            })
+            .collect();
+        let refs: Vec<(&str, &[u8])> = list.iter().map(|(n, b)| (n.as_str(), *b)).collect();
+        ctx.with_wait(|w| rtbake::io::file_set::write_file_set(&dir, &refs, inputs, w))
+            .map_err(|e| file_set_err(e).context(flags.join("/")))?;
+    } else {
+        for (_, path, bytes) in outputs {
+            rtbake::io::atomic::write_atomic(path, bytes)?;
+        }
+    }
+    for (_, path, _) in outputs {
+        ctx.info(format!("wrote {}", path.display()));
+    }
+    Ok(())
 }
 
 /// `42 s`, `7.5 min` or `3.2 h`.
@@ -424,7 +577,10 @@ pub fn fmt_bytes(b: u64) -> String {
     }
 }
 
-/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`.
+/// The largest `--max-memory`: 1024 TiB (a larger value would wrap or read as "unlimited").
+pub const MAX_MEMORY_BYTES: u64 = 1 << 50;
+
+/// Parses `--max-memory`: bytes with an optional K, M, G or T suffix (powers of 1024), e.g. `12G`, at most 1024T.
 pub fn parse_bytes(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
@@ -435,10 +591,11 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
         _ => (t, 0),
     };
     let v: f64 = num.trim().parse().map_err(|_| format!("expected a size like 512M or 12G, got {s:?}"))?;
-    if !(v.is_finite() && v > 0.0) {
-        return Err(format!("must be a size > 0, got {s:?}"));
+    let bytes = v * (1u64 << shift) as f64;
+    if !(v.is_finite() && v > 0.0 && bytes <= MAX_MEMORY_BYTES as f64) {
+        return Err(format!("must be a size in 1..=1024T (bytes, K, M, G or T), got {s:?}"));
     }
-    Ok((v * (1u64 << shift) as f64) as u64)
+    Ok(bytes as u64)
 }
 
 /// Physical memory of this machine, if the platform says.

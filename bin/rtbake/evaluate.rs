@@ -80,6 +80,7 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
         if ext.as_deref() == Some("csv") {
             let p = rtbake::diffusion::tabulated::TabulatedProfile::from_csv_str(&body, text)
                 .map_err(|e| usage(anyhow::anyhow!("--against {e}")))?;
+            crate::profile_source::checked("--against", path, &p)?;
             return Ok((Box::new(p), json!({"model": "tabulated", "file": text}), text.to_string()));
         }
         let stack = LayerStack::from_json_str(&body).map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))?;
@@ -110,14 +111,10 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
         let p = src.build().map_err(usage)?;
         return Ok((p, src.provenance(), format!("skin Cm {} Chd {}", v[0], v[1])));
     }
-    let kind = if rtbake::diffusion::sum_of_gaussians::preset(text).is_some() {
-        Named::Preset { flag: "--against", name: text }
-    } else if rtbake::diffusion::materials::find(text).is_some() {
-        Named::Material { flag: "--against", name: text }
-    } else {
-        return Err(usage_msg(format!("--against must be {TARGET_FORMS}; got '{text}'")));
-    };
-    let (src, p, _) = named(kind)?;
+    // Names resolve only through the library's `ProfileSource`: a preset, else a Jensen material.
+    let (src, p, _) = named(Named::Preset { flag: "--against", name: text })
+        .or_else(|_| named(Named::Material { flag: "--against", name: text }))
+        .map_err(|_| usage_msg(format!("--against must be {TARGET_FORMS}; got '{text}'")))?;
     let label = match src {
         ProfileSource::Material { ref name, .. } => format!("{name} (dipole)"),
         _ => text.to_string(),
@@ -284,6 +281,25 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
                 num("max_percent"),
                 report.get("eq_2_2_rms_percent").map_or("-".into(), |_| format!("{:.3}", num("eq_2_2_rms_percent"))),
                 num("total_difference")
+            );
+        }
+        if worst > 100.0 {
+            // Errors of several hundred percent alarm without saying why: they mean two different profiles.
+            let totals: Vec<f64> =
+                (0..3).filter_map(|c| report["total_difference"][c].as_f64()).map(f64::abs).collect();
+            let biggest_total = totals.iter().cloned().fold(0.0, f64::max);
+            let why = if !a.normalize && biggest_total > 0.05 {
+                format!(
+                    "the totals differ by up to {biggest_total:.3} (e.g. a kernel normalised to total 1 against a \
+                     material's reflectance), and the shapes differ; --normalize compares shapes only"
+                )
+            } else {
+                "their shapes differ (the candidate's radii are not the target's)".to_string()
+            };
+            println!(
+                "note: errors above 100 % mean the candidate is a different profile from the target, not a \
+                 numerical problem: {why}. A fit of this target (rtbake fit gaussians / fit burley with the same \
+                 target) evaluated back gives its fit error, typically a few percent."
             );
         }
     }

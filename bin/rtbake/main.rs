@@ -102,10 +102,37 @@ enum Command {
 
 /// The command line, with every value-taking flag of every subcommand accepting a negative number after a space
 /// (`--thickness-mm -1`), so the range check names the flag instead of clap reporting an unexpected `-1`.
+///
+/// Also: one spelling works everywhere — a command with `--out` accepts `--output` and the other way round, and
+/// `--profile-preset` and `--profile` name the same flag (where a command has only one of each pair); and the
+/// global options are listed under their own heading in every subcommand's help instead of mixed into its flags.
 fn command() -> clap::Command {
     fn negatives(cmd: clap::Command) -> clap::Command {
-        cmd.mut_args(|a| if a.get_action().takes_values() { a.allow_negative_numbers(true) } else { a })
-            .mut_subcommands(negatives)
+        let longs: Vec<String> = cmd.get_arguments().filter_map(|a| a.get_long().map(str::to_string)).collect();
+        let has = |l: &str| longs.iter().any(|x| x == l);
+        let synonym = |long: &str| -> Option<&'static str> {
+            let other = match long {
+                "out" => "output",
+                "output" => "out",
+                "profile-preset" => "profile",
+                "profile" => "profile-preset",
+                _ => return None,
+            };
+            (!has(other)).then_some(other)
+        };
+        cmd.mut_args(|a| {
+            let a = if a.is_global_set() { a.help_heading("Global options") } else { a };
+            let a = match a.get_long().and_then(synonym) {
+                Some(other) => a.visible_alias(other),
+                None => a,
+            };
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negatives)
     }
     negatives(Cli::command())
 }
@@ -123,10 +150,12 @@ fn main() {
         Ok(a) => a,
         Err(e) => cli::exit_with(&e, json),
     };
-    let parsed = match command().try_get_matches_from(argv).and_then(|m| Cli::from_arg_matches(&m)) {
+    let cmd = command();
+    let argv = cli::join_negative_values(argv, &cmd);
+    let parsed = match cmd.clone().try_get_matches_from(argv.clone()).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.
-        Err(e) => cli::exit_clap(e, json),
+        Err(e) => cli::exit_clap(e, json, &cmd, &argv),
     };
     let ctx = Ctx {
         json: parsed.json,

@@ -141,6 +141,16 @@ fn non_finite_error(e: InvalidInput, args: &ProfileArgs) -> anyhow::Error {
         format!("--material {m}")
     } else if let Some(p) = &args.profile_preset {
         format!("--profile-preset {p}")
+    } else if args.burley.is_set() {
+        if e.message.contains("at r = 0 mm") {
+            // R(r) = A·s·(e^(−s·r/d) + e^(−s·r/(3d))) / (8π·d·r) diverges at r = 0: the radius is at fault.
+            return usage(InvalidInput::new(
+                "--radii",
+                "includes r = 0, where Burley's normalized diffusion R(r) diverges (it falls as 1/r from r = 0; \
+                 Christensen & Burley 2015); give radii > 0 (e.g. the default log grid from --r-min-mm)",
+            ));
+        }
+        "--burley-albedo/--burley-mfp-mm".to_string()
     } else {
         "--skin-melanin/--skin-hemoglobin".to_string()
     };

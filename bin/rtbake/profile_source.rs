@@ -157,7 +157,7 @@ pub struct LayeredArgs {
     #[arg(long, value_enum, default_value = "spectral")]
     pub skin_projection: SkinProjectionArg,
     /// Target: your own profile as CSV, the layout `rtbake profile --csv` and `rtbake transport --csv` write (`#`
-    /// comments, header r_mm,R_r,R_g,R_b or r_mm,R, rows of r in mm strictly increasing and R in mm^-2 >= 0, any
+    /// comments, header r_mm,R_r,R_g,R_b (or r_mm,R,G,B) or r_mm,R, rows of r in mm strictly increasing and R in mm^-2 >= 0, any
     /// spacing, >= 2 rows); interpolated linearly in log r, 0 beyond the last radius
     #[arg(long, value_name = "FILE")]
     pub profile_csv: Option<PathBuf>,
@@ -192,6 +192,7 @@ impl LayeredArgs {
             let profile =
                 rtbake::diffusion::tabulated::TabulatedProfile::from_csv_str(&text, &path.display().to_string())
                     .map_err(|e| usage(anyhow::anyhow!("--profile-csv {e}")))?;
+            checked("--profile-csv", path, &profile)?;
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "profile".into());
             let provenance = json!({
                 "model": "tabulated",
@@ -232,6 +233,14 @@ impl LayeredArgs {
         add_standard_errors(&mut provenance, profile.as_ref());
         Ok(Some((profile, provenance, stem)))
     }
+}
+
+/// The one validation of a profile read from a user's file, before any consumer sees it
+/// (`rtbake::fitting::profile_check`): every channel finite, non-negative, with a positive, finite total. The error
+/// names the flag and the file.
+pub fn checked(flag: &str, path: &std::path::Path, profile: &dyn RadialProfile) -> anyhow::Result<()> {
+    rtbake::fitting::profile_check::check_profile(profile)
+        .map_err(|e| usage(anyhow::anyhow!("{flag} {}: {}", path.display(), e.message)))
 }
 
 /// `--skin-melanin CM --skin-hemoglobin CHD` with the default physiology and RGB reduction, through the library's

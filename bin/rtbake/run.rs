@@ -188,13 +188,13 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
         RunCommand::Smaa(s) => {
             let (input, output) = (s.input.expect("clap: --input"), s.output.expect("clap: --output"));
             let a = AaArgs { input, output, edges: s.edges, common: s.common };
-            check_output(&a.output, &[&[a.input.as_path()][..], &a.edges.files()].concat())?;
+            check_output(&a.output, "png", &[&[a.input.as_path()][..], &a.edges.files()].concat())?;
             let img = read_png(&a.input)?;
             let aa = Antialiasing::Smaa(loader::load_smaa_textures(&a.common.baked).map_err(usage)?);
             antialias_file(ctx, &a, img, &aa, "smaa")
         }
         RunCommand::Mlaa(m) => {
-            check_output(&m.aa.output, &[&[m.aa.input.as_path()][..], &m.aa.edges.files()].concat())?;
+            check_output(&m.aa.output, "png", &[&[m.aa.input.as_path()][..], &m.aa.edges.files()].concat())?;
             let map = load_mlaa(&m.aa.common.baked, m.max_distance)?;
             let img = read_png(&m.aa.input)?;
             antialias_file(ctx, &m.aa, img, &Antialiasing::Mlaa(map), "mlaa")
@@ -257,14 +257,30 @@ fn load_mlaa(baked: &Path, n: u32) -> anyhow::Result<MlaaAreaMap> {
 /// The output's directory must exist and be writable before any work is done.
 /// `--output` must be in an existing directory and must not be one of the command's `inputs` (exit 2, both named).
 /// `--output` in an existing directory and not one of the inputs (exit 2 otherwise).
+/// The file's extension must name the format written (`png` or `exr`, any case): `--output s.jpg` is refused
+/// instead of writing PNG bytes under a JPEG name, and so is an existing directory.
 pub(crate) fn check_output_of(path: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
-    check_output(path, inputs)
+    check_output(path, "png", inputs)
 }
 
-fn check_output(path: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
+fn check_output(path: &Path, ext: &str, inputs: &[&Path]) -> anyhow::Result<()> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         return Err(usage_msg(format!("--output {}: directory {} does not exist", path.display(), dir.display())));
+    }
+    if path.is_dir() {
+        return Err(usage_msg(format!(
+            "--output {}: is a directory; give a file name ending in .{ext}",
+            path.display()
+        )));
+    }
+    if !path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case(ext)) {
+        return Err(usage_msg(format!(
+            "--output {}: this command writes {}; the file name must end in .{ext} (accepted: .{ext}, .{})",
+            path.display(),
+            ext.to_ascii_uppercase(),
+            ext.to_ascii_uppercase()
+        )));
     }
     rtbake::io::file_set::check_outputs_not_inputs(&[path.to_path_buf()], inputs)
         .map_err(|e| usage(anyhow::anyhow!("--output: {e}")))
@@ -286,7 +302,10 @@ pub(crate) fn device(ctx: &Ctx, cpu: bool) -> anyhow::Result<Option<Gpu>> {
         ctx.info("backend: CPU reference");
         return Ok(None);
     }
-    let g = create_headless(&Default::default())?;
+    let g = create_headless(&Default::default()).map_err(|e| {
+        anyhow::Error::new(e)
+            .context("could not open a GPU adapter; add --cpu to run the CPU reference of the same passes")
+    })?;
     ctx.info(format!("adapter: {}", g.describe()));
     Ok(Some(g))
 }
@@ -323,6 +342,16 @@ fn report(ctx: &Ctx, pass: &str, output: &Path, img: &Image<u8>, gpu: Option<&Gp
 
 fn read_exr(flag: &str, path: &Path) -> anyhow::Result<Image<f32>> {
     let bytes = std::fs::read(path).map_err(|e| usage(anyhow::anyhow!("{flag} {}: {e}", path.display())))?;
+    // OpenEXR files start with the magic number 76 2f 31 01; say what the file is instead of the decoder's
+    // "file identifier missing".
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        let what = if bytes.starts_with(b"\x89PNG") { "a PNG image" } else { "not an OpenEXR file" };
+        return Err(usage_msg(format!(
+            "{flag} {}: is {what}; {flag} takes an OpenEXR image (linear, half or float; `rtbake run demo \
+             --sss-inputs DIR` writes a matching colour/depth pair)",
+            path.display()
+        )));
+    }
     Ok(io::exr::decode(&bytes, &path.display().to_string()).map_err(usage)?.0)
 }
 
@@ -348,7 +377,7 @@ fn read_kernel(ctx: &Ctx, baked: &Path, kernel: &str) -> anyhow::Result<loader::
 }
 
 fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
-    check_output(&a.output, &[&a.color, &a.depth])?;
+    check_output(&a.output, "exr", &[&a.color, &a.depth])?;
     let baked = &a.common.baked;
     if a.method != SssMethodArg::Importance
         && (a.samples.is_some() || a.profile.is_set() || a.importance_kernel.is_some())
@@ -443,7 +472,7 @@ fn sss(ctx: &Ctx, a: SssArgs) -> anyhow::Result<()> {
 }
 
 fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
-    check_output(&d.output, &[])?;
+    check_output(&d.output, "png", &[])?;
     rtbake::error::check_size("--width/--height", d.width as u64, d.height as u64)?;
     ctx.check_budget(
         &format!("--width {} --height {}", d.width, d.height),
@@ -463,6 +492,7 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
             std::fs::read_to_string(p).map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: {e}", p.display())))?;
         let v: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| usage(anyhow::anyhow!("--rig-weights {}: not valid JSON: {e}", p.display())))?;
+        rtbake::facial::hemoglobin_rig::check_pose_json("--rig-weights", &v).map_err(usage)?;
         assets.set_rig_weights(&v)?;
     }
     ctx.info(format!("hemoglobin rig: {}", assets.rig_source));

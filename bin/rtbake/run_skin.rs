@@ -135,6 +135,7 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
     let mut p = SkinPasses::default();
     if let Some(v) = &a.rig_weights {
         let json = json_arg("--rig-weights", v)?;
+        rtbake::facial::hemoglobin_rig::check_pose_json("--rig-weights", &json).map_err(usage)?;
         let rig = assets.baked_rig.as_ref().ok_or_else(|| {
             usage_msg("--rig-weights needs the hemoglobin rig in the bake directory (facial/hemoglobin/example)")
         })?;

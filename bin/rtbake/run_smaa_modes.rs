@@ -87,112 +87,13 @@ impl From<ModeArg> for SmaaMode {
     }
 }
 
-/// The frames of a sequence, all decoded and checked before any work.
-struct UserFrame {
-    samples: Vec<Vec<u8>>,
-    velocity: Vec<f32>,
-}
+use rtbake::io::frame_sequence::{frame_name, read_frame_sequence, SequenceFrame};
 
-fn frame_name(n: u64) -> String {
-    format!("frame_{n:04}")
-}
-
-fn read_user_frames(dir: &Path, mode: SmaaMode) -> anyhow::Result<(u32, u32, Vec<UserFrame>)> {
-    if !dir.is_dir() {
-        return Err(usage_msg(format!("--input-dir {}: not a directory", dir.display())));
-    }
-    let colour_names = |n: u64| -> Vec<String> {
-        match mode.samples_per_frame() {
-            1 => vec![format!("{}.png", frame_name(n))],
-            _ => (0..2).map(|s| format!("{}_s{s}.png", frame_name(n))).collect(),
-        }
-    };
-    let mut frames = Vec::new();
-    let mut size: Option<(u32, u32, PathBuf)> = None;
-    let mut check_size = |path: &Path, w: u32, h: u32| -> anyhow::Result<()> {
-        match &size {
-            None => size = Some((w, h, path.to_path_buf())),
-            Some((w0, h0, first)) if (*w0, *h0) != (w, h) => {
-                return Err(usage_msg(format!(
-                    "--input-dir: {} is {w}x{h}, but {} is {w0}x{h0} (all frames must have one size)",
-                    path.display(),
-                    first.display()
-                )))
-            }
-            _ => {}
-        }
-        Ok(())
-    };
-    for n in 0.. {
-        let names = colour_names(n);
-        let present: Vec<bool> = names.iter().map(|f| dir.join(f).is_file()).collect();
-        if present.iter().all(|p| !p) {
-            break;
-        }
-        let mut samples = Vec::new();
-        for name in &names {
-            let path = dir.join(name);
-            if !path.is_file() {
-                return Err(usage_msg(format!(
-                    "--input-dir: {} is missing (SMAA {} needs it)",
-                    path.display(),
-                    mode.name()
-                )));
-            }
-            let bytes =
-                std::fs::read(&path).map_err(|e| usage(anyhow::anyhow!("--input-dir {}: {e}", path.display())))?;
-            let img = match io::png::decode(&bytes, &path.display().to_string()).map_err(usage)? {
-                io::png::DecodedPng::U8(img) => img,
-                io::png::DecodedPng::U16(_) => {
-                    return Err(usage_msg(format!("--input-dir {}: 16-bit PNG; expected 8-bit sRGB", path.display())))
-                }
-            };
-            if !(img.channels == 3 || img.channels == 4) {
-                return Err(usage_msg(format!(
-                    "--input-dir {}: {} channel(s); colour frames must be RGB or RGBA",
-                    path.display(),
-                    img.channels
-                )));
-            }
-            check_size(&path, img.width, img.height)?;
-            samples.push(rtbake::runtime::chain::to_rgba8(&img)?.data);
-        }
-        let vpath = dir.join(format!("{}_velocity.exr", frame_name(n)));
-        if !vpath.is_file() {
-            return Err(usage_msg(format!("--input-dir: velocity {} is missing", vpath.display())));
-        }
-        let bytes =
-            std::fs::read(&vpath).map_err(|e| usage(anyhow::anyhow!("--input-dir {}: {e}", vpath.display())))?;
-        let v = io::exr::decode(&bytes, &vpath.display().to_string()).map_err(usage)?.0;
-        if !(2..=4).contains(&v.channels) {
-            return Err(usage_msg(format!(
-                "--input-dir {}: {} channel(s); velocity needs 2 to 4 (R = x, G = y, pixels per frame)",
-                vpath.display(),
-                v.channels
-            )));
-        }
-        check_size(&vpath, v.width, v.height)?;
-        let velocity: Vec<f32> = v.data.chunks(v.channels as usize).flat_map(|p| [p[0], p[1]]).collect();
-        if let Some(i) = velocity.iter().position(|x| !x.is_finite()) {
-            let px = i / 2;
-            return Err(usage_msg(format!(
-                "--input-dir {}: velocity must be finite, pixel ({}, {}) is {}",
-                vpath.display(),
-                px % v.width as usize,
-                px / v.width as usize,
-                velocity[i]
-            )));
-        }
-        frames.push(UserFrame { samples, velocity });
-    }
-    let Some((w, h, _)) = size else {
-        return Err(usage_msg(format!(
-            "--input-dir {}: no {} found (see `rtbake run smaa --help` for the names)",
-            dir.display(),
-            colour_names(0).join(" / ")
-        )));
-    };
-    Ok((w, h, frames))
+/// `--input-dir`: the library's reader (`rtbake::io::frame_sequence`), its errors prefixed with the flag.
+fn read_user_frames(dir: &Path, mode: SmaaMode) -> anyhow::Result<(u32, u32, Vec<SequenceFrame>)> {
+    let seq = read_frame_sequence(dir, mode.samples_per_frame(), mode.name())
+        .map_err(|e| usage(anyhow::anyhow!("--input-dir {e}")))?;
+    Ok((seq.width, seq.height, seq.frames))
 }
 
 fn frame_file(n: u64, w: u32, h: u32, rgba: Vec<u8>) -> anyhow::Result<BakedFile> {
@@ -256,7 +157,7 @@ pub fn run(ctx: &Ctx, a: SmaaArgs, cpu: bool, baked: &Path) -> anyhow::Result<()
         let rgba = match (&user, &scene) {
             (Some(f), _) => {
                 let f = &f[n as usize];
-                seq.run_frame(&ModeFrame { samples: &f.samples, velocity_px: &f.velocity })?
+                seq.run_frame(&ModeFrame { samples: &f.samples, velocity_px: &f.velocity_px })?
             }
             (None, Some(scene)) => {
                 let (samples, velocity) = smaa_modes::scene_frame(scene, mode, n);

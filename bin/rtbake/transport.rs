@@ -230,19 +230,19 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => None,
     };
 
-    // Everything computed: now write (atomically) and print.
+    // Everything computed: now write (one locked set where the outputs share a directory) and print.
+    let mut outputs: Vec<(&str, &Path, Vec<u8>)> = Vec::new();
     if let Some(path) = &args.csv {
-        rtbake::io::atomic::write_atomic(path, csv.as_bytes())?;
-        ctx.info(format!("wrote {}", path.display()));
+        outputs.push(("--csv", path, csv.as_bytes().to_vec()));
     }
     if let Some(path) = &args.out {
-        rtbake::io::atomic::write_atomic(path, (serde_json::to_string_pretty(&json)? + "\n").as_bytes())?;
-        ctx.info(format!("wrote {}", path.display()));
+        outputs.push(("--out", path, (serde_json::to_string_pretty(&json)? + "\n").into_bytes()));
     }
     if let (Some(path), Some(bytes)) = (&args.plot, &plot_bytes) {
-        rtbake::io::atomic::write_atomic(path, bytes)?;
-        ctx.info(format!("wrote {}", path.display()));
+        outputs.push(("--plot", path, bytes.clone()));
     }
+    let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
+    crate::cli::write_outputs(ctx, &outputs, &inputs)?;
     for (c, ch) in result.channels.iter().enumerate() {
         let mut line = format!(
             "{}: Rd {:.5} ± {:.5}, T {:.5} ± {:.5}, Rsp {:.5}",
@@ -263,6 +263,13 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
             );
         }
         ctx.info(line);
+    }
+    if comparison.as_ref().is_some_and(|cmp| cmp.channels.iter().any(|k| k.total_r_difference_percent.abs() > 20.0)) {
+        ctx.info(
+            "note: large differences mean the diffusion model is outside its validity here (it assumes scattering \
+             dominates absorption and layers many transport mean free paths thick); the Monte Carlo result is the \
+             reference, within the ± standard errors printed",
+        );
     }
     if ctx.json {
         ctx.emit_json(&json);

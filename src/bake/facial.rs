@@ -427,10 +427,13 @@ pub fn assets() -> Vec<Asset> {
     ]
 }
 
-/// Rebuilds a rig from its description (`rig.json`, [`RigDescription`]) and the EXR files it names, for
-/// `rtbake maps rig-eval`. `read(file)` returns the bytes of a file named relative to the rig's folder (the caller
-/// does the I/O); every map is checked to be single-channel at the size the description states. Errors name
-/// `param` (the flag the user gave) and the file.
+/// The one reader of a hemoglobin rig: rebuilds it from its description (`rig.json`, [`RigDescription`]) and the
+/// EXR files it names, for `rtbake maps rig-eval` and the runtime's loader. `read(file)` returns the bytes of a file
+/// named relative to the rig's folder (the caller does the I/O, and may check each file against a manifest first);
+/// checked here: the schema, the sizes, at least one map and the neutral map first (eq. 7.6 blends targets over
+/// it), every map single-channel at the size the description states with finite values. Errors name `param` (the
+/// flag the user gave, or the file's path) and the file. A renderer adds only its own limits (the number of
+/// targets a pass holds, the hemoglobin range its LUT indexes).
 pub fn rig_from_description(
     param: &str,
     desc: &RigDescription,
@@ -443,6 +446,16 @@ pub fn rig_from_description(
     let [rw, rh] = desc.rig_size;
     crate::error::check_size(&format!("{param} full_size"), w as u64, h as u64)?;
     crate::error::check_size(&format!("{param} rig_size"), rw as u64, rh as u64)?;
+    match desc.maps.first() {
+        None => return Err(InvalidInput::new(param, "lists no maps; a rig needs the neutral map first")),
+        Some(m) if m.name != "neutral" => {
+            return Err(InvalidInput::new(
+                param,
+                format!("maps[0] is {:?}; eq. 7.6 needs the neutral map first", m.name),
+            ))
+        }
+        Some(_) => {}
+    }
     let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, InvalidInput> {
         let bytes = read(file)?;
         let (img, _) = io::exr::decode(&bytes, file).map_err(|e| InvalidInput::new(param, e.to_string()))?;
@@ -450,6 +463,17 @@ pub fn rig_from_description(
             return Err(InvalidInput::new(
                 param,
                 format!("{file} is {}x{}x{}, the rig says {mw}x{mh}x1", img.width, img.height, img.channels),
+            ));
+        }
+        if let Some(i) = img.data.iter().position(|v| !v.is_finite()) {
+            return Err(InvalidInput::new(
+                param,
+                format!(
+                    "{file}: texel ({}, {}) is {}; a rig map must be finite",
+                    i % mw as usize,
+                    i / mw as usize,
+                    img.data[i]
+                ),
             ));
         }
         Ok(img.data)

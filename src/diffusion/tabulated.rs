@@ -13,6 +13,28 @@ use super::RadialProfile;
 use crate::error::InvalidInput;
 use std::f64::consts::PI;
 
+/// The headers a profile CSV may start with, for messages.
+pub const EXPECTED_HEADERS: &str = "r_mm,R_r,R_g,R_b (also r_mm,R,G,B or r_mm,red,green,blue; more columns after \
+     the three, e.g. T_r,T_g,T_b, are ignored) or exactly r_mm,R for one channel";
+
+/// The number of reflectance channels a header declares (3 or 1), or `None` when it is not one of
+/// [`EXPECTED_HEADERS`]. A single `R` column is accepted only alone, so no channel column is ever silently dropped.
+fn header_channels(cols: &[&str]) -> Option<usize> {
+    let lower: Vec<String> = cols.iter().map(|c| c.to_ascii_lowercase().replace([' ', '(', ')'], "")).collect();
+    if !matches!(lower.first().map(String::as_str), Some("r_mm" | "rmm")) {
+        return None;
+    }
+    let rgb = |a: &str, b: &str, c: &str| lower.len() >= 4 && lower[1] == a && lower[2] == b && lower[3] == c;
+    if rgb("r_r", "r_g", "r_b")
+        || rgb("r", "g", "b")
+        || rgb("red", "green", "blue")
+        || rgb("r_red", "r_green", "r_blue")
+    {
+        return Some(3);
+    }
+    (lower.len() == 2 && lower[1] == "r").then_some(1)
+}
+
 /// R(r) per channel at tabulated radii.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TabulatedProfile {
@@ -25,28 +47,36 @@ impl TabulatedProfile {
     /// Parses and validates a CSV; errors name `source` and the offending (1-based) line.
     pub fn from_csv_str(text: &str, source: &str) -> Result<Self, InvalidInput> {
         let err = |line: usize, msg: String| InvalidInput::new(format!("{source} row {line}"), msg);
+        // Spreadsheet programs start a UTF-8 CSV with a byte-order mark.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut lines =
             text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
         let Some((hl, header)) = lines.next() else {
-            return Err(InvalidInput::new(source, "is empty: expected a header r_mm,R_r,R_g,R_b (or r_mm,R) and rows"));
+            return Err(InvalidInput::new(source, format!("is empty: expected a header {EXPECTED_HEADERS} and rows")));
         };
-        let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-        let channels = match cols.as_slice() {
-            ["r_mm", "R_r", "R_g", "R_b", ..] => 3,
-            ["r_mm", "R", ..] => 1,
-            _ => {
-                return Err(err(
-                    hl + 1,
-                    format!("header must start with r_mm,R_r,R_g,R_b or r_mm,R, got '{}'", header.trim()),
-                ))
-            }
-        };
+        let cols: Vec<&str> = header.split(',').map(|c| c.trim().trim_matches('"')).collect();
+        let channels = header_channels(&cols).ok_or_else(|| {
+            err(
+                hl + 1,
+                format!("header must be {EXPECTED_HEADERS}, got '{}'", header.trim().trim_start_matches('\u{feff}')),
+            )
+        })?;
         let (mut r_mm, mut refl) = (Vec::new(), Vec::new());
         for (i, line) in lines {
             let n = i + 1;
             let fields: Vec<&str> = line.split(',').map(str::trim).collect();
             if fields.len() < 1 + channels {
                 return Err(err(n, format!("expected {} values, got {}", 1 + channels, fields.len())));
+            }
+            if fields.len() > cols.len() {
+                return Err(err(
+                    n,
+                    format!(
+                        "has {} values but the header names {} columns; no value is dropped",
+                        fields.len(),
+                        cols.len()
+                    ),
+                ));
             }
             let mut vals = [0.0f64; 4];
             for (k, f) in fields[..1 + channels].iter().enumerate() {
@@ -151,6 +181,16 @@ mod tests {
     }
 
     #[test]
+    fn spreadsheet_headers_keep_all_three_channels() {
+        let want = [[4.0, 2.0, 1.0], [2.0, 1.0, 0.5]];
+        for header in ["\u{feff}r_mm,R_r,R_g,R_b", "r_mm,R,G,B", "R_MM,r,g,b", "\"r_mm\",\"red\",\"green\",\"blue\""] {
+            let csv = format!("{header}\n0.1,4,2,1\n1,2,1,0.5\n");
+            let p = TabulatedProfile::from_csv_str(&csv, "s.csv").unwrap_or_else(|e| panic!("{header}: {e}"));
+            assert_eq!(p.reflectance_mm2, want, "{header}");
+        }
+    }
+
+    #[test]
     fn bad_csvs_name_the_row() {
         for (text, needle) in [
             ("", "is empty"),
@@ -162,6 +202,9 @@ mod tests {
             ("r_mm,R\n0.1,1\n0.2,-1\n", "row 3"),
             ("r_mm,R_r,R_g,R_b\n0.1,1,1\n", "row 2"),
             ("r_mm,R\n0.1,abc\n0.2,1\n", "row 2"),
+            // A third column beside a single R would be dropped: refused, naming the headers accepted.
+            ("r_mm,R,X\n0.1,1,1\n0.2,1,1\n", "r_mm,R_r,R_g,R_b"),
+            ("r_mm,R\n0.1,1,2\n0.2,1,2\n", "no value is dropped"),
         ] {
             let e = TabulatedProfile::from_csv_str(text, "f.csv").unwrap_err();
             assert!(e.to_string().contains("f.csv") && e.to_string().contains(needle), "{text:?}: {e}");

@@ -229,6 +229,38 @@ pub fn build_rig_with_progress(
 
 /// Turns `name=weight` pairs into one weight per rig map (in rig order; unnamed maps get 0). Weights must be
 /// finite and sum to 1 within 1e-6, unless `normalize` (then they are divided by their sum, which must not be 0).
+/// The largest magnitude of one target's blend weight in eq. 7.6. The weights sum to 1; a pose may extrapolate
+/// beyond a target (a weight above 1 or below 0), but beyond ±1000 the blended maps lose every digit of the
+/// neutral map, and ±1e308 overflows (to a NaN pose) when the runtime sums them in f32.
+pub const MAX_TARGET_WEIGHT: f64 = 1000.0;
+
+/// One target weight of a pose (`param` names the flag or field): finite and within ±[`MAX_TARGET_WEIGHT`].
+pub fn check_target_weight(param: &str, target: &str, w: f64) -> Result<f64, InvalidInput> {
+    if !(w.is_finite() && w.abs() <= MAX_TARGET_WEIGHT) {
+        return Err(InvalidInput::new(
+            param,
+            format!(
+                "weight of '{target}' must be in -{MAX_TARGET_WEIGHT}..={MAX_TARGET_WEIGHT} (the weights sum to 1, \
+                 eq. 7.6), got {w:e}"
+            ),
+        ));
+    }
+    Ok(w)
+}
+
+/// Checks the target weights of a pose object `{"target": weight, …, "global": {…}}` (`--rig-weights`) before a
+/// renderer sums them: every number outside `"global"` through [`check_target_weight`].
+pub fn check_pose_json(param: &str, json: &serde_json::Value) -> Result<(), InvalidInput> {
+    if let Some(obj) = json.as_object() {
+        for (key, v) in obj.iter().filter(|(k, _)| k.as_str() != "global") {
+            if let Some(w) = v.as_f64() {
+                check_target_weight(param, key, w)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 pub fn rig_weights(map_names: &[String], pairs: &[(String, f64)], normalize: bool) -> Result<Vec<f64>, InvalidInput> {
     let mut w = vec![0.0f64; map_names.len()];
     let mut seen = vec![false; map_names.len()];
@@ -242,9 +274,7 @@ pub fn rig_weights(map_names: &[String], pairs: &[(String, f64)], normalize: boo
         if seen[i] {
             return Err(InvalidInput::new("--weights", format!("target '{name}' is given twice")));
         }
-        if !v.is_finite() {
-            return Err(InvalidInput::new("--weights", format!("weight of '{name}' must be finite, got {v}")));
-        }
+        check_target_weight("--weights", name, *v)?;
         seen[i] = true;
         w[i] = *v;
     }

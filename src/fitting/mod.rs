@@ -12,6 +12,7 @@
 pub mod burley_fit;
 pub mod evaluate;
 pub mod nnls;
+pub mod profile_check;
 pub mod quadrature;
 pub mod screen_space;
 pub mod sum_of_gaussians_fit;

@@ -12,17 +12,22 @@
 //! - A whole directory is installed with one `renameat2(RENAME_EXCHANGE)` on Linux (the path always names either
 //!   the old or the new directory); elsewhere (or where the file system refuses the exchange) with two renames
 //!   whose interrupted state is rolled forward to the new directory by the next locked command.
-//! - A file set inside a directory shared with other files ([`write_file_set`]) is staged as temp files made durable
-//!   together (one `syncfs`, [`super::atomic::sync_batch`]),
-//!   committed by atomically writing a journal that lists the renames, then renamed; a kill after the journal is
-//!   rolled forward by the next rtbake command that locks or reads the directory ([`settle`]), a kill before it
-//!   leaves the old set. A set of one file needs no journal: its rename is the commit point, made durable by one
-//!   fsync of its directory. No output may be one of the command's inputs.
+//! - A file set inside a directory shared with other files ([`write_file_set`]) is never visible mixed: the
+//!   directory is staged whole beside itself (`.NAME.rtbake-stage-PID`: every other entry hard-linked, the set's
+//!   files written new, all made durable together, [`super::atomic::sync_batch`]) and exchanged with the old one in
+//!   one `renameat2(RENAME_EXCHANGE)`, so a reader of any file sees the old set or the new one, whatever it reads
+//!   in between. Where the directory cannot be staged that way (no exchange on this platform or file system, an
+//!   entry that cannot be hard-linked, more than [`MAX_LINKED_ENTRIES`] entries, or the directory is this
+//!   process's working directory or holds it) the set is committed by a journal instead: temp files, a journal
+//!   listing the renames written atomically, then the renames; a kill after the journal is rolled forward by the
+//!   next rtbake command that locks or reads the directory ([`settle`]), a kill before it leaves the old set —
+//!   visible mixed only between such a kill and that next command. A set of one file needs neither: its rename is
+//!   the commit point, made durable by one fsync of its directory. No output may be one of the command's inputs.
 //! - Kill points for tests: `RTBAKE_FAULT_INJECT` holds comma-separated directives checked at each named step:
 //!   `kill@STEP` exits at once (status 137, no clean-up, like SIGKILL), `hold@STEP` prints
 //!   `rtbake-fault: holding at STEP` on stderr and blocks until a line arrives on stdin, `no-exchange` forces the
-//!   two-rename fallback. Steps: `locked`, `staged`, `before-swap`, `after-ready`, `between-renames`,
-//!   `after-swap`, `journal-written`, `mid-commit`, `probe`.
+//!   two-rename fallback for directories and the journal for file sets. Steps: `locked`, `staged`,
+//!   `before-swap`, `after-ready`, `between-renames`, `after-swap`, `journal-written`, `mid-commit`, `probe`.
 
 use super::IoError;
 use std::fs;
@@ -216,6 +221,9 @@ impl DirLock {
             let _ = file.set_len(0);
             let _ = (&file).write_all(std::process::id().to_string().as_bytes());
         }
+        // Staging directories of killed writers (they held this lock while they lived): removed by whoever locks
+        // the directory next, readers (`verify`) included.
+        remove_stale_stages(&resolved);
         fault_point("locked");
         Ok(Self { dir: resolved, mode, _file: Some(file) })
     }
@@ -477,6 +485,172 @@ pub fn settle(dir: &Path, wait: &Wait) -> Result<Option<String>, FileSetError> {
     settle_locked(lock.dir())
 }
 
+/// Directories with more entries than this are not staged whole (hard-linking them would cost more than the set):
+/// their file sets are committed by the journal.
+pub const MAX_LINKED_ENTRIES: usize = 10_000;
+
+/// Holding the lock of `dir` (shared or exclusive): removes the staging directories killed writers left beside it
+/// (`.NAME.rtbake-stage-PID` whose process is gone; a writer stages only while it holds this lock exclusively, so
+/// no live writer's stage can be seen here). A stage of a live process — the lock-free writability probe of
+/// [`probe_writable`] — is kept.
+fn remove_stale_stages(dir: &Path) {
+    let prefix = format!(".{}.rtbake-stage-", dir_name(dir));
+    let Ok(rd) = fs::read_dir(parent_of(dir)) else { return };
+    for e in rd.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else { continue };
+        if pid != std::process::id() && !process_alive(pid) {
+            let _ = fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Whether a process with this id exists (Unix: `kill(pid, 0)`; elsewhere assumed alive).
+pub fn process_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else { return false };
+        // SAFETY: signal 0 performs only the existence and permission check.
+        let r = unsafe { libc::kill(pid, 0) };
+        r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// Recreates the tree under `from` in `to` with hard links (directories made, files linked, symbolic links copied),
+/// leaving out the relative paths in `skip`. `false` when an entry cannot be reproduced that way (a special file,
+/// a hard link refused) or there are more than [`MAX_LINKED_ENTRIES`] entries.
+fn link_tree(from: &Path, to: &Path, rel: &str, skip: &[&str], count: &mut usize) -> std::io::Result<bool> {
+    for e in fs::read_dir(from)? {
+        let e = e?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        let child_rel = if rel.is_empty() { name.clone() } else { format!("{rel}/{name}") };
+        *count += 1;
+        if *count > MAX_LINKED_ENTRIES {
+            return Ok(false);
+        }
+        let (src, dst) = (e.path(), to.join(&name));
+        let ft = e.file_type()?;
+        if ft.is_dir() {
+            fs::create_dir(&dst)?;
+            fs::set_permissions(&dst, fs::metadata(&src)?.permissions())?;
+            if !link_tree(&src, &dst, &child_rel, skip, count)? {
+                return Ok(false);
+            }
+        } else if skip.contains(&child_rel.as_str()) || super::atomic::is_temp_name(&name) {
+            continue;
+        } else if ft.is_symlink() {
+            #[cfg(unix)]
+            std::os::unix::fs::symlink(fs::read_link(&src)?, &dst)?;
+            #[cfg(not(unix))]
+            return Ok(false);
+        } else if ft.is_file() {
+            if fs::hard_link(&src, &dst).is_err() {
+                return Ok(false);
+            }
+        } else {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// Writes the set by staging the whole directory beside it and exchanging the two (see the module docs). `Ok(false)`:
+/// not possible here, nothing changed, the caller commits by the journal.
+fn swap_whole_directory(lock: &DirLock, files: &[(&str, &[u8])]) -> Result<bool, FileSetError> {
+    let root = lock.dir();
+    if fault_flag("no-exchange") || cfg!(not(target_os = "linux")) {
+        return Ok(false);
+    }
+    // Exchanging the working directory (or a directory above it) would leave this process, and a shell started
+    // there, in the swapped-out copy.
+    if std::env::current_dir().ok().and_then(|d| fs::canonicalize(d).ok()).is_some_and(|cwd| cwd.starts_with(root)) {
+        return Ok(false);
+    }
+    let stage = sibling(root, "stage");
+    let _ = fs::remove_dir_all(&stage);
+    fs::create_dir(&stage).map_err(|e| io_err(&stage, e))?;
+    let give_up = |stage: &Path| {
+        let _ = fs::remove_dir_all(stage);
+        Ok(false)
+    };
+    let skip: Vec<&str> = files.iter().map(|(rel, _)| *rel).collect();
+    let mut count = 0;
+    match link_tree(root, &stage, "", &skip, &mut count) {
+        Ok(true) => {}
+        Ok(false) | Err(_) => return give_up(&stage),
+    }
+    let written = (|| -> Result<Vec<PathBuf>, FileSetError> {
+        let mut paths = Vec::with_capacity(files.len());
+        for (rel, bytes) in files {
+            let dst = stage.join(rel);
+            if let Some(p) = dst.parent() {
+                fs::create_dir_all(p).map_err(|e| io_err(p, e))?;
+            }
+            if dst.is_dir() {
+                return Err(FileSetError::Unusable {
+                    path: root.join(rel).display().to_string(),
+                    detail: "is a directory; cannot write a file there".into(),
+                });
+            }
+            fs::write(&dst, bytes).map_err(|e| io_err(&root.join(rel), e))?;
+            paths.push(dst);
+        }
+        super::atomic::sync_batch(&stage, &paths)?;
+        Ok(paths)
+    })();
+    let paths = match written {
+        Ok(p) => p,
+        Err(e) => {
+            let _ = fs::remove_dir_all(&stage);
+            return Err(e);
+        }
+    };
+    let mut dirs: Vec<PathBuf> = paths.iter().filter_map(|p| p.parent().map(Path::to_path_buf)).collect();
+    dirs.push(stage.clone());
+    dirs.sort();
+    dirs.dedup();
+    dirs.iter().for_each(|d| sync_dir(d));
+    if let Ok(md) = fs::metadata(root) {
+        let _ = fs::set_permissions(&stage, md.permissions());
+    }
+    fault_point("staged");
+    fault_point("before-swap");
+    match exchange(&stage, root) {
+        Ok(()) => {
+            sync_dir(parent_of(root));
+            fault_point("after-swap");
+            // `stage` now holds the old directory: its links and the old versions of the set's files.
+            let _ = fs::remove_dir_all(&stage);
+            Ok(true)
+        }
+        Err(e) if exchange_unsupported(&e) => give_up(&stage),
+        Err(e) => {
+            let _ = fs::remove_dir_all(&stage);
+            Err(io_err(root, e))
+        }
+    }
+}
+
+/// For a file `rel` (`/`-separated) listed in `dir`: the target of the first symbolic link on its path inside
+/// `dir` (the file itself or a directory above it), if any. A listed file must be a regular file inside the
+/// directory: a link to an identical file elsewhere would let that other file change what the directory holds.
+pub fn symlink_on_path(dir: &Path, rel: &str) -> Option<String> {
+    let mut p = dir.to_path_buf();
+    for part in rel.split('/') {
+        p.push(part);
+        if fs::symlink_metadata(&p).ok()?.file_type().is_symlink() {
+            let target = fs::read_link(&p).map(|t| t.display().to_string()).unwrap_or_else(|_| "?".into());
+            return Some(format!("{} is a symbolic link to {target}", p.strip_prefix(dir).unwrap_or(&p).display()));
+        }
+    }
+    None
+}
+
 /// Same file: equal canonical paths, or (Unix) the same device and inode.
 fn same_file(a: &Path, b: &Path) -> bool {
     match (fs::canonicalize(a), fs::canonicalize(b)) {
@@ -524,11 +698,22 @@ pub fn write_file_set(
         }
     }
     let outputs: Vec<PathBuf> = files.iter().map(|(rel, _)| dir.join(rel)).collect();
+    for (k, (rel, _)) in files.iter().enumerate() {
+        if files[..k].iter().any(|(r, _)| r == rel) {
+            return Err(FileSetError::Unusable {
+                path: dir.join(rel).display().to_string(),
+                detail: "is given for two outputs of one command; give each output its own file".into(),
+            });
+        }
+    }
     check_outputs_not_inputs(&outputs, inputs)?;
     fs::create_dir_all(dir).map_err(|e| io_err(dir, e))?;
     let lock = DirLock::acquire(dir, LockMode::Exclusive, wait)?;
     let root = lock.dir().to_path_buf();
     settle_locked(&root)?;
+    if files.len() > 1 && swap_whole_directory(&lock, files)? {
+        return Ok(outputs);
+    }
     // Stage.
     let mut renames: Vec<(String, String)> = Vec::new();
     let staged = (|| -> Result<(), FileSetError> {

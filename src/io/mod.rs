@@ -8,6 +8,7 @@ pub mod atomic;
 pub mod dds;
 pub mod exr;
 pub mod file_set;
+pub mod frame_sequence;
 pub mod ktx2;
 pub mod png;
 pub mod source;

@@ -99,7 +99,7 @@ fn the_largest_sizes_help_allows_are_refused_up_front_when_they_exceed_the_time_
             "60",
         ],
         "--output",
-        &out,
+        &out.with_extension("png"),
         &["--width 16384 --height 16384", "--max-seconds 60"],
         "time budget of 60 s",
     );

@@ -52,11 +52,26 @@ fn a_killed_rig_write_is_never_seen_mixed() {
     assert!(hemoglobin("neutral", &old_ref, "").status.success());
     assert!(hemoglobin("joy", &new_ref, "").status.success());
     assert_ne!(files_of(&old_ref), files_of(&new_ref));
-    for (step, committed) in [("locked", false), ("staged", false), ("journal-written", true), ("mid-commit", true)] {
-        let rig = t.path().join(format!("rig-{step}"));
+    // The directory exchanged whole (Linux), and the journal where it cannot be (`no-exchange`).
+    for (step, committed, fault) in [
+        ("locked", false, ""),
+        ("staged", false, ""),
+        ("before-swap", false, ""),
+        ("after-swap", true, ""),
+        ("staged", false, ",no-exchange"),
+        ("journal-written", true, ",no-exchange"),
+        ("mid-commit", true, ",no-exchange"),
+    ] {
+        let rig = t.path().join(format!("rig-{step}{}", fault.replace(',', "-")));
         assert!(hemoglobin("neutral", &rig, "").status.success());
-        let o = hemoglobin("joy", &rig, &format!("kill@{step}"));
+        let o = hemoglobin("joy", &rig, &format!("kill@{step}{fault}"));
         assert_eq!(o.status.code(), Some(137), "{step}: {}", stderr(&o));
+        if fault.is_empty() {
+            // Exchanged whole: what any reader sees right after the kill, before any rtbake command runs, is one
+            // complete set, old or new.
+            let want = if committed { &new_ref } else { &old_ref };
+            assert_eq!(files_of(&rig), files_of(want), "{step}: visible mixed or incomplete right after the kill");
+        }
         // rig-eval reads the rig: it first completes a committed set, so it never evaluates a mix.
         let h = t.path().join(format!("h-{step}.exr"));
         let o =
