@@ -166,7 +166,7 @@ pub fn decode(bytes: &[u8], path: &str) -> Result<(PixelFormat, u32, u32, Vec<u8
     let err = |d: String| IoError::Decode { path: path.to_string(), detail: d };
     let dds = Dds::read(bytes).map_err(|e| err(e.to_string()))?;
     if dds.get_dxgi_format().is_none() {
-        return decode_legacy(&dds).map_err(err);
+        return decode_legacy(&dds, bytes).map_err(err);
     }
     let format = match dds.get_dxgi_format() {
         Some(DxgiFormat::R8_UNorm) => PixelFormat::R8Unorm,
@@ -180,18 +180,26 @@ pub fn decode(bytes: &[u8], path: &str) -> Result<(PixelFormat, u32, u32, Vec<u8
     Ok((format, dds.get_width(), dds.get_height(), data))
 }
 
-/// The legacy 8-bit files [`encode_u8_legacy`] writes, back to (format, width, height, R[G[BA]] bytes).
-fn decode_legacy(dds: &Dds) -> Result<(PixelFormat, u32, u32, Vec<u8>), String> {
-    use ddsfile::D3DFormat;
-    let data = dds.get_data(0).map_err(|e| e.to_string())?;
-    let (format, data) = match dds.get_d3d_format() {
-        Some(D3DFormat::L8) => (PixelFormat::R8Unorm, data.to_vec()),
-        Some(D3DFormat::A8L8) => (PixelFormat::R8G8Unorm, data.to_vec()),
-        Some(D3DFormat::A8R8G8B8) => {
-            (PixelFormat::R8G8B8A8Unorm, data.chunks_exact(4).flat_map(|p| [p[2], p[1], p[0], p[3]]).collect())
-        }
-        other => return Err(format!("unsupported legacy format {other:?}")),
+/// The legacy 8-bit files [`encode_u8_legacy`] writes, back to (format, width, height, R[G[BA]] bytes): the
+/// pixel-format block must be exactly one of [`legacy_format`]'s.
+fn decode_legacy(dds: &Dds, file: &[u8]) -> Result<(PixelFormat, u32, u32, Vec<u8>), String> {
+    let word = |at: usize| file.get(at..at + 4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")));
+    let field = |at: usize| word(at).ok_or_else(|| "truncated header".to_string());
+    let (flags, bits) = (field(PF_FLAGS)?, field(PF_FLAGS + 8)?);
+    let masks = [field(PF_FLAGS + 12)?, field(PF_FLAGS + 16)?, field(PF_FLAGS + 20)?, field(PF_FLAGS + 24)?];
+    let channels = [1, 2, 4]
+        .into_iter()
+        .find(|&c| legacy_format(c).is_some_and(|(_, f, b, m)| (f, b, m) == (flags, bits, masks)))
+        .ok_or_else(|| format!("unsupported legacy pixel format (flags {flags:#x}, {bits} bits, masks {masks:x?})"))?;
+    let (w, h) = (dds.get_width() as usize, dds.get_height() as usize);
+    // The top mip level follows the 128-byte header.
+    let data = file.get(128..128 + w * h * channels as usize).ok_or("truncated payload")?;
+    let data = if channels == 4 {
+        data.chunks_exact(4).flat_map(|p| [p[2], p[1], p[0], p[3]]).collect()
+    } else {
+        data.to_vec()
     };
+    let format = PixelFormat::unorm8_for(channels).expect("1, 2 or 4 channels");
     Ok((format, dds.get_width(), dds.get_height(), data))
 }
 

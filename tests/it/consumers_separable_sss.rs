@@ -48,10 +48,11 @@ fn baked_separable_files() -> std::collections::BTreeMap<String, Vec<u8>> {
 
 #[test]
 fn readme_recipe_compiles_every_baked_kernel_into_the_published_header() {
-    let Some(h) = reference_file("consumers/separable-sss/SeparableSSS.h", "SeparableSSS.h compile") else { return };
-    if !tool_available("SeparableSSS.h compile", "glslangValidator", &["--version"], "apt-get install glslang-tools") {
-        return;
-    }
+    // Both inputs are checked (and each missing one reported) before returning, so one skip never hides the other.
+    let header = reference_file("consumers/separable-sss/SeparableSSS.h", "SeparableSSS.h compile");
+    let glslang =
+        tool_available("SeparableSSS.h compile", "glslangValidator", &["--version"], "apt-get install glslang-tools");
+    let (Some(h), true) = (header, glslang) else { return };
     let block = readme_patch_block();
     let files = baked_separable_files();
     let mut ns: Vec<usize> = Vec::new();
