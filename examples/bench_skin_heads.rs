@@ -53,8 +53,12 @@ fn main() {
                 render(gpu.as_ref(), &head, &s, &assets).expect("render");
                 t.elapsed().as_secs_f64() * 1e3
             };
+            // Progress on stderr (a software adapter takes minutes per shader); the table stays on stdout.
+            let started = Instant::now();
+            eprint!("  {name}, {heads} head(s): warm-up + 5 runs ...");
             run();
             let mut v: Vec<f64> = (0..5).map(|_| run()).collect();
+            eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
             v.sort_by(f64::total_cmp);
             row.push((v[2], v[0], v[4]));
         }

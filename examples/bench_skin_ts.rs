@@ -87,8 +87,12 @@ fn main() {
                     let (_, stats) = render(gpu.as_ref(), &head, &s, ts, &assets).expect("render");
                     (stats, t.elapsed().as_secs_f64() * 1e3)
                 };
+                // Progress on stderr (a software adapter takes minutes per row); the table stays on stdout.
+                let started = Instant::now();
+                eprint!("  {n} head(s) at {d} m, {name}: warm-up + {runs} runs ...");
                 let (stats, _) = run();
                 let mut v: Vec<f64> = (0..runs).map(|_| run().1).collect();
+                eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
                 v.sort_by(f64::total_cmp);
                 let med = v[v.len() / 2];
                 let (b_stats, b_ms) = base.get_or_insert_with(|| (stats.clone(), med)).clone();

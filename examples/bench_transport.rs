@@ -100,6 +100,13 @@ fn main() {
     ];
     let threads = rayon::current_num_threads();
     let mcml = std::env::var_os("RTBAKE_MCML");
+    if mcml.is_none() {
+        println!(
+            "MCML comparison left out: RTBAKE_MCML is unset. To include it, build MCML 2.0 (Wang's distribution, \
+             github.com/lhvwang/MCML, folder V2/MCML2.0; make the buffer FindDataLine returns `static` for a modern \
+             compiler), e.g. `gcc -O3 -march=native -o mcml *.c -lm`, and run with RTBAKE_MCML=/path/to/mcml"
+        );
+    }
     let gpu: Option<(Gpu, TransportGpu)> = match create_headless(&Default::default()) {
         Ok(g) => {
             println!("GPU adapter: {}", g.describe());

@@ -55,7 +55,8 @@ pub enum AaTexture {
 pub enum AaFormat {
     /// Raw payload, row-major, top row first, channels interleaved.
     Bin,
-    /// DDS with DXGI R8G8_UNORM / R8_UNORM (non-sRGB).
+    /// DDS with DXGI R8G8_UNORM / R8_UNORM (non-sRGB), and `<stem>_dx9.dds` with the legacy header
+    /// (D3DFMT_A8L8 / L8) for readers without DX10 support.
     Dds,
     /// KTX2 with VK_FORMAT_R8G8_UNORM / R8_UNORM, linear transfer.
     Ktx2,

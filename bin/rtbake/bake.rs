@@ -164,8 +164,16 @@ pub fn run_verify(mut a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
             )),
             other => classify(other),
         })?;
+    let failed = || format!("verify: {} of {} files failed in {}", report.problems, report.files.len(), report.dir);
     if ctx.json {
-        ctx.emit_json(&serde_json::to_value(&report)?);
+        let mut v = serde_json::to_value(&report)?;
+        // On failure the report also carries the keys of every --json error object, so one parser serves all.
+        if !report.is_ok() {
+            v["error"] = failed().into();
+            v["param"] = Value::Null;
+            v["exit_code"] = 1.into();
+        }
+        ctx.emit_json(&v);
     }
     for f in &report.files {
         if f.status != FileStatus::Ok {
@@ -176,7 +184,7 @@ pub fn run_verify(mut a: VerifyArgs, ctx: &Ctx) -> anyhow::Result<()> {
         ctx.info(format!("verify: {} files OK in {}", report.files.len(), report.dir));
         Ok(())
     } else {
-        Err(anyhow::anyhow!("verify: {} of {} files failed in {}", report.problems, report.files.len(), report.dir))
+        Err(anyhow::anyhow!(failed()))
     }
 }
 

@@ -237,7 +237,7 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
                     inner: candidate.as_ref(),
                     totals: candidate.total_reflectance(),
                 };
-                overlay_plot(&t, name, Some((&c, "candidate")), &title)
+                rtbake::plot::profile::normalized(overlay_plot(&t, name, Some((&c, "candidate")), &title))
             } else {
                 overlay_plot(target_profile.as_ref(), name, Some((candidate.as_ref(), "candidate")), &title)
             }

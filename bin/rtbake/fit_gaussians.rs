@@ -135,7 +135,10 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
         } else {
             profile
         };
-        let plot = fit_overlay_plot(plotted.as_ref(), Some(&fit.sum), &format!("{stem}: {count}-Gaussian fit"));
+        let mut plot = fit_overlay_plot(plotted.as_ref(), Some(&fit.sum), &format!("{stem}: {count}-Gaussian fit"));
+        if settings.normalize {
+            plot = rtbake::plot::profile::normalized(plot);
+        }
         let mut extra = obj.clone();
         for k in ScreenSpaceParams::new(&fit.sum, stretch)?.to_json().keys() {
             extra.remove(k);

@@ -100,8 +100,8 @@ pub struct ProfileArgs {
     out: Option<PathBuf>,
     /// Also write a plot, PNG or SVG by the extension (.png / .svg): two stacked panels over a log r axis (mm),
     /// r R(r) on a linear y axis above and R(r) on a log y axis below, at the tabulated radii; solid R per channel,
-    /// dashed lighter T where present, dashed darker --overlay-fit. The PNG has numeric tick labels only (the
-    /// SVG carries titles and the legend).
+    /// dashed lighter T where present, dashed darker --overlay-fit. PNG and SVG carry the same text: titles,
+    /// tick labels, axis names with units and the legend.
     #[arg(long, value_name = "FILE")]
     plot: Option<PathBuf>,
     /// Overlay a K-Gaussian fit with shared variances (R, G, B share the variances; fitted in profile units, not

@@ -380,8 +380,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "reference": "Christensen & Burley 2015 (Pixar TM 15-04); dipole: Jensen et al. 2001; layered multipole: \
                       Donner & Jensen 2005"});
     let mut files = Vec::new();
-    let mut csv = format!("# rtbake burley-profiles: {reference}\n");
-    csv.push_str(
+    // Header row and data rows only (pandas/spreadsheet defaults); the provenance is in fits.json.
+    let mut csv = String::from(
         "case,channel,target_total,fit_albedo,fit_d_mm,fit_rR_error_percent,fit_max_percent,fit_total_difference,\
          artist_albedo,artist_d_mm,artist_rR_error_percent,artist_max_percent\n",
     );

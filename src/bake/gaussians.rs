@@ -168,11 +168,14 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     } else {
         Box::new(profile)
     };
-    let plot = fit_overlay_plot(
+    let mut plot = fit_overlay_plot(
         plotted.as_ref(),
         Some(&fit.sum),
         &format!("{}: dipole vs {}-Gaussian fit", m.name, p.fit.count),
     );
+    if p.fit.normalize {
+        plot = crate::plot::profile::normalized(plot);
+    }
     gaussian_files(&stem, &fit.sum, p.stretch, extra, &plot)
 }
 

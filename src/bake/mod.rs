@@ -50,8 +50,28 @@ impl Asset {
         if let Some(level) = level {
             supercompress_ktx2(&mut files, level)?;
         }
+        add_bevy_meta_files(&mut files);
         Ok(files)
     }
+}
+
+/// Adds a Bevy `<file>.meta` (`is_srgb: false`, [`io::bevy_meta`]) beside every linear data texture Bevy's image
+/// loader opens, so a Bevy app loads the file as linear data without loading code of its own.
+pub fn add_bevy_meta_files(files: &mut Vec<BakedFile>) {
+    let metas: Vec<BakedFile> = files
+        .iter()
+        .filter(|f| io::bevy_meta::wants_meta(&f.meta.format, &f.meta.color_space))
+        .map(|f| {
+            text_file(
+                &io::bevy_meta::meta_path(&f.path),
+                io::bevy_meta::linear_image_meta(),
+                "bevy-meta",
+                "ron",
+                "Bevy asset settings for the texture of the same name (ImageLoader, is_srgb: false: linear data)",
+            )
+        })
+        .collect();
+    files.extend(metas);
 }
 
 /// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).
@@ -101,7 +121,8 @@ pub mod skin;
 pub mod transmittance;
 pub mod transport;
 
-/// Writes an 8-bit UNORM texture as raw `.bin`, DDS, KTX2 and PNG (`{stem}.bin`, …). `convention` describes the
+/// Writes an 8-bit UNORM texture as raw `.bin`, DDS (DX10 `{stem}.dds` and legacy-header `{stem}_dx9.dds`), KTX2
+/// and PNG (`{stem}.bin`, …). `convention` describes the
 /// layout for the manifest. PNG of RG data is RGB with B = 0 (what engines and browsers load as R, G), tagged linear.
 pub fn unorm8_texture_files(
     stem: &str,
@@ -193,6 +214,20 @@ pub fn unorm8_texture_files_in(
     }
     if let Some(bytes) = dds? {
         files.push(BakedFile { path: format!("{stem}.dds"), bytes, meta: meta("dds") });
+        // The legacy-header copy for readers without DX10 support (ImageMagick 6, OpenImageIO 2.4).
+        let (name, ..) = io::dds::legacy_format(img.channels)
+            .ok_or_else(|| BakeError::Other(format!("{stem}: no legacy DDS format for {} channels", img.channels)))?;
+        let mut legacy = meta("dds");
+        legacy.convention = format!(
+            "{}; legacy DDS header, {name}{}",
+            legacy.convention,
+            match img.channels {
+                2 => " (R in L, G in A: sample .ra in D3D9, as SMAA_AREATEX_SELECT does)",
+                4 => " (texels stored B, G, R, A)",
+                _ => "",
+            }
+        );
+        files.push(BakedFile { path: format!("{stem}_dx9.dds"), bytes: io::dds::encode_u8_legacy(img)?, meta: legacy });
     }
     if let Some(bytes) = ktx2? {
         files.push(BakedFile { path: format!("{stem}.ktx2"), bytes, meta: meta("ktx2") });
@@ -213,6 +248,22 @@ pub fn float_texture_files(
     convention: &str,
     tolerance: f64,
 ) -> Result<Vec<BakedFile>, BakeError> {
+    let title = stem.rsplit('/').next().unwrap_or(stem);
+    let axes = crate::plot::preview::PreviewAxes::texels(title, img.width, img.height);
+    float_texture_files_with_preview(stem, img, kind, convention, tolerance, &axes)
+}
+
+/// [`float_texture_files`] with the preview labelled by `axes` (title, axis names with units, ticks): the preview is
+/// the table's sRGB-encoded colours scaled up inside that frame (a one-row table becomes a band), see
+/// [`crate::plot::preview`].
+pub fn float_texture_files_with_preview(
+    stem: &str,
+    img: &Image<f32>,
+    kind: &str,
+    convention: &str,
+    tolerance: f64,
+    axes: &crate::plot::preview::PreviewAxes,
+) -> Result<Vec<BakedFile>, BakeError> {
     let meta = |format: &str, pf: Option<PixelFormat>, st: &str, cs: &str, tol: Option<f64>| FileMeta {
         kind: kind.into(),
         format: format.into(),
@@ -227,13 +278,18 @@ pub fn float_texture_files(
         supercompression: None,
     };
     let half_tol = tolerance.max(1e-3);
+    let preview_img = crate::plot::preview::labelled_preview(&io::png::srgb_preview_pixels(img), axes);
     let mut preview = meta("png", None, "u8", "srgb", Some(1.0));
     preview.kind = "preview".into();
-    preview.convention = format!("{convention}; 8-bit sRGB-encoded for viewing only, do not sample as linear data");
+    (preview.width, preview.height, preview.channels) = (preview_img.width, preview_img.height, 3);
+    preview.convention = format!(
+        "{convention}; preview for viewing only (do not sample): the table's colours sRGB-encoded (alpha dropped), \
+         each texel drawn as a block inside a frame with title, axis names and ticks"
+    );
     // The four encoders are independent and run side by side (same bytes; errors reported in file order).
     let ((exr_f32, exr_f16), (ktx2, png)) = rayon::join(
         || rayon::join(|| io::exr::encode(img, ExrPrecision::F32), || io::exr::encode(img, ExrPrecision::F16)),
-        || rayon::join(|| io::ktx2::encode_f16(img), || io::png::encode_srgb_preview(img)),
+        || rayon::join(|| io::ktx2::encode_f16(img), || io::png::encode_u8_as(&preview_img, io::png::PngColor::Srgb)),
     );
     Ok(vec![
         BakedFile {

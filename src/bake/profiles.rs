@@ -338,10 +338,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         })
         .collect();
     let mut files = Vec::new();
-    let mut totals = String::from(
-        "# rtbake diffusion-profiles: totals R^(0) = int 2 pi r R(r) dr and T^(0) (empty where the model has no T)\n\
-         profile,total_R_r,total_R_g,total_R_b,total_T_r,total_T_g,total_T_b\n",
-    );
+    let mut totals = String::from("profile,total_R_r,total_R_g,total_R_b,total_T_r,total_T_g,total_T_b\n");
     for result in per_profile {
         let (profile_files, row) = result?;
         files.extend(profile_files);
@@ -352,7 +349,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         totals,
         "csv",
         "csv",
-        "one row per baked profile (stem below profiles/): total_R = R^(0), total_T = T^(0) per channel",
+        "one row per baked profile (stem below profiles/): total_R = R^(0) = int 2 pi r R(r) dr, total_T = T^(0) per \
+         channel (empty where the model has no T)",
     ));
     Ok(files)
 }

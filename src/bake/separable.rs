@@ -78,7 +78,7 @@ fn default_kernels_params() -> Value {
 }
 
 /// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl`, the upstream-form `{stem}_SeparableSSS.h`
-/// kernel (pasted in place of `SeparableSSS.h`'s preset of the same N) and the raw little-endian
+/// kernel (in place of `SeparableSSS.h`'s whole kernel section, any N) and the raw little-endian
 /// `{stem}_f32x4.bin` (N taps of `[r, g, b, offset]`, the runtime upload path). Pure; `rtbake kernel --out` uses
 /// it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
@@ -101,7 +101,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
         "shader-include",
         "hlsl",
         "SeparableSSS.h form: #define SSSS_N_SAMPLES N + static const float4 kernel[N] (rgb = weight, a = offset), \
-         to replace the header's built-in preset of the same N",
+         to replace the header's whole kernel section (#ifdef SSSS_N_SAMPLES to its #endif) for any N",
     ));
     let n = k.taps.len() as u32;
     files.push(BakedFile {

@@ -1,6 +1,6 @@
 //! Skin-colour assets in `baked/skin/`: the melanin × hemoglobin lookup table (thesis §7.6, eq. 7.7, Fig. 7.9).
 
-use super::{float_texture_files, json_file, parse_params, text_file, Asset, BakeError, BakedFile};
+use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::skin_color::lut::{bake_lut_with_progress, IndexForm, LutLayout};
 use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
@@ -54,6 +54,26 @@ pub fn convention(layout: &LutLayout) -> String {
     )
 }
 
+/// The preview's axes: melanin Cm along x, hemoglobin Chd down y, both on the table's cube-root index.
+fn lut_axes(layout: &LutLayout) -> crate::plot::preview::PreviewAxes {
+    let (cm_max, chd_max) = (layout.index_form.melanin_max(), layout.index_form.hemoglobin_max());
+    // Texel i of n holds max*(i/(n-1))^3: a value v sits at i = cbrt(v/max)*(n-1).
+    let ticks = |max: f64, n: u32| -> Vec<(f64, String)> {
+        [0.0, 0.01, 0.05, 0.1, 0.2, 0.3, 0.5]
+            .iter()
+            .filter(|&&v| v <= max)
+            .map(|&v| (((v / max).cbrt() * (n - 1) as f64 + 0.5) / n as f64, format!("{v}")))
+            .collect()
+    };
+    crate::plot::preview::PreviewAxes {
+        title: "skin colour LUT: diffuse albedo (linear sRGB, shown sRGB-encoded)".into(),
+        x_label: format!("melanin fraction Cm (0..{cm_max}, cube-root axis)"),
+        x_ticks: ticks(cm_max, layout.width),
+        y_label: format!("hemoglobin fraction Chd (0..{chd_max}, cube-root)"),
+        y_ticks: ticks(chd_max, layout.height),
+    }
+}
+
 /// Every file of the skin-colour asset for `p`.
 /// File name relative to the sidecar's own directory (the sidecar sits beside the files it lists, whether in a
 /// bake's `skin/` or in `rtbake skin-color --out DIR`).
@@ -74,9 +94,12 @@ pub fn skin_color_lut_files_with_progress(
     let model = p.model().map_err(invalid)?;
     let img = bake_lut_with_progress(&model, &layout, p.lut_evaluation, progress).map_err(invalid)?;
     let conv = convention(&layout);
-    let mut files = float_texture_files(LUT_STEM, &img, "lut", &conv, LUT_TOLERANCE)?;
+    let mut files =
+        super::float_texture_files_with_preview(LUT_STEM, &img, "lut", &conv, LUT_TOLERANCE, &lut_axes(&layout))?;
     files.push(json_file(SIDECAR_PATH, &sidecar(p, &layout, &img), "json", &conv));
-    files.push(text_file(SAMPLES_PATH, samples_csv(&model, &layout).map_err(invalid)?, "csv", "csv", &conv));
+    let samples_conv = "skin colour samples evaluated directly by the spectral model (not read from the table); \
+        linear = linear sRGB albedo, srgb8 = IEC 61966-2-1 encoded 8-bit";
+    files.push(text_file(SAMPLES_PATH, samples_csv(&model, &layout).map_err(invalid)?, "csv", "csv", samples_conv));
     files.push(text_file(
         SPECTRA_PATH,
         spectra_csv(&model).map_err(invalid)?,
@@ -170,8 +193,7 @@ fn sidecar(p: &SkinColorParams, layout: &LutLayout, img: &crate::image_buf::Imag
 
 fn samples_csv(model: &TwoLayerSkinModel, layout: &LutLayout) -> Result<String, SkinColorError> {
     let mut s = String::from(
-        "# skin colour samples evaluated directly by the spectral model (not read from the table); linear = linear \
-         sRGB albedo, srgb8 = IEC 61966-2-1 encoded 8-bit\nmelanin_cm,hemoglobin_chd,texcoord_u,texcoord_v,\
+        "melanin_cm,hemoglobin_chd,texcoord_u,texcoord_v,\
          linear_r,linear_g,linear_b,srgb8_r,srgb8_g,srgb8_b\n",
     );
     for &chd in &SAMPLE_HEMOGLOBIN {

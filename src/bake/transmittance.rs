@@ -1,6 +1,6 @@
 //! Transmittance table T(s) (thesis eq. 5.12) in `baked/transmittance/`, from d'Eon's 6-Gaussian skin preset.
 
-use super::{float_texture_files, json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
+use super::{json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::{self, TransmittanceSidecar};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::error::InvalidInput;
@@ -25,7 +25,16 @@ pub fn table_files(
     })?;
     let formula = model.formula(settings.form);
     let convention = settings.convention_for(formula);
-    let mut files = float_texture_files(stem, &img, "lut", &convention, VERIFY_TOLERANCE)?;
+    let s_max = settings.s_max_mm;
+    let ticks: Vec<f64> = (0..=4).map(|k| (s_max * k as f64 / 4.0 * 1e4).round() / 1e4).collect();
+    let axes = crate::plot::preview::PreviewAxes {
+        title: format!("{}: transmittance T(s) per channel (RGB, sRGB-encoded for viewing)", sibling_name(stem)),
+        x_label: "thickness s (mm)".into(),
+        x_ticks: crate::plot::preview::PreviewAxes::node_ticks(0.0, s_max, settings.samples, &ticks, ""),
+        y_label: if img.height > 1 { "identical rows".into() } else { String::new() },
+        y_ticks: Vec::new(),
+    };
+    let mut files = super::float_texture_files_with_preview(stem, &img, "lut", &convention, VERIFY_TOLERANCE, &axes)?;
     let mut meta = FileMeta::text("lut", "png", &format!("{convention}; 16-bit linear: value = sample/65535"));
     meta.width = img.width;
     meta.height = img.height;
@@ -107,4 +116,9 @@ pub fn assets() -> Vec<Asset> {
         },
         bake,
     }]
+}
+
+/// The file name part of a stem (`burley/transmission/x` → `x`).
+fn sibling_name(stem: &str) -> &str {
+    stem.rsplit('/').next().unwrap_or(stem)
 }

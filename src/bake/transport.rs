@@ -123,8 +123,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     }
     let provenance = json!({"settings": params, "reference": "Monte Carlo after Wang, Jacques & Zheng 1995 (MCML); \
         dipole: Jensen et al. 2001; layered multipole: Donner & Jensen 2005"});
-    let mut csv = format!("# rtbake transport-report: {provenance}\n");
-    csv.push_str(
+    // Header row and data rows only (pandas/spreadsheet defaults); the provenance is in report.json.
+    let mut csv = String::from(
         "case,channel,albedo_prime,total_R_mc,total_R_mc_se,model,total_R_diffusion,total_R_difference_percent,\
          rR_error_percent,rR_error_far_percent\n",
     );

@@ -174,18 +174,11 @@ impl ProfileTable {
         v
     }
 
-    /// CSV: `#` comment lines with the provenance and the totals, a header, one row per radius.
+    /// CSV: a header row, one row per radius, nothing else (no comment lines: pandas, numpy and spreadsheets
+    /// read it with their defaults). The provenance, the totals and any clamping note are in [`Self::to_json`].
     pub fn to_csv(&self) -> String {
         let mut s = String::new();
-        s.push_str(&format!("# rtbake profile: {}\n", self.provenance));
         let t3 = |t: &[f64; 3]| format!("{:e},{:e},{:e}", t[0], t[1], t[2]);
-        s.push_str(&format!("# total_R (r,g,b): {}\n", t3(&self.total_reflectance)));
-        if let Some(t) = &self.total_transmittance {
-            s.push_str(&format!("# total_T (r,g,b): {}\n", t3(t)));
-        }
-        if let Some(note) = self.clamped_negative.describe() {
-            s.push_str(&format!("# {note}\n"));
-        }
         s.push_str("r_mm,R_r,R_g,R_b");
         if self.transmittance_mm2.is_some() {
             s.push_str(",T_r,T_g,T_b");

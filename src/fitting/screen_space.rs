@@ -163,6 +163,7 @@ impl ScreenSpaceParams {
     pub fn to_json(&self) -> serde_json::Map<String, Value> {
         let file = GaussiansFile {
             shared_variances: self.shared,
+            array_layout: if self.shared { ARRAY_LAYOUT_PER_GAUSSIAN } else { ARRAY_LAYOUT_PER_CHANNEL }.into(),
             variances: self.variance_like(&self.variances_mm2),
             weights: self.weight_like(&self.weights),
             blend_weights: self.weight_like(&self.blend_weights),
@@ -242,6 +243,13 @@ mod tests {
     }
 }
 
+/// `array_layout` of a shared-variance file.
+pub const ARRAY_LAYOUT_PER_GAUSSIAN: &str = "per Gaussian: variances[i] (one per Gaussian, shared by R, G, B); \
+weights[i], blend_weights[i] = [r, g, b] of Gaussian i";
+/// `array_layout` of a per-channel file.
+pub const ARRAY_LAYOUT_PER_CHANNEL: &str = "per channel: variances[c][i], weights[c][i], blend_weights[c][i] for \
+channel c (0 = R, 1 = G, 2 = B) and Gaussian i";
+
 /// The keys of a sum-of-Gaussians / screen-space parameter file (`sss/gaussians/*.json`, `rtbake fit gaussians
 /// --json`) that the runtime reads. Shapes depend on `shared_variances` (shared: `variances` is one array and the
 /// weight-like keys are `[r, g, b]` per Gaussian; per channel: `[[r…], [g…], [b…]]`), so they stay JSON values
@@ -249,6 +257,10 @@ mod tests {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GaussiansFile {
     pub shared_variances: bool,
+    /// How the arrays are indexed, spelled out for readers of the file ([`ARRAY_LAYOUT_PER_GAUSSIAN`] or
+    /// [`ARRAY_LAYOUT_PER_CHANNEL`]); absent in files written before it existed.
+    #[serde(default)]
+    pub array_layout: String,
     pub variances: Value,
     pub weights: Value,
     pub blend_weights: Value,

@@ -5,6 +5,7 @@
 //! truncated file. Decoders exist for every format we write (read-back tests, `verify`) and for user inputs.
 
 pub mod atomic;
+pub mod bevy_meta;
 pub mod dds;
 pub mod exr;
 pub mod file_set;

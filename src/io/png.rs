@@ -117,6 +117,27 @@ pub fn encode_linear16(img: &ImageF32) -> Result<Vec<u8>, IoError> {
     encode_u16(&Image::from_vec(img.width, img.height, img.channels, data))
 }
 
+/// The RGB colours of a float table (1–4 channels; missing colour channels 0, alpha dropped) sRGB-encoded to 8 bits,
+/// for labelled previews (`crate::plot::preview`).
+pub fn srgb_preview_pixels(img: &ImageF32) -> Image<u8> {
+    let ch = img.channels as usize;
+    let mut data = Vec::with_capacity(img.data.len() / ch * 3);
+    for px in img.data.chunks_exact(ch) {
+        for c in 0..3 {
+            // One channel is shown grey; two are R, G with B = 0.
+            let v = if ch == 1 {
+                px[0] as f64
+            } else if c < ch.min(3) {
+                px[c] as f64
+            } else {
+                0.0
+            };
+            data.push((crate::color::srgb::encode(v) * 255.0).round() as u8);
+        }
+    }
+    Image::from_vec(img.width, img.height, 3, data)
+}
+
 /// Linear float → 8-bit **sRGB-encoded** preview tagged sRGB (for viewing only; alpha, if any, stays linear).
 pub fn encode_srgb_preview(img: &ImageF32) -> Result<Vec<u8>, IoError> {
     let ch = img.channels;

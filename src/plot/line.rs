@@ -388,7 +388,7 @@ fn char_advance() -> f64 {
     (FONT.character_size.width + FONT.character_spacing) as f64
 }
 
-fn text_width(s: &str) -> f64 {
+pub(super) fn text_width(s: &str) -> f64 {
     s.chars().count() as f64 * char_advance() - FONT.character_spacing as f64
 }
 
@@ -430,12 +430,12 @@ impl embedded_graphics::draw_target::DrawTarget for GlyphSink<'_> {
     }
 }
 
-struct Canvas {
-    img: Image<u8>,
+pub(super) struct Canvas {
+    pub(super) img: Image<u8>,
 }
 
 impl Canvas {
-    fn put(&mut self, x: i64, y: i64, color: [u8; 3]) {
+    pub(super) fn put(&mut self, x: i64, y: i64, color: [u8; 3]) {
         if x >= 0 && y >= 0 && (x as u32) < self.img.width && (y as u32) < self.img.height {
             for (ch, v) in color.iter().enumerate() {
                 self.img.set(x as u32, y as u32, ch as u32, *v);
@@ -444,7 +444,7 @@ impl Canvas {
     }
 
     /// A 2-pixel-wide line (1 pixel for axis-aligned lines); dashed lines alternate 6 px on, 4 px off.
-    fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool) {
+    pub(super) fn line(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, color: [u8; 3], dashed: bool) {
         self.dashed_line(x0, y0, x1, y1, color, dashed, 0.0);
     }
 
@@ -470,13 +470,13 @@ impl Canvas {
     }
 
     /// Draws `s` rotated 90° counter-clockwise (reading bottom to top), centred vertically on `y`, left edge at `x`.
-    fn text_vertical(&mut self, s: &str, x: f64, y: f64, color: [u8; 3]) {
+    pub(super) fn text_vertical(&mut self, s: &str, x: f64, y: f64, color: [u8; 3]) {
         let origin = (x.round() as i64, (y + text_width(s) / 2.0).round() as i64);
         self.glyphs(s, origin, true, color);
     }
 
     /// Draws `s` with the raster font; (x, y) is the top-left corner, or the top-centre when `centered`.
-    fn text(&mut self, s: &str, x: f64, y: f64, centered: bool, color: [u8; 3]) {
+    pub(super) fn text(&mut self, s: &str, x: f64, y: f64, centered: bool, color: [u8; 3]) {
         let x = if centered { x - text_width(s) / 2.0 } else { x };
         self.glyphs(s, (x.round() as i64, y.round() as i64), false, color);
     }

@@ -140,6 +140,16 @@ pub fn render(panels: &[LinePlot], format: PlotFormat, provenance: &Value) -> Re
 /// Plot colours of the R, G, B channels.
 pub const CHANNEL_COLORS: [[u8; 3]; 3] = [[200, 30, 30], [20, 140, 40], [30, 60, 210]];
 
+/// The y-axis name of an [`overlay_plot`] of profiles normalised to total reflectance 1 (R(r)/R_total): the same
+/// units as r·R(r) but a different scale (skin1's red peaks near 0.16 instead of 0.022), so the label says so.
+pub const NORMALIZED_Y_LABEL: &str = "r R(r) / R_total (1/mm; each channel normalised to total 1)";
+
+/// `plot` relabelled for profiles normalised to total 1 ([`NORMALIZED_Y_LABEL`]).
+pub fn normalized(mut plot: LinePlot) -> LinePlot {
+    plot.y_label = NORMALIZED_Y_LABEL.into();
+    plot
+}
+
 /// r·R(r) (mm⁻¹) on a log r axis per channel, with an optional fitted sum overlaid (dashed). The r range spans the
 /// profile's 0.1 %–99.9 % energy quantiles, widened by 3× on both sides; 240 log-spaced points.
 pub fn fit_overlay_plot(profile: &dyn RadialProfile, fit: Option<&RgbGaussians>, title: &str) -> LinePlot {

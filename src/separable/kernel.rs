@@ -405,20 +405,32 @@ impl Kernel {
 
 impl Kernel {
     /// The kernel in the form `SeparableSSS.h` takes (Jimenez et al., github.com/iryoku/separable-sss): a
-    /// `#define SSSS_N_SAMPLES N` and a `float4 kernel[] = { … };` array, to paste in place of the header's
-    /// built-in preset of the same N (the block under `#if SSSS_QUALITY == …`). The array is `static const`:
+    /// `#define SSSS_N_SAMPLES N` and a `float4 kernel[] = { … };` array that replaces the header's whole kernel
+    /// section (`#ifdef SSSS_N_SAMPLES` … its `#endif`: the runtime declaration and the three `SSSS_QUALITY`
+    /// presets), so any N works and the hard-coded `#define SSSS_QUALITY 1` cannot select a preset instead.
+    /// A guard `#error`s when `SSSS_N_SAMPLES` is already defined (the text pasted beside the section, not in
+    /// place of it), and the licence line the header's terms ask for is carried. The array is `static const`:
     /// a plain global would be a uniform of `$Global` whose initializer D3D without the Effects framework and
     /// glslang both drop (measured: glslang's SPIR-V holds no kernel constants then), while `static const`
     /// compiles the taps into the shader. Taps are printed with 9 significant digits (f32 round-trip).
     pub fn separable_sss_h(&self, from: &str) -> String {
         let s = &self.spec;
+        let n = s.samples;
         let mut t = format!("/* {} */\n", crate::io::source::preamble_text(from));
+        t.push_str(SEPARABLE_SSS_NOTICE);
         t.push_str(&format!(
-            "/* Separable SSS kernel for SeparableSSS.h: strength {:?}, falloff {:?}, range {}, exponent {}.\n   \
-             Replace the preset block with N = {} (#define SSSS_N_SAMPLES ... float4 kernel[] = {{...}};) by this text. */\n",
-            s.params.strength, s.params.falloff, self.range, s.exponent, s.samples
+            "/* Separable SSS kernel, N = {n}: strength {:?}, falloff {:?}, range {}, exponent {}.\n   \
+             Use: in SeparableSSS.h, replace its whole kernel section (from the line `#ifdef SSSS_N_SAMPLES` to the \
+             `#endif` that closes it,\n   just before \"Porting Functions\") by this text or an #include of this \
+             file; SSSS_QUALITY is then not used. The README's\n   \"Separable SSS\" section gives a one-line \
+             awk command that does it. */\n",
+            s.params.strength, s.params.falloff, self.range, s.exponent
         ));
-        t.push_str(&format!("#define SSSS_N_SAMPLES {}\nstatic const float4 kernel[] = {{\n", s.samples));
+        t.push_str(&format!(
+            "#if defined(SSSS_N_SAMPLES)\n#error \"SSSS_N_SAMPLES is already defined: this file replaces SeparableSSS.h's \
+             kernel section (see above), it is not an addition to it\"\n#endif\n\
+             #define SSSS_N_SAMPLES {n}\nstatic const float4 kernel[] = {{\n"
+        ));
         for tap in &self.taps {
             let c: Vec<String> = tap.iter().map(|v| format!("{:.8e}", *v as f32)).collect();
             t.push_str(&format!("    float4({}),\n", c.join(", ")));
@@ -447,6 +459,11 @@ pub fn taps_from_f32x4_le(bytes: &[u8]) -> Result<Vec<[f32; 4]>, InvalidInput> {
         .map(|t| std::array::from_fn(|i| f32::from_le_bytes(t[4 * i..4 * i + 4].try_into().expect("4 bytes"))))
         .collect())
 }
+
+/// The licence line SeparableSSS's terms ask for, carried by every file in its kernel form (see NOTICE).
+pub const SEPARABLE_SSS_NOTICE: &str = "/* Kernel form and generator after Separable SSS \
+(https://github.com/iryoku/separable-sss, BSD-style licence, see rtbake's NOTICE):\n   \
+\"Uses Separable SSS. Copyright (C) 2012 by Jorge Jimenez and Diego Gutierrez.\" */\n";
 
 /// How the `kernel` array is laid out (recorded in every kernel file).
 pub const LAYOUT_DOC: &str = "kernel[i] = [r, g, b, offset]: per-channel weight (each channel sums to 1 over all \

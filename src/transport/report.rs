@@ -1,7 +1,8 @@
 //! A Monte Carlo result as text: CSV in the layout of `rtbake profile --csv`
-//! ([`crate::diffusion::table::ProfileTable::to_csv`]: `#` lines, header `r_mm,R_r,R_g,R_b[,T_r,T_g,T_b]`, one row
-//! per bin centre, R and T in mm⁻²) so every consumer of profile tables (the fits' `--profile-csv`) reads it
-//! unchanged; standard errors are in the JSON ([`to_json`]: `R_se`, `T_se`), not in the CSV.
+//! ([`crate::diffusion::table::ProfileTable::to_csv`]: header `r_mm,R_r,R_g,R_b[,T_r,T_g,T_b]`, one row per bin
+//! centre, R and T in mm⁻², no comment lines) so every consumer of profile tables (the fits' `--profile-csv`,
+//! pandas, spreadsheets) reads it unchanged; provenance, totals and standard errors are in the JSON ([`to_json`]:
+//! `R_se`, `T_se`), not in the CSV.
 
 use super::compare::Comparison;
 use super::mc::McResult;
@@ -11,20 +12,11 @@ fn has_transmittance(r: &McResult) -> bool {
     r.channels.iter().any(|c| c.transmittance.mean > 0.0)
 }
 
-/// CSV, see the module docs. `provenance` goes into the first `#` line.
-pub fn to_csv(r: &McResult, provenance: &Value) -> String {
+/// CSV, see the module docs (header row and data rows only; `provenance` and the totals go to [`to_json`]).
+pub fn to_csv(r: &McResult, _provenance: &Value) -> String {
     let mut s = String::new();
-    s.push_str(&format!("# rtbake transport: {provenance}\n"));
     let t3 = |f: &dyn Fn(usize) -> f64| format!("{:e},{:e},{:e}", f(0), f(1), f(2));
-    s.push_str(&format!(
-        "# photons per channel {}, bins of {} mm at their centres; standard errors in the JSON output\n",
-        r.photons, r.settings.bin_mm
-    ));
-    s.push_str(&format!("# total_R (r,g,b): {}\n", t3(&|c| r.channels[c].diffuse_reflectance.mean)));
     let transmits = has_transmittance(r);
-    if transmits {
-        s.push_str(&format!("# total_T (r,g,b): {}\n", t3(&|c| r.channels[c].transmittance.mean)));
-    }
     s.push_str(if transmits { "r_mm,R_r,R_g,R_b,T_r,T_g,T_b\n" } else { "r_mm,R_r,R_g,R_b\n" });
     for (i, radius) in r.settings.radii_mm().iter().enumerate() {
         s.push_str(&format!("{radius:e},{}", t3(&|c| r.channels[c].reflectance_mm2[i].mean)));

@@ -1,7 +1,9 @@
 //! Bevy (`bevy_anti_alias` 0.20.1) ships its SMAA LUTs as `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2`, Zstandard-
 //! supercompressed at level 15, and loads them with the `ktx2` crate + zstd. rtbake's Bevy-named files must hold
 //! the same supercompressed level data byte for byte, the same header and data format descriptor, and decode
-//! (ktx2 crate + zstd, Bevy's path) to the `.bin` payloads.
+//! (ktx2 crate + zstd, Bevy's path) to the `.bin` payloads. Every linear data texture Bevy's image loader opens
+//! carries a `<file>.meta` with `is_srgb: false`, parsed here with RON into the shape of Bevy's `AssetMeta` /
+//! `ImageLoaderSettings` (Bevy 0.20, `bevy_asset::meta`, `bevy_image::image_loader`), as Bevy's asset server does.
 
 use crate::support::{baked_dir, reference_file};
 
@@ -63,6 +65,18 @@ fn check(asset: &str, name: &str, bin: &str) {
         bytes[off..off + len].to_vec()
     };
     assert_eq!(dfd(&ours), dfd(&bevy), "{name}: data format descriptor");
+    // What the README says: the 80-byte header is Bevy's byte for byte except kvdByteLength (bytes 60..64), since
+    // the KTXwriter value names rtbake instead of KTX-Software; the KTXwriterScParams entry is the same.
+    let differing: Vec<usize> = (0..80).filter(|&i| ours[i] != bevy[i]).collect();
+    assert!(differing.iter().all(|i| (60..64).contains(i)), "{name}: header bytes {differing:?} differ");
+    let kvd = |b: &[u8]| {
+        let (off, len) =
+            (u32::from_le_bytes(b[56..60].try_into().unwrap()), u32::from_le_bytes(b[60..64].try_into().unwrap()));
+        b[off as usize..(off + len) as usize].to_vec()
+    };
+    let sc = b"KTXwriterScParams\0--zstd 15\0";
+    assert!(kvd(&ours).windows(sc.len()).any(|w| w == sc) && kvd(&bevy).windows(sc.len()).any(|w| w == sc));
+    assert!(kvd(&ours).windows(19).any(|w| w == b"KTXwriter\0rtbake 0."), "{name}: KTXwriter");
     assert_eq!(r.transfer_function(), Some(ktx2::TransferFunction::Linear));
 }
 
@@ -116,4 +130,138 @@ fn aa_command_writes_zstd_ktx2_with_the_zstd_flag() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["param"], "--zstd", "{v}");
     assert!(!bad.exists());
+}
+
+/// Bevy's `AssetMetaMinimal` (read first, to pick the loader).
+#[derive(serde::Deserialize)]
+struct AssetMetaMinimal {
+    asset: AssetActionMinimal,
+}
+#[derive(serde::Deserialize)]
+enum AssetActionMinimal {
+    Load { loader: String },
+    Process { processor: String },
+    Ignore,
+}
+
+/// Bevy's `AssetMeta<ImageLoader, ()>`: the fields and their serde attributes as Bevy declares them.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AssetMeta {
+    meta_format_version: String,
+    #[serde(default)]
+    processed_info: Option<ron::Value>,
+    asset: AssetAction,
+}
+#[derive(serde::Deserialize)]
+#[allow(dead_code)] // Bevy's shape; only the Load variant's settings are checked.
+enum AssetAction {
+    Load { loader: String, settings: ImageLoaderSettings },
+    Process { processor: String, settings: ron::Value },
+    Ignore,
+}
+/// Bevy's `ImageLoaderSettings` (no serde default on the struct: `format`, `is_srgb`, `sampler`, `asset_usage`
+/// must be present).
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ImageLoaderSettings {
+    format: ImageFormatSetting,
+    #[serde(default)]
+    texture_format: Option<ron::Value>,
+    is_srgb: bool,
+    sampler: ImageSampler,
+    asset_usage: RenderAssetUsages,
+    #[serde(default)]
+    array_layout: Option<ron::Value>,
+}
+#[derive(serde::Deserialize, PartialEq, Debug)]
+enum ImageFormatSetting {
+    FromExtension,
+    Format(String),
+    Guess,
+}
+#[derive(serde::Deserialize, PartialEq, Debug)]
+enum ImageSampler {
+    Default,
+    Descriptor(ron::Value),
+}
+/// bitflags' human-readable form: the flag names joined by `|`.
+#[derive(serde::Deserialize)]
+struct RenderAssetUsages(String);
+
+/// Parses a `.meta` the way Bevy's asset server does and returns its image-loader settings.
+fn parse_bevy_meta(text: &[u8]) -> Result<ImageLoaderSettings, String> {
+    let minimal: AssetMetaMinimal = ron::de::from_bytes(text).map_err(|e| e.to_string())?;
+    match minimal.asset {
+        AssetActionMinimal::Load { loader } if loader == "bevy_image::image_loader::ImageLoader" => {}
+        AssetActionMinimal::Load { loader } => return Err(format!("loader {loader}")),
+        AssetActionMinimal::Process { processor } => return Err(format!("processor {processor}")),
+        AssetActionMinimal::Ignore => return Err("Ignore".into()),
+    }
+    let meta: AssetMeta = ron::de::from_bytes(text).map_err(|e| e.to_string())?;
+    if meta.meta_format_version != "1.0" {
+        return Err(format!("meta_format_version {}", meta.meta_format_version));
+    }
+    assert!(meta.processed_info.is_none(), "source assets carry no processed_info");
+    match meta.asset {
+        AssetAction::Load { settings, .. } => Ok(settings),
+        _ => Err("not a Load action".into()),
+    }
+}
+
+fn check_linear_meta(path: &str, text: &[u8]) {
+    let s = parse_bevy_meta(text).unwrap_or_else(|e| panic!("{path}.meta: {e}"));
+    assert!(!s.is_srgb, "{path}.meta: is_srgb must be false");
+    assert_eq!((s.format, s.sampler), (ImageFormatSetting::FromExtension, ImageSampler::Default), "{path}");
+    assert!(s.texture_format.is_none() && s.array_layout.is_none(), "{path}");
+    let mut flags: Vec<&str> = s.asset_usage.0.split('|').map(str::trim).collect();
+    flags.sort();
+    assert_eq!(flags, ["MAIN_WORLD", "RENDER_WORLD"], "{path}: asset_usage");
+}
+
+#[test]
+fn every_linear_texture_bevy_loads_has_a_meta_with_is_srgb_false() {
+    let mut checked = 0;
+    for name in ["smaa-area", "smaa-search", "mlaa-v1.3", "transmittance"] {
+        let a = rtbake::bake::registry().into_iter().find(|a| a.name == name).unwrap();
+        let files = a.run(&(a.default_params)()).unwrap();
+        let by_path: std::collections::HashMap<&str, &rtbake::bake::BakedFile> =
+            files.iter().map(|f| (f.path.as_str(), f)).collect();
+        for f in &files {
+            let meta = by_path.get(format!("{}.meta", f.path).as_str());
+            let bevy_opens = matches!(f.meta.format.as_str(), "ktx2" | "dds" | "png");
+            if bevy_opens && f.meta.color_space == "linear" {
+                let m = meta.unwrap_or_else(|| panic!("{name}: {} has no .meta", f.path));
+                assert_eq!((m.meta.format.as_str(), m.meta.kind.as_str()), ("ron", "bevy-meta"));
+                check_linear_meta(&f.path, &m.bytes);
+                checked += 1;
+            } else {
+                // sRGB previews and plots load correctly with Bevy's default; other formats are not images.
+                assert!(meta.is_none(), "{name}: {} has a .meta", f.path);
+            }
+        }
+    }
+    assert!(checked >= 10, "only {checked} textures checked");
+    // Bad input: Bevy refuses a meta without is_srgb or with an unknown field; the parse above is that strict.
+    let good = rtbake::io::bevy_meta::linear_image_meta();
+    let without = good.replace("            is_srgb: false,\n", "");
+    let e = parse_bevy_meta(without.as_bytes()).err().expect("a meta without is_srgb parsed");
+    assert!(e.contains("is_srgb"), "{e}");
+    let unknown = good.replace("is_srgb: false,", "is_srgb: false, srgb: false,");
+    assert!(parse_bevy_meta(unknown.as_bytes()).is_err(), "an unknown field parsed");
+}
+
+#[test]
+fn every_committed_linear_texture_has_its_bevy_meta() {
+    let m = rtbake::manifest::Manifest::load(&baked_dir()).unwrap();
+    let mut n = 0;
+    for e in &m.files {
+        if matches!(e.meta.format.as_str(), "ktx2" | "dds" | "png") && e.meta.color_space == "linear" {
+            let p = format!("{}.meta", e.path);
+            assert!(m.entry(&p).is_some(), "{p} not in the manifest");
+            check_linear_meta(&e.path, &std::fs::read(baked_dir().join(&p)).unwrap());
+            n += 1;
+        }
+    }
+    assert!(n > 50, "{n}");
 }

@@ -30,3 +30,27 @@ fn usage_errors_from_the_parser_are_json_too() {
     assert_eq!(v["exit_code"], 2);
     assert!(v["error"].as_str().unwrap().contains("--dir"), "{v}");
 }
+
+#[test]
+fn a_failed_verify_report_carries_the_error_keys() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path().join("b");
+    let o = rtbake(&["bake", "smaa-search", "--out", d.to_str().unwrap(), "--quiet"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rtbake(&["verify", "--dir", d.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0));
+    let ok: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(ok.get("error").is_none() && ok.get("exit_code").is_none(), "a passing report has no error keys: {ok}");
+    // One flipped byte: exit 1, the report listing the file, and the error object's keys beside it.
+    let f = d.join("aa/smaa/SearchTex.bin");
+    let mut b = std::fs::read(&f).unwrap();
+    b[0] ^= 1;
+    std::fs::write(&f, b).unwrap();
+    let v = error_object(&["verify", "--dir", d.to_str().unwrap(), "--json"]);
+    assert_eq!(v["exit_code"], 1, "{v}");
+    assert_eq!(v["param"], serde_json::Value::Null);
+    let error = v["error"].as_str().unwrap();
+    assert!(error.starts_with("verify: 1 of ") && error.contains("files failed"), "{error}");
+    let files = v["files"].as_array().unwrap();
+    assert!(files.iter().any(|f| f["path"] == "aa/smaa/SearchTex.bin" && f["status"] != "ok"), "{v}");
+}

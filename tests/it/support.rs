@@ -64,13 +64,40 @@ pub fn external_inputs_required() -> bool {
 /// was not checked. The message goes straight to the process' stderr (not through the test harness' capture), so
 /// a plain `cargo test` shows it.
 pub fn skip_missing(what: &str, path: &std::path::Path, env_var: &str) {
-    let msg =
-        format!("SKIPPED: {what} — {} not found (set {env_var}; see README \"Tests and ../shared\")", path.display());
+    let msg = format!(
+        "SKIPPED{}: {what} — {} not found ({}; set {env_var}; see README \"Tests and ../shared\")",
+        test_name(),
+        path.display(),
+        origin_of(path)
+    );
     if external_inputs_required() {
         panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
     }
     use std::io::Write;
     let _ = writeln!(std::io::stderr(), "{msg}");
+}
+
+/// ` [module::test]` of the running test (the harness names each test's thread after it), so that skips of
+/// different tests over the same input read differently.
+pub fn test_name() -> String {
+    std::thread::current().name().filter(|n| *n != "main").map(|n| format!(" [{n}]")).unwrap_or_default()
+}
+
+/// Where a missing external input comes from, by its place under `../shared`.
+fn origin_of(path: &std::path::Path) -> &'static str {
+    let p = path.to_string_lossy();
+    if p.contains("consumers/bevy_anti_alias") {
+        "Bevy's SMAA LUTs, from the bevy_anti_alias 0.20.1 crate on crates.io"
+    } else if p.contains("consumers/separable-sss") {
+        "SeparableSSS.h of github.com/iryoku/separable-sss"
+    } else if p.contains("heads/") {
+        "the Lee Perry-Smith head scan as distributed with the three.js examples"
+    } else if p.ends_with("data") || p.contains("shared/data") {
+        "the physical data tables of ../shared/data (spectra, absorption coefficients)"
+    } else {
+        "the upstream SMAA (github.com/iryoku/smaa) and Jimenez MLAA textures of ../shared/reference, not \
+         redistributed in a clone"
+    }
 }
 
 /// The reference folder if it holds the golden files; otherwise reports the skip of `what` under the rule above.
@@ -158,7 +185,11 @@ pub fn tool_available(what: &str, cmd: &str, args: &[&str], install: &str) -> bo
         .map(|s| s.success())
         .unwrap_or(false);
     if !ok {
-        let msg = format!("SKIPPED: {what} — `{cmd} {}` does not run ({install}; .ci/run installs it)", args.join(" "));
+        let msg = format!(
+            "SKIPPED{}: {what} — `{cmd} {}` does not run ({install}; .ci/run installs it)",
+            test_name(),
+            args.join(" ")
+        );
         if external_inputs_required() {
             panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
         }
