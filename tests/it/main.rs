@@ -36,6 +36,7 @@ mod fitting_determinism;
 mod fitting_published;
 mod importance_cli;
 mod mesh_raster;
+mod mesh_scan;
 mod newcomer_cli;
 mod newcomer_profile_floor;
 mod newcomer_provenance;
