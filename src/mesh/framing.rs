@@ -42,7 +42,8 @@ pub enum MeshUnits {
 
 impl MeshUnits {
     /// The accepted spellings, for messages and `--help`.
-    pub const ACCEPTED: &'static str = "mm, cm, m, in, auto (height = an adult head's 230 mm) or a number of mm per unit";
+    pub const ACCEPTED: &'static str =
+        "mm, cm, m, in, auto (height = an adult head's 230 mm) or a number of mm per unit";
 
     /// Parses `mm`, `cm`, `m`, `in`, `auto` or a positive number of millimetres per unit; `param` names the flag.
     pub fn parse(param: &str, s: &str) -> Result<MeshUnits, InvalidInput> {
@@ -212,7 +213,8 @@ mod tests {
         assert!((Bounds::of(&inch).size()[1] - 4.0 * 0.0254).abs() < 1e-7);
         // The same head authored in arbitrary units at two scales frames to the same metres under "auto".
         for s in [0.37, 8.6, 1234.0] {
-            let a = frame_in_metres(&box_mesh(s, [1.0, 2.0, 3.0]), MeshUnits::parse("u", "auto").unwrap(), "u").unwrap();
+            let a =
+                frame_in_metres(&box_mesh(s, [1.0, 2.0, 3.0]), MeshUnits::parse("u", "auto").unwrap(), "u").unwrap();
             let h = Bounds::of(&a).size()[1];
             assert!((h - 0.230).abs() < 1e-5, "scale {s}: height {h} m");
         }

@@ -187,12 +187,18 @@ pub fn material_images(
                 })
             }
             gltf::image::Source::Uri { uri, mime_type } => {
-                let bytes = if uri.starts_with("data:") { decode_data_uri(uri) } else { external(uri) }
-                    .map_err(|e| bad(format!("image {} ({}): {e}", img.index(), uri.chars().take(64).collect::<String>())))?;
+                let bytes =
+                    if uri.starts_with("data:") { decode_data_uri(uri) } else { external(uri) }.map_err(|e| {
+                        bad(format!("image {} ({}): {e}", img.index(), uri.chars().take(64).collect::<String>()))
+                    })?;
                 Ok(EncodedImage {
                     mime_type: mime_type.map(str::to_string),
                     bytes,
-                    origin: if uri.starts_with("data:") { format!("image {} (data URI)", img.index()) } else { uri.to_string() },
+                    origin: if uri.starts_with("data:") {
+                        format!("image {} (data URI)", img.index())
+                    } else {
+                        uri.to_string()
+                    },
                 })
             }
         }
@@ -291,10 +297,12 @@ mod tests {
 
     #[test]
     fn material_images_come_from_data_uris_and_outside_files() {
-        let mut doc: serde_json::Value = serde_json::from_slice(&triangle_gltf(true, true, [0.0; 3], [1.0; 3])).unwrap();
+        let mut doc: serde_json::Value =
+            serde_json::from_slice(&triangle_gltf(true, true, [0.0; 3], [1.0; 3])).unwrap();
         let b64 = base64::engine::general_purpose::STANDARD.encode(b"PNGBYTES");
         doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-        doc["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 1}}]);
+        doc["materials"] =
+            json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 1}}]);
         doc["textures"] = json!([{"source": 0}, {"source": 1}]);
         doc["images"] = json!([
             {"uri": format!("data:image/png;base64,{b64}"), "mimeType": "image/png"},

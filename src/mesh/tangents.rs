@@ -149,7 +149,8 @@ pub fn mikktspace_tangents(mesh: &Mesh) -> (Mesh, Vec<[f32; 4]>) {
             }
         }
     }
-    let tangents = tangents.iter().enumerate().map(|(v, t)| t.unwrap_or_else(|| fallback[v.min(fallback.len() - 1)])).collect();
+    let tangents =
+        tangents.iter().enumerate().map(|(v, t)| t.unwrap_or_else(|| fallback[v.min(fallback.len() - 1)])).collect();
     (out, tangents)
 }
 

@@ -52,7 +52,11 @@ fn check_shape(param: &str, img: &ImageU8, what: &str) -> Result<(), InvalidInpu
 pub fn albedo_linear(param: &str, img: &ImageU8) -> Result<ImageF32, InvalidInput> {
     check_shape(param, img, "an albedo map")?;
     let lut: Vec<f32> = (0..256).map(|i| crate::color::srgb::decode(i as f64 / 255.0) as f32).collect();
-    let data = img.data.chunks_exact(img.channels as usize).flat_map(|p| [p[0], p[1], p[2]].map(|c| lut[c as usize])).collect();
+    let data = img
+        .data
+        .chunks_exact(img.channels as usize)
+        .flat_map(|p| [p[0], p[1], p[2]].map(|c| lut[c as usize]))
+        .collect();
     Ok(ImageF32::from_vec(img.width, img.height, 3, data))
 }
 
