@@ -328,8 +328,8 @@ mod tests {
         let skin = BeerLambert::from_reduced("sigma", [0.032, 0.17, 0.48], [0.74, 0.88, 1.01]).unwrap();
         assert_eq!(skin.at(0.0), [1.0; 3]);
         let st = skin.sigma_t_per_mm;
-        for c in 0..3 {
-            assert!((skin.at(1.0 / st[c])[c] - (-1f64).exp()).abs() < 1e-12);
+        for (c, &st_c) in st.iter().enumerate() {
+            assert!((skin.at(1.0 / st_c)[c] - (-1f64).exp()).abs() < 1e-12);
         }
         let t = skin.at(2.0);
         assert!(t[0] > t[1] && t[1] > t[2], "{t:?}");

@@ -4,10 +4,12 @@
 //! - **Units.** A mesh is authored in some unit ([`MeshUnits`]): glTF says metres, OBJ says nothing, and a scan is
 //!   often in arbitrary units (the Lee Perry-Smith head of the seeds' demos is about 8.6 units wide). The diffusion
 //!   kernels are physical widths in mm, so the unit decides how much the skin blurs; [`MeshUnits::HeadHeightMm`]
-//!   ("auto") assumes the mesh is a head and scales its height (y extent) to an adult's menton–crown height,
-//!   [`ADULT_HEAD_HEIGHT_MM`].
-//! - **Framing.** [`frame_in_metres`] moves the mesh's bounding-box centre to the origin and its positions to metres
-//!   (the renderer's world unit), so the camera of `run skin` looks at the middle of any mesh.
+//!   ("auto") assumes the mesh is a head, y up, and scales its head height ([`head_height_units`]) to an adult's
+//!   menton–crown height, [`ADULT_HEAD_HEIGHT_MM`]. A head-only mesh's head height is its y extent; a bust's
+//!   (head and shoulders, as the scan) is measured from the crown down to the narrowest slice of the neck.
+//! - **Framing.** [`frame_in_metres`] moves the middle of the mesh's head (the bounding box's centre in x and z,
+//!   half the head height below the crown in y) to the origin and its positions to metres (the renderer's world
+//!   unit), so the camera of `run skin` looks at the face of any head or bust.
 //! - **TAP's distances.** Jimenez, Sundstedt & Gutierrez, *Screen-Space Perceptual Rendering of Human Skin*, ACM TAP
 //!   6(4), 2009, §6: "The three camera configurations used were at 28, 50, and 132 distance units, which in the
 //!   article are referred to zoom, near, and far (for reference, the head is 27 distance units tall)".
@@ -76,6 +78,43 @@ impl MeshUnits {
     }
 }
 
+/// Horizontal slices [`head_height_units`] cuts a mesh into.
+const SLICES: usize = 64;
+
+/// The height of the head of a y-up mesh facing +z, in its units: its y extent, or — for a bust, whose lowest
+/// quarter is more than 1.6 times as wide (x) as the widest slice of its top half — the distance from the top down
+/// to the chin, found where the front of the face falls back: the first slice below the nose tip (the front-most
+/// point of the top half) whose front-most z lies more than a quarter of the head's width behind the tip. On the
+/// Lee Perry-Smith scan (a bust 7.9 units tall) that gives about 4.6 units, the chin's own level being 4.5 below
+/// the crown; on a head-only mesh it is the full height.
+pub fn head_height_units(mesh: &Mesh) -> f32 {
+    let b = Bounds::of(mesh);
+    let (lo, hi) = (b.min[1], b.max[1]);
+    let height = hi - lo;
+    if height.is_nan() || height <= 0.0 {
+        return height;
+    }
+    // Per slice (slice 0 at the top): x extent and front-most z.
+    let mut span = vec![(f32::MAX, f32::MIN); SLICES];
+    let mut front = vec![f32::MIN; SLICES];
+    for p in &mesh.positions {
+        let k = (((hi - p[1]) / height * SLICES as f32) as usize).min(SLICES - 1);
+        span[k] = (span[k].0.min(p[0]), span[k].1.max(p[0]));
+        front[k] = front[k].max(p[2]);
+    }
+    let width: Vec<f32> = span.iter().map(|(a, b)| if a <= b { b - a } else { 0.0 }).collect();
+    let head_w = width[..SLICES / 2].iter().cloned().fold(0.0f32, f32::max);
+    let shoulders = width[3 * SLICES / 4..].iter().cloned().fold(0.0f32, f32::max);
+    if shoulders <= 1.6 * head_w {
+        return height;
+    }
+    let nose_k = (0..SLICES / 2).fold(0, |n, k| if front[k] > front[n] { k } else { n });
+    match (nose_k..SLICES).find(|&k| front[k] > f32::MIN && front[k] < front[nose_k] - 0.25 * head_w) {
+        Some(chin_k) => height * chin_k as f32 / SLICES as f32,
+        None => height,
+    }
+}
+
 /// Axis-aligned bounds of a mesh, in its units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
@@ -104,20 +143,22 @@ impl Bounds {
     }
 }
 
-/// The mesh with its bounding-box centre at the origin and its positions in metres (`mm_per_unit` = 1000), the
-/// renderer's world unit; the units come from `units` (which may depend on the mesh's height). Normals, UVs and
+/// The mesh with its head's centre (see the code) at the origin and its positions in metres (`mm_per_unit` = 1000), the
+/// renderer's world unit; the units come from `units` (`auto` depends on [`head_height_units`]). Normals, UVs and
 /// indices are unchanged. Refuses a flat mesh (zero height) under `auto` units, naming `param`.
 pub fn frame_in_metres(mesh: &Mesh, units: MeshUnits, param: &str) -> Result<Mesh, InvalidInput> {
     let b = Bounds::of(mesh);
-    let height = b.size()[1];
-    if matches!(units, MeshUnits::HeadHeightMm(_)) && !(height > 0.0) {
+    let height = head_height_units(mesh);
+    if matches!(units, MeshUnits::HeadHeightMm(_)) && (height.is_nan() || height <= 0.0) {
         return Err(InvalidInput::new(param, "auto needs a mesh with a height (y extent) > 0; give the units instead"));
     }
     let to_m = units.mm_per_unit(height) / 1000.0;
     if !(to_m.is_finite() && to_m > 0.0) {
         return Err(InvalidInput::new(param, format!("gives {to_m} m per unit; accepted: {}", MeshUnits::ACCEPTED)));
     }
-    let c = b.centre();
+    // Centre on the head: the box's centre in x and z, the head's middle in y (the box's for a head alone).
+    let mut c = b.centre();
+    c[1] = b.max[1] - 0.5 * height;
     let positions = mesh.positions.iter().map(|p| [0, 1, 2].map(|i| (p[i] - c[i]) * to_m)).collect();
     Mesh::new(param, positions, mesh.normals.clone(), mesh.uvs.clone(), mesh.indices.clone(), 1000.0)
 }
@@ -220,6 +261,32 @@ mod tests {
         }
         let n = frame_in_metres(&m, MeshUnits::parse("u", "25.4").unwrap(), "u").unwrap();
         assert_eq!(Bounds::of(&n).size(), Bounds::of(&inch).size());
+    }
+
+    /// A bust: a 2-wide head with a nose on a 1-wide neck on 6-wide shoulders. Its head height runs from the top
+    /// to where the face falls back (the chin, at y = 5).
+    #[test]
+    fn a_bust_is_measured_from_the_crown_to_the_neck() {
+        // Each slab is a strip of quads in x at depth z.
+        let slab = |x: f32, z: f32, y0: f32, y1: f32| -> Vec<[f32; 3]> {
+            (0..=20)
+                .flat_map(|i| {
+                    let y = y0 + (y1 - y0) * i as f32 / 20.0;
+                    [[-x, y, z], [x, y, z + 0.01]]
+                })
+                .collect()
+        };
+        let mut p = slab(3.0, 0.0, 0.0, 3.9); // shoulders, y 0..3.9
+        p.extend(slab(0.5, 0.0, 4.0, 4.9)); // neck, y 4..4.9
+        p.extend(slab(1.0, 1.0, 5.0, 9.0)); // face, y 5..9, its front at z = 1
+        let n = p.len() as u32;
+        let idx: Vec<u32> = (0..n - 2).step_by(2).flat_map(|i| [i, i + 1, i + 2]).collect();
+        let m = Mesh::new("bust", p, vec![[0.0, 0.0, 1.0]; n as usize], vec![[0.0, 0.0]; n as usize], idx, 1.0);
+        let m = m.unwrap();
+        let h = head_height_units(&m);
+        assert!(h > 3.8 && h < 4.3, "crown (9) to the chin (5): {h}");
+        // A head alone is its full height.
+        assert_eq!(head_height_units(&box_mesh(1.0, [0.0; 3])), 4.0);
     }
 
     #[test]
