@@ -14,6 +14,12 @@
 //! "transmission profile" engine bakers (Unreal's Subsurface Profile, Unity HDRP) derive from a Burley profile.
 //! [`TransmittanceModel`] is either source; Burley has only the plane-integral ("physical") form.
 //!
+//! Green's transmittance (Green, "Real-time approximations to subsurface scattering", *GPU Gems* ch. 16, 2004;
+//! thesis §5.3, the baseline §5.6 compares against) is Beer–Lambert attenuation through the thickness s the shadow
+//! map measures, T_c(s) = exp(−s·σt,c) ([`BeerLambert`]): one exponential per channel, no multiple scattering and
+//! no layers. For a layer given by σa and σs′ it uses the reduced extinction σt′ = σa + σs′ (the diffusion models'
+//! coefficient; with the unreduced σt = σa + σs′/(1 − g) skin would be opaque past a fraction of a mm).
+//!
 //! **Table convention** (node-inclusive): texel i of n holds s = s_max·i/(n − 1); a shader samples with linear
 //! filtering at u = s/s_max·(n − 1)/n + 0.5/n (clamp to edge). The optional 2-D variant repeats the row h times.
 
@@ -72,6 +78,48 @@ pub fn transmittance(sum: &RgbGaussians, s_mm: f64, form: TransmittanceForm) -> 
             .sum()
     })
 }
+
+/// Green's Beer–Lambert transmittance T_c(s) = exp(−s·σt,c) (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BeerLambert {
+    /// Extinction coefficient per channel, mm⁻¹.
+    pub sigma_t_per_mm: [f64; 3],
+}
+
+impl BeerLambert {
+    /// Validates σt (finite, > 0, at most 10⁴ mm⁻¹), naming `param`.
+    pub fn new(param: &str, sigma_t_per_mm: [f64; 3]) -> Result<BeerLambert, InvalidInput> {
+        for v in sigma_t_per_mm {
+            check_range(param, v, 1e-9, 1e4, "1/mm")?;
+        }
+        Ok(BeerLambert { sigma_t_per_mm })
+    }
+
+    /// From a layer's σa and σs′ (mm⁻¹): σt′ = σa + σs′ per channel.
+    pub fn from_reduced(
+        param: &str,
+        sigma_a_per_mm: [f64; 3],
+        sigma_s_prime_per_mm: [f64; 3],
+    ) -> Result<BeerLambert, InvalidInput> {
+        Self::new(param, [0, 1, 2].map(|c| sigma_a_per_mm[c] + sigma_s_prime_per_mm[c]))
+    }
+
+    /// T(s) per channel, s ≥ 0 mm.
+    pub fn at(&self, s_mm: f64) -> [f64; 3] {
+        self.sigma_t_per_mm.map(|st| (-s_mm * st).exp())
+    }
+
+    /// The n × h RGB table of [`TableSettings`] (its `form` does not apply and is ignored).
+    pub fn table(&self, settings: &TableSettings) -> Result<ImageF32, TransmittanceError> {
+        settings.validate()?;
+        let row: Vec<f32> =
+            (0..settings.samples).flat_map(|i| self.at(settings.s_of_texel(i)).map(|t| t as f32)).collect();
+        Ok(ImageF32::from_vec(settings.samples, settings.height, 3, row.repeat(settings.height as usize)))
+    }
+}
+
+/// The formula string of Green's transmittance.
+pub const GREEN_FORMULA: &str = "T(s) = exp(-s sigma_t) (Green 2004, Beer-Lambert through the thickness)";
 
 /// What a transmittance table is computed from.
 #[derive(Clone, Debug, PartialEq)]
@@ -271,5 +319,26 @@ mod tests {
             }
         }
         assert_eq!(img.data[..3], [0.8, 0.5, 0.3]);
+    }
+
+    /// Green's T(s): T(0) = 1, each channel falls by e per 1/σt mm, the table's texels are the formula at their
+    /// nodes; for Jensen et al. 2001's Skin1 (σa, σs′) red carries furthest; bad σt is named.
+    #[test]
+    fn green_beer_lambert() {
+        let skin = BeerLambert::from_reduced("sigma", [0.032, 0.17, 0.48], [0.74, 0.88, 1.01]).unwrap();
+        assert_eq!(skin.at(0.0), [1.0; 3]);
+        let st = skin.sigma_t_per_mm;
+        for (c, &st_c) in st.iter().enumerate() {
+            assert!((skin.at(1.0 / st_c)[c] - (-1f64).exp()).abs() < 1e-12);
+        }
+        let t = skin.at(2.0);
+        assert!(t[0] > t[1] && t[1] > t[2], "{t:?}");
+        let settings = TableSettings { samples: 5, height: 2, s_max_mm: 4.0, form: TransmittanceForm::Physical };
+        let table = skin.table(&settings).unwrap();
+        assert_eq!((table.width, table.height, table.channels), (5, 2, 3));
+        assert_eq!(table.data[3..6], skin.at(1.0).map(|v| v as f32));
+        assert_eq!(table.row(0), table.row(1));
+        assert_eq!(BeerLambert::new("--sigma-t", [1.0, -1.0, 1.0]).unwrap_err().param, "--sigma-t");
+        assert!(BeerLambert::new("--sigma-t", [1.0, f64::NAN, 1.0]).is_err());
     }
 }

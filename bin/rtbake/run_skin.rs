@@ -3,6 +3,7 @@
 
 use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::io::{self, atomic::write_atomic};
+use rtbake::mesh::framing::{frame_in_metres, head_height_units, MeshUnits, TapDistance};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
@@ -54,6 +55,12 @@ pub enum StretchArg {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MeshOriginArg {
+    Bounds,
+    Authored,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum OnOff {
     On,
     Off,
@@ -70,16 +77,26 @@ pub struct SkinArgs {
     /// Heads side by side, 0.25 m apart, 1..=16 (TAP 2009 Table III: 1, 3, 5).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     heads: u32,
-    /// Camera distance from the heads, metres, 0.2..=100 (30° vertical field of view).
-    #[arg(long, default_value_t = 0.6, allow_negative_numbers = true, value_name = "M")]
-    distance: f32,
+    /// Camera distance from the heads' centre: metres (0.2..=100), or TAP 2009's zoom, near or far, which keep
+    /// the paper's ratios to the head's height (28, 50 and 132 units for a 27-unit head; 30° vertical field of view).
+    #[arg(long, default_value = "0.6", allow_hyphen_values = true, value_name = "M|zoom|near|far")]
+    distance: String,
     /// Mesh: glTF 2.0 (.gltf with embedded or neighbouring buffers, .glb) or Wavefront OBJ, with vertex normals
     /// and texture coordinates (TEXCOORD_0 / vt); default: the procedural head (about 6 600 triangles).
     #[arg(long, value_name = "FILE")]
     mesh: Option<PathBuf>,
-    /// Millimetres per OBJ unit (glTF is in metres).
-    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
-    mesh_mm_per_unit: f32,
+    /// What one unit of --mesh is: mm, cm, m, in, auto (the mesh is a y-up head or bust: its crown-to-neck height
+    /// becomes an adult head's 230 mm, for scans in arbitrary units) or a number of mm per unit. Default: m (glTF's
+    /// unit; OBJ has none).
+    #[arg(long, value_name = "UNITS")]
+    mesh_units: Option<String>,
+    /// Millimetres per unit of --mesh (a number; the same as --mesh-units NUMBER).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "mesh_units")]
+    mesh_mm_per_unit: Option<f32>,
+    /// Where --mesh's origin goes: bounds (its bounding-box centre is put where the camera looks, so any mesh is
+    /// framed) or authored (the file's own origin).
+    #[arg(long, value_enum, default_value = "bounds")]
+    mesh_origin: MeshOriginArg,
     /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ), tap2009 (α = 11, β = 800, no clamp of
     /// the depth derivative, TAP 2009 §4) — both stated for a 20° field of view and scaled to the camera's — or
     /// physical (α from the camera: each Gaussian at its width in mm, as TS and SS Jittered).
@@ -154,8 +171,9 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
     Ok(p)
 }
 
-/// Reads and validates `--mesh` (exit 2 naming the file and the defect).
-fn load_mesh(path: &Path, mm_per_unit: f32) -> anyhow::Result<Mesh> {
+/// Reads and validates `--mesh` (exit 2 naming the file and the defect), then puts it in metres (`units`) with
+/// its bounding-box centre at the origin unless `origin` is authored.
+fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Result<Mesh> {
     let name = format!("--mesh {}", path.display());
     let meta = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
     if meta.len() > MAX_MESH_FILE_BYTES {
@@ -173,10 +191,47 @@ fn load_mesh(path: &Path, mm_per_unit: f32) -> anyhow::Result<Mesh> {
             }
             std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))
         }),
-        Some("obj") => parse_obj(&name, &bytes, mm_per_unit),
+        Some("obj") => parse_obj(&name, &bytes, 1000.0),
         _ => return Err(usage_msg(format!("{name}: unknown extension; accepted .gltf, .glb, .obj"))),
     };
-    mesh.map_err(usage)
+    let mesh = mesh.map_err(usage)?;
+    let flag = "--mesh-units";
+    let framed = match origin {
+        MeshOriginArg::Bounds => frame_in_metres(&mesh, units, flag),
+        MeshOriginArg::Authored => {
+            // Positions as authored, scaled about the file's own origin.
+            let height = head_height_units(&mesh);
+            let to_m = units.mm_per_unit(height) / 1000.0;
+            let positions = mesh.positions.iter().map(|p| p.map(|c| c * to_m)).collect();
+            Mesh::new(flag, positions, mesh.normals.clone(), mesh.uvs.clone(), mesh.indices.clone(), 1000.0)
+        }
+    };
+    framed.map_err(usage)
+}
+
+/// The units of --mesh from --mesh-units / --mesh-mm-per-unit (default metres).
+fn mesh_units(a: &SkinArgs) -> anyhow::Result<MeshUnits> {
+    match (&a.mesh_units, a.mesh_mm_per_unit) {
+        (Some(u), _) => MeshUnits::parse("--mesh-units", u).map_err(usage),
+        (None, Some(v)) => {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(usage_msg(format!("--mesh-mm-per-unit must be a finite number > 0, got {v}")));
+            }
+            MeshUnits::parse("--mesh-mm-per-unit", &v.to_string()).map_err(usage)
+        }
+        (None, None) => Ok(MeshUnits::Metres),
+    }
+}
+
+/// --distance: metres, or TAP 2009's named distance for a head `height_m` tall.
+fn camera_distance(v: &str, height_m: f32) -> anyhow::Result<(f32, Option<TapDistance>)> {
+    if let Some(d) = TapDistance::parse(v.trim()) {
+        return Ok((d.camera_distance_m(height_m), Some(d)));
+    }
+    let m: f32 = v.trim().parse().map_err(|_| {
+        usage_msg(format!("--distance {v:?}: accepted a number of metres in 0.2..=100, or zoom, near, far (TAP 2009)"))
+    })?;
+    Ok((m, None))
 }
 
 /// The texture-space settings of `a` (validated: --ts-map-size in range).
@@ -196,7 +251,13 @@ fn ts_settings(a: &SkinArgs) -> anyhow::Result<TsSettings> {
 }
 
 pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
-    let settings = SkinRenderSettings {
+    let units = mesh_units(&a)?;
+    if a.mesh.is_none() && (a.mesh_units.is_some() || a.mesh_mm_per_unit.is_some()) {
+        return Err(usage_msg("--mesh-units and --mesh-mm-per-unit apply to --mesh only".to_string()));
+    }
+    // Named distances need the head's height: the procedural head's is known without reading a file.
+    let provisional = camera_distance(&a.distance, 0.23)?;
+    let mut settings = SkinRenderSettings {
         shader: match a.shader {
             ShaderArg::None => SkinShader::None,
             ShaderArg::SsFull => SkinShader::SsFull,
@@ -205,7 +266,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
             ShaderArg::Ts => SkinShader::Ts(ts_settings(&a)?),
         },
         heads: a.heads,
-        distance_m: a.distance,
+        distance_m: provisional.0,
         width: a.width,
         height: a.height,
         melanin: a.melanin,
@@ -219,9 +280,6 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         return Err(usage_msg("--ts-map-size and --ts-opt apply to --shader ts only".to_string()));
     }
     settings.validate().map_err(usage)?;
-    if !(a.mesh_mm_per_unit.is_finite() && a.mesh_mm_per_unit > 0.0) {
-        return Err(usage_msg(format!("--mesh-mm-per-unit must be a finite number > 0, got {}", a.mesh_mm_per_unit)));
-    }
     let inputs: Vec<&Path> = a.mesh.iter().map(|p| p.as_path()).collect();
     crate::run::check_output_of(&a.output, &inputs)?;
     ctx.check_budget(
@@ -235,9 +293,20 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         rtbake::runtime::demo::time_estimate_seconds(a.width, a.height, a.common.cpu) + 0.5,
     )?;
     let mesh = match &a.mesh {
-        Some(p) => load_mesh(p, a.mesh_mm_per_unit)?,
+        Some(p) => load_mesh(p, units, a.mesh_origin)?,
         None => default_head(),
     };
+    let head_height_m = head_height_units(&mesh) * mesh.mm_per_unit / 1000.0;
+    if a.mesh.is_some() && !(0.1..=0.5).contains(&head_height_m) {
+        ctx.info(format!(
+            "note: --mesh is {:.0} mm tall read as {units:?}; a head is about 230 mm (give --mesh-units: {})",
+            head_height_m * 1000.0,
+            MeshUnits::ACCEPTED
+        ));
+    }
+    let (distance_m, named) = camera_distance(&a.distance, head_height_m)?;
+    settings.distance_m = distance_m;
+    settings.validate().map_err(usage)?;
     let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
     let passes = passes(&a, &assets)?;
     let gpu = crate::run::device(ctx, a.common.cpu)?;
@@ -264,6 +333,22 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
             "width": out.width,
             "height": out.height,
             "adapter": gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU reference".into()),
+            "camera": {
+                "distance_m": distance_m,
+                "tap_distance": named.map(|d| d.name()),
+                "fov_y_deg": settings.camera().fov_y_deg,
+                "viewport": [out.width, out.height],
+                "head_height_mm": head_height_m * 1000.0,
+            },
+            "ss_full_stretch": matches!(a.shader, ShaderArg::SsFull).then(|| {
+                let p = settings.stretch.apply(assets.gaussian_params, settings.camera().fov_y_deg);
+                let v = p.for_viewport_height(out.height);
+                serde_json::json!({
+                    "preset": format!("{:?}", a.stretch).to_lowercase(),
+                    "alpha_at_720px": p.alpha, "alpha_at_viewport": v.alpha, "beta": p.beta,
+                    "gamma": if p.gamma == f32::MAX { None } else { Some(p.gamma) },
+                })
+            }),
             "wall_ms": ms,
         }));
     }

@@ -11,8 +11,28 @@ pub fn encode(linear: f64) -> f64 {
     }
 }
 
+/// Linear value of an sRGB-encoded one in [0, 1] (the inverse of [`encode`]: v/12.92 up to 0.04045, else
+/// ((v + 0.055)/1.055)^2.4).
+pub fn decode(encoded: f64) -> f64 {
+    let v = encoded.clamp(0.0, 1.0);
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn decode_inverts_encode() {
+        for i in 0..=255 {
+            let v = i as f64 / 255.0;
+            assert!((super::encode(super::decode(v)) - v).abs() < 1e-12, "{v}");
+        }
+        assert!((super::decode(0.461_356_1) - 0.18).abs() < 1e-6);
+    }
+
     #[test]
     fn mid_grey_and_ends() {
         assert_eq!(super::encode(0.0), 0.0);

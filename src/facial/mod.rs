@@ -11,10 +11,12 @@
 //! | [`disk_stats`] | exact disk mean/σ (eq. 7.1) in O(r) per texel, brute-force reference |
 //! | [`resample`] | area-weighted resampling for any ratio, bilinear reconstruction (texel centres, clamp) |
 //! | [`hemoglobin_rig`] | rig parameters (eq. 7.4–7.5), evaluation (eq. 7.6), weights |
+//! | [`appearance_transfer`] | a rig's relative changes carried onto another character's neutral map (§7.4.2) |
 //! | [`synthetic`] | procedural capillary-like hemoglobin maps and expression targets, synthetic wrinkles |
 //! | [`wrinkles`] | partial-derivative / difference normal encodings, cone clamp, zone masks, Table 8.1 |
 //! | [`inputs`] | decoding of concentration maps, normal maps and masks with their value mappings |
 
+pub mod appearance_transfer;
 pub mod disk_stats;
 pub mod hemoglobin_rig;
 pub mod inputs;

@@ -20,31 +20,7 @@ pub fn parse_gltf(
 ) -> Result<Mesh, InvalidInput> {
     let bad = |m: String| InvalidInput::new(what, m);
     let g = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("is not a valid glTF 2.0 file: {e}")))?;
-    let mut buffers = Vec::new();
-    for b in g.document.buffers() {
-        let data = match b.source() {
-            gltf::buffer::Source::Bin => g
-                .blob
-                .clone()
-                .ok_or_else(|| bad(format!("buffer {} refers to a GLB binary chunk it lacks", b.index())))?,
-            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                let payload = uri
-                    .split_once(";base64,")
-                    .map(|(_, p)| p)
-                    .ok_or_else(|| bad(format!("buffer {} has a data URI that is not base64", b.index())))?;
-                base64::engine::general_purpose::STANDARD
-                    .decode(payload)
-                    .map_err(|e| bad(format!("buffer {}: bad base64: {e}", b.index())))?
-            }
-            gltf::buffer::Source::Uri(uri) => {
-                external(uri).map_err(|e| bad(format!("buffer {} ({uri}): {e}", b.index())))?
-            }
-        };
-        if data.len() < b.length() {
-            return Err(bad(format!("buffer {} holds {} bytes, declares {}", b.index(), data.len(), b.length())));
-        }
-        buffers.push(data);
-    }
+    let buffers = load_buffers(what, &g, external)?;
     let scene = g
         .document
         .default_scene()
@@ -130,6 +106,119 @@ pub fn parse_gltf(
     Mesh::new(what, pos, nrm, uvs, idx, 1000.0)
 }
 
+/// The bytes of every buffer of `g`: the GLB binary chunk, `data:` URIs, or `external(uri)`.
+fn load_buffers(
+    what: &str,
+    g: &gltf::Gltf,
+    external: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+) -> Result<Vec<Vec<u8>>, InvalidInput> {
+    let bad = |m: String| InvalidInput::new(what, m);
+    let mut buffers = Vec::new();
+    for b in g.document.buffers() {
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => g
+                .blob
+                .clone()
+                .ok_or_else(|| bad(format!("buffer {} refers to a GLB binary chunk it lacks", b.index())))?,
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                decode_data_uri(uri).map_err(|e| bad(format!("buffer {}: {e}", b.index())))?
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                external(uri).map_err(|e| bad(format!("buffer {} ({uri}): {e}", b.index())))?
+            }
+        };
+        if data.len() < b.length() {
+            return Err(bad(format!("buffer {} holds {} bytes, declares {}", b.index(), data.len(), b.length())));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// The payload of a base64 `data:` URI.
+fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    let payload = uri.split_once(";base64,").map(|(_, p)| p).ok_or("a data URI that is not base64")?;
+    base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64: {e}"))
+}
+
+/// An image a glTF material refers to, still encoded (PNG or JPEG as the file stores it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EncodedImage {
+    /// The MIME type the file declares, if any (`image/png`, `image/jpeg`).
+    pub mime_type: Option<String>,
+    pub bytes: Vec<u8>,
+    /// Where it came from, for messages: `image 0 (buffer view 3)` or its URI.
+    pub origin: String,
+}
+
+/// The maps of a glTF material that the skin renderer uses (glTF 2.0 §3.9: `pbrMetallicRoughness.
+/// baseColorTexture`, sRGB; `normalTexture`, linear, tangent space in MikkTSpace with green up).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MaterialImages {
+    pub base_color: Option<EncodedImage>,
+    pub normal: Option<EncodedImage>,
+}
+
+/// The base-colour and normal images of the first material of the default scene's meshes that has either (the
+/// Lee Perry-Smith file of the three.js examples has none: its maps are separate files). Reads no file itself:
+/// `external(uri)` supplies images stored beside a `.gltf`.
+pub fn material_images(
+    what: &str,
+    bytes: &[u8],
+    external: &dyn Fn(&str) -> Result<Vec<u8>, String>,
+) -> Result<MaterialImages, InvalidInput> {
+    let bad = |m: String| InvalidInput::new(what, m);
+    let g = gltf::Gltf::from_slice(bytes).map_err(|e| bad(format!("is not a valid glTF 2.0 file: {e}")))?;
+    let buffers = load_buffers(what, &g, external)?;
+    let image = |tex: gltf::Texture| -> Result<EncodedImage, InvalidInput> {
+        let img = tex.source();
+        match img.source() {
+            gltf::image::Source::View { view, mime_type } => {
+                let buf = &buffers[view.buffer().index()];
+                let range = view.offset()..view.offset() + view.length();
+                let bytes = buf
+                    .get(range)
+                    .ok_or_else(|| bad(format!("image {} lies outside its buffer", img.index())))?
+                    .to_vec();
+                Ok(EncodedImage {
+                    mime_type: Some(mime_type.to_string()),
+                    bytes,
+                    origin: format!("image {} (buffer view {})", img.index(), view.index()),
+                })
+            }
+            gltf::image::Source::Uri { uri, mime_type } => {
+                let bytes =
+                    if uri.starts_with("data:") { decode_data_uri(uri) } else { external(uri) }.map_err(|e| {
+                        bad(format!("image {} ({}): {e}", img.index(), uri.chars().take(64).collect::<String>()))
+                    })?;
+                Ok(EncodedImage {
+                    mime_type: mime_type.map(str::to_string),
+                    bytes,
+                    origin: if uri.starts_with("data:") {
+                        format!("image {} (data URI)", img.index())
+                    } else {
+                        uri.to_string()
+                    },
+                })
+            }
+        }
+    };
+    for mesh in g.document.meshes() {
+        for p in mesh.primitives() {
+            let m = p.material();
+            let base = m.pbr_metallic_roughness().base_color_texture().map(|t| t.texture());
+            let normal = m.normal_texture().map(|t| t.texture());
+            if base.is_some() || normal.is_some() {
+                return Ok(MaterialImages {
+                    base_color: base.map(image).transpose()?,
+                    normal: normal.map(image).transpose()?,
+                });
+            }
+        }
+    }
+    Ok(MaterialImages::default())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -204,5 +293,32 @@ mod tests {
         assert!(e.to_string().contains("not a valid glTF"), "{e}");
         let e = parse_gltf("t.gltf", &triangle_gltf(true, true, [0.0; 3], [1.0, 0.0, 1.0]), &no_files).unwrap_err();
         assert!(e.to_string().contains("singular"), "{e}");
+    }
+
+    #[test]
+    fn material_images_come_from_data_uris_and_outside_files() {
+        let mut doc: serde_json::Value =
+            serde_json::from_slice(&triangle_gltf(true, true, [0.0; 3], [1.0; 3])).unwrap();
+        let b64 = base64::engine::general_purpose::STANDARD.encode(b"PNGBYTES");
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        doc["materials"] =
+            json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 1}}]);
+        doc["textures"] = json!([{"source": 0}, {"source": 1}]);
+        doc["images"] = json!([
+            {"uri": format!("data:image/png;base64,{b64}"), "mimeType": "image/png"},
+            {"uri": "normal.jpg"}
+        ]);
+        let bytes = serde_json::to_vec(&doc).unwrap();
+        let files = |uri: &str| if uri == "normal.jpg" { Ok(b"JPEG".to_vec()) } else { Err(format!("{uri} missing")) };
+        let m = material_images("t.gltf", &bytes, &files).unwrap();
+        assert_eq!(m.base_color.as_ref().unwrap().bytes, b"PNGBYTES");
+        assert_eq!(m.base_color.unwrap().mime_type.as_deref(), Some("image/png"));
+        let n = m.normal.unwrap();
+        assert_eq!((n.bytes.as_slice(), n.origin.as_str()), (&b"JPEG"[..], "normal.jpg"));
+        // A missing outside image is named; a material-less file has no maps.
+        let e = material_images("t.gltf", &bytes, &no_files).unwrap_err();
+        assert!(e.to_string().contains("normal.jpg"), "{e}");
+        let plain = triangle_gltf(true, true, [0.0; 3], [1.0; 3]);
+        assert_eq!(material_images("t.gltf", &plain, &no_files).unwrap(), MaterialImages::default());
     }
 }

@@ -12,6 +12,7 @@
 //! Positions are in mesh units with [`Mesh::mm_per_unit`] saying what one unit is (glTF: metres, 1000 mm).
 
 pub mod camera;
+pub mod framing;
 pub mod gltf;
 pub mod head;
 pub mod obj;

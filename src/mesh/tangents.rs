@@ -17,8 +17,16 @@
 //! the texture, [`super::Mesh::uvs`]) B points towards increasing v: the DirectX green convention of the wrinkle
 //! maps ([`crate::facial::wrinkles`]). Triangles whose uv area is zero add nothing; a vertex with no usable
 //! triangle gets an arbitrary unit tangent perpendicular to its normal and w = 1.
+//!
+//! **MikkTSpace** ([`mikktspace_tangents`]; Mikkelsen, *Simulation of Wrinkled Surfaces Revisited*, MSc thesis,
+//! University of Copenhagen, 2008) is the frame normal maps are baked in by xNormal, Blender and Substance and the
+//! one glTF 2.0 prescribes: per face corner, order-independent, with the same sign convention (the bitangent is
+//! `w·(N × T)` and points along ∂p/∂v). A scanned head's normal map is only reproduced exactly in that frame, so a
+//! mesh rendered with a normal map uses it; where the corners of one vertex get different frames (mirrored UVs
+//! without a seam) the vertex is split. The computation is `bevy_mikktspace`'s port of the reference C code.
 
 use super::Mesh;
+use bevy_mikktspace::{Geometry, TangentSpace};
 
 fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -74,6 +82,76 @@ pub fn vertex_tangents(mesh: &Mesh) -> Vec<[f32; 4]> {
             [t[0], t[1], t[2], w]
         })
         .collect()
+}
+
+/// The mesh's face corners as MikkTSpace sees them, and the frame it writes back per corner.
+struct Corners<'a> {
+    mesh: &'a Mesh,
+    frames: Vec<Option<[f32; 4]>>,
+}
+
+impl Geometry for Corners<'_> {
+    fn num_faces(&self) -> usize {
+        self.mesh.indices.len() / 3
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.positions[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.normals[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        self.mesh.uvs[self.mesh.indices[face * 3 + vert] as usize]
+    }
+    fn set_tangent(&mut self, frame: Option<TangentSpace>, face: usize, vert: usize) {
+        self.frames[face * 3 + vert] = frame.map(|t| t.tangent_encoded());
+    }
+}
+
+/// MikkTSpace tangents (see the module doc): the mesh, with a vertex split wherever its corners got different
+/// frames, and one unit tangent `(x, y, z)` with handedness `w` (±1) per vertex of that mesh. Corners MikkTSpace
+/// leaves without a frame (no usable neighbour) take [`vertex_tangents`]' frame of their vertex.
+pub fn mikktspace_tangents(mesh: &Mesh) -> (Mesh, Vec<[f32; 4]>) {
+    let mut corners = Corners { mesh, frames: vec![None; mesh.indices.len()] };
+    let fallback = vertex_tangents(mesh);
+    // The port reports an error only for meshes it cannot index (none of ours: every face is a triangle); the
+    // fallback frame then stands for every corner.
+    let _ = bevy_mikktspace::generate_tangents(&mut corners);
+    let mut out = mesh.clone();
+    let mut tangents: Vec<Option<[f32; 4]>> = vec![None; mesh.positions.len()];
+    for (k, idx) in out.indices.iter_mut().enumerate() {
+        let v = *idx as usize;
+        let frame = corners.frames[k].unwrap_or(fallback[v]);
+        match tangents[v] {
+            None => tangents[v] = Some(frame),
+            Some(t) if t == frame => {}
+            Some(_) => {
+                // Another frame at the same vertex: reuse a split copy with this frame, or make one.
+                let copy = (mesh.positions.len()..out.positions.len()).find(|&c| {
+                    tangents[c] == Some(frame)
+                        && out.positions[c] == mesh.positions[v]
+                        && out.normals[c] == mesh.normals[v]
+                        && out.uvs[c] == mesh.uvs[v]
+                });
+                *idx = match copy {
+                    Some(c) => c as u32,
+                    None => {
+                        out.positions.push(mesh.positions[v]);
+                        out.normals.push(mesh.normals[v]);
+                        out.uvs.push(mesh.uvs[v]);
+                        tangents.push(Some(frame));
+                        (out.positions.len() - 1) as u32
+                    }
+                };
+            }
+        }
+    }
+    let tangents =
+        tangents.iter().enumerate().map(|(v, t)| t.unwrap_or_else(|| fallback[v.min(fallback.len() - 1)])).collect();
+    (out, tangents)
 }
 
 #[cfg(test)]
@@ -137,5 +215,51 @@ mod tests {
             let v = t[i as usize];
             assert!(dot([v[0], v[1], v[2]], dpdu) > 0.0);
         }
+    }
+
+    /// MikkTSpace gives the flat square the same frame as the derivative construction (T = +x, bitangent along
+    /// ∂p/∂v, w = −1 for v down the texture), keeps every vertex, and on the head agrees with it closely.
+    #[test]
+    fn mikktspace_agrees_with_the_uv_derivatives() {
+        let sq = square(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+        let (m, t) = mikktspace_tangents(&sq);
+        assert_eq!(m.positions.len(), 4);
+        for v in &t {
+            assert!((v[0] - 1.0).abs() < 1e-6 && v[1].abs() < 1e-6 && v[2].abs() < 1e-6 && v[3] == -1.0, "{v:?}");
+        }
+        let head = crate::mesh::head::default_head();
+        let (m, t) = mikktspace_tangents(&head);
+        assert_eq!(t.len(), m.positions.len());
+        assert_eq!(m.indices.len(), head.indices.len());
+        let lengyel = vertex_tangents(&m);
+        let mut close = 0;
+        for ((v, n), l) in t.iter().zip(&m.normals).zip(&lengyel) {
+            let tv = [v[0], v[1], v[2]];
+            assert!((dot(tv, tv) - 1.0).abs() < 1e-4, "{v:?}");
+            assert!(dot(tv, *n).abs() < 1e-3, "{v:?} vs {n:?}");
+            if dot(tv, [l[0], l[1], l[2]]) > 0.95 && v[3] == l[3] {
+                close += 1;
+            }
+        }
+        assert!(close as f64 > 0.95 * t.len() as f64, "{close} of {} within 18°", t.len());
+    }
+
+    /// Two triangles that share an edge but mirror their UVs (no seam): the shared vertices get two frames of
+    /// opposite handedness, so they are split and every corner keeps its own frame.
+    #[test]
+    fn mirrored_uvs_split_the_shared_vertices() {
+        let m = Mesh::new(
+            "mirror",
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]],
+            vec![[0.0, 0.0, 1.0]; 4],
+            vec![[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 1.0]],
+            vec![0, 1, 2, 0, 2, 3],
+            1000.0,
+        )
+        .unwrap();
+        let (out, t) = mikktspace_tangents(&m);
+        assert_eq!(out.positions.len(), 6, "vertices 0 and 2 split");
+        let w: Vec<f32> = out.indices.iter().map(|&i| t[i as usize][3]).collect();
+        assert!(w[..3].iter().all(|&x| x == w[0]) && w[3..].iter().all(|&x| x == w[3]) && w[0] != w[3], "{w:?}");
     }
 }

@@ -1,5 +1,5 @@
 //! TAP 2009 Table II (Jimenez, Sundstedt & Gutierrez 2009, §6): "Output for the Chi-Square Analysis (df = 1, 0.05
-//! Level of Significance)" of the 2AFC study, 32 participants per comparison, TS (texture-space diffusion) against
+//! Level of Significance)" of the 2AFC study, 32 responses per comparison (16 participants, each pair shown twice, §5.2), TS (texture-space diffusion) against
 //! No SSS, SS Jittered and SS Full at three camera distances (Far, Near, Zoom) and four light angles.
 //!
 //! The paper prints χ² and p only. The counts are the ones those χ² imply: χ² = (2c − 32)²/32 has the two roots
@@ -18,8 +18,11 @@ pub struct PublishedRow {
     pub p_value: f64,
 }
 
-/// Participants per comparison ("an expected 16/16 (32 for each comparison)").
-pub const PARTICIPANTS: u64 = 32;
+/// Responses per comparison ("an expected 16/16 (32 for each comparison)"): 16 participants, each of whom saw
+/// every pair twice (§5.2, counterbalanced order).
+pub const RESPONSES_PER_COMPARISON: u64 = 32;
+/// Participants of the study (§5.2); each answered every comparison twice.
+pub const PARTICIPANTS: u64 = 16;
 
 const fn row(
     configuration: &'static str,
@@ -48,7 +51,7 @@ pub const PUBLISHED: [PublishedRow; 36] = [
     row("TS - Zoom - 150°", "No SSS", 32, 32.0, 0.000), row("TS - Zoom - 150°", "SS Jittered", 28, 18.0, 0.000), row("TS - Zoom - 150°", "SS Full", 18, 0.5, 0.480),
 ];
 
-/// The implied counts as the input of [`super::chi_square_2afc`]: comparison "TS vs SHADER", TS chosen of 32.
+/// The implied counts as the input of [`super::chi_square_2afc`]: comparison "TS vs SHADER", TS chosen of 32 responses.
 pub fn implied_counts() -> Vec<PreferenceCount> {
     PUBLISHED
         .iter()
@@ -56,7 +59,7 @@ pub fn implied_counts() -> Vec<PreferenceCount> {
             configuration: r.configuration.to_string(),
             comparison: format!("TS vs {}", r.shader),
             chosen: r.ts_chosen,
-            total: PARTICIPANTS,
+            total: RESPONSES_PER_COMPARISON,
         })
         .collect()
 }

@@ -41,6 +41,7 @@ mod fitting_published;
 mod importance_cli;
 mod input_validation_cli;
 mod mesh_raster;
+mod mesh_scan;
 mod newcomer_cli;
 mod newcomer_profile_floor;
 mod newcomer_provenance;

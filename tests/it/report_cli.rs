@@ -100,3 +100,42 @@ print("ok")
     assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
     assert_eq!(String::from_utf8_lossy(&py.stdout).trim(), "ok");
 }
+
+/// `--plot` draws TAP 2009 Fig. 8 as a PNG a person can read (two labelled panels) and the JSON carries the
+/// proportions behind it; a counts file without distances or angles, or a plot with an unknown extension, exits 2
+/// with nothing written.
+#[test]
+fn the_fig_8_proportions_and_their_plot() {
+    let t = tempfile::tempdir().unwrap();
+    let png = t.path().join("fig8.png");
+    let o = rtbake(&["--json", "report", "chi2", "--counts", "tap2009", "--plot", png.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let by_angle = v["proportions"]["by_light_azimuth_deg"].as_array().unwrap();
+    assert_eq!(by_angle.len(), 4);
+    // 110°: SS Full chosen 17 + 19 + 22 = 58 of 96.
+    let full_110 = by_angle[2][1].as_array().unwrap().iter().find(|p| p["comparison"] == "TS vs SS Full").unwrap();
+    assert_eq!(
+        (by_angle[2][0].as_f64(), full_110["chosen"].as_u64(), full_110["total"].as_u64()),
+        (Some(110.0), Some(58), Some(96))
+    );
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (760, 720));
+    let svg = t.path().join("fig8.svg");
+    let o = rtbake(&["report", "chi2", "--counts", "tap2009", "--plot", svg.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("per camera distance") && text.contains("chance (0.5)"));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("TS vs SS Full 58/96"));
+
+    let counts = t.path().join("c.csv");
+    std::fs::write(&counts, "configuration,comparison,chosen,total\nsession 1,A vs B,10,20\n").unwrap();
+    let none = t.path().join("none.png");
+    let o = rtbake(&["report", "chi2", "--counts", counts.to_str().unwrap(), "--plot", none.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--plot"), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = rtbake(&["report", "chi2", "--counts", "tap2009", "--plot", t.path().join("f.jpg").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("accepted .png, .svg"));
+    assert!(!none.exists() && !t.path().join("f.jpg").exists());
+}
