@@ -1,7 +1,7 @@
 //! Small wgpu helpers shared by the passes: explicit-format textures, uploads, read-backs, full-screen
 //! fragment pipelines and GPU timestamp collection. Nothing here creates a device.
 
-use super::RuntimeError;
+use crate::runtime::RuntimeError;
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
