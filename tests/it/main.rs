@@ -10,6 +10,7 @@ mod support;
 
 mod aa_cli;
 mod aa_golden;
+mod architecture;
 mod bake_cli;
 mod baked_conformance;
 mod burley_bake;
