@@ -311,7 +311,7 @@ mod tests {
 
     type Edit = Box<dyn Fn(&mut Value)>;
 
-    /// Issue 15 finding 4: a file tampered together with its sha256 must fail whatever else the manifest says.
+    /// A file tampered together with its sha256 must fail whatever else the manifest says.
     #[test]
     fn manifest_cannot_switch_verification_off() {
         let t = tempfile::tempdir().unwrap();

@@ -114,7 +114,7 @@ pub fn antialias_with<'g>(
 }
 
 /// Peak memory (bytes) and wall time (s) of `rtbake run smaa|mlaa` on a `w`×`h` image, decoding and encoding
-/// included (issue 15's budget check, before the pass): times measured with the release build on the project's 2-core
+/// included (the budget check, before the pass): times measured with the release build on the project's 2-core
 /// machine at 1024² on the CPU path (SMAA 0.41 s, MLAA 0.78 s), doubled; the GPU path takes a tenth of the CPU time
 /// plus 1 s of device set-up and the same host buffers. Memory: 24 bytes per pixel + 32 MiB, from peak RSS measured
 /// on the CPU path (4096²: SMAA 11 B/px, MLAA 14 B/px; SMAA at 16384²: 4.1 GB, 15.3 B/px), so the largest input

@@ -61,7 +61,7 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
 }
 
 /// Peak host memory of [`render`] at `w`×`h`, in bytes: 120 bytes per pixel + 64 MiB, from peak RSS of the CPU
-/// path measured at 512² and 1024² (115 B/pixel; issue 15). The GPU path keeps the same host-side buffers.
+/// path measured at 512² and 1024² (115 B/pixel). The GPU path keeps the same host-side buffers.
 pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
     120 * w as u64 * h as u64 + (64 << 20)
 }
@@ -107,7 +107,7 @@ pub fn render<'g>(
     shade(gpu, lit, assets, Some(method), crate::runtime::aa::scene::render_shapes(w, h, 1), aa)
 }
 
-/// Wall time of [`render`] at `w`×`h` plus the PNG encoding (issue 15's budget check): 1 µs per pixel on the CPU
+/// Wall time of [`render`] at `w`×`h` plus the PNG encoding (the budget check): 1 µs per pixel on the CPU
 /// path (0.94 s at 1024² on the project's 2-core machine, release), a tenth of it with a GPU, plus 0.5 s start-up.
 pub fn time_estimate_seconds(w: u32, h: u32, cpu: bool) -> f64 {
     let per_pixel = if cpu { 1.0e-6 } else { 0.1e-6 };

@@ -1,4 +1,4 @@
-//! `rtbake run skin`: heads rendered from a triangle mesh through the skin chain (issue 14; TAP 2009 §5–6 compares
+//! `rtbake run skin`: heads rendered from a triangle mesh through the skin chain (TAP 2009 §5–6 compares
 //! shaders on heads; thesis ch. 4–6 for the screen-space passes, ch. 5 Listing 5.1 for thickness from a shadow map).
 //!
 //! 1. The mesh (the procedural [`crate::mesh::head::default_head`] or a glTF/OBJ), repeated `heads` times 0.25 m

@@ -1,4 +1,4 @@
-//! The mesh G-buffer pass of the skin renderer (issue 14; TAP 2009 §5 renders heads, thesis ch. 3–5 shades them):
+//! The mesh G-buffer pass of the skin renderer (TAP 2009 §5 renders heads, thesis ch. 3–5 shades them):
 //! a wgpu render pipeline with a `Depth32Float` depth buffer (less-than test, back faces culled, counter-clockwise
 //! front faces) that writes per pixel the view-space unit normal and the linear view depth in mm
 //! (`Rgba16Float`), the texture coordinates with a coverage flag (`Rgba16Float`) and the view-space tangent of

@@ -1,4 +1,4 @@
-//! The passes of the thesis' skin shader that `run skin` adds around its SSS shader (issue 14, part B), chosen
+//! The passes of the thesis' skin shader that `run skin` adds around its SSS shader, chosen
 //! per frame: the rig's eq. 7.6 in texture space ([`crate::runtime::skin::mesh_inputs`], thesis §7.6) and the wrinkle pass
 //! ([`crate::runtime::skin::wrinkles`], thesis ch. 8 Listing 8.1) before shading, and bloom on the final HDR frame before
 //! tone mapping ([`crate::runtime::skin::bloom`], thesis ch. 4), and the G-buffer's sample count (MSAA). The default is the
