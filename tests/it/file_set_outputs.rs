@@ -1,4 +1,4 @@
-//! Issue 15, findings 6 and 7: multi-file outputs outside `bake` are one set (locked, all or nothing, a kill rolled
+//! Multi-file outputs outside `bake` are one set (locked, all or nothing, a kill rolled
 //! forward by the next command that locks or reads the directory), and an output equal to an input is refused.
 //! Kill points come from the `RTBAKE_FAULT_INJECT` hook, not from timing.
 

@@ -1,4 +1,4 @@
-//! Issue 15, findings 9 and 11: non-finite results are errors naming their input (nothing written), negative
+//! Non-finite results are errors naming their input (nothing written), negative
 //! numbers after a space reach the range check that names the flag, and `--asset-params` type errors name the
 //! field.
 

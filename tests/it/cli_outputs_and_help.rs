@@ -1,4 +1,5 @@
-//! The first-hour CLI fixes of issue 16 (points 4–8): one contract per test.
+//! What a first use of the CLI meets: map channels, pure CSV on stdout, output folders and lists, how to bake a
+//! missing table, binary formats for large tables, `--help` texts, a quiet GPU start — one contract per test.
 
 use crate::support::{crate_dir, rtbake};
 use rtbake::image_buf::Image;

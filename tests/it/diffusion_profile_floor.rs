@@ -1,5 +1,5 @@
 //! Layered profile tables never hold negative R or T: where the numerical inverse Hankel transform's error floor
-//! dips below zero at large r, the table holds 0 and says so (issue 16, point 5).
+//! dips below zero at large r, the table holds 0 and says so.
 
 use rtbake::diffusion::layered::Adding;
 use rtbake::diffusion::multipole::Series;

@@ -1,4 +1,4 @@
-//! Every command of the README runs as written (issue 16, point 3): the lines of the README's ```sh blocks are run
+//! Every command of the README runs as written: the lines of the README's ```sh blocks are run
 //! in order with `sh -c` in a scratch directory (the first of them bakes `baked/` there), with this build's
 //! `rtbake` first on the PATH. Only files a fresh clone has, or an earlier command wrote, may be named.
 

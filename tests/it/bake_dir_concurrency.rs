@@ -1,4 +1,4 @@
-//! Issue 15, findings 1, 2, 5 and 10: the bake directory under concurrent runs, kills at every step of the swap, a
+//! The bake directory under concurrent runs, kills at every step of the swap, a
 //! symlinked `--out` and `--out .`. Concurrency uses two real processes; the interleaving is forced through the
 //! `RTBAKE_FAULT_INJECT` hook (`hold@STEP` stops a process at STEP until a line arrives on its stdin), never sleeps.
 

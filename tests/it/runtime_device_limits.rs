@@ -1,4 +1,4 @@
-//! Issue 15, finding 3: the GPU path checks every image against the adapter's real limits before it allocates,
+//! The GPU path checks every image against the adapter's real limits before it allocates,
 //! and refuses with the limit named (exit 2 from the command) instead of panicking inside wgpu.
 
 use crate::support::{baked_smaa, gpu};

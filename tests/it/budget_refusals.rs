@@ -1,4 +1,4 @@
-//! Issue 15, finding 8: every size range `--help` documents is one the machine can serve. Each heavy job estimates
+//! Every size range `--help` documents is one the machine can serve. Each heavy job estimates
 //! its peak memory and its run time before any work (from the models' `memory_estimate_bytes` /
 //! `time_estimate_seconds`) and refuses, with exit 2, the flags, the estimate and the budget named, whatever exceeds
 //! `--max-memory` or `--max-seconds` (default 600 s); the largest sizes `--help` allows are refused in well under

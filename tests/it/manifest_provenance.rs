@@ -1,4 +1,4 @@
-//! The manifest records rtbake's own provenance (issue 16, point 2): the crate version and the git tree id of the
+//! The manifest records rtbake's own provenance: the crate version and the git tree id of the
 //! `src/` it was compiled from, captured at build time — not the directory the user bakes in — and re-baking the
 //! same tree leaves `manifest.json` byte-identical.
 
