@@ -12,7 +12,13 @@ use crate::runtime::aa::modes_cpu::SmaaModesCpu;
 use crate::runtime::aa::smaa::{Smaa, SmaaOptions, SmaaTextures};
 use crate::runtime::aa::smaa_cpu;
 use crate::runtime::backend::{Backend, Prepared};
+use crate::runtime::loader::BakedRig;
 use crate::runtime::sampler::FilterPrecision;
+use crate::runtime::skin::bloom::{self, BloomParams};
+use crate::runtime::skin::mesh_inputs::{self, RigAtUv, RigPose};
+use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::skin::wrinkles::{self, WrinkleMaps};
+use crate::runtime::skin::{bloom_cpu, mesh_inputs_cpu, wrinkles_cpu};
 use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSss, GaussianSssParams};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
 use crate::runtime::sss::separable::{SeparableSss, SssKernel, SssParams};
@@ -274,4 +280,46 @@ impl<'g> SmaaSequence<'g> {
         let out = self.0.run(|g, p| p.run_frame(&g.device, &g.queue, frame), |p| Ok(p.run_frame(frame)?))?;
         Ok(opaque(out))
     }
+}
+
+/// Bloom ([`crate::runtime::skin::bloom::bloom`]) on `gpu`, or its CPU twin.
+pub fn bloom_for<'g>(
+    gpu: impl Into<Backend<'g>>,
+    width: u32,
+    height: u32,
+    hdr_rgba: &[f32],
+    p: &BloomParams,
+) -> Result<Vec<f32>, RuntimeError> {
+    gpu.into().run(
+        |g| bloom::bloom(&g.device, &g.queue, width, height, hdr_rgba, p),
+        || Ok(bloom_cpu::bloom(width, height, hdr_rgba, p)?),
+    )
+}
+
+/// H per pixel of the G-buffer `g` for the baked rig in `pose` ([`mesh_inputs::hemoglobin_at_uv`]) on `gpu`, or its
+/// CPU twin.
+pub fn hemoglobin_for_gbuffer<'g>(
+    gpu: impl Into<Backend<'g>>,
+    g: &MeshGBuffer,
+    rig: &BakedRig,
+    pose: &RigPose,
+) -> Result<Vec<f32>, RuntimeError> {
+    let maps = RigAtUv { rig: &rig.rig, h0: &rig.h0, pose };
+    gpu.into().run(
+        |d| mesh_inputs::hemoglobin_at_uv(&d.device, &d.queue, g.width, g.height, &g.uv, &g.covered, &maps),
+        || mesh_inputs_cpu::hemoglobin_at_uv(&g.uv, &g.covered, &maps),
+    )
+}
+
+/// The wrinkle pass's normals ([`wrinkles::wrinkled_normals`]) on `gpu`, or its CPU twin.
+pub fn wrinkled_normals_for<'g>(
+    gpu: impl Into<Backend<'g>>,
+    g: &MeshGBuffer,
+    maps: &WrinkleMaps,
+    weights: &[f32; 8],
+) -> Result<Vec<[f32; 3]>, RuntimeError> {
+    gpu.into().run(
+        |d| wrinkles::wrinkled_normals(&d.device, &d.queue, g, maps, weights),
+        || Ok(wrinkles_cpu::wrinkled_normals(g, maps, weights)?),
+    )
 }

@@ -227,6 +227,18 @@ pub fn fullscreen_pipeline(
     fs_entry: &str,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    let target = wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL };
+    fullscreen_pipeline_with(device, label, module, fs_entry, &[Some(target)])
+}
+
+/// As [`fullscreen_pipeline`] with the colour `targets` given (several render targets, blending).
+pub fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fs_entry: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
@@ -243,7 +255,7 @@ pub fn fullscreen_pipeline(
             module,
             entry_point: Some(fs_entry),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            targets,
         }),
         multiview_mask: None,
         cache: None,

@@ -28,10 +28,23 @@ pub mod transport;
 
 // The flat module paths of the callers (`bin/`, tests, examples), each an alias of its room's module.
 pub use aa::{edges as smaa_edges, mlaa, modes as smaa_modes, moving_scene, scene, smaa};
-pub use skin::{
-    bloom, inputs as skin_inputs, mesh_inputs as mesh_skin_inputs, mesh_raster, passes as skin_passes, texture_space,
-    wrinkles as wrinkle_pass,
-};
+pub use skin::{inputs as skin_inputs, mesh_raster, passes as skin_passes, texture_space};
+
+/// The skin passes under the callers' flat paths, with the function that runs each on a backend.
+pub mod bloom {
+    pub use super::chain::bloom_for;
+    pub use super::skin::bloom::*;
+}
+/// See [`bloom`].
+pub mod mesh_skin_inputs {
+    pub use super::chain::hemoglobin_for_gbuffer;
+    pub use super::skin::mesh_inputs::*;
+}
+/// See [`bloom`].
+pub mod wrinkle_pass {
+    pub use super::chain::wrinkled_normals_for;
+    pub use super::skin::wrinkles::*;
+}
 pub use sss::{gaussian as gaussian_sss, importance as importance_sss, separable as separable_sss};
 pub use transport::mc_gpu as transport_gpu;
 

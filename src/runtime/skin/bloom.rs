@@ -24,7 +24,6 @@
 //! per-blur sums in the same order).
 
 use crate::error::{check_range, InvalidInput};
-use crate::runtime::backend::Backend;
 use crate::runtime::compute_chain::{self, Buffer, Stage};
 use crate::runtime::RuntimeError;
 
@@ -133,21 +132,6 @@ pub fn bloom(
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())
-}
-
-/// [`bloom`] on the GPU, or its CPU twin when `gpu` is the CPU.
-pub fn bloom_for<'g>(
-    gpu: impl Into<Backend<'g>>,
-    width: u32,
-    height: u32,
-    hdr_rgba: &[f32],
-    p: &BloomParams,
-) -> Result<Vec<f32>, RuntimeError> {
-    let gpu: Backend = gpu.into();
-    gpu.run(
-        |g| bloom(&g.device, &g.queue, width, height, hdr_rgba, p),
-        || Ok(crate::runtime::skin::bloom_cpu::bloom(width, height, hdr_rgba, p)?),
-    )
 }
 
 #[cfg(test)]

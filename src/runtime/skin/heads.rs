@@ -171,7 +171,7 @@ pub(crate) fn geometry(
         || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
     )?;
     if let Some(w) = &passes.wrinkles {
-        g.normal_view = crate::runtime::skin::wrinkles::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
+        g.normal_view = crate::runtime::chain::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
     }
     let shadow = ShadowMap::new(gpu, mesh, &cam)?;
     let thickness = thickness_mm(&g, &cam, &shadow, mesh.mm_per_unit);
@@ -189,7 +189,7 @@ pub(crate) fn geometry(
         Some(r) => {
             let neutral = crate::runtime::skin::mesh_inputs::RigPose::neutral(r.names.len());
             let pose = passes.rig_pose.as_ref().unwrap_or(&neutral);
-            Some(crate::runtime::skin::mesh_inputs::hemoglobin_for_gbuffer(gpu, &g, r, pose)?)
+            Some(crate::runtime::chain::hemoglobin_for_gbuffer(gpu, &g, r, pose)?)
         }
         None => None,
     };

@@ -204,27 +204,8 @@ impl SkinInputs {
         let ubo = gpu::uniform_buffer(device, "skin params", bytemuck::bytes_of(&params));
         let module = gpu::shader(device, "skin_inputs.wgsl", SHADER);
         let target = |f| Some(wgpu::ColorTargetState { format: f, blend: None, write_mask: wgpu::ColorWrites::ALL });
-        let pipe = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("skin inputs"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_skin"),
-                compilation_options: Default::default(),
-                targets: &[target(F::Rgba16Float), target(F::Rgba16Float)],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let targets = [target(F::Rgba16Float), target(F::Rgba16Float)];
+        let pipe = gpu::fullscreen_pipeline_with(device, "skin inputs", &module, "fs_skin", &targets);
         let lin = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let rig_view = rig_tex.create_view(&wgpu::TextureViewDescriptor {

@@ -322,7 +322,7 @@ pub(crate) fn composite(
                 hdr[4 * i + c] = sampler::srgb_to_linear(rgba[4 * i + c] as f32 / 255.0);
             }
         }
-        let out = crate::runtime::skin::bloom::bloom_for(gpu, w, h, &hdr, b)?;
+        let out = crate::runtime::chain::bloom_for(gpu, w, h, &hdr, b)?;
         for i in (0..n).filter(|&i| !geo.skin[i]) {
             if out[4 * i..4 * i + 3] != hdr[4 * i..4 * i + 3] {
                 for c in 0..3 {

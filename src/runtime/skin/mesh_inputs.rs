@@ -19,7 +19,6 @@
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
-use crate::runtime::backend::Backend;
 use crate::runtime::compute_chain::{self, Buffer, Stage};
 use crate::runtime::loader::BakedRig;
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
@@ -177,21 +176,6 @@ pub fn hemoglobin_at_uv(
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())
-}
-
-/// H per pixel of the G-buffer `g` for the baked rig in `pose`: the GPU pass, or its CPU twin when `gpu` is the CPU.
-pub fn hemoglobin_for_gbuffer<'g>(
-    gpu: impl Into<Backend<'g>>,
-    g: &crate::runtime::skin::mesh_raster::MeshGBuffer,
-    rig: &BakedRig,
-    pose: &RigPose,
-) -> Result<Vec<f32>, RuntimeError> {
-    let gpu: Backend = gpu.into();
-    let maps = RigAtUv { rig: &rig.rig, h0: &rig.h0, pose };
-    gpu.run(
-        |d| hemoglobin_at_uv(&d.device, &d.queue, g.width, g.height, &g.uv, &g.covered, &maps),
-        || crate::runtime::skin::mesh_inputs_cpu::hemoglobin_at_uv(&g.uv, &g.covered, &maps),
-    )
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub enum SkinShader {
     SsJittered,
     /// d'Eon et al.'s texture-space diffusion (TAP's "TS") with the thesis ch. 3 optimisations switchable
     /// ([`crate::runtime::skin::texture_space`]).
-    Ts(crate::runtime::skin::texture_space::TsSettings),
+    Ts(TsSettings),
 }
 
 /// The stretch parameters of the SS Full shader (eq. 4.1–4.4 / TAP 2009 eq. 2–3).

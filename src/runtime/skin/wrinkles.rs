@@ -23,7 +23,6 @@ use crate::baked_layout::path;
 use crate::error::InvalidInput;
 use crate::facial::wrinkles::{zone_weights, TABLE_8_1};
 use crate::io::PixelFormat;
-use crate::runtime::backend::Backend;
 use crate::runtime::compute_chain::{self, Buffer, Stage};
 use crate::runtime::loader::{BakedDir, LutError, LutSpec};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
@@ -177,20 +176,6 @@ pub fn wrinkled_normals(
     )?;
     let f: &[f32] = bytemuck::cast_slice(&out);
     Ok(f.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
-}
-
-/// [`wrinkled_normals`] on the GPU, or its CPU twin when `gpu` is the CPU.
-pub fn wrinkled_normals_for<'g>(
-    gpu: impl Into<Backend<'g>>,
-    g: &MeshGBuffer,
-    maps: &WrinkleMaps,
-    weights: &[f32; 8],
-) -> Result<Vec<[f32; 3]>, RuntimeError> {
-    let gpu: Backend = gpu.into();
-    gpu.run(
-        |d| wrinkled_normals(&d.device, &d.queue, g, maps, weights),
-        || Ok(crate::runtime::skin::wrinkles_cpu::wrinkled_normals(g, maps, weights)?),
-    )
 }
 
 #[cfg(test)]

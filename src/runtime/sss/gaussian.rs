@@ -146,38 +146,15 @@ impl GaussianSss {
                 operation: wgpu::BlendOperation::Add,
             },
         };
-        let pipe_v = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gsss vertical"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_vertical"),
-                compilation_options: Default::default(),
-                targets: &[
-                    Some(wgpu::ColorTargetState {
-                        format: F::Rgba16Float,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    }),
-                    Some(wgpu::ColorTargetState {
-                        format: F::Rgba16Float,
-                        blend: Some(blend),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    }),
-                ],
+        let targets = [
+            Some(wgpu::ColorTargetState { format: F::Rgba16Float, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+            Some(wgpu::ColorTargetState {
+                format: F::Rgba16Float,
+                blend: Some(blend),
+                write_mask: wgpu::ColorWrites::ALL,
             }),
-            multiview_mask: None,
-            cache: None,
-        });
+        ];
+        let pipe_v = gpu::fullscreen_pipeline_with(device, "gsss vertical", &module, "fs_vertical", &targets);
         let lin = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (iv, dv, rt1_view, rt2_view, rtf_view) = (view(&input), view(&depth), view(&rt1), view(&rt2), view(&rtf));

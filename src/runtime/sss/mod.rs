@@ -2,8 +2,7 @@
 //!
 //! - [`separable`] (`separable.wgsl`, [`separable_cpu`]): separable SSS, Jimenez et al., CGF 2015 (thesis ch. 6);
 //! - [`gaussian`] (`gaussian.wgsl`, [`gaussian_cpu`]): the screen-space sum of Gaussians, TAP 2009 (thesis ch. 4);
-//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel;
-//! - [`camera`]: the camera facts the passes share (field of view, world scale).
+//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel.
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
 
