@@ -10,8 +10,9 @@
 
 use crate::aa::mlaa_area::MlaaVersion;
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{AaInputs, EdgeSettings, EdgeStage};
-use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::aa::edges::{EdgeSettings, EdgeStage};
+use crate::runtime::aa::three_pass::ThreePass;
+use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
 /// Luma edge threshold of the MLAA listings.
@@ -20,7 +21,7 @@ pub const MLAA_THRESHOLD: f32 = 0.1;
 /// Maximum distance N the runtime uses unless told otherwise (a map the default bake holds).
 pub const DEFAULT_MAX_DISTANCE: u32 = 33;
 
-/// Number of timed passes [`Mlaa::encode`] records.
+/// Number of timed passes [`ThreePass::encode`] records.
 pub const MLAA_PASSES: u32 = 3;
 
 /// A Jimenez MLAA v1.4 area map: 5N×5N RG8 bytes (top row first) for maximum distance N, validated by
@@ -68,17 +69,13 @@ struct Params {
 const SHADER: &str = include_str!("mlaa.wgsl");
 
 /// MLAA for one frame size and area map. Create once, run per frame.
-pub struct Mlaa {
-    width: u32,
-    height: u32,
-    color: wgpu::Texture,
-    edges: wgpu::Texture,
-    weights: wgpu::Texture,
-    output: wgpu::Texture,
-    views: [wgpu::TextureView; 3],
-    pipes: [wgpu::RenderPipeline; 3],
-    groups: [wgpu::BindGroup; 3],
-    extra: EdgeStage,
+pub struct Mlaa(ThreePass);
+
+impl std::ops::Deref for Mlaa {
+    type Target = ThreePass;
+    fn deref(&self) -> &ThreePass {
+        &self.0
+    }
 }
 
 impl Mlaa {
@@ -92,7 +89,7 @@ impl Mlaa {
         Self::with_options(device, queue, width, height, map, &MlaaOptions::default())
     }
 
-    /// As [`Self::new`] with an edge detector and mask; depth and mask come through [`Self::run_with`].
+    /// As [`Self::new`] with an edge detector and mask; depth and mask come through [`ThreePass::run_with`].
     pub fn with_options(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -155,71 +152,8 @@ impl Mlaa {
         let ov = view(&output);
         let extra = EdgeStage::new(device, (width, height), (&cv, &ov), &options.edges, 0.0, options.masked)?;
         let views = [ev, wv, ov];
-        Ok(Self { width, height, color, edges, weights, output, views, pipes, groups, extra })
-    }
-
-    pub fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.color
-    }
-    /// The antialiased output (masked when the options say so).
-    pub fn output(&self) -> &wgpu::Texture {
-        self.extra.masked_output().unwrap_or(&self.output)
-    }
-    pub fn edges(&self) -> &wgpu::Texture {
-        &self.edges
-    }
-    pub fn weights(&self) -> &wgpu::Texture {
-        &self.weights
-    }
-
-    /// Uploads one frame (`width·height·4` bytes, RGBA8, sRGB-encoded, top row first).
-    pub fn upload(&self, queue: &wgpu::Queue, rgba: &[u8]) -> Result<(), InvalidInput> {
-        let want = self.width as usize * self.height as usize * 4;
-        if rgba.len() != want {
-            return Err(InvalidInput::new("image", format!("must hold {want} RGBA8 bytes, got {}", rgba.len())));
-        }
-        gpu::upload(queue, &self.color, rgba);
-        Ok(())
-    }
-
-    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
-        for (k, label) in ["mlaa edges", "mlaa weights", "mlaa blend"].iter().enumerate() {
-            let slot = timer.map(|(t, first)| (t, first + k as u32));
-            if k == 0 && self.extra.encode_edges(enc, &self.views[0], slot) {
-                continue;
-            }
-            gpu::draw_fullscreen(enc, label, &self.pipes[k], &self.groups[k], &self.views[k], slot);
-        }
-        self.extra.encode_mask(enc);
-    }
-
-    /// Validates and uploads the depth and mask the options read (named `--depth`/`--mask`).
-    pub fn upload_inputs(&self, queue: &wgpu::Queue, inputs: &AaInputs) -> Result<(), InvalidInput> {
-        self.extra.upload(queue, inputs)
-    }
-
-    /// Uploads `rgba`, runs the three passes and reads the result back.
-    pub fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, rgba: &[u8]) -> Result<Vec<u8>, RuntimeError> {
-        self.run_with(device, queue, rgba, &AaInputs::default())
-    }
-
-    /// As [`Self::run`] with the depth and mask the options read.
-    pub fn run_with(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        rgba: &[u8],
-        inputs: &AaInputs,
-    ) -> Result<Vec<u8>, RuntimeError> {
-        self.upload(queue, rgba)?;
-        self.upload_inputs(queue, inputs)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mlaa") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        gpu::read_texture(device, queue, self.output())
+        let labels = ["mlaa edges", "mlaa weights", "mlaa blend"];
+        let name = "mlaa";
+        Ok(Self(ThreePass { width, height, color, edges, weights, output, views, pipes, groups, extra, labels, name }))
     }
 }

@@ -4,6 +4,7 @@
 //! - [`mlaa`] (`mlaa.wgsl`, [`mlaa_cpu`]): Jimenez's MLAA, GPU Pro 2, 2011 (Listings 9.1–9.5);
 //! - [`edges`] (`edges.wgsl`, [`edges_cpu`]): the colour/depth edge detectors, predication and masks both share;
 //! - [`modes`] (`modes.wgsl`, [`modes_cpu`]): SMAA S2x/T2x/4x over [`smaa::Smaa::with_subsample`];
+//! - [`three_pass`]: the textures and the three full-screen passes SMAA and MLAA share;
 //! - [`scene`], [`moving_scene`]: procedural test scenes with supersampled ground truth (CPU only).
 
 pub mod edges;
@@ -16,3 +17,4 @@ pub mod moving_scene;
 pub mod scene;
 pub mod smaa;
 pub mod smaa_cpu;
+pub mod three_pass;

@@ -10,8 +10,9 @@
 //! ([`crate::runtime::aa::edges`]).
 
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{AaInputs, EdgeSettings, EdgeStage, SMAA_LOCAL_CONTRAST_ADAPTATION};
-use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::aa::edges::{EdgeSettings, EdgeStage, SMAA_LOCAL_CONTRAST_ADAPTATION};
+use crate::runtime::aa::three_pass::ThreePass;
+use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
 /// SMAA area texture size (RG8).
@@ -105,27 +106,17 @@ struct Params {
 
 const SHADER: &str = include_str!("smaa.wgsl");
 
-/// Number of timed passes [`Smaa::encode`] records (edges, weights, blending).
+/// Number of timed passes [`ThreePass::encode`] records (edges, weights, blending).
 pub const SMAA_PASSES: u32 = 3;
 
 /// SMAA 1x for one frame size. Create once, run per frame.
-pub struct Smaa {
-    width: u32,
-    height: u32,
-    color: wgpu::Texture,
-    edges: wgpu::Texture,
-    weights: wgpu::Texture,
-    output: wgpu::Texture,
-    edges_view: wgpu::TextureView,
-    weights_view: wgpu::TextureView,
-    output_view: wgpu::TextureView,
-    pipe_edges: wgpu::RenderPipeline,
-    pipe_weights: wgpu::RenderPipeline,
-    pipe_blend: wgpu::RenderPipeline,
-    bg_edges: wgpu::BindGroup,
-    bg_weights: wgpu::BindGroup,
-    bg_blend: wgpu::BindGroup,
-    extra: EdgeStage,
+pub struct Smaa(ThreePass);
+
+impl std::ops::Deref for Smaa {
+    type Target = ThreePass;
+    fn deref(&self) -> &ThreePass {
+        &self.0
+    }
 }
 
 impl Smaa {
@@ -152,7 +143,7 @@ impl Smaa {
         Self::with_options(device, queue, width, height, luts, &SmaaOptions { subsample, ..Default::default() })
     }
 
-    /// As [`Self::new`] with every option; a pass that reads depth or a mask takes them through [`Self::run_with`]
+    /// As [`Self::new`] with every option; a pass that reads depth or a mask takes them through [`ThreePass::run_with`]
     /// (or [`Self::upload_inputs`]).
     pub fn with_options(
         device: &wgpu::Device,
@@ -222,94 +213,19 @@ impl Smaa {
             SMAA_LOCAL_CONTRAST_ADAPTATION,
             options.masked,
         )?;
-        Ok(Self {
+        Ok(Self(ThreePass {
             width,
             height,
             color,
             edges,
             weights,
             output,
-            edges_view,
-            weights_view,
-            output_view,
-            pipe_edges,
-            pipe_weights,
-            pipe_blend,
-            bg_edges,
-            bg_weights,
-            bg_blend,
+            views: [edges_view, weights_view, output_view],
+            pipes: [pipe_edges, pipe_weights, pipe_blend],
+            groups: [bg_edges, bg_weights, bg_blend],
             extra,
-        })
-    }
-
-    pub fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-
-    /// The input texture (`Rgba8Unorm`, sRGB-encoded values); other passes may render into it directly.
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.color
-    }
-
-    /// The antialiased output (`Rgba8Unorm`, sRGB-encoded values; masked when the options say so).
-    pub fn output(&self) -> &wgpu::Texture {
-        self.extra.masked_output().unwrap_or(&self.output)
-    }
-
-    /// The edges texture (`Rg8Unorm`: R left edge, G top edge).
-    pub fn edges(&self) -> &wgpu::Texture {
-        &self.edges
-    }
-
-    /// The blending-weights texture (`Rgba8Unorm`).
-    pub fn weights(&self) -> &wgpu::Texture {
-        &self.weights
-    }
-
-    /// Uploads one frame (`width·height·4` bytes, RGBA8, sRGB-encoded, top row first).
-    pub fn upload(&self, queue: &wgpu::Queue, rgba: &[u8]) -> Result<(), InvalidInput> {
-        let want = self.width as usize * self.height as usize * 4;
-        if rgba.len() != want {
-            return Err(InvalidInput::new("image", format!("must hold {want} RGBA8 bytes, got {}", rgba.len())));
-        }
-        gpu::upload(queue, &self.color, rgba);
-        Ok(())
-    }
-
-    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
-        let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
-        if !self.extra.encode_edges(enc, &self.edges_view, slot(0)) {
-            gpu::draw_fullscreen(enc, "smaa edges", &self.pipe_edges, &self.bg_edges, &self.edges_view, slot(0));
-        }
-        gpu::draw_fullscreen(enc, "smaa weights", &self.pipe_weights, &self.bg_weights, &self.weights_view, slot(1));
-        gpu::draw_fullscreen(enc, "smaa blend", &self.pipe_blend, &self.bg_blend, &self.output_view, slot(2));
-        self.extra.encode_mask(enc);
-    }
-
-    /// Validates and uploads the depth and mask the options read (sizes, finiteness; named `--depth`/`--mask`).
-    pub fn upload_inputs(&self, queue: &wgpu::Queue, inputs: &AaInputs) -> Result<(), InvalidInput> {
-        self.extra.upload(queue, inputs)
-    }
-
-    /// Uploads `rgba`, runs the three passes and reads the result back.
-    pub fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, rgba: &[u8]) -> Result<Vec<u8>, RuntimeError> {
-        self.run_with(device, queue, rgba, &AaInputs::default())
-    }
-
-    /// As [`Self::run`] with the depth and mask the options read.
-    pub fn run_with(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        rgba: &[u8],
-        inputs: &AaInputs,
-    ) -> Result<Vec<u8>, RuntimeError> {
-        self.upload(queue, rgba)?;
-        self.upload_inputs(queue, inputs)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("smaa") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        gpu::read_texture(device, queue, self.output())
+            labels: ["smaa edges", "smaa weights", "smaa blend"],
+            name: "smaa",
+        }))
     }
 }
