@@ -1,4 +1,4 @@
-//! Issue 13 part B: SMAA's colour and depth edge detectors, predicated thresholding, MLAA's depth edges
+//! SMAA's colour and depth edge detectors, predicated thresholding, MLAA's depth edges
 //! (Listing 9.1) and matte/stencil masking — GPU vs CPU twin, the mask's pass-through, the CLI's flags and bad
 //! input, and a quality check where luma cannot see the edges.
 
