@@ -17,7 +17,7 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 
 pub const MANIFEST_NAME: &str = "manifest.json";
-pub const SCHEMA: &str = "rtbake-manifest/1";
+pub const SCHEMA: &str = crate::baked_layout::schema::MANIFEST;
 
 /// Git tree id of the `src/` this rtbake was compiled from (computed by `build.rs` from the files, so it also
 /// names uncommitted sources; `git rev-parse <commit>:src` prints the same id for a clean checkout).

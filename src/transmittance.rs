@@ -238,7 +238,7 @@ impl TableSettings {
     }
 
     /// Peak memory of baking this table with its files (f32 table, f16 copies, EXR/KTX2/PNG encodings), in bytes:
-    /// 56 bytes per texel + 32 MiB, from peak RSS measured at 512² and 2048² texels (51 B/texel; issue 15).
+    /// 56 bytes per texel + 32 MiB, from peak RSS measured at 512² and 2048² texels (51 B/texel).
     pub fn memory_estimate_bytes(&self) -> u64 {
         56 * self.samples as u64 * self.height as u64 + (32 << 20)
     }
@@ -272,7 +272,7 @@ pub fn table(sum: &RgbGaussians, settings: &TableSettings) -> Result<ImageF32, T
 }
 
 impl TableSettings {
-    /// Wall time of baking this table with its files (issue 15's budget check): 1.4 µs per texel, dominated by the
+    /// Wall time of baking this table with its files (the budget check): 1.4 µs per texel, dominated by the
     /// PNG and EXR encoders, plus 0.1 s; 16384 × 16384 took about 6 min on the project's 2-core machine.
     pub fn time_estimate_seconds(&self) -> f64 {
         0.1 + 1.4e-6 * self.samples as f64 * self.height as f64

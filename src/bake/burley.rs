@@ -1,4 +1,4 @@
-//! Burley's normalized diffusion for the profiles rtbake knows, in `baked/burley/` (asset `burley-profiles`; issue 11:
+//! Burley's normalized diffusion for the profiles rtbake knows, in `baked/burley/` (asset `burley-profiles`:
 //! what engine bakers — Unreal's Subsurface Profile, Unity HDRP's Diffusion Profile — use, measured against physics).
 //!
 //! For every case (the 11 Jensen 2001 materials as dipoles, η = 1.3; the physiological two-layer skins as layered

@@ -10,7 +10,7 @@
 //! chords of half-width `hw(dy) = floor(sqrt(r² − dy²))`, so with per-row prefix sums each chord costs two look-ups
 //! and a texel costs O(r) (not O(r²)).
 //!
-//! Layout of the work (issue 17): the map is cut into bands of [`BAND_ROWS`] rows (the parallel tasks; each
+//! Layout of the work: the map is cut into bands of [`BAND_ROWS`] rows (the parallel tasks; each
 //! reads its `BAND_ROWS + 2r` prefix rows into per-thread buffers reused across bands), a band into tiles of 256
 //! columns (their prefix rows stay in L2), and a tile row into blocks of 8 texels whose sums stay in AVX2 registers
 //! across all 2r + 1 chords; two consecutive output rows are summed together, so every prefix row is read once for

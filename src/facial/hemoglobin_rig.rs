@@ -343,15 +343,15 @@ pub fn evaluate(rig: &HemoglobinRig, weights: &[f64], global_scale: f64) -> Vec<
     out
 }
 /// Wall time of [`build_rig`] on `maps` maps (neutral + targets) of `width`×`height` at disk radius `radius`
-/// (issue 15's budget check): 1.5 ns per texel, map and chord row (2r + 1 rows per disk) on one thread, divided by
+/// (the budget check): 1.5 ns per texel, map and chord row (2r + 1 rows per disk) on one thread, divided by
 /// `threads`. Measured with the release build on the project's 2-core machine: 4096², 9 maps, r = 32: 6.4 s on 2
-/// threads before issue 17 (1.3 ns), 3.3 s of CPU after it (0.33 ns; `examples/bench_facial.rs`); the estimate
+/// threads with the earlier, unfused build (1.3 ns), 3.3 s of CPU with the fused band-wise one (0.33 ns; `examples/bench_facial.rs`); the estimate
 /// keeps the older, larger figure, so it only ever over-estimates.
 pub fn time_estimate_seconds(width: u32, height: u32, maps: usize, radius: u32, threads: usize) -> f64 {
     1.5e-9 * width as f64 * height as f64 * maps as f64 * (2 * radius as u64 + 1) as f64 / threads.max(1) as f64
 }
 
-/// Wall time of [`evaluate`] at full resolution `width`×`height` with its EXR encoding (`maps rig-eval`; issue 15's
+/// Wall time of [`evaluate`] at full resolution `width`×`height` with its EXR encoding (`maps rig-eval`; the
 /// budget check): 0.25 µs per output texel + 0.5 s. Measured with the release build on the project's 2-core machine:
 /// 4096², 5 maps, f32 output: 2.0 s (0.12 µs per texel); the estimate doubles it.
 pub fn evaluate_time_estimate_seconds(width: u32, height: u32) -> f64 {
@@ -367,7 +367,7 @@ pub fn evaluate_memory_estimate_bytes(width: u32, height: u32, rig_width: u32, r
 
 /// Peak memory of [`build_rig`] with its files, in bytes: the decoded maps (f32) and, counted from the buffers of
 /// the unfused build (full-size mean and σ of the neutral and of one target, f64, the full-size scale and bias,
-/// the encoded outputs), 72 bytes per texel, plus 32 MiB. Since issue 17 the build keeps only the floored σn (f64)
+/// the encoded outputs), 72 bytes per texel, plus 32 MiB. The fused build keeps only the floored σn (f64)
 /// and H0 (f32) at full size, so this over-estimates.
 pub fn memory_estimate_bytes(width: u32, height: u32, maps: usize) -> u64 {
     let texels = width as u64 * height as u64;

@@ -237,7 +237,7 @@ pub fn quantize_u16(size: u32, values: &[f64]) -> Image<u16> {
 /// The fixture / demo set: `neutral` then one map per named expression, as 16-bit single-channel images.
 /// Unknown expression names are an error naming `param`.
 /// Wall time (s) and peak memory (bytes) of [`hemoglobin_set`] of `maps` maps (neutral + expressions) at
-/// `size`² with their 16-bit PNG encoding (`maps synthetic`; issue 15's budget check). Measured with the release
+/// `size`² with their 16-bit PNG encoding (`maps synthetic`; the budget check). Measured with the release
 /// build on the project's 2-core machine: 5 maps at 4096² took 40.8 s and 300 MB (0.49 µs and 3.6 bytes per texel
 /// and map); the estimate takes 0.6 µs and 8 bytes, plus 0.3 s and 32 MiB.
 pub fn hemoglobin_set_estimate(size: u32, maps: usize) -> (u64, f64) {

@@ -286,7 +286,7 @@ pub fn table_8_1_json() -> serde_json::Value {
 }
 
 /// Peak memory (bytes) and wall time (s) of converting a `w`×`h` normal map (with a base map of the same size when
-/// `with_base`) into the wrinkle files (issue 15's budget check, after decoding the input, before the work): 86 MB
+/// `with_base`) into the wrinkle files (the budget check, after decoding the input, before the work): 86 MB
 /// and 0.2 s at 1024² measured on the project's 2-core machine, doubled, plus 48 bytes per texel for the base.
 pub fn wrinkle_estimate(w: u32, h: u32, with_base: bool) -> (u64, f64) {
     let px = w as u64 * h as u64;

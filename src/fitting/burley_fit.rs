@@ -1,4 +1,4 @@
-//! Burley's normalized diffusion fitted to a diffusion profile, per channel (issue 11).
+//! Burley's normalized diffusion fitted to a diffusion profile, per channel.
 //!
 //! For each channel the albedo A and shape parameter d of R_B(r) = A (e^(−r/d) + e^(−r/(3d)))/(8πd r)
 //! (Christensen & Burley 2015, eq. 2; [`crate::diffusion::burley`]) minimise the L2 error of r·R(r) (the curve the

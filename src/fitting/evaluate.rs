@@ -1,4 +1,4 @@
-//! Evaluating given profile parameters against a target profile (issue 11: `rtbake evaluate`).
+//! Evaluating given profile parameters against a target profile (`rtbake evaluate`).
 //!
 //! A candidate radial profile (a sum of Gaussians, Burley's normalized diffusion, any [`RadialProfile`]) is compared
 //! with a target on the fixed radial grid of the fits ([`RadialGrid::standard`], 1e-5..1e3 mm, 16 nodes per decade)

@@ -1,17 +1,30 @@
-//! Whole-image entry points used by the command and the demo: pick the GPU pass or its CPU reference, run it on
-//! an `Image<u8>`, return an `Image<u8>`. Pure with respect to files (the caller reads and writes them).
+//! Whole-image entry points used by the command and the demo: run a pass on the [`Backend`] the caller names (the
+//! GPU pass or its CPU twin) on an `Image<u8>` or linear f32 frame, return the result. Pure with respect to files
+//! (the caller reads and writes them).
 
-use super::cpu::{self, FilterPrecision};
-use super::device::Gpu;
-use super::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
-use super::importance_sss::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
-use super::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
-use super::separable_sss::{SeparableSss, SssKernel, SssParams};
-use super::smaa::{Smaa, SmaaOptions, SmaaTextures};
-use super::smaa_edges::{AaInputs, EdgeSettings};
-use super::RuntimeError;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
+use crate::runtime::aa::edges::{AaInputs, EdgeSettings};
+use crate::runtime::aa::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
+use crate::runtime::aa::mlaa_cpu;
+use crate::runtime::aa::modes::{opaque, ModeFrame, SmaaMode, SmaaModes, TemporalResolve};
+use crate::runtime::aa::modes_cpu::SmaaModesCpu;
+use crate::runtime::aa::smaa::{Smaa, SmaaOptions, SmaaTextures};
+use crate::runtime::aa::smaa_cpu;
+use crate::runtime::backend::{Backend, Prepared};
+use crate::runtime::loader::BakedRig;
+use crate::runtime::sampler::FilterPrecision;
+use crate::runtime::skin::bloom::{self, BloomParams};
+use crate::runtime::skin::mesh_inputs::{self, RigAtUv, RigPose};
+use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::skin::wrinkles::{self, WrinkleMaps};
+use crate::runtime::skin::{bloom_cpu, mesh_inputs_cpu, wrinkles_cpu};
+use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSss, GaussianSssParams};
+use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
+use crate::runtime::sss::separable::{SeparableSss, SssKernel, SssParams};
+use crate::runtime::sss::{gaussian_cpu, importance_cpu, separable_cpu};
+use crate::runtime::transport::mc_gpu::TransportGpu;
+use crate::runtime::RuntimeError;
 
 /// A morphological antialiasing method with its lookup textures.
 pub enum Antialiasing {
@@ -39,30 +52,35 @@ pub fn to_rgba8(img: &Image<u8>) -> Result<Image<u8>, InvalidInput> {
 }
 
 /// Antialiases an RGBA8 (sRGB-encoded) image on `gpu`, or with the CPU reference when `gpu` is `None`.
-pub fn antialias(gpu: Option<&Gpu>, img: &Image<u8>, aa: &Antialiasing) -> Result<Image<u8>, RuntimeError> {
+pub fn antialias<'g>(
+    gpu: impl Into<Backend<'g>>,
+    img: &Image<u8>,
+    aa: &Antialiasing,
+) -> Result<Image<u8>, RuntimeError> {
     if img.channels != 4 {
         return Err(InvalidInput::new("image", format!("must be RGBA8, got {} channels", img.channels)).into());
     }
     let (w, h) = (img.width, img.height);
     crate::error::check_size("--input", w as u64, h as u64)?;
-    let data = match (gpu, aa) {
-        (Some(g), Antialiasing::Smaa(t)) => {
-            Smaa::new(&g.device, &g.queue, w, h, t)?.run(&g.device, &g.queue, &img.data)?
-        }
-        (Some(g), Antialiasing::Mlaa(m)) => {
-            Mlaa::new(&g.device, &g.queue, w, h, m)?.run(&g.device, &g.queue, &img.data)?
-        }
-        (None, Antialiasing::Smaa(t)) => cpu::smaa::smaa(&img.data, w, h, t, FilterPrecision::Exact).output,
-        (None, Antialiasing::Mlaa(m)) => cpu::mlaa::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output,
+    let gpu = gpu.into();
+    let data = match aa {
+        Antialiasing::Smaa(t) => gpu.run(
+            |g| Smaa::new(&g.device, &g.queue, w, h, t)?.run(&g.device, &g.queue, &img.data),
+            || Ok(smaa_cpu::smaa(&img.data, w, h, t, FilterPrecision::Exact).output),
+        )?,
+        Antialiasing::Mlaa(m) => gpu.run(
+            |g| Mlaa::new(&g.device, &g.queue, w, h, m)?.run(&g.device, &g.queue, &img.data),
+            || Ok(mlaa_cpu::mlaa(&img.data, w, h, m, FilterPrecision::Exact).output),
+        )?,
     };
     Ok(Image::from_vec(w, h, 4, data))
 }
 
 /// As [`antialias`] with an edge detector other than luma, predicated thresholding and/or a matte/stencil mask
-/// ([`super::smaa_edges`]): `inputs.depth` when `edges` need it, `inputs.mask` (one byte per pixel, ≥ 128 = inside)
+/// ([`crate::runtime::aa::edges`]): `inputs.depth` when `edges` need it, `inputs.mask` (one byte per pixel, ≥ 128 = inside)
 /// masks the pass when present.
-pub fn antialias_with(
-    gpu: Option<&Gpu>,
+pub fn antialias_with<'g>(
+    gpu: impl Into<Backend<'g>>,
     img: &Image<u8>,
     aa: &Antialiasing,
     edges: &EdgeSettings,
@@ -74,31 +92,35 @@ pub fn antialias_with(
     let (w, h) = (img.width, img.height);
     crate::error::check_size("--input", w as u64, h as u64)?;
     let masked = inputs.mask.is_some();
-    let data = match (gpu, aa) {
-        (Some(g), Antialiasing::Smaa(t)) => {
+    let gpu = gpu.into();
+    let exact = FilterPrecision::Exact;
+    let data = match aa {
+        Antialiasing::Smaa(t) => {
             let options = SmaaOptions { edges: *edges, masked, ..Default::default() };
-            Smaa::with_options(&g.device, &g.queue, w, h, t, &options)?
-                .run_with(&g.device, &g.queue, &img.data, inputs)?
+            gpu.run(
+                |g| {
+                    Smaa::with_options(&g.device, &g.queue, w, h, t, &options)?
+                        .run_with(&g.device, &g.queue, &img.data, inputs)
+                },
+                || Ok(smaa_cpu::smaa_with_options(&img.data, (w, h), t, exact, &options, inputs)?.output),
+            )?
         }
-        (Some(g), Antialiasing::Mlaa(m)) => {
+        Antialiasing::Mlaa(m) => {
             let options = MlaaOptions { edges: *edges, masked };
-            Mlaa::with_options(&g.device, &g.queue, w, h, m, &options)?
-                .run_with(&g.device, &g.queue, &img.data, inputs)?
-        }
-        (None, Antialiasing::Smaa(t)) => {
-            let options = SmaaOptions { edges: *edges, masked, ..Default::default() };
-            cpu::smaa::smaa_with_options(&img.data, (w, h), t, FilterPrecision::Exact, &options, inputs)?.output
-        }
-        (None, Antialiasing::Mlaa(m)) => {
-            let options = MlaaOptions { edges: *edges, masked };
-            cpu::mlaa::mlaa_with_options(&img.data, (w, h), m, FilterPrecision::Exact, &options, inputs)?.output
+            gpu.run(
+                |g| {
+                    Mlaa::with_options(&g.device, &g.queue, w, h, m, &options)?
+                        .run_with(&g.device, &g.queue, &img.data, inputs)
+                },
+                || Ok(mlaa_cpu::mlaa_with_options(&img.data, (w, h), m, exact, &options, inputs)?.output),
+            )?
         }
     };
     Ok(Image::from_vec(w, h, 4, data))
 }
 
 /// Peak memory (bytes) and wall time (s) of `rtbake run smaa|mlaa` on a `w`×`h` image, decoding and encoding
-/// included (issue 15's budget check, before the pass): times measured with the release build on the project's 2-core
+/// included (the budget check, before the pass): times measured with the release build on the project's 2-core
 /// machine at 1024² on the CPU path (SMAA 0.41 s, MLAA 0.78 s), doubled; the GPU path takes a tenth of the CPU time
 /// plus 1 s of device set-up and the same host buffers. Memory: 24 bytes per pixel + 32 MiB, from peak RSS measured
 /// on the CPU path (4096²: SMAA 11 B/px, MLAA 14 B/px; SMAA at 16384²: 4.1 GB, 15.3 B/px), so the largest input
@@ -132,8 +154,11 @@ pub fn antialias_estimate_with(
     let per_px = if edges.is_plain_luma() { 0 } else { 16 }
         + if edges.needs_depth() { 8 } else { 0 }
         + if masked { 6 } else { 0 };
-    let slower =
-        if edges.is_plain_luma() || edges.detector == super::smaa_edges::EdgeDetector::Depth { 1.0 } else { 2.0 };
+    let slower = if edges.is_plain_luma() || edges.detector == crate::runtime::aa::edges::EdgeDetector::Depth {
+        1.0
+    } else {
+        2.0
+    };
     (bytes + per_px * px, seconds * slower)
 }
 
@@ -167,53 +192,51 @@ pub enum Subsurface<'a> {
 
 /// Blurs linear RGBA f32 `rgba` (alpha = SSS strength) with linear depth `depth_linear` (one value per pixel, the
 /// units of the kernel's / α's world scale) on `gpu`, or with the CPU reference when `gpu` is `None`.
-pub fn subsurface(
-    gpu: Option<&Gpu>,
+pub fn subsurface<'g>(
+    gpu: impl Into<Backend<'g>>,
     rgba: &[f32],
     depth_linear: &[f32],
     (w, h): (u32, u32),
     method: &Subsurface,
 ) -> Result<Vec<f32>, RuntimeError> {
     crate::error::check_size("--width/--height", w as u64, h as u64)?;
-    Ok(match (gpu, method) {
-        (Some(g), Subsurface::Separable { kernel, params }) => {
-            SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear)?
-        }
-        (None, Subsurface::Separable { kernel, params }) => {
-            cpu::separable_sss::separable_sss(rgba, depth_linear, w, h, kernel, params)
-        }
-        (Some(g), Subsurface::Gaussians { blurs, params }) => {
+    let gpu = gpu.into();
+    match method {
+        Subsurface::Separable { kernel, params } => gpu.run(
+            |g| SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear),
+            || Ok(separable_cpu::separable_sss(rgba, depth_linear, w, h, kernel, params)),
+        ),
+        Subsurface::Gaussians { blurs, params } => {
+            // The α·h/720 viewport scaling of eq. 4.1, the same for both backends.
             let gp = params.for_viewport_height(h);
-            GaussianSss::new(&g.device, w, h, blurs, &gp)?.run(&g.device, &g.queue, rgba, depth_linear)?
+            gpu.run(
+                |g| GaussianSss::new(&g.device, w, h, blurs, &gp)?.run(&g.device, &g.queue, rgba, depth_linear),
+                || Ok(gaussian_cpu::gaussian_sss(rgba, depth_linear, w, h, blurs, &gp)),
+            )
         }
-        (None, Subsurface::Gaussians { blurs, params }) => {
-            cpu::gaussian_sss::gaussian_sss(rgba, depth_linear, w, h, blurs, &params.for_viewport_height(h))
-        }
-        (Some(g), Subsurface::Importance { samples, params }) => {
-            ImportanceSss::new(&g.device, w, h, samples, params)?.run(&g.device, &g.queue, rgba, depth_linear)?
-        }
-        (None, Subsurface::Importance { samples, params }) => {
-            samples.validate()?;
-            params.validate()?;
-            cpu::importance_sss::importance_sss(rgba, depth_linear, w, h, samples, params)
-        }
-    })
+        Subsurface::Importance { samples, params } => gpu.run(
+            |g| ImportanceSss::new(&g.device, w, h, samples, params)?.run(&g.device, &g.queue, rgba, depth_linear),
+            || {
+                samples.validate()?;
+                params.validate()?;
+                Ok(importance_cpu::importance_sss(rgba, depth_linear, w, h, samples, params))
+            },
+        ),
+    }
 }
 
-/// Monte Carlo photon transport ([`crate::transport::mc`]) on `gpu` ([`super::transport_gpu`], f32, the same
+/// Monte Carlo photon transport ([`crate::transport::mc`]) on `gpu` ([`crate::runtime::transport::mc_gpu`], f32, the same
 /// random streams) or with the CPU reference when `gpu` is `None`; `progress(fraction done)` as the run advances.
-pub fn transport(
-    gpu: Option<&Gpu>,
+pub fn transport<'g>(
+    gpu: impl Into<Backend<'g>>,
     stack: &crate::transport::McStack,
     settings: &crate::transport::McSettings,
     progress: &dyn Fn(f64),
 ) -> Result<crate::transport::McResult, RuntimeError> {
-    match gpu {
-        Some(g) => {
-            super::transport_gpu::TransportGpu::new(&g.device)?.simulate(&g.device, &g.queue, stack, settings, progress)
-        }
-        None => Ok(crate::transport::mc::simulate_with_progress(stack, settings, progress)),
-    }
+    gpu.into().run(
+        |g| TransportGpu::new(&g.device)?.simulate(&g.device, &g.queue, stack, settings, progress),
+        || Ok(crate::transport::mc::simulate_with_progress(stack, settings, progress)),
+    )
 }
 
 /// Peak host memory (bytes) and an upper wall time (s) of [`transport`]: the CPU path's figures
@@ -226,51 +249,77 @@ pub fn transport_estimate(
     threads: usize,
 ) -> (u64, f64) {
     let bytes = if gpu {
-        super::transport_gpu::memory_estimate_bytes(settings, layers)
+        crate::runtime::transport::mc_gpu::memory_estimate_bytes(settings, layers)
     } else {
         settings.memory_estimate_bytes(layers)
     };
     (bytes, settings.time_estimate_seconds(threads))
 }
 
-/// SMAA 1x/S2x/T2x/4x over a frame sequence, on the GPU ([`super::smaa_modes::SmaaModes`]) or its CPU twin
-/// ([`super::cpu::smaa_modes::SmaaModesCpu`]).
-pub enum SmaaSequence<'g> {
-    Gpu(&'g Gpu, Box<super::smaa_modes::SmaaModes>),
-    Cpu(Box<super::cpu::smaa_modes::SmaaModesCpu>),
-}
+/// SMAA 1x/S2x/T2x/4x over a frame sequence, on the GPU ([`SmaaModes`]) or its CPU twin ([`SmaaModesCpu`]).
+pub struct SmaaSequence<'g>(Prepared<'g, Box<SmaaModes>, Box<SmaaModesCpu>>);
 
 impl<'g> SmaaSequence<'g> {
     /// `gpu: None` = the CPU twin.
     pub fn new(
-        gpu: Option<&'g Gpu>,
+        gpu: impl Into<Backend<'g>>,
         (w, h): (u32, u32),
-        luts: &super::smaa::SmaaTextures,
-        mode: super::smaa_modes::SmaaMode,
-        resolve: super::smaa_modes::TemporalResolve,
+        luts: &SmaaTextures,
+        mode: SmaaMode,
+        resolve: TemporalResolve,
     ) -> Result<Self, RuntimeError> {
-        Ok(match gpu {
-            Some(g) => Self::Gpu(
-                g,
-                Box::new(super::smaa_modes::SmaaModes::new(&g.device, &g.queue, w, h, luts, mode, resolve)?),
-            ),
-            None => Self::Cpu(Box::new(super::cpu::smaa_modes::SmaaModesCpu::new(
-                w,
-                h,
-                luts,
-                super::cpu::FilterPrecision::Exact,
-                mode,
-                resolve,
-            )?)),
-        })
+        let exact = FilterPrecision::Exact;
+        Ok(Self(gpu.into().prepare(
+            |g| Ok(Box::new(SmaaModes::new(&g.device, &g.queue, w, h, luts, mode, resolve)?)),
+            || Ok(Box::new(SmaaModesCpu::new(w, h, luts, exact, mode, resolve)?)),
+        )?))
     }
 
     /// Runs one frame; returns the displayed image (RGBA8, sRGB-encoded, alpha 255).
-    pub fn run_frame(&mut self, frame: &super::smaa_modes::ModeFrame<'_>) -> Result<Vec<u8>, RuntimeError> {
-        let out = match self {
-            Self::Gpu(g, p) => p.run_frame(&g.device, &g.queue, frame)?,
-            Self::Cpu(p) => p.run_frame(frame)?,
-        };
-        Ok(super::smaa_modes::opaque(out))
+    pub fn run_frame(&mut self, frame: &ModeFrame<'_>) -> Result<Vec<u8>, RuntimeError> {
+        let out = self.0.run(|g, p| p.run_frame(&g.device, &g.queue, frame), |p| Ok(p.run_frame(frame)?))?;
+        Ok(opaque(out))
     }
+}
+
+/// Bloom ([`crate::runtime::skin::bloom::bloom`]) on `gpu`, or its CPU twin.
+pub fn bloom_for<'g>(
+    gpu: impl Into<Backend<'g>>,
+    width: u32,
+    height: u32,
+    hdr_rgba: &[f32],
+    p: &BloomParams,
+) -> Result<Vec<f32>, RuntimeError> {
+    gpu.into().run(
+        |g| bloom::bloom(&g.device, &g.queue, width, height, hdr_rgba, p),
+        || Ok(bloom_cpu::bloom(width, height, hdr_rgba, p)?),
+    )
+}
+
+/// H per pixel of the G-buffer `g` for the baked rig in `pose` ([`mesh_inputs::hemoglobin_at_uv`]) on `gpu`, or its
+/// CPU twin.
+pub fn hemoglobin_for_gbuffer<'g>(
+    gpu: impl Into<Backend<'g>>,
+    g: &MeshGBuffer,
+    rig: &BakedRig,
+    pose: &RigPose,
+) -> Result<Vec<f32>, RuntimeError> {
+    let maps = RigAtUv { rig: &rig.rig, h0: &rig.h0, pose };
+    gpu.into().run(
+        |d| mesh_inputs::hemoglobin_at_uv(&d.device, &d.queue, g.width, g.height, &g.uv, &g.covered, &maps),
+        || mesh_inputs_cpu::hemoglobin_at_uv(&g.uv, &g.covered, &maps),
+    )
+}
+
+/// The wrinkle pass's normals ([`wrinkles::wrinkled_normals`]) on `gpu`, or its CPU twin.
+pub fn wrinkled_normals_for<'g>(
+    gpu: impl Into<Backend<'g>>,
+    g: &MeshGBuffer,
+    maps: &WrinkleMaps,
+    weights: &[f32; 8],
+) -> Result<Vec<[f32; 3]>, RuntimeError> {
+    gpu.into().run(
+        |d| wrinkles::wrinkled_normals(&d.device, &d.queue, g, maps, weights),
+        || Ok(wrinkles_cpu::wrinkled_normals(g, maps, weights)?),
+    )
 }

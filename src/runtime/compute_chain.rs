@@ -4,9 +4,9 @@
 //! entry points in one submission, one buffer read back. Flat buffers with the filtering done in shader
 //! arithmetic keep the passes free of texture formats and filter precision (the CPU twins do the same f32 sums).
 
-use super::gpu;
-use super::RuntimeError;
 use crate::error::InvalidInput;
+use crate::runtime::gpu;
+use crate::runtime::RuntimeError;
 
 /// A storage buffer of the chain: initial contents, or zeroed with a size in bytes.
 pub(crate) enum Buffer<'a> {

@@ -9,7 +9,7 @@
 //! The device is created with the adapter's own limits; [`check_image_fits`] compares an image with them before a
 //! pass allocates anything (wgpu panics on an over-limit texture or buffer), and refuses with the limit named.
 
-use super::RuntimeError;
+use crate::runtime::RuntimeError;
 
 /// A device, its queue and a description of the adapter behind them.
 pub struct Gpu {

@@ -1,7 +1,7 @@
 //! Small wgpu helpers shared by the passes: explicit-format textures, uploads, read-backs, full-screen
 //! fragment pipelines and GPU timestamp collection. Nothing here creates a device.
 
-use super::RuntimeError;
+use crate::runtime::RuntimeError;
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
@@ -227,6 +227,18 @@ pub fn fullscreen_pipeline(
     fs_entry: &str,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    let target = wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL };
+    fullscreen_pipeline_with(device, label, module, fs_entry, &[Some(target)])
+}
+
+/// As [`fullscreen_pipeline`] with the colour `targets` given (several render targets, blending).
+pub fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fs_entry: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
@@ -243,7 +255,7 @@ pub fn fullscreen_pipeline(
             module,
             entry_point: Some(fs_entry),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            targets,
         }),
         multiview_mask: None,
         cache: None,

@@ -22,7 +22,7 @@ use crate::baked_layout::{
 };
 use crate::io::PixelFormat;
 use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What a pass expects of one LUT.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,10 +70,108 @@ pub enum LutError {
     Content { path: String, message: String },
 }
 
-/// Reads `dir/manifest.json` and loads one LUT after checking it against `spec`.
-pub fn load_lut(dir: &Path, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
-    let manifest = Manifest::load(dir)?;
-    load_lut_with(dir, &manifest, spec)
+/// A bake directory opened once: its `manifest.json` read and parsed when opened, then every asset handed out typed
+/// after the manifest checks ([`LutError`] on any mismatch). The `load_*` functions open one for a single asset.
+pub struct BakedDir {
+    dir: PathBuf,
+    manifest: Manifest,
+}
+
+impl BakedDir {
+    /// Reads `dir/manifest.json`.
+    pub fn open(dir: &Path) -> Result<Self, LutError> {
+        Ok(Self { dir: dir.to_path_buf(), manifest: Manifest::load(dir)? })
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The parsed manifest.
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// One LUT after checking it against `spec` ([`load_lut`]).
+    pub fn lut(&self, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
+        load_lut_with(&self.dir, &self.manifest, spec)
+    }
+
+    /// The MLAA v1.4 area map of maximum distance `n` ([`load_mlaa_area`]).
+    pub fn mlaa_area(&self, n: u32) -> Result<Vec<u8>, LutError> {
+        self.lut(&LutSpec::mlaa_area(n))
+    }
+
+    /// SMAA area + search textures from a bake directory.
+    pub fn smaa_textures(&self) -> Result<crate::runtime::aa::smaa::SmaaTextures, LutError> {
+        smaa_textures_in(&self.dir, &self.manifest)
+    }
+
+    /// Loads a separable-SSS kernel JSON (`rtbake-separable-kernel/1`) after the manifest checks; refuses a kernel
+    /// whose tap count differs from `samples`, whose first tap is not the centre, whose channels do not each sum to 1
+    /// (±1e-4), or whose `step_divisor` is not the 3 the shader hard-codes.
+    pub fn separable_kernel(&self, path: &str) -> Result<BakedKernel, LutError> {
+        separable_kernel_in(&self.dir, &self.manifest, path)
+    }
+
+    /// Loads a separable-SSS kernel from its raw little-endian `f32 × 4 × N` file (`{stem}_f32x4.bin`, the layout
+    /// `SeparableSSS.h`'s runtime `kernel[SSSS_N_SAMPLES]` takes) after the manifest checks (format raw, f32,
+    /// R32G32B32A32, 1 row); the taps get the same content checks as the JSON (centre first, channels sum to 1).
+    pub fn separable_kernel_f32x4(&self, path: &str) -> Result<crate::runtime::sss::separable::SssKernel, LutError> {
+        separable_kernel_f32x4_in(&self.dir, &self.manifest, path)
+    }
+
+    /// Loads an importance-sampled disk kernel JSON (`rtbake-importance-kernel/1`: `sss/importance/*.json`,
+    /// `burley/kernels/*.json`) after the manifest checks, as the importance SSS pass takes it: offsets (x, y, r in mm)
+    /// and per-channel weights. Refuses a kernel whose sample count differs from `samples`, whose radii disagree with
+    /// the offsets (1e-6 mm relative), whose channels do not each sum to 1 (±1e-4), or with a non-positive cut-off.
+    pub fn importance_kernel(
+        &self,
+        path: &str,
+    ) -> Result<crate::runtime::sss::importance::ImportanceSamples, LutError> {
+        importance_kernel_in(&self.dir, &self.manifest, path)
+    }
+
+    /// Loads a sum-of-Gaussians JSON (`sss/gaussians/*.json`) after the manifest checks. The pass blurs all three
+    /// channels with one σ per Gaussian, so `shared_variances` must be true. The recorded `blend_weights` and
+    /// `incremental_variances` must agree with eq. 4.8 and vᵢ − vᵢ₋₁ recomputed from `weights` and `variances`
+    /// (1e-6): a file edited in one place only is refused.
+    pub fn gaussians(&self, path: &str) -> Result<BakedGaussians, LutError> {
+        gaussians_in(&self.dir, &self.manifest, path)
+    }
+
+    /// Loads T(s) (EXR f32 RGB, `width` samples, identical rows) and its sidecar JSON (`s_max_mm`, `samples`,
+    /// node-inclusive texel convention), both through the manifest checks. Refuses a table whose rows differ, whose
+    /// sidecar disagrees with the EXR's width, whose convention is not node-inclusive, or whose T(0) is not ≈ 1
+    /// per channel (±1e-3; eq. 5.12 at s = 0 is Σ wᵢ).
+    pub fn transmittance(&self, path: &str) -> Result<TransmittanceTable, LutError> {
+        transmittance_in(&self.dir, &self.manifest, path)
+    }
+
+    /// Loads the skin colour LUT (EXR f32 RGB, ≥ 2×2) and its sidecar JSON through the manifest checks. The pass
+    /// indexes it with u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), node-inclusive ([`crate::runtime::skin::inputs::CM_MAX`],
+    /// [`crate::runtime::skin::inputs::CHD_MAX`]); a sidecar with other ranges or another size is refused.
+    pub fn skin_lut(&self, path: &str) -> Result<AlbedoLut, LutError> {
+        skin_lut_in(&self.dir, &self.manifest, path)
+    }
+
+    /// The skin LUTs of the pass from a bake directory: the albedo LUT at `skin_lut` and T(s) at `transmittance`.
+    pub fn skin_luts(
+        &self,
+        skin_lut: &str,
+        transmittance: &str,
+    ) -> Result<crate::runtime::skin::inputs::SkinLuts, LutError> {
+        skin_luts_in(&self.dir, &self.manifest, skin_lut, transmittance)
+    }
+
+    /// Loads a hemoglobin rig (`rtbake-hemoglobin-rig/1`) and every map it names (paths relative to the rig file's
+    /// folder), each through the manifest checks: single-channel f32 EXRs, scale/bias at `rig_size`, H0 at
+    /// `full_size`. Refuses more targets than the pass holds ([`crate::runtime::skin::inputs::MAX_RIG_TARGETS`]), a
+    /// first map that is not the neutral one, and values outside the dermal-hemoglobin range the skin LUT indexes.
+    pub fn hemoglobin_rig(&self, path: &str) -> Result<BakedRig, LutError> {
+        hemoglobin_rig_in(&self.dir, &self.manifest, path)
+    }
 }
 
 /// Loads one LUT described by an already-parsed manifest.
@@ -186,17 +284,10 @@ fn sample_type(pf: PixelFormat) -> &'static str {
     }
 }
 
-/// SMAA area + search textures from a bake directory.
-pub fn load_smaa_textures(dir: &Path) -> Result<crate::runtime::smaa::SmaaTextures, LutError> {
-    let manifest = Manifest::load(dir)?;
-    let area = load_lut_with(dir, &manifest, &LutSpec::smaa_area())?;
-    let search = load_lut_with(dir, &manifest, &LutSpec::smaa_search())?;
-    Ok(crate::runtime::smaa::SmaaTextures { area, search })
-}
-
-/// MLAA v1.4 area map of maximum distance `n` from a bake directory.
-pub fn load_mlaa_area(dir: &Path, n: u32) -> Result<Vec<u8>, LutError> {
-    load_lut(dir, &LutSpec::mlaa_area(n))
+fn smaa_textures_in(dir: &Path, manifest: &Manifest) -> Result<crate::runtime::aa::smaa::SmaaTextures, LutError> {
+    let area = load_lut_with(dir, manifest, &LutSpec::smaa_area())?;
+    let search = load_lut_with(dir, manifest, &LutSpec::smaa_search())?;
+    Ok(crate::runtime::aa::smaa::SmaaTextures { area, search })
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -280,30 +371,23 @@ fn shaped<T: serde::de::DeserializeOwned>(v: &serde_json::Value, path: &str, key
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedKernel {
     /// Taps `[r, g, b, offset]`, centre first, as the pass takes them.
-    pub kernel: crate::runtime::separable_sss::SssKernel,
+    pub kernel: crate::runtime::sss::separable::SssKernel,
     /// Largest |offset| in kernel units.
     pub range: f64,
     /// The world-space width the kernel was made for, if the file records it.
     pub sss_width: Option<f32>,
 }
 
-/// Loads a separable-SSS kernel JSON (`rtbake-separable-kernel/1`) after the manifest checks; refuses a kernel
-/// whose tap count differs from `samples`, whose first tap is not the centre, whose channels do not each sum to 1
-/// (±1e-4), or whose `step_divisor` is not the 3 the shader hard-codes.
-pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutError> {
-    let manifest = Manifest::load(dir)?;
-    let v = load_json(dir, &manifest, path)?;
+fn separable_kernel_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<BakedKernel, LutError> {
+    let v = load_json(dir, manifest, path)?;
     separable_kernel_from_json(&v, path)
 }
 
-/// Loads a separable-SSS kernel from its raw little-endian `f32 × 4 × N` file (`{stem}_f32x4.bin`, the layout
-/// `SeparableSSS.h`'s runtime `kernel[SSSS_N_SAMPLES]` takes) after the manifest checks (format raw, f32,
-/// R32G32B32A32, 1 row); the taps get the same content checks as the JSON (centre first, channels sum to 1).
-pub fn load_separable_kernel_f32x4(
+fn separable_kernel_f32x4_in(
     dir: &Path,
+    manifest: &Manifest,
     path: &str,
-) -> Result<crate::runtime::separable_sss::SssKernel, LutError> {
-    let manifest = Manifest::load(dir)?;
+) -> Result<crate::runtime::sss::separable::SssKernel, LutError> {
     let expect = Expect {
         format: "raw",
         pixel_format: Some(PixelFormat::R32G32B32A32Sfloat),
@@ -312,7 +396,7 @@ pub fn load_separable_kernel_f32x4(
         sample_type: "f32",
         data: DataKind::Table,
     };
-    let (bytes, entry) = read_checked(dir, &manifest, path, &expect)?;
+    let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
     let taps = crate::separable::kernel::taps_from_f32x4_le(&bytes).map_err(|e| content(path, e.to_string()))?;
     if taps.len() != entry.meta.width as usize || entry.meta.height != 1 {
         return Err(content(
@@ -329,7 +413,7 @@ pub fn load_separable_kernel_f32x4(
             return Err(content(path, format!("channel {c} weights sum to {sum}, expected 1 (±1e-4)")));
         }
     }
-    crate::runtime::separable_sss::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))
+    crate::runtime::sss::separable::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))
 }
 
 /// The content checks of [`load_separable_kernel`] on an already-parsed kernel file (`path` names it in errors);
@@ -360,20 +444,16 @@ pub fn separable_kernel_from_json(v: &serde_json::Value, path: &str) -> Result<B
     }
     let range = file.range;
     let sss_width = file.sss_width.map(|w| w as f32);
-    let kernel = crate::runtime::separable_sss::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))?;
+    let kernel = crate::runtime::sss::separable::SssKernel::new(taps).map_err(|e| content(path, e.to_string()))?;
     Ok(BakedKernel { kernel, range, sss_width })
 }
 
-/// Loads an importance-sampled disk kernel JSON (`rtbake-importance-kernel/1`: `sss/importance/*.json`,
-/// `burley/kernels/*.json`) after the manifest checks, as the importance SSS pass takes it: offsets (x, y, r in mm)
-/// and per-channel weights. Refuses a kernel whose sample count differs from `samples`, whose radii disagree with
-/// the offsets (1e-6 mm relative), whose channels do not each sum to 1 (±1e-4), or with a non-positive cut-off.
-pub fn load_importance_kernel(
+fn importance_kernel_in(
     dir: &Path,
+    manifest: &Manifest,
     path: &str,
-) -> Result<crate::runtime::importance_sss::ImportanceSamples, LutError> {
-    let manifest = Manifest::load(dir)?;
-    let v = load_json(dir, &manifest, path)?;
+) -> Result<crate::runtime::sss::importance::ImportanceSamples, LutError> {
+    let v = load_json(dir, manifest, path)?;
     importance_kernel_from_json(&v, path)
 }
 
@@ -381,7 +461,7 @@ pub fn load_importance_kernel(
 pub fn importance_kernel_from_json(
     v: &serde_json::Value,
     path: &str,
-) -> Result<crate::runtime::importance_sss::ImportanceSamples, LutError> {
+) -> Result<crate::runtime::sss::importance::ImportanceSamples, LutError> {
     let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
     if found != schema::IMPORTANCE_KERNEL {
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::IMPORTANCE_KERNEL)));
@@ -415,7 +495,7 @@ pub fn importance_kernel_from_json(
             return Err(content(path, format!("channel {} weights sum to {sum}, must be 1", ["r", "g", "b"][c])));
         }
     }
-    let samples = crate::runtime::importance_sss::ImportanceSamples {
+    let samples = crate::runtime::sss::importance::ImportanceSamples {
         offsets_mm: file.kernel.iter().map(|s| [s.x_mm as f32, s.y_mm as f32, s.r_mm as f32, 0.0]).collect(),
         weights: file
             .kernel
@@ -433,19 +513,14 @@ pub fn importance_kernel_from_json(
 pub struct BakedGaussians {
     pub fit: crate::diffusion::sum_of_gaussians::SumOfGaussians,
     /// Incremental blurs and blend weights w′ᵢ (eq. 4.8), checked against the values recorded in the file.
-    pub blurs: crate::runtime::gaussian_sss::GaussianBlurs,
+    pub blurs: crate::runtime::sss::gaussian::GaussianBlurs,
     /// α, β, γ as recorded (lod factor: the exact rule of eq. 4.6).
-    pub params: crate::runtime::gaussian_sss::GaussianSssParams,
+    pub params: crate::runtime::sss::gaussian::GaussianSssParams,
 }
 
-/// Loads a sum-of-Gaussians JSON (`sss/gaussians/*.json`) after the manifest checks. The pass blurs all three
-/// channels with one σ per Gaussian, so `shared_variances` must be true. The recorded `blend_weights` and
-/// `incremental_variances` must agree with eq. 4.8 and vᵢ − vᵢ₋₁ recomputed from `weights` and `variances`
-/// (1e-6): a file edited in one place only is refused.
-pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError> {
-    use crate::runtime::gaussian_sss::{GaussianBlurs, GaussianSssParams};
-    let manifest = Manifest::load(dir)?;
-    let file: GaussiansFile = typed(load_json(dir, &manifest, path)?, path)?;
+fn gaussians_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<BakedGaussians, LutError> {
+    use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSssParams};
+    let file: GaussiansFile = typed(load_json(dir, manifest, path)?, path)?;
     if !file.shared_variances {
         return Err(content(path, "per-channel variances; the screen-space pass needs shared_variances = true"));
     }
@@ -490,15 +565,10 @@ pub struct TransmittanceTable {
     pub s_max_mm: f32,
 }
 
-/// Loads T(s) (EXR f32 RGB, `width` samples, identical rows) and its sidecar JSON (`s_max_mm`, `samples`,
-/// node-inclusive texel convention), both through the manifest checks. Refuses a table whose rows differ, whose
-/// sidecar disagrees with the EXR's width, whose convention is not node-inclusive, or whose T(0) is not ≈ 1
-/// per channel (±1e-3; eq. 5.12 at s = 0 is Σ wᵢ).
-pub fn load_transmittance(dir: &Path, path: &str) -> Result<TransmittanceTable, LutError> {
-    let manifest = Manifest::load(dir)?;
-    let img = load_exr_f32(dir, &manifest, path, 3, (2, 1))?;
+fn transmittance_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<TransmittanceTable, LutError> {
+    let img = load_exr_f32(dir, manifest, path, 3, (2, 1))?;
     let side_path = path::sidecar(path);
-    let side: TransmittanceSidecar = typed(load_json(dir, &manifest, &side_path)?, &side_path)?;
+    let side: TransmittanceSidecar = typed(load_json(dir, manifest, &side_path)?, &side_path)?;
     if side.samples != img.width {
         return Err(content(&side_path, format!("samples = {}, the table {path} is {} wide", side.samples, img.width)));
     }
@@ -532,15 +602,11 @@ pub struct AlbedoLut {
     pub albedo: Vec<[f32; 3]>,
 }
 
-/// Loads the skin colour LUT (EXR f32 RGB, ≥ 2×2) and its sidecar JSON through the manifest checks. The pass
-/// indexes it with u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), node-inclusive ([`crate::runtime::skin_inputs::CM_MAX`],
-/// [`crate::runtime::skin_inputs::CHD_MAX`]); a sidecar with other ranges or another size is refused.
-pub fn load_skin_lut(dir: &Path, path: &str) -> Result<AlbedoLut, LutError> {
-    use crate::runtime::skin_inputs::{CHD_MAX, CM_MAX};
-    let manifest = Manifest::load(dir)?;
-    let img = load_exr_f32(dir, &manifest, path, 3, (2, 2))?;
+fn skin_lut_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<AlbedoLut, LutError> {
+    use crate::runtime::skin::inputs::{CHD_MAX, CM_MAX};
+    let img = load_exr_f32(dir, manifest, path, 3, (2, 2))?;
     let side_path = path::sidecar(path);
-    let side: SkinLutSidecar = typed(load_json(dir, &manifest, &side_path)?, &side_path)?;
+    let side: SkinLutSidecar = typed(load_json(dir, manifest, &side_path)?, &side_path)?;
     let (w, h) = (side.width, side.height);
     if (w, h) != (img.width, img.height) {
         return Err(content(&side_path, format!("says {w}x{h}, the LUT {path} is {}x{}", img.width, img.height)));
@@ -556,15 +622,15 @@ pub fn load_skin_lut(dir: &Path, path: &str) -> Result<AlbedoLut, LutError> {
     Ok(AlbedoLut { width: img.width, height: img.height, albedo })
 }
 
-/// The skin LUTs of the pass from a bake directory: the albedo LUT at `skin_lut` and T(s) at `transmittance`.
-pub fn load_skin_luts(
+fn skin_luts_in(
     dir: &Path,
+    manifest: &Manifest,
     skin_lut: &str,
     transmittance: &str,
-) -> Result<crate::runtime::skin_inputs::SkinLuts, LutError> {
-    let lut = load_skin_lut(dir, skin_lut)?;
-    let t = load_transmittance(dir, transmittance)?;
-    Ok(crate::runtime::skin_inputs::SkinLuts {
+) -> Result<crate::runtime::skin::inputs::SkinLuts, LutError> {
+    let lut = skin_lut_in(dir, manifest, skin_lut)?;
+    let t = transmittance_in(dir, manifest, transmittance)?;
+    Ok(crate::runtime::skin::inputs::SkinLuts {
         albedo_size: (lut.width, lut.height),
         albedo: lut.albedo,
         transmittance: t.values,
@@ -576,7 +642,7 @@ pub fn load_skin_luts(
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedRig {
     /// Targets in the file's order (`maps[0]` = neutral).
-    pub rig: crate::runtime::skin_inputs::RigScaleBiasMaps,
+    pub rig: crate::runtime::skin::inputs::RigScaleBiasMaps,
     /// Target names, same order.
     pub names: Vec<String>,
     /// Mean-free neutral hemoglobin H0 (eq. 7.4), `full_size`, top row first.
@@ -601,14 +667,9 @@ impl BakedRig {
     }
 }
 
-/// Loads a hemoglobin rig (`rtbake-hemoglobin-rig/1`) and every map it names (paths relative to the rig file's
-/// folder), each through the manifest checks: single-channel f32 EXRs, scale/bias at `rig_size`, H0 at
-/// `full_size`. Refuses more targets than the pass holds ([`crate::runtime::skin_inputs::MAX_RIG_TARGETS`]), a
-/// first map that is not the neutral one, and values outside the dermal-hemoglobin range the skin LUT indexes.
-pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError> {
-    use crate::runtime::skin_inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
-    let manifest = Manifest::load(dir)?;
-    let v = load_json(dir, &manifest, path)?;
+fn hemoglobin_rig_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<BakedRig, LutError> {
+    use crate::runtime::skin::inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
+    let v = load_json(dir, manifest, path)?;
     let found = v.get("schema").and_then(|s| s.as_str()).unwrap_or_default();
     if found != schema::HEMOGLOBIN_RIG {
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::HEMOGLOBIN_RIG)));
@@ -623,7 +684,7 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
     }
     let map1 = |file: &str, (w, h): (u32, u32)| -> Result<Vec<f32>, LutError> {
         let p = format!("{folder}{file}");
-        let img = load_exr_f32(dir, &manifest, &p, 1, (1, 1))?;
+        let img = load_exr_f32(dir, manifest, &p, 1, (1, 1))?;
         if (img.width, img.height) != (w, h) {
             return Err(content(&p, format!("{}x{}, the rig says {w}x{h}", img.width, img.height)));
         }
@@ -651,4 +712,71 @@ pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError>
     let rig = RigScaleBiasMaps { width: rw, height: rh, targets };
     rig.validate().map_err(|e| content(path, e.to_string()))?;
     Ok(BakedRig { rig, names, h0, global_scales })
+}
+
+// One asset from a bake directory: each opens a [`BakedDir`] (reads the manifest) for that asset alone.
+
+/// Reads `dir/manifest.json` and loads one LUT after checking it against `spec`.
+pub fn load_lut(dir: &Path, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
+    BakedDir::open(dir)?.lut(spec)
+}
+
+/// MLAA v1.4 area map of maximum distance `n` from a bake directory.
+pub fn load_mlaa_area(dir: &Path, n: u32) -> Result<Vec<u8>, LutError> {
+    BakedDir::open(dir)?.mlaa_area(n)
+}
+
+/// [`BakedDir::smaa_textures`] of a bake directory opened for it alone.
+pub fn load_smaa_textures(dir: &Path) -> Result<crate::runtime::aa::smaa::SmaaTextures, LutError> {
+    BakedDir::open(dir)?.smaa_textures()
+}
+
+/// [`BakedDir::separable_kernel`] of a bake directory opened for it alone.
+pub fn load_separable_kernel(dir: &Path, path: &str) -> Result<BakedKernel, LutError> {
+    BakedDir::open(dir)?.separable_kernel(path)
+}
+
+/// [`BakedDir::separable_kernel_f32x4`] of a bake directory opened for it alone.
+pub fn load_separable_kernel_f32x4(
+    dir: &Path,
+    path: &str,
+) -> Result<crate::runtime::sss::separable::SssKernel, LutError> {
+    BakedDir::open(dir)?.separable_kernel_f32x4(path)
+}
+
+/// [`BakedDir::importance_kernel`] of a bake directory opened for it alone.
+pub fn load_importance_kernel(
+    dir: &Path,
+    path: &str,
+) -> Result<crate::runtime::sss::importance::ImportanceSamples, LutError> {
+    BakedDir::open(dir)?.importance_kernel(path)
+}
+
+/// [`BakedDir::gaussians`] of a bake directory opened for it alone.
+pub fn load_gaussians(dir: &Path, path: &str) -> Result<BakedGaussians, LutError> {
+    BakedDir::open(dir)?.gaussians(path)
+}
+
+/// [`BakedDir::transmittance`] of a bake directory opened for it alone.
+pub fn load_transmittance(dir: &Path, path: &str) -> Result<TransmittanceTable, LutError> {
+    BakedDir::open(dir)?.transmittance(path)
+}
+
+/// [`BakedDir::skin_lut`] of a bake directory opened for it alone.
+pub fn load_skin_lut(dir: &Path, path: &str) -> Result<AlbedoLut, LutError> {
+    BakedDir::open(dir)?.skin_lut(path)
+}
+
+/// [`BakedDir::skin_luts`] of a bake directory opened for it alone.
+pub fn load_skin_luts(
+    dir: &Path,
+    skin_lut: &str,
+    transmittance: &str,
+) -> Result<crate::runtime::skin::inputs::SkinLuts, LutError> {
+    BakedDir::open(dir)?.skin_luts(skin_lut, transmittance)
+}
+
+/// [`BakedDir::hemoglobin_rig`] of a bake directory opened for it alone.
+pub fn load_hemoglobin_rig(dir: &Path, path: &str) -> Result<BakedRig, LutError> {
+    BakedDir::open(dir)?.hemoglobin_rig(path)
 }

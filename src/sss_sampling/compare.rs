@@ -1,5 +1,5 @@
 //! Importance-sampled disk vs separable vs sum-of-Gaussians kernels at equal fetch budgets, against the exact
-//! convolution of a profile (issue 11).
+//! convolution of a profile.
 //!
 //! # The test
 //!
@@ -328,7 +328,7 @@ pub fn markdown_table(rows: &[(String, usize, [MethodErrors; 3])]) -> String {
     s
 }
 
-/// The comparison of the issue's three profiles (skin1 dipole, d'Eon 6-Gaussian skin, a Burley skin) at
+/// The comparison of three profiles (skin1 dipole, d'Eon 6-Gaussian skin, a Burley skin) at
 /// N = 20, 40, 80 with the default pixel (125/720 mm): the rows of [`markdown_table`].
 pub fn default_comparison() -> Result<Vec<(String, usize, [MethodErrors; 3])>, CompareError> {
     use crate::diffusion::burley::{RgbBurley, ShapeFit};

@@ -1,4 +1,4 @@
-//! Importance-sampled screen-space SSS kernels (issue 11): the disk sampling Unity HDRP's diffusion profiles use,
+//! Importance-sampled screen-space SSS kernels: the disk sampling Unity HDRP's diffusion profiles use,
 //! for any [`crate::diffusion::RadialProfile`] (Golubev, "Efficient Screen-Space Subsurface Scattering Using
 //! Burley's Normalized Diffusion in Real-Time", SIGGRAPH 2018 course "Advances in Real-Time Rendering").
 //!

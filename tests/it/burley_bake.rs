@@ -1,4 +1,4 @@
-//! The `burley-profiles` bake asset (issue 11): every Jensen 2001 material and physiological skin gets a Burley fit
+//! The `burley-profiles` bake asset: every Jensen 2001 material and physiological skin gets a Burley fit
 //! that is the optimum of its own metric (never worse than the artist mapping A = Rd, ℓ = 1/σ_tr it is reported
 //! beside), errors that `rtbake evaluate` reproduces, and transmission profiles whose Burley table is the closed-form
 //! plane integral of the fitted profile (T(0) = A) and whose Gaussian table starts at the Gaussians' total.

@@ -1,4 +1,4 @@
-//! Issue 11 (part), user-facing profile inputs. `rtbake profile --burley-albedo … --burley-mfp-mm …`: Burley's
+//! User-facing profile inputs. `rtbake profile --burley-albedo … --burley-mfp-mm …`: Burley's
 //! normalized diffusion as a profile source (the values are the library's closed form, the totals are the albedos,
 //! the provenance rebuilds the same profile, bad input exits 2 naming the flag and the channel). `--profile-csv`:
 //! a tabulated profile in the `rtbake profile --csv` layout for the fits (rtbake's own output reproduces the
@@ -65,7 +65,7 @@ fn bad_burley_input_exits_2_naming_the_flag() {
     assert_eq!(o.status.code(), Some(2), "--burley-albedo needs --burley-mfp-mm");
 }
 
-/// `--profile-csv` (issue 11): rtbake's own `profile --csv` output fed back reproduces the fit of the built-in
+/// `--profile-csv`: rtbake's own `profile --csv` output fed back reproduces the fit of the built-in
 /// profile (variances within 0.5 %, every weight above 1 % of the largest within 1 %, error within 0.05 points), for a
 /// dipole (skin1) and for the layered multipole of the physiological two-layer skin (Cm 0.1, Chd 0.1).
 #[test]
@@ -157,7 +157,7 @@ fn fit_burley_recovers_a_burley_profile_from_its_csv() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--profile-csv"));
 }
 
-/// `rtbake kernel --profile-csv` (issue 11) fits strength and falloff to the user's profile exactly as
+/// `rtbake kernel --profile-csv` fits strength and falloff to the user's profile exactly as
 /// `rtbake fit separable --profile-csv` does, then builds the same taps as `kernel --strength S --falloff F`; given
 /// together with --strength the two sources are refused (exit 2, both named) and nothing is written.
 #[test]
@@ -202,7 +202,7 @@ fn kernel_from_a_profile_csv_is_the_fit_separable_kernel() {
     assert!(!out.exists());
 }
 
-/// `rtbake transmittance --burley-*` (issue 11: the transmission profile engine bakers derive from Burley): T(s) is
+/// `rtbake transmittance --burley-*` (the transmission profile engine bakers derive from Burley): T(s) is
 /// the closed-form plane integral A (e^(−s/d) + 3e^(−s/(3d)))/4 at every texel of the baked table, T(0) = A, the
 /// sidecar records A and d instead of Gaussians, and the form is the plane integral whatever --physical says.
 #[test]
@@ -246,7 +246,7 @@ fn transmittance_from_burley_is_the_plane_integral() {
     }
 }
 
-/// `rtbake transmittance --profile-csv` (issue 11) fits --count Gaussians to the user's profile as --material does
+/// `rtbake transmittance --profile-csv` fits --count Gaussians to the user's profile as --material does
 /// to the built-in one: rtbake's own skin1 CSV gives T(s) within 1 % (of T(0)) of `--material skin1`. Two profile
 /// sources, or fit flags without a fitted profile, exit 2 and write nothing.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 11: `rtbake evaluate` — given parameters against a target profile, with the fits' metrics. A fit's own
+//! `rtbake evaluate` — given parameters against a target profile, with the fits' metrics. A fit's own
 //! parameters evaluated back reproduce the error the fit reported; a profile against its own CSV is within the CSV's
 //! interpolation error (over the CSV's range only); `--max-error` gates with exit 1 after printing the report; the
 //! separable fit beats thesis Table 6.1 under the metric it minimises; bad input exits 2 naming the flag, writing

@@ -1,4 +1,4 @@
-//! Issue 11 (part): `rtbake importance-kernel` (an importance-sampled disk kernel of any profile; files and their
+//! `rtbake importance-kernel` (an importance-sampled disk kernel of any profile; files and their
 //! consumers) and `rtbake run sss --method importance`; bad input exits 2 naming the flag and writes nothing.
 
 use crate::support::rtbake;

@@ -1,4 +1,4 @@
-//! Issue 14: the mesh G-buffer pass (`runtime::mesh_raster`) against its CPU twin on the procedural default head,
+//! The mesh G-buffer pass (`runtime::mesh_raster`) against its CPU twin on the procedural default head,
 //! and the geometry it must show: the nose tip nearest the camera at the distance the mesh puts it, the silhouette
 //! as wide as the head's projection, normals facing the camera on the visible side.
 

@@ -1,4 +1,4 @@
-//! Issue 14: `rtbake report chi2` — TAP 2009 Table II's χ² and significance from the counts the paper implies, the
+//! `rtbake report chi2` — TAP 2009 Table II's χ² and significance from the counts the paper implies, the
 //! same from a user's counts file, and bad counts files refused (exit 2, the line and column named, nothing written).
 
 use crate::support::rtbake;

@@ -18,8 +18,9 @@ fn gpu_vs_cpu(w: u32, h: u32, n: u32) {
     let (fw, mw) = within(&weights, &c.weights, 1);
     let (fo, mo) = within(&out, &c.output, 1);
     eprintln!("{w}x{h} N={n}: edges exact {fe:.5}; weights ±1 {fw:.5} (max {mw}); output ±1 {fo:.5} (max {mo})");
-    assert!(fe >= 0.9999, "edges differ: {fe}");
-    assert!(fo >= 0.999, "output channels within 1/255: {fo}");
+    let name = format!("mlaa_{w}x{h}_n{n}");
+    assert_gpu_matches_cpu(&name, fe >= 0.9999, &format!("edges exact {fe}"), (w, h, 2), &edges, &c.edges);
+    assert_gpu_matches_cpu(&name, fo >= 0.999, &format!("output within 1/255 {fo}"), (w, h, 4), &out, &c.output);
     assert!(out != img, "MLAA must change the aliased image");
 }
 

@@ -28,9 +28,32 @@ fn gpu_vs_cpu(w: u32, h: u32) {
         pixels_within(&out, &c.output, 4, 1)
     );
     assert!(edge_px > 0, "the test scene must have edges");
-    assert!(fe >= 0.9999, "edges differ: {fe}");
-    assert!(fo >= 0.999, "output channels within 1/255: {fo}");
+    let name = format!("smaa_{w}x{h}");
+    assert_gpu_matches_cpu(&name, fe >= 0.9999, &format!("edges exact {fe}"), (w, h, 2), &edges, &c.edges);
+    assert_gpu_matches_cpu(&name, fo >= 0.999, &format!("output within 1/255 {fo}"), (w, h, 4), &out, &c.output);
     assert!(out != img, "SMAA must change the aliased image");
+}
+
+#[test]
+fn a_failing_comparison_writes_the_two_images_and_their_difference() {
+    let (gpu_img, mut cpu_img) = (vec![10u8; 4 * 6 * 4], vec![10u8; 4 * 6 * 4]);
+    cpu_img[0] = 12;
+    let caught = std::panic::catch_unwind(|| {
+        assert_gpu_matches_cpu("comparison_self_test", false, "one sample", (4, 6, 4), &gpu_img, &cpu_img)
+    });
+    let message = *caught.unwrap_err().downcast::<String>().unwrap();
+    let dir = comparison_dir("comparison_self_test");
+    assert!(message.contains(&dir.display().to_string()), "{message}");
+    let diff = std::fs::read(dir.join("difference.png")).unwrap();
+    let rtbake::io::png::DecodedPng::U8(diff) = rtbake::io::png::decode(&diff, "difference.png").unwrap() else {
+        panic!("difference.png is not 8-bit")
+    };
+    assert_eq!((diff.width, diff.height, diff.channels), (4, 6, 4));
+    // |10 − 12| × 16 at the first sample, 0 elsewhere (alpha 255).
+    assert_eq!(&diff.data[..8], &[32, 0, 0, 255, 0, 0, 0, 255]);
+    for f in ["gpu.png", "cpu.png"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 14 part B: the passes of the thesis' skin shader around `run skin`'s SSS shader — the rig's eq. 7.6 at
+//! The passes of the thesis' skin shader around `run skin`'s SSS shader — the rig's eq. 7.6 at
 //! the mesh's uv (GPU vs CPU twin, redness in the expected direction) and bad input (exit 2 naming the flag,
 //! nothing written).
 

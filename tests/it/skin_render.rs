@@ -1,4 +1,4 @@
-//! Issue 14: `rtbake run skin` — heads from a mesh through the skin chain. The GPU chain agrees with its CPU twin,
+//! `rtbake run skin` — heads from a mesh through the skin chain. The GPU chain agrees with its CPU twin,
 //! the SSS shaders (separable, SS Full, SS Jittered) soften the lit skin (red more than blue, as the skin profiles are widest in red), a mesh file is
 //! rendered like the built-in head, and bad meshes and settings exit 2 naming the file or flag, writing nothing.
 

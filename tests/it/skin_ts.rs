@@ -1,4 +1,4 @@
-//! Issue 14, texture-space diffusion (`run skin --shader ts`; d'Eon et al. 2007, thesis ch. 3): the GPU pass agrees
+//! Texture-space diffusion (`run skin --shader ts`; d'Eon et al. 2007, thesis ch. 3): the GPU pass agrees
 //! with its CPU twin, every shader's error against a converged TS reference (TS at a 2048² map, no optimisation),
 //! each ch. 3 optimisation leaves the image within a stated tolerance while skipping the texels it claims, and bad
 //! `--ts-*` input exits 2 naming the flag, writing nothing.
@@ -161,7 +161,7 @@ fn ts_without_diffusion_is_the_no_sss_frame() {
 /// Error of every shader against the converged reference (TS, 2048² map, no optimisation), 320×180, one head at
 /// 0.6 m. The reference is converged: TS at 1024² is within PSNR 55 dB of it and closer than TS at 256². TS at the
 /// default map is closer than every screen-space shader; SS Full — with TAP 2009's α = 11, β = 800 and with α at
-/// the physical scale — is closer than SS Jittered and no SSS (issue 14); and, 3 pixels or more inside the
+/// the physical scale — is closer than SS Jittered and no SSS; and, 3 pixels or more inside the
 /// silhouette, the physically scaled SS Jittered (taps in mm) is closer than no SSS.
 #[test]
 fn error_of_each_shader_against_a_converged_ts_reference() {

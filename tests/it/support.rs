@@ -223,3 +223,42 @@ pub fn edge_error_and_psnr(img: &[u8], truth: &[u8], mask: &[bool]) -> (f64, f64
     let mse = se / (img.len() / 4 * 3) as f64;
     (sum / n as f64, 10.0 * (255.0f64 * 255.0 / mse).log10())
 }
+
+/// Where a GPU/CPU comparison named `name` leaves its images: `CARGO_TARGET_TMPDIR/gpu-cpu-diffs/NAME/`.
+pub fn comparison_dir(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gpu-cpu-diffs").join(name)
+}
+
+/// Writes the GPU and CPU images of a comparison (`w`×`h`, `ch` interleaved 8-bit channels) and their difference
+/// (|gpu − cpu| per channel, ×16 so that a 1/255 step is visible; alpha 255) as `gpu.png`, `cpu.png` and
+/// `difference.png` into [`comparison_dir`]`(name)`, and returns that folder.
+pub fn write_comparison(name: &str, (w, h, ch): (u32, u32, u32), gpu: &[u8], cpu: &[u8]) -> PathBuf {
+    use rtbake::image_buf::Image;
+    let dir = comparison_dir(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let diff: Vec<u8> = gpu
+        .iter()
+        .zip(cpu)
+        .enumerate()
+        .map(|(i, (a, b))| if ch == 4 && i % 4 == 3 { 255 } else { a.abs_diff(*b).saturating_mul(16) })
+        .collect();
+    for (file, data) in [("gpu.png", gpu), ("cpu.png", cpu), ("difference.png", &diff[..])] {
+        let png = rtbake::io::png::encode_u8(&Image::from_vec(w, h, ch, data.to_vec())).unwrap();
+        std::fs::write(dir.join(file), png).unwrap();
+    }
+    dir
+}
+
+/// Asserts a GPU/CPU agreement `ok` (described by `what`); when it fails, writes the two images and their
+/// difference ([`write_comparison`]) and names the folder in the panic message.
+pub fn assert_gpu_matches_cpu(name: &str, ok: bool, what: &str, size: (u32, u32, u32), gpu: &[u8], cpu: &[u8]) {
+    if !ok {
+        let dir = write_comparison(name, size, gpu, cpu);
+        panic!("{name}: GPU and CPU differ: {what}; gpu.png, cpu.png and difference.png are in {}", dir.display());
+    }
+}
+
+/// Linear f32 samples as 8-bit for viewing a comparison (clamped to [0, 1], ×255, rounded).
+pub fn unorm8_of(samples: &[f32]) -> Vec<u8> {
+    samples.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8).collect()
+}

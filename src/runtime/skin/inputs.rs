@@ -1,0 +1,332 @@
+//! Skin shading inputs on the GPU: hemoglobin from the appearance rig (Jimenez et al., "A Practical Appearance
+//! Model for Dynamic Facial Color", SIGGRAPH Asia 2010; thesis eq. 7.6), albedo from the melanin × hemoglobin LUT
+//! (eq. 7.7, normalised index u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), node-inclusive), and transmittance T(s)·E
+//! through thin regions (Jimenez et al., "Real-Time Realistic Skin Translucency", IEEE CG&A 2010; thesis eq.
+//! 5.12–5.13, E = max(0.3 + dot(−N, L), 0)). One fragment pass, two `Rgba16Float` targets. CPU twin
+//! [`crate::runtime::skin::inputs_cpu`].
+
+use crate::error::InvalidInput;
+use crate::runtime::gpu;
+use crate::runtime::RuntimeError;
+
+/// Melanin volume fraction spanned by the LUT's u axis (thesis Table 7.1).
+pub const CM_MAX: f32 = 0.5;
+/// Dermal hemoglobin volume fraction spanned by the LUT's v axis (thesis Table 7.1).
+pub const CHD_MAX: f32 = 0.32;
+/// Largest number of rig targets (weights) the pass takes.
+pub const MAX_RIG_TARGETS: usize = 8;
+
+/// The skin LUTs as plain data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinLuts {
+    /// Albedo LUT width (melanin, columns) and height (hemoglobin, rows).
+    pub albedo_size: (u32, u32),
+    /// Linear RGB albedo, row-major, top row = lowest hemoglobin (v = 0).
+    pub albedo: Vec<[f32; 3]>,
+    /// T(s) for s = s_max·i/(n−1), i = 0..n−1 (node-inclusive), linear RGB.
+    pub transmittance: Vec<[f32; 3]>,
+    pub s_max_mm: f32,
+}
+
+/// The hemoglobin rig (eq. 7.6): per target i, low-resolution scale_i and bias_i maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigScaleBiasMaps {
+    pub width: u32,
+    pub height: u32,
+    /// Per target: (scale, bias) per texel, row-major, top row first.
+    pub targets: Vec<Vec<[f32; 2]>>,
+}
+
+/// Per-pixel inputs of one frame (all top row first, `width × height`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkinFrame {
+    pub width: u32,
+    pub height: u32,
+    /// Melanin volume fraction Cm.
+    pub melanin: Vec<f32>,
+    /// Mean-free neutral hemoglobin H0 (eq. 7.4).
+    pub h0: Vec<f32>,
+    /// Thickness s in mm for the transmittance lookup.
+    pub thickness_mm: Vec<f32>,
+    /// Unit normals.
+    pub normals: Vec<[f32; 3]>,
+}
+
+fn invalid(param: &str, msg: String) -> InvalidInput {
+    InvalidInput::new(param, msg)
+}
+
+impl SkinLuts {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let (w, h) = self.albedo_size;
+        if w < 2 || h < 2 || self.albedo.len() != (w * h) as usize {
+            return Err(invalid(
+                "skin LUT",
+                format!("needs >= 2x2 texels and {w}x{h} values, got {}", self.albedo.len()),
+            ));
+        }
+        if self.transmittance.len() < 2 {
+            return Err(invalid("transmittance table", "needs at least 2 texels".into()));
+        }
+        crate::error::check_positive("transmittance s_max_mm", self.s_max_mm as f64, "mm")?;
+        Ok(())
+    }
+}
+
+impl RigScaleBiasMaps {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let n = (self.width * self.height) as usize;
+        if self.targets.is_empty() || self.targets.len() > MAX_RIG_TARGETS || self.targets.iter().any(|t| t.len() != n)
+        {
+            return Err(invalid(
+                "hemoglobin rig",
+                format!("needs 1..={MAX_RIG_TARGETS} targets of {}x{} texels", self.width, self.height),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl SkinFrame {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let n = (self.width * self.height) as usize;
+        if self.melanin.len() != n || self.h0.len() != n || self.thickness_mm.len() != n || self.normals.len() != n {
+            return Err(invalid("skin frame", format!("all maps must be {}x{}", self.width, self.height)));
+        }
+        Ok(())
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    rt: [f32; 4],
+    light: [f32; 4],
+    lut: [f32; 4],
+    cfg: [f32; 4],
+    weights: [[f32; 4]; 2],
+}
+
+const SHADER: &str = include_str!("inputs.wgsl");
+
+fn f16_bytes(v: impl Iterator<Item = f32>) -> Vec<u8> {
+    let h: Vec<half::f16> = v.map(half::f16::from_f32).collect();
+    bytemuck::cast_slice(&h).to_vec()
+}
+
+/// Skin inputs for one frame size, LUTs and rig.
+pub struct SkinInputs {
+    width: u32,
+    height: u32,
+    maps: wgpu::Texture,
+    normals: wgpu::Texture,
+    albedo: wgpu::Texture,
+    transmitted: wgpu::Texture,
+    albedo_view: wgpu::TextureView,
+    transmitted_view: wgpu::TextureView,
+    pipe: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    ubo: wgpu::Buffer,
+    params: Params,
+}
+
+fn data_texture(
+    device: &wgpu::Device,
+    label: &str,
+    w: u32,
+    h: u32,
+    layers: u32,
+    f: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: f,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
+impl SkinInputs {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        width: u32,
+        height: u32,
+        luts: &SkinLuts,
+        rig: &RigScaleBiasMaps,
+    ) -> Result<Self, RuntimeError> {
+        crate::error::check_size("image", width as u64, height as u64)?;
+        crate::runtime::device::check_image_fits(device, width, height, 16)?;
+        luts.validate()?;
+        rig.validate()?;
+        use wgpu::TextureFormat as F;
+        let maps = data_texture(device, "skin maps", width, height, 1, F::Rgba32Float);
+        let normals = data_texture(device, "skin normals", width, height, 1, F::Rgba32Float);
+        let k = rig.targets.len() as u32;
+        // At least two layers: the GL backend cannot view a one-layer texture as a 2D array.
+        let rig_tex = data_texture(device, "skin rig", rig.width, rig.height, k.max(2), F::Rg16Float);
+        for (i, t) in rig.targets.iter().enumerate() {
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &rig_tex,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: i as u32 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &f16_bytes(t.iter().flatten().copied()),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(rig.width * 4),
+                    rows_per_image: Some(rig.height),
+                },
+                wgpu::Extent3d { width: rig.width, height: rig.height, depth_or_array_layers: 1 },
+            );
+        }
+        let (lw, lh) = luts.albedo_size;
+        let lut_tex = gpu::texture(device, "skin albedo LUT", lw, lh, F::Rgba16Float);
+        gpu::upload(queue, &lut_tex, &f16_bytes(luts.albedo.iter().flat_map(|c| [c[0], c[1], c[2], 1.0])));
+        let nt = luts.transmittance.len() as u32;
+        let t_tex = gpu::texture(device, "skin T(s)", nt, 1, F::Rgba16Float);
+        gpu::upload(queue, &t_tex, &f16_bytes(luts.transmittance.iter().flat_map(|c| [c[0], c[1], c[2], 1.0])));
+        let albedo = gpu::texture(device, "skin albedo", width, height, F::Rgba16Float);
+        let transmitted = gpu::texture(device, "skin transmitted", width, height, F::Rgba16Float);
+        let params = Params {
+            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+            light: [0.0, 0.0, 1.0, 0.0],
+            lut: [lw as f32, lh as f32, nt as f32, luts.s_max_mm],
+            cfg: [k as f32, 0.0, 0.0, 0.0],
+            weights: [[0.0; 4]; 2],
+        };
+        let ubo = gpu::uniform_buffer(device, "skin params", bytemuck::bytes_of(&params));
+        let module = gpu::shader(device, "skin_inputs.wgsl", SHADER);
+        let target = |f| Some(wgpu::ColorTargetState { format: f, blend: None, write_mask: wgpu::ColorWrites::ALL });
+        let targets = [target(F::Rgba16Float), target(F::Rgba16Float)];
+        let pipe = gpu::fullscreen_pipeline_with(device, "skin inputs", &module, "fs_skin", &targets);
+        let lin = gpu::linear_clamp_sampler(device);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let rig_view = rig_tex.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        use wgpu::BindingResource as R;
+        let (mv, nv, lv, tv) = (view(&maps), view(&normals), view(&lut_tex), view(&t_tex));
+        let group = gpu::bind_group(
+            device,
+            "skin inputs",
+            &pipe.get_bind_group_layout(0),
+            &[
+                (0, ubo.as_entire_binding()),
+                (1, R::TextureView(&mv)),
+                (2, R::TextureView(&nv)),
+                (3, R::TextureView(&rig_view)),
+                (4, R::TextureView(&lv)),
+                (5, R::TextureView(&tv)),
+                (6, R::Sampler(&lin)),
+            ],
+        );
+        let (albedo_view, transmitted_view) = (view(&albedo), view(&transmitted));
+        Ok(Self {
+            width,
+            height,
+            maps,
+            normals,
+            albedo,
+            transmitted,
+            albedo_view,
+            transmitted_view,
+            pipe,
+            group,
+            ubo,
+            params,
+        })
+    }
+
+    /// Albedo (rgb) and hemoglobin H (a), `Rgba16Float`.
+    pub fn albedo(&self) -> &wgpu::Texture {
+        &self.albedo
+    }
+    /// T(s)·E (rgb) and E (a), `Rgba16Float`.
+    pub fn transmitted(&self) -> &wgpu::Texture {
+        &self.transmitted
+    }
+
+    /// Uploads a frame and the per-frame rig weights and light direction (unit, towards the light).
+    pub fn upload(
+        &mut self,
+        queue: &wgpu::Queue,
+        frame: &SkinFrame,
+        rig_weights: &[f32],
+        light_dir: [f32; 3],
+    ) -> Result<(), InvalidInput> {
+        frame.validate()?;
+        if (frame.width, frame.height) != (self.width, self.height) {
+            return Err(invalid("skin frame", format!("must be {}x{}", self.width, self.height)));
+        }
+        if rig_weights.len() != self.params.cfg[0] as usize {
+            return Err(invalid(
+                "--rig-weights",
+                format!("needs one weight per rig target ({}), got {}", self.params.cfg[0], rig_weights.len()),
+            ));
+        }
+        let mut w = [[0.0f32; 4]; 2];
+        for (i, v) in rig_weights.iter().enumerate() {
+            w[i / 4][i % 4] = *v;
+        }
+        self.params.weights = w;
+        self.params.light = [light_dir[0], light_dir[1], light_dir[2], 0.0];
+        queue.write_buffer(&self.ubo, 0, bytemuck::bytes_of(&self.params));
+        let n = (self.width * self.height) as usize;
+        let maps: Vec<f32> = (0..n).flat_map(|i| [frame.melanin[i], frame.h0[i], frame.thickness_mm[i], 0.0]).collect();
+        let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
+        gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps));
+        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
+        Ok(())
+    }
+
+    /// Records the pass.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder) {
+        let att = |v| {
+            Some(wgpu::RenderPassColorAttachment {
+                view: v,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("skin inputs"),
+            color_attachments: &[att(&self.albedo_view), att(&self.transmitted_view)],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipe);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Uploads, runs and reads back (albedo+H, T·E+E) as RGBA f32.
+    pub fn run(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &SkinFrame,
+        rig_weights: &[f32],
+        light_dir: [f32; 3],
+    ) -> Result<(Vec<f32>, Vec<f32>), RuntimeError> {
+        self.upload(queue, frame, rig_weights, light_dir)?;
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin") });
+        self.encode(&mut enc);
+        queue.submit([enc.finish()]);
+        let read = |t| gpu::read_texture_f16(device, queue, t);
+        Ok((read(&self.albedo)?, read(&self.transmitted)?))
+    }
+}

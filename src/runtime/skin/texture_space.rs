@@ -1,0 +1,435 @@
+//! Texture-space diffusion, TAP 2009's "TS" shader (d'Eon, Luebke and Enderton, "Efficient Rendering of Human
+//! Skin", EGSR 2007) in `rtbake run skin --shader ts`, with the three optimisations of Jimenez's thesis ch. 3
+//! (culled, depth-sized and clipped irradiance maps; maths in [`crate::shading::texture_space`]).
+//!
+//! Per head of the row (each head has its own maps, as the thesis' multi-head scenes):
+//! 1. **Irradiance map**: the head's mesh rasterised at its texture coordinates into a `T`×`T` map (host side,
+//!    [`crate::shading::texture_space::rasterise_uv`]); each texel is lit exactly as the screen-space shaders'
+//!    pixels are — albedo from the skin LUT at the texel's H0 and melanin, Lambert key light + ambient on the
+//!    texel's view-space normal, plus the back light's T(s)·E with the shadow map's thickness at the texel's
+//!    surface point (stored with the reflected light and blurred with it, thesis §5.4; [`crate::runtime::skin::lighting`]'s
+//!    `lit_geometry`, on the GPU skin-inputs pass when there is a device) — so only the diffusion differs between
+//!    shaders. Alpha = 1 on shaded texels, 0 on uncovered ones and,
+//!    with the optimisations, on culled (N·V < cos 105°, §3.2) and clipped (outside the view frustum, eq. 3.3–3.4)
+//!    ones. With the depth-based optimisation `T` = min(d_ref/d, 1)·`T_max` (eq. 3.1–3.2).
+//! 2. **Stretch map**: |∂P/∂u|, |∂P/∂v| of each texel's triangle in mm per texel.
+//! 3. **Blurs** (GPU compute pass, `skin/texture_space.wgsl`, or the CPU twin [`crate::runtime::skin::texture_space_cpu`]):
+//!    the 6 Gaussians of the baked fit (`DemoAssets::blurs`) chained with incremental variances, u then v, 7 taps
+//!    each `σᵢ / stretch` texels apart, alpha-0 texels skipped (Listing 3.3) and excluded from their neighbours'
+//!    sums; the weighted sum Σ wᵢ·blurᵢ (wᵢ of the fit, normalised per channel) accumulated as they go.
+//! 4. **Final pass**: each visible pixel of the head samples the sum at its uv (bilinear); pixels with no shaded
+//!    texel in reach keep their unblurred diffuse. The specular layer is composited as for the other shaders
+//!    (`demo::composite`).
+//!
+//! The UV rasterisation, culling and clipping run on the host on both paths (they are counted, not timed, by the
+//! Table 3.1 figures: [`TsStats`]); the GPU runs the lighting, the 12 blur passes and the gather.
+//!
+//! `d_ref` of eq. 3.1 ("dependent of both model scale and frame resolution", thesis §3.3) is taken as the distance
+//! at which one pixel of the frame covers four texels of the `T_max` map ([`d_ref_m`]).
+
+use crate::error::InvalidInput;
+use crate::image_buf::Image;
+use crate::mesh::Mesh;
+use crate::runtime::backend::Backend;
+use crate::runtime::gpu;
+use crate::runtime::skin::heads::{self, row_of_heads};
+use crate::runtime::skin::inputs::{RigScaleBiasMaps, SkinFrame};
+use crate::runtime::skin::lighting::{composite, lit_geometry, DemoAssets, Geometry};
+use crate::runtime::skin::passes::SkinPasses;
+use crate::runtime::skin::settings::{SkinRenderSettings, HEAD_SPACING_M};
+pub use crate::runtime::skin::settings::{TsSettings, DEFAULT_MAP_SIZE, MAX_MAP_SIZE, MIN_MAP_SIZE};
+use crate::runtime::skin::texture_space_cpu;
+use crate::runtime::RuntimeError;
+use crate::shading::texture_space::{
+    depth_sized_map, frustum_planes_eye, inside_frustum, is_culled, nearest_corner_distance, normalised_weights,
+    rasterise_uv, UvMap,
+};
+use nalgebra::{Vector3, Vector4};
+use std::collections::HashMap;
+use wgpu::util::DeviceExt;
+
+/// Peak host memory of the texture-space pass with a `map_size`² map, bytes: the UV map (33 B per texel), the
+/// texels' skin frame and lit layers (~80 B) and the irradiance map (16 B), doubled for the per-size map cache and
+/// the depth-sized maps.
+pub fn memory_estimate_bytes(map_size: u32) -> u64 {
+    2 * 130 * map_size as u64 * map_size as u64
+}
+
+/// The work of one head's texture-space pass (Table 3.1's optimisations save on these).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TsHeadStats {
+    /// Irradiance map edge used, texels.
+    pub map_size: u32,
+    /// Distance from the eye to the head's nearest bounding-box corner, m (eq. 3.1's d).
+    pub distance_m: f32,
+    /// Texels covered by the UV layout.
+    pub covered_texels: u64,
+    /// Covered texels culled (§3.2) — their fragments discarded.
+    pub culled_texels: u64,
+    /// Covered, not culled texels clipped (§3.4).
+    pub clipped_texels: u64,
+    /// Texels lit and blurred: covered − culled − clipped.
+    pub shaded_texels: u64,
+    /// Visible pixels of the head in the frame.
+    pub pixels: u64,
+}
+
+/// Per-head statistics of a frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TsStats {
+    pub heads: Vec<TsHeadStats>,
+    /// eq. 3.1's d_ref, m.
+    pub d_ref_m: f32,
+}
+
+impl TsStats {
+    /// Texels lit and blurred over all heads.
+    pub fn shaded_texels(&self) -> u64 {
+        self.heads.iter().map(|h| h.shaded_texels).sum()
+    }
+
+    /// Texel blur evaluations over all heads: 12 passes (6 Gaussians × u, v) per shaded texel.
+    pub fn blur_evaluations(&self) -> u64 {
+        12 * self.shaded_texels()
+    }
+
+    /// Texels allocated over all heads (T² per head).
+    pub fn map_texels(&self) -> u64 {
+        self.heads.iter().map(|h| h.map_size as u64 * h.map_size as u64).sum()
+    }
+}
+
+/// Renders `mesh` (repeated `s.heads` times) with texture-space diffusion (RGBA8, sRGB-encoded) and the work done,
+/// with no extra pass ([`SkinPasses::none`], as `skin_render::render`).
+pub fn render<'g>(
+    gpu: impl Into<Backend<'g>>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    ts: TsSettings,
+    assets: &DemoAssets,
+) -> Result<(Image<u8>, TsStats), RuntimeError> {
+    let gpu: Backend = gpu.into();
+    render_with(gpu, mesh, s, ts, &SkinPasses::none(), assets)
+}
+
+/// [`render`] with the passes of `passes` (rig pose, wrinkles and MSAA of the G-buffer, bloom), as
+/// `skin_render::render_with` applies them to the screen-space shaders. The rig pose and wrinkles shape the
+/// screen-space G-buffer whose pixels gather the blurred map (the texels use the mesh's vertex normals and H0).
+pub fn render_with<'g>(
+    gpu: impl Into<Backend<'g>>,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    ts: TsSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<(Image<u8>, TsStats), RuntimeError> {
+    let gpu: Backend = gpu.into();
+    s.validate()?;
+    ts.validate()?;
+    let heads = row_of_heads(mesh, s.heads)?;
+    let (geo, g, shadow) = heads::geometry(gpu, &heads, s, passes, assets)?;
+    // As `skin_render::render_with`: a neutral rig (scale 1, bias 0), post-scatter texturing (the maps hold
+    // irradiance; each pixel's albedo multiplies what it gathers, thesis §7.6) and the passes' bloom.
+    let mut assets = assets.clone();
+    assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
+    assets.rig_weights = vec![1.0];
+    assets.post_scatter_albedo = true;
+    assets.bloom = passes.bloom;
+    let lit = lit_geometry(gpu, geo, &assets)?;
+    let cam = s.camera();
+    let (w, h) = (s.width, s.height);
+    let view = cam.view();
+    let inv_view = view.try_inverse().expect("a look-at view is invertible");
+    let rot = view.fixed_view::<3, 3>(0, 0).into_owned();
+    let mmu = mesh.mm_per_unit;
+    let spacing = HEAD_SPACING_M * 1000.0 / mmu;
+    let centre = 0.5 * (s.heads - 1) as f32;
+    // The head of each visible pixel, from its world-space x.
+    let mut pixels_of: Vec<Vec<usize>> = vec![Vec::new(); s.heads as usize];
+    for i in 0..(w * h) as usize {
+        if !g.covered[i] {
+            continue;
+        }
+        let ray = heads::view_ray(&cam, w, h, i);
+        let d = g.depth_mm[i] / mmu;
+        let p = inv_view * Vector4::new(ray[0] * d, ray[1] * d, -d, 1.0);
+        let k = (p.x / spacing + centre).round().clamp(0.0, (s.heads - 1) as f32) as usize;
+        pixels_of[k].push(i);
+    }
+    let planes = frustum_planes_eye(&cam.projection(w as f32 / h as f32));
+    let mut maps: HashMap<u32, UvMap> = HashMap::new();
+    let base = maps.entry(ts.map_size).or_insert_with(|| rasterise_uv(mesh, ts.map_size));
+    let d_ref_m = d_ref_m(base, h, cam.fov_y_deg);
+    let weights = normalised_weights(&assets.blurs.blend);
+    let sigmas = &assets.blurs.incremental_sigma_mm;
+    let (lo, hi) = mesh.bounds();
+    let mut pass = gpu.prepare(|g| TextureSpaceDiffusion::new(&g.device), || Ok(()))?;
+    let mut diffuse = lit.diffuse.clone();
+    let mut stats = TsStats { heads: Vec::new(), d_ref_m };
+    for (k, pixels) in pixels_of.iter().enumerate() {
+        let dx = (k as f32 - centre) * spacing;
+        let (lo_k, hi_k) = ([lo[0] + dx, lo[1], lo[2]], [hi[0] + dx, hi[1], hi[2]]);
+        let distance_m = nearest_corner_distance(cam.eye, lo_k, hi_k) * mmu / 1000.0;
+        let size = if ts.depth_sized { depth_sized_map(ts.map_size, d_ref_m, distance_m) } else { ts.map_size };
+        let uv = maps.entry(size).or_insert_with(|| rasterise_uv(mesh, size));
+        let mut st = TsHeadStats { map_size: size, distance_m, pixels: pixels.len() as u64, ..Default::default() };
+        // The texels as a frame for the lighting of the screen-space shaders.
+        let n = (size * size) as usize;
+        let mut frame = SkinFrame {
+            width: size,
+            height: size,
+            melanin: vec![0.0; n],
+            h0: vec![0.0; n],
+            thickness_mm: vec![assets.luts.s_max_mm; n],
+            normals: vec![[0.0, 0.0, 1.0]; n],
+        };
+        let mut shaded = vec![false; n];
+        #[allow(clippy::needless_range_loop)] // t indexes the UV map and the texel frame alike
+        for t in 0..n {
+            if !uv.covered[t] {
+                continue;
+            }
+            st.covered_texels += 1;
+            let p = uv.position[t];
+            let pw = [p[0] + dx, p[1], p[2]];
+            let nw = uv.normal[t];
+            if ts.cull && is_culled(nw, [0, 1, 2].map(|a| cam.eye[a] - pw[a])) {
+                st.culled_texels += 1;
+                continue;
+            }
+            let pe = view * Vector4::new(pw[0], pw[1], pw[2], 1.0);
+            if ts.clip && !inside_frustum(&planes, [pe.x, pe.y, pe.z]) {
+                st.clipped_texels += 1;
+                continue;
+            }
+            shaded[t] = true;
+            st.shaded_texels += 1;
+            let (u, v) =
+                (((t as u32 % size) as f32 + 0.5) / size as f32, ((t as u32 / size) as f32 + 0.5) / size as f32);
+            frame.melanin[t] = s.melanin;
+            // As `skin_render::geometry` at a pixel with this uv.
+            frame.h0[t] = match &assets.baked_rig {
+                Some(r) => r.h0_at(u, v),
+                None => 0.006 * ((u * 400.0).sin() * (v * 300.0).cos()),
+            };
+            let nv = rot * Vector3::from(nw);
+            frame.normals[t] = [nv.x, nv.y, nv.z];
+            // The back light's transmittance joins the texel's light before the blurs (thesis §5.4), with the
+            // thickness the shadow map gives at the texel's surface point (Listing 5.1).
+            frame.thickness_mm[t] = shadow.thickness_mm(pw, nw).min(assets.luts.s_max_mm);
+        }
+        stats.heads.push(st);
+        if st.shaded_texels == 0 {
+            continue;
+        }
+        let texels = Geometry { frame, depth: vec![1.0; n], skin: shaded, specular: None };
+        let irr = lit_geometry(gpu, texels, &assets)?.diffuse;
+        let irr: Vec<[f32; 4]> = irr.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+        let uvs: Vec<[f32; 2]> = pixels.iter().map(|&i| g.uv[i]).collect();
+        let stretch = &uv.stretch_mm_per_texel;
+        let out = pass.run(
+            |g, p| p.run(&g.device, &g.queue, &irr, stretch, size, sigmas, &weights, &uvs),
+            |_| {
+                let sum = texture_space_cpu::blur_sum(&irr, stretch, size, sigmas, &weights);
+                Ok(texture_space_cpu::gather(&sum, size, &uvs))
+            },
+        )?;
+        for (&i, o) in pixels.iter().zip(&out) {
+            if o[3] > 0.0 {
+                diffuse[4 * i..4 * i + 3].copy_from_slice(&o[..3]);
+            }
+        }
+    }
+    let background = heads::BACKGROUND.repeat((w * h) as usize);
+    for (px, a) in diffuse.chunks_exact_mut(4).zip(lit.albedo.chunks_exact(4)) {
+        for c in 0..3 {
+            px[c] *= a[c];
+        }
+    }
+    let mut img = composite(gpu, &lit.geo, &diffuse, background, assets.bloom.as_ref(), None)?;
+    heads::blend_coverage(&mut img, &g.coverage);
+    Ok((img, stats))
+}
+
+/// eq. 3.1's d_ref for a frame `height_px` tall with a vertical field of view `fov_y_deg`: the distance (m) at which
+/// one pixel covers four texels of `map` along the coarser texel direction, max(stretch_u, stretch_v), of the median
+/// texel; closer than d_ref the map keeps its full size. (Two texels per pixel changed the image at 2 m by more
+/// than switching SSS off does — RMSE 0.0032 vs 0.0022, `tests/it/skin_ts.rs` — four keep it at 0.0014.)
+pub fn d_ref_m(map: &UvMap, height_px: u32, fov_y_deg: f32) -> f32 {
+    let mut s: Vec<f32> =
+        map.stretch_mm_per_texel.iter().zip(&map.covered).filter(|(_, &c)| c).map(|(st, _)| st[0].max(st[1])).collect();
+    if s.is_empty() {
+        return f32::INFINITY;
+    }
+    let mid = s.len() / 2;
+    let median = *s.select_nth_unstable_by(mid, f32::total_cmp).1;
+    // Pixel footprint at distance d: d · 2 tan(fov/2) / height_px (m) = 4 · median (mm) / 1000.
+    4.0 * median / 1000.0 * height_px as f32 / (2.0 * (0.5 * fov_y_deg.to_radians()).tan())
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct BlurParams {
+    size: u32,
+    dir: u32,
+    accumulate: u32,
+    pad0: u32,
+    sigma_mm: [f32; 4],
+    weight: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GatherParams {
+    size: u32,
+    count: u32,
+    pad: [u32; 2],
+}
+
+/// The GPU blur and gather pipelines (`skin/texture_space.wgsl`).
+pub struct TextureSpaceDiffusion {
+    blur: wgpu::ComputePipeline,
+    gather: wgpu::ComputePipeline,
+}
+
+const SHADER: &str = include_str!("texture_space.wgsl");
+/// Gather workgroups per dispatch row (the shader's `65535u * 64u` stride).
+const GATHER_ROW_GROUPS: u32 = 65535;
+
+impl TextureSpaceDiffusion {
+    pub fn new(device: &wgpu::Device) -> Result<Self, RuntimeError> {
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = gpu::shader(device, "texture space", SHADER);
+        let pipe = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (blur, gather) = (pipe("blur"), pipe("gather"));
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RuntimeError::Gpu(format!("texture-space shader: {e}")));
+        }
+        Ok(Self { blur, gather })
+    }
+
+    /// The chained blurs of `irradiance` (premultiplied RGBA, `size`×`size`, alpha 0 = not shaded), their sum
+    /// weighted by `weights`, sampled at `uvs`: (rgb, 1) per uv, zeros where no shaded texel is in reach. Same
+    /// results as [`crate::runtime::skin::texture_space_cpu::blur_sum`] then [`crate::runtime::skin::texture_space_cpu::gather`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        irradiance: &[[f32; 4]],
+        stretch_mm_per_texel: &[[f32; 2]],
+        size: u32,
+        incremental_sigma_mm: &[f32],
+        weights: &[[f32; 3]],
+        uvs: &[[f32; 2]],
+    ) -> Result<Vec<[f32; 4]>, RuntimeError> {
+        let map_bytes = size as u64 * size as u64 * 16;
+        let limit = device.limits().max_storage_buffer_binding_size;
+        if map_bytes > limit {
+            return Err(InvalidInput::new(
+                "--ts-map-size",
+                format!("{size}² RGBA f32 is {map_bytes} bytes, over the adapter's storage-binding limit {limit}"),
+            )
+            .into());
+        }
+        let storage = |label: &str, bytes: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            })
+        };
+        let a = storage("ts chain", bytemuck::cast_slice(irradiance));
+        let b = storage("ts temp", &vec![0u8; map_bytes as usize]);
+        let acc = storage("ts sum", &vec![0u8; map_bytes as usize]);
+        let stretch = storage("ts stretch", bytemuck::cast_slice(stretch_mm_per_texel));
+        let groups = size.div_ceil(8);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ts") });
+        let layout = self.blur.get_bind_group_layout(0);
+        for (sigma, w) in incremental_sigma_mm.iter().zip(weights) {
+            for (dir, src, dst) in [(0u32, &a, &b), (1, &b, &a)] {
+                let p = BlurParams {
+                    size,
+                    dir,
+                    accumulate: dir,
+                    pad0: 0,
+                    sigma_mm: [*sigma, 0.0, 0.0, 0.0],
+                    weight: [w[0], w[1], w[2], 0.0],
+                };
+                let ubuf = gpu::uniform_buffer(device, "ts blur", bytemuck::bytes_of(&p));
+                let bind = gpu::bind_group(
+                    device,
+                    "ts blur",
+                    &layout,
+                    &[
+                        (0, ubuf.as_entire_binding()),
+                        (1, src.as_entire_binding()),
+                        (2, dst.as_entire_binding()),
+                        (3, stretch.as_entire_binding()),
+                        (4, acc.as_entire_binding()),
+                    ],
+                );
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("ts blur"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.blur);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(groups, groups, 1);
+            }
+        }
+        let count = uvs.len() as u32;
+        // A head with no visible pixel still has its maps blurred (as d'Eon's shader); its uv list is padded to one
+        // entry because wgpu refuses empty bindings.
+        let padded: Vec<[f32; 2]> = if uvs.is_empty() { vec![[0.0; 2]] } else { uvs.to_vec() };
+        let uv_buf = storage("ts uvs", bytemuck::cast_slice(&padded));
+        let out_bytes = (uvs.len() as u64 * 16).max(16);
+        let out = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ts gathered"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ts readback"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let gp = GatherParams { size, count, pad: [0; 2] };
+        let ubuf = gpu::uniform_buffer(device, "ts gather", bytemuck::bytes_of(&gp));
+        let bind = gpu::bind_group(
+            device,
+            "ts gather",
+            &self.gather.get_bind_group_layout(0),
+            &[
+                (5, ubuf.as_entire_binding()),
+                (6, acc.as_entire_binding()),
+                (7, uv_buf.as_entire_binding()),
+                (8, out.as_entire_binding()),
+            ],
+        );
+        {
+            let mut pass = enc
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("ts gather"), timestamp_writes: None });
+            pass.set_pipeline(&self.gather);
+            pass.set_bind_group(0, &bind, &[]);
+            let groups = count.div_ceil(64).max(1);
+            pass.dispatch_workgroups(groups.min(GATHER_ROW_GROUPS), groups.div_ceil(GATHER_ROW_GROUPS), 1);
+        }
+        enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
+        queue.submit([enc.finish()]);
+        let bytes = gpu::map_read(device, &readback)?;
+        let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(v[..uvs.len()].to_vec())
+    }
+}

@@ -1,0 +1,284 @@
+//! Screen-space sum-of-Gaussians SSS on the GPU (Jimenez, Sundstedt, Gutierrez, "Screen-Space Perceptual
+//! Rendering of Human Skin", ACM TAP 2009; thesis ch. 4): each Gaussian of a fit (d'Eon et al. 2007) is applied
+//! on top of the previous one with the incremental variance vᵢ − vᵢ₋₁, as a horizontal and a vertical 7-tap blur
+//! (Listing 4.1) stretched by eq. 4.1–4.4, skipped where the depth LOD test of eq. 4.6 says it is narrower than
+//! half a pixel, and accumulated into the final target by hardware alpha blending with the per-channel blend
+//! constant w′ᵢ = wᵢ / Σⱼ≤ᵢ wⱼ (eq. 4.8–4.9). The first Gaussian is the unblurred image (w′₁ = 1).
+//!
+//! Textures: diffuse `Rgba16Float` (linear, alpha = local SSS level, 0 = not skin), depth `R32Float` (linear,
+//! loaded, never filtered), RT1/RT2/RTF `Rgba16Float`. CPU twin [`crate::runtime::sss::gaussian_cpu`].
+
+use crate::diffusion::sum_of_gaussians::SumOfGaussians;
+use crate::error::{check_non_negative, check_positive, InvalidInput};
+use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::RuntimeError;
+
+/// The blurs derived from a sum-of-Gaussians fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaussianBlurs {
+    /// sqrt(vᵢ) in mm, ascending (used by the depth LOD test, eq. 4.6).
+    pub sigma_mm: Vec<f32>,
+    /// sqrt(vᵢ − vᵢ₋₁) in mm: the blur applied on top of the previous Gaussian (first: sqrt(v₁)).
+    pub incremental_sigma_mm: Vec<f32>,
+    /// w′ᵢ per channel (eq. 4.8); w′₁ = 1.
+    pub blend: Vec<[f32; 3]>,
+}
+
+impl GaussianBlurs {
+    /// From a fit with ascending variances (eq. 4.8 and the incremental variances of §4.2.1).
+    pub fn from_sum_of_gaussians(fit: &SumOfGaussians) -> Result<Self, InvalidInput> {
+        let v = &fit.variances_mm2;
+        if v.is_empty() || v.len() != fit.weights.len() {
+            return Err(InvalidInput::new("gaussians", "need as many weights as variances, at least one"));
+        }
+        if v.windows(2).any(|p| p[1] <= p[0]) || v[0] <= 0.0 {
+            return Err(InvalidInput::new("gaussians", "variances must be positive and strictly ascending"));
+        }
+        let mut cum = [0.0f64; 3];
+        let mut blend = Vec::new();
+        for (i, w) in fit.weights.iter().enumerate() {
+            let mut b = [1.0f32; 3];
+            for c in 0..3 {
+                cum[c] += w[c];
+                if i > 0 {
+                    b[c] = if cum[c] > 0.0 { (w[c] / cum[c]) as f32 } else { 0.0 };
+                    // eq. 4.8
+                }
+            }
+            blend.push(b);
+        }
+        let incremental_sigma_mm =
+            (0..v.len()).map(|i| (v[i] - if i == 0 { 0.0 } else { v[i - 1] }).sqrt() as f32).collect();
+        Ok(Self { sigma_mm: v.iter().map(|x| x.sqrt() as f32).collect(), incremental_sigma_mm, blend })
+    }
+}
+
+/// Stretch and LOD parameters (thesis defaults: α = 31.5, β = 800, γ = 0.001 for a 1-unit head, 20° FOV,
+/// 720-pixel viewport; lod 2.0 = the exact rule of eq. 4.6, the thesis ships 0.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussianSssParams {
+    pub alpha: f32,
+    pub beta: f32,
+    pub gamma: f32,
+    pub lod_factor: f32,
+}
+
+impl Default for GaussianSssParams {
+    fn default() -> Self {
+        Self { alpha: 31.5, beta: 800.0, gamma: 0.001, lod_factor: 2.0 }
+    }
+}
+
+/// Viewport height (pixels) for which α of eq. 4.1 is stated.
+pub const ALPHA_VIEWPORT_HEIGHT_PX: f32 = 720.0;
+
+impl GaussianSssParams {
+    /// α scaled from the 720-pixel viewport it is stated for to a viewport `height_px` tall (the stretch of eq. 4.1
+    /// is in pixels, so it grows with the resolution); β, γ and the LOD factor are unchanged.
+    pub fn for_viewport_height(self, height_px: u32) -> Self {
+        Self { alpha: self.alpha * height_px as f32 / ALPHA_VIEWPORT_HEIGHT_PX, ..self }
+    }
+
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_positive("--alpha", self.alpha as f64, "")?;
+        check_non_negative("--beta", self.beta as f64, "")?;
+        check_non_negative("--gamma", self.gamma as f64, "")?;
+        check_positive("--lod-factor", self.lod_factor as f64, "")?;
+        Ok(())
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    rt: [f32; 4],
+    stretch: [f32; 4],
+    blur: [f32; 4],
+}
+
+const SHADER: &str = include_str!("gaussian.wgsl");
+
+/// Screen-space sum-of-Gaussians SSS for one frame size and fit.
+pub struct GaussianSss {
+    width: u32,
+    height: u32,
+    input: wgpu::Texture,
+    depth: wgpu::Texture,
+    rt1: wgpu::Texture,
+    rtf: wgpu::Texture,
+    rt1_view: wgpu::TextureView,
+    rt2_view: wgpu::TextureView,
+    rtf_view: wgpu::TextureView,
+    pipe_h: wgpu::RenderPipeline,
+    pipe_v: wgpu::RenderPipeline,
+    /// Per Gaussian after the first: (horizontal group, vertical group, w′).
+    steps: Vec<(wgpu::BindGroup, wgpu::BindGroup, [f32; 3])>,
+}
+
+impl GaussianSss {
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        blurs: &GaussianBlurs,
+        params: &GaussianSssParams,
+    ) -> Result<Self, RuntimeError> {
+        crate::error::check_size("image", width as u64, height as u64)?;
+        crate::runtime::device::check_image_fits(device, width, height, 8)?;
+        params.validate()?;
+        use wgpu::TextureFormat as F;
+        let input = gpu::texture(device, "gsss input", width, height, F::Rgba16Float);
+        let rt1 = gpu::texture(device, "gsss rt1", width, height, F::Rgba16Float);
+        let rt2 = gpu::texture(device, "gsss rt2", width, height, F::Rgba16Float);
+        let rtf = gpu::texture(device, "gsss rtf", width, height, F::Rgba16Float);
+        let depth = gpu::data_texture(device, "gsss depth", width, height, F::R32Float);
+        let module = gpu::shader(device, "gaussian_sss.wgsl", SHADER);
+        let pipe_h = gpu::fullscreen_pipeline(device, "gsss horizontal", &module, "fs_horizontal", F::Rgba16Float);
+        let blend = wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Constant,
+                dst_factor: wgpu::BlendFactor::OneMinusConstant,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+        };
+        let targets = [
+            Some(wgpu::ColorTargetState { format: F::Rgba16Float, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+            Some(wgpu::ColorTargetState {
+                format: F::Rgba16Float,
+                blend: Some(blend),
+                write_mask: wgpu::ColorWrites::ALL,
+            }),
+        ];
+        let pipe_v = gpu::fullscreen_pipeline_with(device, "gsss vertical", &module, "fs_vertical", &targets);
+        let lin = gpu::linear_clamp_sampler(device);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (iv, dv, rt1_view, rt2_view, rtf_view) = (view(&input), view(&depth), view(&rt1), view(&rt2), view(&rtf));
+        let (lh, lv) = (pipe_h.get_bind_group_layout(0), pipe_v.get_bind_group_layout(0));
+        use wgpu::BindingResource as R;
+        let mut steps = Vec::new();
+        for i in 1..blurs.sigma_mm.len() {
+            let mk = |dir: [f32; 2]| Params {
+                rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+                stretch: [params.alpha, params.beta, params.gamma, params.lod_factor],
+                blur: [blurs.incremental_sigma_mm[i], blurs.sigma_mm[i], dir[0], dir[1]],
+            };
+            let uh = gpu::uniform_buffer(device, "gsss h", bytemuck::bytes_of(&mk([1.0, 0.0])));
+            let uv = gpu::uniform_buffer(device, "gsss v", bytemuck::bytes_of(&mk([0.0, 1.0])));
+            let gh = gpu::bind_group(
+                device,
+                "gsss h",
+                &lh,
+                &[
+                    (0, uh.as_entire_binding()),
+                    (1, R::TextureView(&rt1_view)),
+                    (2, R::TextureView(&dv)),
+                    (3, R::TextureView(&iv)),
+                    (6, R::Sampler(&lin)),
+                ],
+            );
+            let gv = gpu::bind_group(
+                device,
+                "gsss v",
+                &lv,
+                &[
+                    (0, uv.as_entire_binding()),
+                    (1, R::TextureView(&rt2_view)),
+                    (2, R::TextureView(&dv)),
+                    (3, R::TextureView(&iv)),
+                    (6, R::Sampler(&lin)),
+                ],
+            );
+            steps.push((gh, gv, blurs.blend[i]));
+        }
+        Ok(Self { width, height, input, depth, rt1, rtf, rt1_view, rt2_view, rtf_view, pipe_h, pipe_v, steps })
+    }
+
+    /// The diffuse input (`Rgba16Float`, linear, alpha = SSS level); other passes may render into it.
+    pub fn input(&self) -> &wgpu::Texture {
+        &self.input
+    }
+    /// The final target RTF (`Rgba16Float`).
+    pub fn output(&self) -> &wgpu::Texture {
+        &self.rtf
+    }
+
+    /// Number of passes [`Self::encode`] records (two per Gaussian after the first).
+    pub fn passes(&self) -> u32 {
+        2 * self.steps.len() as u32
+    }
+
+    /// Uploads `color` (RGBA f32, linear, alpha = SSS level) and `depth` (linear), both top row first.
+    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
+        gpu::upload_sss_frame(queue, (&self.input, &self.depth), color, depth)
+    }
+
+    /// Records the whole chain; pass k (0-based, H and V alternating) uses timer slot `first + k`.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+        let full = wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 };
+        let whole = |t| wgpu::TexelCopyTextureInfo {
+            texture: t,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        };
+        enc.copy_texture_to_texture(whole(&self.input), whole(&self.rt1), full);
+        enc.copy_texture_to_texture(whole(&self.input), whole(&self.rtf), full);
+        for (k, (gh, gv, w)) in self.steps.iter().enumerate() {
+            let slot = |j: u32| timer.map(|(t, first)| (t, first + 2 * k as u32 + j));
+            gpu::draw_fullscreen(enc, "gsss horizontal", &self.pipe_h, gh, &self.rt2_view, slot(0));
+            let ts = slot(1).map(|(t, i)| wgpu::RenderPassTimestampWrites {
+                query_set: &t.query_set,
+                beginning_of_pass_write_index: Some(2 * i),
+                end_of_pass_write_index: Some(2 * i + 1),
+            });
+            let load = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gsss vertical"),
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &self.rt1_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: load,
+                    }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &self.rtf_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: load,
+                    }),
+                ],
+                depth_stencil_attachment: None,
+                timestamp_writes: ts,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipe_v);
+            pass.set_bind_group(0, gv, &[]);
+            pass.set_blend_constant(wgpu::Color { r: w[0] as f64, g: w[1] as f64, b: w[2] as f64, a: 1.0 });
+            pass.draw(0..3, 0..1);
+        }
+    }
+
+    /// Uploads, runs and reads back RTF as RGBA f32.
+    pub fn run(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        color: &[f32],
+        depth: &[f32],
+    ) -> Result<Vec<f32>, RuntimeError> {
+        self.upload(queue, color, depth)?;
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gsss") });
+        self.encode(&mut enc, None);
+        queue.submit([enc.finish()]);
+        let bytes = gpu::read_texture(device, queue, &self.rtf)?;
+        let half: &[half::f16] = bytemuck::cast_slice(&bytes);
+        Ok(half.iter().map(|v| v.to_f32()).collect())
+    }
+}

@@ -1,0 +1,205 @@
+//! Importance-sampled screen-space SSS on the GPU: one full-screen pass over an N-sample disk kernel
+//! ([`crate::sss_sampling::disk`]; the sampling of Unity HDRP's diffusion profiles, Golubev 2018) on a linear HDR
+//! irradiance image (`Rgba16Float`, alpha = per-pixel strength, 0 = not skin: passes through) with a linear depth
+//! image (`R32Float`). Resources created once in [`ImportanceSss::new`]; CPU twin
+//! [`crate::runtime::sss::importance_cpu`].
+//!
+//! **Scale.** Depth is in world units; a world unit is `mm_per_world_unit` mm (default 125, the separable fit's
+//! scale: a head 1 unit tall). A pinhole camera with vertical field of view FOVy maps a length L (world units) at
+//! linear depth z to L·(H/2)·(1/tan(FOVy/2))/z pixels on an H-pixel-tall image, in x and y alike (square pixels).
+//! So sample i lands at `pixel + (xᵢ, yᵢ)mm · strength · (H/2)·(1/tan(FOVy/2)) / (z · mm_per_world_unit)`, with the
+//! strength (alpha) scaling the radius as the separable pass scales its step.
+//!
+//! **Depth.** Like the separable pass's follow-surface (not Unity's 3-D distance, which needs the profile itself
+//! in the shader): a sample whose depth differs from the centre's by Δz is replaced by the centre colour in the
+//! proportion s = saturate(|Δz|·mm_per_world_unit / cutoff_mm), cutoff_mm the kernel's 0.999 radius: a surface
+//! farther away than the kernel reaches contributes nothing. Depth is fetched bilinearly (four loads: R32Float is
+//! not filterable without `FLOAT32_FILTERABLE`).
+//!
+//! **Samples** live in the uniform block (≤ [`MAX_SAMPLES`] = 1024, 32 KiB): per sample (x mm, y mm, r mm, 0) and
+//! the normalised (w_r, w_g, w_b, 0).
+
+use crate::error::{check_positive, check_range, InvalidInput};
+use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::RuntimeError;
+use crate::sss_sampling::ImportanceKernel;
+
+/// Largest sample count the shader's uniform block holds.
+pub const MAX_SAMPLES: usize = crate::sss_sampling::disk::MAX_SAMPLES;
+
+/// The disk samples as the pass uploads them (f32).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportanceSamples {
+    /// Per sample: (x mm, y mm, r mm, 0).
+    pub offsets_mm: Vec<[f32; 4]>,
+    /// Per sample: normalised (w_r, w_g, w_b, 0); each channel sums to 1.
+    pub weights: Vec<[f32; 4]>,
+    /// The kernel's cut-off radius (F⁻¹(0.999) of the sampled channel), mm.
+    pub cutoff_mm: f32,
+}
+
+impl ImportanceSamples {
+    /// From a library kernel.
+    pub fn from_kernel(k: &ImportanceKernel) -> Self {
+        let offsets_mm = k
+            .samples
+            .iter()
+            .map(|s| {
+                let [x, y] = s.offset_mm();
+                [x as f32, y as f32, s.r_mm as f32, 0.0]
+            })
+            .collect();
+        let weights =
+            k.samples.iter().map(|s| [s.weight[0] as f32, s.weight[1] as f32, s.weight[2] as f32, 0.0]).collect();
+        Self { offsets_mm, weights, cutoff_mm: k.cutoff_mm as f32 }
+    }
+
+    /// Validates the count (1..=1024), finiteness and the cut-off (> 0).
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        let n = self.offsets_mm.len();
+        if n == 0 || n > MAX_SAMPLES || self.weights.len() != n {
+            return Err(InvalidInput::new(
+                "samples",
+                format!("must be 1..={MAX_SAMPLES} offsets with as many weights, got {n} and {}", self.weights.len()),
+            ));
+        }
+        if self.offsets_mm.iter().chain(&self.weights).flatten().any(|v| !v.is_finite()) {
+            return Err(InvalidInput::new("samples", "offsets and weights must be finite"));
+        }
+        check_positive("cutoff_mm", self.cutoff_mm as f64, "mm")?;
+        Ok(())
+    }
+}
+
+/// Shader parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImportanceSssParams {
+    /// mm per world unit of the depth (`--mm-per-world-unit`, default 125).
+    pub mm_per_world_unit: f32,
+    /// Vertical field of view in degrees (`--fovy`).
+    pub fovy_deg: f32,
+    /// Attenuate samples across depth differences (`--follow-surface`).
+    pub follow_surface: bool,
+}
+
+impl Default for ImportanceSssParams {
+    fn default() -> Self {
+        Self { mm_per_world_unit: 125.0, fovy_deg: 20.0, follow_surface: true }
+    }
+}
+
+impl ImportanceSssParams {
+    pub fn validate(&self) -> Result<(), InvalidInput> {
+        check_positive("--mm-per-world-unit", self.mm_per_world_unit as f64, "mm")?;
+        check_range("--fovy", self.fovy_deg, 1.0, 179.0, "degrees")?;
+        Ok(())
+    }
+    /// 1/tan(0.5·FOVy): distance to the projection window.
+    pub fn dist_to_window(&self) -> f32 {
+        1.0 / (0.5 * self.fovy_deg.to_radians()).tan()
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    rt: [f32; 4],
+    cfg: [f32; 4],
+    samples: [[f32; 4]; 2 * MAX_SAMPLES],
+}
+
+const SHADER: &str = include_str!("importance.wgsl");
+
+/// Importance-sampled SSS for one frame size and kernel.
+pub struct ImportanceSss {
+    color: wgpu::Texture,
+    depth: wgpu::Texture,
+    output: wgpu::Texture,
+    pipe: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    target: wgpu::TextureView,
+}
+
+impl ImportanceSss {
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        samples: &ImportanceSamples,
+        params: &ImportanceSssParams,
+    ) -> Result<Self, RuntimeError> {
+        crate::error::check_size("image", width as u64, height as u64)?;
+        crate::runtime::device::check_image_fits(device, width, height, 8)?;
+        params.validate()?;
+        samples.validate()?;
+        use wgpu::TextureFormat as F;
+        let color = gpu::texture(device, "isss colour", width, height, F::Rgba16Float);
+        let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
+        let depth = gpu::data_texture(device, "isss depth", width, height, F::R32Float);
+        let module = gpu::shader(device, "importance_sss.wgsl", SHADER);
+        let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
+        let lin = gpu::linear_clamp_sampler(device);
+        let mut p: Params = bytemuck::Zeroable::zeroed();
+        let n = samples.offsets_mm.len();
+        for i in 0..n {
+            p.samples[2 * i] = samples.offsets_mm[i];
+            p.samples[2 * i + 1] = samples.weights[i];
+        }
+        p.rt = [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32];
+        p.cfg = [
+            0.5 * height as f32 * params.dist_to_window() / params.mm_per_world_unit,
+            params.mm_per_world_unit / samples.cutoff_mm,
+            if params.follow_surface { 1.0 } else { 0.0 },
+            n as f32,
+        ];
+        let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (cv, dv) = (view(&color), view(&depth));
+        let layout = pipe.get_bind_group_layout(0);
+        use wgpu::BindingResource as R;
+        let group = gpu::bind_group(
+            device,
+            "isss",
+            &layout,
+            &[(0, ubo.as_entire_binding()), (1, R::TextureView(&cv)), (2, R::TextureView(&dv)), (6, R::Sampler(&lin))],
+        );
+        let target = view(&output);
+        Ok(Self { color, depth, output, pipe, group, target })
+    }
+
+    /// The irradiance input (`Rgba16Float`, linear, alpha = strength).
+    pub fn input(&self) -> &wgpu::Texture {
+        &self.color
+    }
+    /// The blurred result (`Rgba16Float`).
+    pub fn output(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.
+    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
+        gpu::upload_sss_frame(queue, (&self.color, &self.depth), color, depth)
+    }
+
+    /// Records the pass.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+        gpu::draw_fullscreen(enc, "isss", &self.pipe, &self.group, &self.target, timer);
+    }
+
+    /// Uploads, runs the pass and reads back RGBA f32.
+    pub fn run(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        color: &[f32],
+        depth: &[f32],
+    ) -> Result<Vec<f32>, RuntimeError> {
+        self.upload(queue, color, depth)?;
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("isss") });
+        self.encode(&mut enc, None);
+        queue.submit([enc.finish()]);
+        let bytes = gpu::read_texture(device, queue, &self.output)?;
+        let half: &[half::f16] = bytemuck::cast_slice(&bytes);
+        Ok(half.iter().map(|v| v.to_f32()).collect())
+    }
+}
