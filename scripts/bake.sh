@@ -3,5 +3,5 @@
 # This is the one command that produced the repository's baked/ directory.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo run --release -- bake --out baked "$@"
-cargo run --release -- verify --dir baked
+cargo run --locked -- bake --out baked "$@"
+cargo run --locked -- verify --dir baked

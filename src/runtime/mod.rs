@@ -4,7 +4,7 @@
 //! [`skin`] (the skin renderer's passes and frames), [`transport`] (Monte Carlo on the GPU). Each pass `x.rs` sits
 //! beside its WGSL `x.wgsl` and its CPU twin `x_cpu.rs` (rayon, no adapter needed), whose arithmetic mirrors the
 //! shader; the tests compare the two on the same inputs. Shared plumbing: [`gpu`] (textures, full-screen
-//! pipelines, read-back), [`compute_chain`], [`sampler`] (the CPU's sampler emulation), [`device`], [`loader`]
+//! pipelines, read-back), `compute_chain`, [`sampler`] (the CPU's sampler emulation), [`device`], [`loader`]
 //! (the bake directory). [`chain`] holds the whole-image entry points.
 //!
 //! Invariants, stated as absences:

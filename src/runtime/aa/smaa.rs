@@ -144,7 +144,7 @@ impl Smaa {
     }
 
     /// As [`Self::new`] with every option; a pass that reads depth or a mask takes them through [`ThreePass::run_with`]
-    /// (or [`Self::upload_inputs`]).
+    /// (or [`ThreePass::upload_inputs`]).
     pub fn with_options(
         device: &wgpu::Device,
         queue: &wgpu::Queue,

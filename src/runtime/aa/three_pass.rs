@@ -1,5 +1,5 @@
 //! The three full-screen passes SMAA 1x and MLAA share (thesis ch. 9–10): edge detection (or the
-//! [`EdgeStage`] of another detector), blending weights, neighbourhood blending, then the optional mask; the
+//! `EdgeStage` of another detector), blending weights, neighbourhood blending, then the optional mask; the
 //! frame's textures, its upload and read-back. [`crate::runtime::aa::smaa::Smaa`] and
 //! [`crate::runtime::aa::mlaa::Mlaa`] build the pipelines and bind groups and hand them over.
 

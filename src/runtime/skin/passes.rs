@@ -15,7 +15,7 @@ pub struct Wrinkles {
     pub zone_weights: [f32; 8],
 }
 
-/// What `run skin` adds to the SSS shader of [`crate::runtime::skin::frame::SkinRenderSettings`].
+/// What `run skin` adds to the SSS shader of [`crate::runtime::skin::settings::SkinRenderSettings`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SkinPasses {
     /// The rig's pose (eq. 7.6 weights and global state); None: the neutral pose (weight 1 on neutral, g = 1).
