@@ -86,6 +86,11 @@ pub struct RigEvalArgs {
     /// Output precision of the EXR.
     #[arg(long, default_value = "f32", value_parser = ["f32", "f16"])]
     precision: String,
+    /// Appearance transfer (thesis §7.4.2): another character's neutral hemoglobin map (PNG or EXR, read as `maps
+    /// hemoglobin --neutral` reads it, at the rig's full size). The rig's relative changes (each target's local
+    /// mean shift and spread ratio, eq. 7.3–7.5) are applied to it instead of to the subject's own map.
+    #[arg(long, value_name = "FILE")]
+    neutral: Option<PathBuf>,
     /// Output EXR file (single channel Y, concentration units).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
@@ -346,6 +351,31 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         let p = dir.join(file);
         std::fs::read(&p).map_err(|e| InvalidInput::new(param.clone(), format!("{}: cannot read: {e}", p.display())))
     })?;
+    let rig = match &a.neutral {
+        None => rig,
+        Some(path) => {
+            let other = inputs::decode_concentration(
+                "--neutral",
+                &path.display().to_string(),
+                &read_input("--neutral", path)?,
+                None,
+            )?;
+            if (other.image.width, other.image.height) != (rig.width, rig.height) {
+                return Err(usage_msg(format!(
+                    "--neutral {}: {}x{} texels; the rig was built from {}x{} maps, so the other character's neutral \
+                     map must be {}x{}",
+                    path.display(),
+                    other.image.width,
+                    other.image.height,
+                    rig.width,
+                    rig.height,
+                    rig.width,
+                    rig.height
+                )));
+            }
+            rtbake::facial::appearance_transfer::transfer_rig(&rig, &other.image.data, "--neutral")?
+        }
+    };
     let (w, h) = (rig.width, rig.height);
     let out = hemoglobin_rig::evaluate(&rig, &weights, a.global_scale);
     let precision = if a.precision == "f16" { io::exr::ExrPrecision::F16 } else { io::exr::ExrPrecision::F32 };
@@ -358,6 +388,7 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
     let out_name = a.out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let out_dir = a.out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let mut read: Vec<PathBuf> = vec![a.rig.clone(), dir.join(&desc.h0.exr)];
+    read.extend(a.neutral.iter().cloned());
     for m in &desc.maps {
         read.push(dir.join(&m.scale_exr));
         read.push(dir.join(&m.bias_exr));

@@ -355,7 +355,7 @@ impl RadialProfile for LayeredProfile {
         (rt.iter().map(|x| x.0).collect(), Some(rt.iter().map(|x| x.1).collect()))
     }
 }
-/// Wall time of tabulating a layered profile at `radii` radii (issue 15's budget check, before any work): per
+/// Wall time of tabulating a layered profile at `radii` radii (the budget check before any work): per
 /// radius 14 µs per layer with the exact series, 0.06 µs per layer and image pair with `Series::Truncated`, for 2
 /// rayon threads, scaled by 2 / `threads`. Measured with the release build on the project's 2-core machine (2-layer
 /// skin: 28 s for 10⁶ radii exact, 236 s for 10⁵ radii at 10 000 pairs); conservative elsewhere.

@@ -161,10 +161,10 @@ pub fn bake_lut_with_progress(
     Ok(img)
 }
 
-/// Wall time of [`bake_lut`] (issue 15's budget check, before any work): per texel and wavelength band 30 ns
+/// Wall time of [`bake_lut`] (the budget check before any work): per texel and wavelength band 30 ns
 /// tabulated, 250 ns direct, on one thread, divided by `threads`, plus 1 s of model set-up (the epidermis tables).
 /// Measured with the release build on the project's 2-core machine (256² at 401 bands on one thread: 0.6–0.7 s
-/// tabulated before issue 17, 0.07 s after it (the vectorised loop); 4.5–5.9 s direct); the estimate rounds up.
+/// tabulated before the vectorised row loop, 0.07 s with it; 4.5–5.9 s direct); the estimate rounds up.
 pub fn time_estimate_seconds(layout: &LutLayout, evaluation: LutEvaluation, bands: usize, threads: usize) -> f64 {
     let per_eval = match evaluation {
         LutEvaluation::Tabulated => 30e-9,

@@ -130,7 +130,7 @@ impl McSettings {
         (WAVE_CHUNKS as u64 + 3 * u64::from(self.batches) + 1) * tally + 12 * 16 * self.bins as u64
     }
 
-    /// Wall time of [`simulate`] (issue 15's budget check, before any work): three channels of `photons` at
+    /// Wall time of [`simulate`] (the budget check before any work): three channels of `photons` at
     /// 600 000 photon histories/s per thread (150 000 where the lane engine runs its portable path, no AVX2), below
     /// the slowest case measured with the release build on the project's 2-core machine (semi-infinite, albedo 0.9,
     /// mismatched boundary, `examples/bench_transport`, 2026-11-25, one thread: 2.72 M histories per CPU second on

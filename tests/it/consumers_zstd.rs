@@ -1,4 +1,4 @@
-//! `--zstd LEVEL` on every command that writes KTX2 (issue 10): each KTX2 file becomes Zstandard-supercompressed
+//! `--zstd LEVEL` on every command that writes KTX2: each KTX2 file becomes Zstandard-supercompressed
 //! (scheme 2) and decodes, the way Bevy loads KTX2 (`ktx2` crate + zstd), to the level data of the uncompressed
 //! file the same command writes without the flag; every other file is byte-identical. The bake records the level
 //! as the `ktx2_zstd` asset parameter, so `verify` recomputes the compressed bytes and catches an edited level.

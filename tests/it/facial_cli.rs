@@ -360,3 +360,68 @@ fn synthetic_command_writes_the_fixtures() {
         &bad,
     );
 }
+
+/// Appearance transfer (thesis §7.4.2): `rig-eval --neutral OTHER` with the neutral weight gives OTHER back, with a
+/// target it gives OTHER's detail under the subject's change (not the subject's own map); a neutral map of the
+/// wrong size exits 2 naming `--neutral`, nothing written.
+#[test]
+fn rig_eval_transfers_the_rig_to_another_neutral_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rig");
+    let anger = format!("anger={}", s(&fixture("anger")));
+    let neutral_fixture = fixture("neutral");
+    let args = ["maps", "hemoglobin", "--neutral", s(&neutral_fixture), "--target", &anger, "--radius", "4"];
+    let o = rtbake(&[&args[..], &["--rig-size", "16", "--out", s(&out)]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // Another character: the subject's neutral map mirrored left to right, 10 % more blood.
+    let subject = match rtbake::io::png::decode(&std::fs::read(fixture("neutral")).unwrap(), "n").unwrap() {
+        rtbake::io::png::DecodedPng::U16(i) => i,
+        _ => unreachable!(),
+    };
+    let (w, h) = (subject.width, subject.height);
+    let mut other = subject.clone();
+    for y in 0..h {
+        for x in 0..w {
+            let v = subject.data[(y * w + (w - 1 - x)) as usize] as f64 * 1.1;
+            other.data[(y * w + x) as usize] = v.min(65535.0) as u16;
+        }
+    }
+    let other_png = dir.path().join("other.png");
+    std::fs::write(&other_png, rtbake::io::png::encode_u16(&other).unwrap()).unwrap();
+    let rig = out.join("rig.json");
+    let eval = |weights: &str, neutral: Option<&Path>, name: &str| -> Vec<f32> {
+        let path = dir.path().join(name);
+        let mut a = vec!["maps", "rig-eval", "--rig", s(&rig), "--weights", weights, "--out", s(&path)];
+        if let Some(n) = neutral {
+            a.extend_from_slice(&["--neutral", s(n)]);
+        }
+        let o = rtbake(&a);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        rtbake::io::exr::decode(&std::fs::read(&path).unwrap(), "h").unwrap().0.data
+    };
+    let back = eval("neutral=1", Some(&other_png), "b.exr");
+    let worst = back.iter().zip(&other.data).map(|(a, &b)| (a - b as f32 / 65535.0).abs()).fold(0.0f32, f32::max);
+    assert!(worst < 1e-6, "the neutral weight reproduces the other map: {worst}");
+    let angry_other = eval("anger=1", Some(&other_png), "a.exr");
+    let angry_subject = eval("anger=1", None, "s.exr");
+    let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+    // The subject's mean change carries over; the detail is the other character's (mirrored), not the subject's.
+    let other_mean = mean(&other.data.iter().map(|&v| v as f32 / 65535.0).collect::<Vec<_>>());
+    let subject_mean = mean(&subject.data.iter().map(|&v| v as f32 / 65535.0).collect::<Vec<_>>());
+    let (shift_other, shift_subject) = (mean(&angry_other) - other_mean, mean(&angry_subject) - subject_mean);
+    assert!(
+        (shift_other - shift_subject).abs() < 0.05 * shift_subject.abs().max(1e-4),
+        "{shift_other} vs {shift_subject}"
+    );
+    let differs = angry_other.iter().zip(&angry_subject).filter(|(a, b)| (*a - *b).abs() > 1e-3).count();
+    assert!(differs > angry_other.len() / 4, "{differs} of {} texels differ", angry_other.len());
+
+    let small = dir.path().join("small.png");
+    write_png16(&small, w / 2, h / 2, 1, 3000);
+    let none = dir.path().join("none.exr");
+    assert_bad(
+        &["maps", "rig-eval", "--rig", s(&rig), "--weights", "anger=1", "--neutral", s(&small), "--out", s(&none)],
+        &["--neutral", &format!("must be {w}x{h}")],
+        &none,
+    );
+}
