@@ -310,6 +310,10 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
     let passes = passes(&a, &assets)?;
     let gpu = crate::run::device(ctx, a.common.cpu)?;
+    if let Some(g) = &gpu {
+        // Every pass against the adapter's limits before any work (the CPU twins have none).
+        skin_render::check_frame_fits(&g.device.limits(), &settings, &passes).map_err(usage)?;
+    }
     let t = Instant::now();
     let out = skin_render::render_with(gpu.as_ref(), &mesh, &settings, &passes, &assets)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;

@@ -101,6 +101,14 @@ async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError
     Ok(Gpu { device, queue, adapter_info: info, timestamps })
 }
 
+/// Bytes of a read-back buffer of a `width`×`height` image of `bytes_per_texel`-byte texels, rows padded to
+/// wgpu's copy alignment (what [`check_image_fits`] compares with `max_buffer_size`).
+pub fn readback_bytes(width: u32, height: u32, bytes_per_texel: u32) -> u64 {
+    let row = (width as u64 * bytes_per_texel as u64).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
+    row * height as u64
+}
+
 /// Refuses, before any allocation, a `width`×`height` image that the device cannot hold: its 2-D texture edge
 /// limit, or the largest buffer the pass needs (a tightly padded read-back of `bytes_per_texel`-byte texels).
 /// The error is bad input (exit 2) naming the limit and the way out (`--cpu`, or a smaller image).
@@ -122,9 +130,7 @@ pub fn check_image_fits(
         )
         .into());
     }
-    let row = (width as u64 * bytes_per_texel as u64).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64)
-        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
-    let bytes = row * height as u64;
+    let bytes = readback_bytes(width, height, bytes_per_texel);
     if bytes > limits.max_buffer_size {
         return Err(crate::error::InvalidInput::new(
             "image",

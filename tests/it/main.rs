@@ -61,6 +61,7 @@ mod runtime_device_limits;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
 mod runtime_importance_sss;
+mod runtime_limits_precheck;
 mod runtime_loader;
 mod runtime_loader_tables;
 mod runtime_mlaa;

@@ -89,6 +89,21 @@ struct Params {
     mix: [f32; 4],
 }
 
+/// Bytes of the storage buffers [`bloom`] binds for a `width`×`height` frame with `p`, in binding order: the HDR
+/// frame (RGBA f32), the three Gaussians' taps, the three thresholded and blurred RGBA f32 planes (one per
+/// Gaussian, the largest), and the horizontal and vertical blur results (RGBA f32).
+pub fn storage_buffer_bytes(width: u32, height: u32, p: &BloomParams) -> [u64; 5] {
+    let n = width as u64 * height as u64;
+    let taps: usize = p.kernels(height).iter().map(Vec::len).sum();
+    [16 * n, 4 * taps as u64, 3 * 16 * n, 16 * n, 16 * n]
+}
+
+/// The largest buffer [`bloom`] allocates for a `width`×`height` frame, bytes: the three blurred planes, 48 bytes
+/// per pixel (checked against the adapter's storage-binding limit before a frame is rendered).
+pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
+    3 * 16 * width as u64 * height as u64
+}
+
 /// Blooms a `width`×`height` linear HDR frame (RGBA, alpha passed through) on the GPU.
 pub fn bloom(
     device: &wgpu::Device,
@@ -111,6 +126,7 @@ pub fn bloom(
         mix: [p.mix[0], p.mix[1], p.mix[2], 0.0],
     };
     let taps: Vec<f32> = kernels.concat();
+    let bytes = storage_buffer_bytes(width, height, p);
     let out = compute_chain::run(
         device,
         queue,
@@ -120,9 +136,9 @@ pub fn bloom(
         &[
             Buffer::Data(bytemuck::cast_slice(hdr_rgba)),
             Buffer::Data(bytemuck::cast_slice(&taps)),
-            Buffer::Zeroed(3 * 16 * n as u64),
-            Buffer::Zeroed(16 * n as u64),
-            Buffer::Zeroed(16 * n as u64),
+            Buffer::Zeroed(bytes[2]),
+            Buffer::Zeroed(bytes[3]),
+            Buffer::Zeroed(bytes[4]),
         ],
         &[
             Stage { entry: "bright", groups: compute_chain::groups_8x8(width, height) },
@@ -137,6 +153,20 @@ pub fn bloom(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_largest_buffer_is_the_one_bloom_allocates() {
+        let p = BloomParams::default();
+        for (w, h) in [(8, 8), (37, 21), (2560, 1440)] {
+            let bytes = storage_buffer_bytes(w, h, &p);
+            // The data buffers hold exactly what bloom uploads: the RGBA f32 frame and the concatenated taps.
+            assert_eq!(bytes[0], (4 * w * h) as u64 * 4);
+            assert_eq!(bytes[1], p.kernels(h).concat().len() as u64 * 4);
+            assert_eq!(*bytes.iter().max().unwrap(), largest_buffer_bytes(w, h), "{w}x{h}");
+        }
+        // The figure a 2560x1440 frame was refused with by a software adapter after rendering.
+        assert_eq!(largest_buffer_bytes(2560, 1440), 176_947_200);
+    }
 
     #[test]
     fn kernels_are_normalised_and_scale_with_the_frame() {

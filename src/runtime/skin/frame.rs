@@ -38,6 +38,133 @@ use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
+/// The largest `w`×`h` frame with `width`:`height`'s aspect (scaled down from it) for which `fits` holds.
+fn largest_fitting(width: u32, height: u32, fits: impl Fn(u32, u32) -> bool) -> Option<(u32, u32)> {
+    let (mut w, mut h) = (width, height);
+    // Halve to a size that fits, then grow back in 1 % steps: a few dozen pure evaluations.
+    while !fits(w, h) {
+        if w <= 1 && h <= 1 {
+            return None;
+        }
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+    }
+    let scaled = |k: f64| (((width as f64 * k) as u32).max(1), ((height as f64 * k) as u32).max(1));
+    let mut k = w as f64 / width as f64;
+    while k < 1.0 {
+        let next = scaled((k * 1.01).min(1.0));
+        if !fits(next.0, next.1) || next == (w, h) {
+            break;
+        }
+        (w, h) = next;
+        k = (k * 1.01).min(1.0);
+    }
+    // Then single pixels, keeping the aspect as closely as whole pixels allow.
+    while w < width && fits(w + 1, (((w + 1) as u64 * height as u64) / width as u64).max(1) as u32) {
+        w += 1;
+        h = ((w as u64 * height as u64) / width as u64).max(1) as u32;
+    }
+    Some((w, h))
+}
+
+/// Checks every GPU pass of the `run skin` frame `s` with `passes` against the adapter's `limits` — before any
+/// work, so an over-limit frame is refused at once instead of after rendering — and refuses with the pass, the
+/// limit, the largest frame of the same aspect that fits and the flags that avoid it (`--width/--height`,
+/// `--bloom off`, `--ts-map-size`, `--cpu`: the CPU twins have no such limit). Each pass's footprint comes from the
+/// function beside it: the G-buffer ([`mesh_raster::GBUFFER_BYTES_PER_TEXEL`], the largest per-pixel image, as
+/// the SSS passes' textures are smaller), the rig at uv ([`mesh_inputs::largest_buffer_bytes`]), the wrinkle pass
+/// ([`wrinkles::largest_buffer_bytes`]), the texture-space gather ([`texture_space::gather_buffer_bytes`]), bloom ([`bloom::largest_buffer_bytes`]) and the texture-space irradiance
+/// map ([`texture_space::map_buffer_bytes`]).
+///
+/// [`mesh_raster::GBUFFER_BYTES_PER_TEXEL`]: crate::runtime::skin::mesh_raster::GBUFFER_BYTES_PER_TEXEL
+/// [`mesh_inputs::largest_buffer_bytes`]: crate::runtime::skin::mesh_inputs::largest_buffer_bytes
+/// [`wrinkles::largest_buffer_bytes`]: crate::runtime::skin::wrinkles::largest_buffer_bytes
+/// [`bloom::largest_buffer_bytes`]: crate::runtime::skin::bloom::largest_buffer_bytes
+/// [`texture_space::gather_buffer_bytes`]: crate::runtime::skin::texture_space::gather_buffer_bytes
+/// [`texture_space::map_buffer_bytes`]: crate::runtime::skin::texture_space::map_buffer_bytes
+pub fn check_frame_fits(
+    limits: &wgpu::Limits,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+) -> Result<(), InvalidInput> {
+    use crate::runtime::device::readback_bytes;
+    use crate::runtime::skin::{bloom, mesh_inputs, mesh_raster, texture_space, wrinkles};
+    let (w, h) = (s.width, s.height);
+    let edge = limits.max_texture_dimension_2d;
+    let storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let gbuffer = mesh_raster::GBUFFER_BYTES_PER_TEXEL;
+    let gbuffer_fits =
+        |w: u32, h: u32| w <= edge && h <= edge && readback_bytes(w, h, gbuffer) <= limits.max_buffer_size;
+    // Per-pixel storage buffers of the passes this frame runs: (pass, bytes of a w×h frame, way out).
+    type PerPixel = (&'static str, fn(u32, u32) -> u64, &'static str);
+    let mut per_pixel: Vec<PerPixel> = Vec::new();
+    if passes.rig_pose.is_some() {
+        per_pixel.push(("the rig at uv (--rig-weights)", mesh_inputs::largest_buffer_bytes, ""));
+    }
+    if passes.wrinkles.is_some() {
+        per_pixel.push(("the wrinkle pass (--wrinkles)", wrinkles::largest_buffer_bytes, ""));
+    }
+    if matches!(s.shader, SkinShader::Ts(_)) {
+        // A head covering every pixel gathers one RGBA f32 per pixel.
+        let gather: fn(u32, u32) -> u64 = |w, h| texture_space::gather_buffer_bytes(w as u64 * h as u64);
+        per_pixel.push(("the texture-space gather (--shader ts)", gather, ""));
+    }
+    if passes.bloom.is_some() {
+        per_pixel.push(("bloom", bloom::largest_buffer_bytes, ", or --bloom off"));
+    }
+    let all_fit = |w: u32, h: u32| gbuffer_fits(w, h) && per_pixel.iter().all(|(_, bytes, _)| bytes(w, h) <= storage);
+    let largest = || match largest_fitting(w, h, all_fit) {
+        Some((fw, fh)) => format!("--width {fw} --height {fh} is the largest frame of this aspect that fits"),
+        None => "no frame of this aspect fits".to_string(),
+    };
+    let flag = "--width/--height";
+    if !gbuffer_fits(w, h) {
+        return Err(InvalidInput::new(
+            flag,
+            format!(
+                "{w}x{h}: the G-buffer ({gbuffer} bytes per pixel, a {}-byte read-back) exceeds this GPU's limits \
+                (max_texture_dimension_2d {edge}, max_buffer_size {}); {}; or --cpu (the CPU twins have no such \
+                limit)",
+                readback_bytes(w, h, gbuffer),
+                limits.max_buffer_size,
+                largest()
+            ),
+        ));
+    }
+    for (pass, bytes, way_out) in &per_pixel {
+        let b = bytes(w, h);
+        if b > storage {
+            return Err(InvalidInput::new(
+                flag,
+                format!(
+                    "{w}x{h}: {pass} needs a {b}-byte storage buffer, over this GPU's limit of {storage} bytes \
+                    (max_storage_buffer_binding_size); {}{way_out}; or --cpu (the CPU twins have no such limit)",
+                    largest()
+                ),
+            ));
+        }
+    }
+    if let SkinShader::Ts(ts) = s.shader {
+        // With --ts-opt depth, --ts-map-size is the largest map (T_max); every map is at most that.
+        let b = texture_space::map_buffer_bytes(ts.map_size);
+        if b > storage || ts.map_size > edge {
+            let mut fit = ts.map_size.min(edge);
+            while texture_space::map_buffer_bytes(fit) > storage {
+                fit -= 1;
+            }
+            return Err(InvalidInput::new(
+                "--ts-map-size",
+                format!(
+                    "{}: the {0}² irradiance map needs {b}-byte storage buffers, over this GPU's limit of {storage} \
+                    bytes (max_storage_buffer_binding_size) or its {edge}-texel edge; use --ts-map-size {fit} or \
+                    less, or --cpu (the CPU twins have no such limit)",
+                    ts.map_size
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The 13 jittered taps of d'Eon's 6-Gaussian skin as the disk pass's samples; the follow-surface cut-off is 1.5×
 /// the widest tap.
 pub fn jittered_samples() -> Result<ImportanceSamples, InvalidInput> {
@@ -107,4 +234,74 @@ pub fn render_with<'g>(
     let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
     blend_coverage(&mut frame, &coverage);
     Ok(frame)
+}
+
+#[cfg(test)]
+mod limits_tests {
+    use super::*;
+    use crate::runtime::skin::bloom::largest_buffer_bytes as bloom_bytes;
+    use crate::runtime::skin::settings::{StretchPreset, TsSettings};
+
+    fn settings(shader: SkinShader, width: u32, height: u32) -> SkinRenderSettings {
+        SkinRenderSettings {
+            shader,
+            heads: 1,
+            distance_m: 0.6,
+            width,
+            height,
+            melanin: 0.02,
+            stretch: StretchPreset::Thesis,
+        }
+    }
+
+    /// A software adapter's limits: 128 MiB storage bindings, 8192-texel textures.
+    fn limits() -> wgpu::Limits {
+        wgpu::Limits {
+            max_storage_buffer_binding_size: 1 << 27,
+            max_buffer_size: 1 << 31,
+            max_texture_dimension_2d: 8192,
+            ..wgpu::Limits::downlevel_defaults()
+        }
+    }
+
+    fn suggested(msg: &str) -> (u32, u32) {
+        let rest = &msg[msg.find("--width ").expect(msg) + 8..];
+        let w: u32 = rest.split_whitespace().next().unwrap().parse().unwrap();
+        let h: u32 = rest.split("--height ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+        (w, h)
+    }
+
+    #[test]
+    fn bloom_over_the_storage_limit_is_refused_naming_the_flags_and_the_largest_frame() {
+        let l = limits();
+        let s = settings(SkinShader::Separable, 2560, 1440);
+        let err = check_frame_fits(&l, &s, &SkinPasses::default()).unwrap_err();
+        assert_eq!(err.param, "--width/--height");
+        for part in ["bloom", "176947200", "134217728", "--bloom off", "--cpu", "max_storage_buffer_binding_size"] {
+            assert!(err.message.contains(part), "{part}: {err}");
+        }
+        let (w, h) = suggested(&err.message);
+        assert!(bloom_bytes(w, h) <= 1 << 27, "{w}x{h}");
+        // The next wider frame of the same aspect does not fit.
+        assert!(bloom_bytes(w + 1, (w + 1) * 1440 / 2560) > 1 << 27, "{w}x{h} is not the largest");
+        // 16:9 kept to a pixel.
+        assert!((w as f64 / h as f64 - 16.0 / 9.0).abs() < 0.01, "{w}x{h}");
+        // Without bloom the same frame fits; so does the suggested one with bloom.
+        assert_eq!(check_frame_fits(&l, &s, &SkinPasses::none()), Ok(()));
+        assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, w, h), &SkinPasses::default()), Ok(()));
+    }
+
+    #[test]
+    fn a_frame_beyond_the_texture_edge_and_an_oversized_irradiance_map_are_refused() {
+        let l = wgpu::Limits { max_texture_dimension_2d: 2048, ..limits() };
+        let err = check_frame_fits(&l, &settings(SkinShader::None, 4096, 1024), &SkinPasses::none()).unwrap_err();
+        assert!(err.message.contains("G-buffer") && err.message.contains("--cpu"), "{err}");
+        assert_eq!(suggested(&err.message), (2048, 512));
+        let small = wgpu::Limits { max_storage_buffer_binding_size: 1 << 20, ..limits() };
+        let ts = SkinShader::Ts(TsSettings { map_size: 1024, ..Default::default() });
+        let err = check_frame_fits(&small, &settings(ts, 64, 64), &SkinPasses::none()).unwrap_err();
+        assert_eq!(err.param, "--ts-map-size");
+        // 256² RGBA f32 is exactly 1 MiB.
+        assert!(err.message.contains("--ts-map-size 256 ") && err.message.contains("--cpu"), "{err}");
+    }
 }

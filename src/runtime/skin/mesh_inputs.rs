@@ -134,6 +134,12 @@ struct Params {
     weights: [[f32; 4]; 2],
 }
 
+/// The largest per-pixel buffer [`hemoglobin_at_uv`] allocates for a `width`×`height` G-buffer, bytes: uv and
+/// coverage, one vec4 of f32 per pixel (the rig and H₀ maps are the baked maps, independent of the frame).
+pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
+    16 * width as u64 * height as u64
+}
+
 /// Per pixel of a `width`×`height` frame, (u, v, covered) → H (0 where not covered), on the GPU.
 pub fn hemoglobin_at_uv(
     device: &wgpu::Device,

@@ -68,6 +68,14 @@ pub(crate) fn camera_uniform(mesh: &Mesh, camera: &Camera, width: u32, height: u
 /// Sample counts of the G-buffer raster (`--msaa`).
 pub const SAMPLE_COUNTS: [u32; 2] = [1, 4];
 
+/// The G-buffer's targets: normal+depth, uv+coverage and tangent, each RGBA f16.
+const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Number of [`GBUFFER_FORMAT`] targets.
+const GBUFFER_TARGETS: u32 = 3;
+/// Bytes per pixel of the G-buffer: its three RGBA f16 targets and the f32 depth buffer (the largest per-pixel
+/// footprint of the skin frame's images, checked against the adapter's limits before a frame is rendered).
+pub const GBUFFER_BYTES_PER_TEXEL: u32 = GBUFFER_TARGETS * 8 + 4;
+
 /// Refuses a sample count other than 1 or 4 (`--msaa`).
 pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
     if !SAMPLE_COUNTS.contains(&samples) {
@@ -110,7 +118,7 @@ pub fn rasterise_samples(
         }
     }
     camera.validate()?;
-    crate::runtime::device::check_image_fits(device, width, height, 8 + 8 + 8 + 4)?;
+    crate::runtime::device::check_image_fits(device, width, height, GBUFFER_BYTES_PER_TEXEL)?;
     let vertex_bytes = mesh.positions.len() as u64 * 48;
     if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
         return Err(InvalidInput::new(
@@ -137,7 +145,7 @@ pub fn rasterise_samples(
     let ubuf =
         gpu::uniform_buffer(device, "mesh camera", bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)));
     let module = gpu::shader(device, "mesh_raster", include_str!("mesh_raster.wgsl"));
-    let gformat = wgpu::TextureFormat::Rgba16Float;
+    let gformat = GBUFFER_FORMAT;
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("mesh g-buffer"),
         layout: None,
@@ -291,5 +299,17 @@ pub(crate) fn resolve_coverage(g: &mut MeshGBuffer, a: &[f32], b: &[f32], c: &[f
         g.depth_mm[i] = a[4 * i + 3] / cov;
         g.uv[i] = [b[4 * i] / cov, b[4 * i + 1] / cov];
         g.tangent_view[i] = std::array::from_fn(|k| c[4 * i + k] / cov);
+    }
+}
+
+#[cfg(test)]
+mod gbuffer_size_tests {
+    use super::*;
+
+    #[test]
+    fn gbuffer_bytes_per_texel_are_its_formats() {
+        let colour = GBUFFER_FORMAT.block_copy_size(None).unwrap();
+        let depth = wgpu::TextureFormat::Depth32Float.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)).unwrap();
+        assert_eq!(GBUFFER_BYTES_PER_TEXEL, GBUFFER_TARGETS * colour + depth);
     }
 }

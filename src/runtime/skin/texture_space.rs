@@ -48,6 +48,18 @@ use nalgebra::{Vector3, Vector4};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
 
+/// Bytes of each of the three irradiance-map buffers (chain, temporary, weighted sum) of a `size`² map on the GPU:
+/// one RGBA f32 per texel, the largest buffer of the texture-space pass apart from the per-pixel gather.
+pub fn map_buffer_bytes(size: u32) -> u64 {
+    size as u64 * size as u64 * 16
+}
+
+/// Bytes of the gathered-irradiance buffer for `pixels` covered pixels of one head (one RGBA f32 each, at least
+/// one): at most 16 bytes per pixel of the frame.
+pub fn gather_buffer_bytes(pixels: u64) -> u64 {
+    (pixels * 16).max(16)
+}
+
 /// Peak host memory of the texture-space pass with a `map_size`² map, bytes: the UV map (33 B per texel), the
 /// texels' skin frame and lit layers (~80 B) and the irradiance map (16 B), doubled for the per-size map cache and
 /// the depth-sized maps.
@@ -332,7 +344,7 @@ impl TextureSpaceDiffusion {
         weights: &[[f32; 3]],
         uvs: &[[f32; 2]],
     ) -> Result<Vec<[f32; 4]>, RuntimeError> {
-        let map_bytes = size as u64 * size as u64 * 16;
+        let map_bytes = map_buffer_bytes(size);
         let limit = device.limits().max_storage_buffer_binding_size;
         if map_bytes > limit {
             return Err(InvalidInput::new(
@@ -392,7 +404,7 @@ impl TextureSpaceDiffusion {
         // entry because wgpu refuses empty bindings.
         let padded: Vec<[f32; 2]> = if uvs.is_empty() { vec![[0.0; 2]] } else { uvs.to_vec() };
         let uv_buf = storage("ts uvs", bytemuck::cast_slice(&padded));
-        let out_bytes = (uvs.len() as u64 * 16).max(16);
+        let out_bytes = gather_buffer_bytes(uvs.len() as u64);
         let out = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ts gathered"),
             size: out_bytes,

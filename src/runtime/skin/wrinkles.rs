@@ -139,6 +139,13 @@ struct Params {
     weights: [[f32; 4]; 2],
 }
 
+/// The largest per-pixel buffer [`wrinkled_normals`] allocates for a `width`×`height` G-buffer, bytes: the uv and
+/// coverage, the normals, the tangents and the result, each one vec4 of f32 per pixel (the PD map and zone masks
+/// are the baked maps, independent of the frame).
+pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
+    16 * width as u64 * height as u64
+}
+
 /// The wrinkled view-space normals of `g` (uncovered pixels keep theirs), on the GPU.
 pub fn wrinkled_normals(
     device: &wgpu::Device,
@@ -148,7 +155,6 @@ pub fn wrinkled_normals(
     weights: &[f32; 8],
 ) -> Result<Vec<[f32; 3]>, RuntimeError> {
     maps.validate()?;
-    let n = (g.width * g.height) as usize;
     let params = Params {
         size: [g.width as f32, g.height as f32, maps.pd_size.0 as f32, maps.pd_size.1 as f32],
         mask: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
@@ -169,7 +175,7 @@ pub fn wrinkled_normals(
             Buffer::Data(bytemuck::cast_slice(&g.tangent_view)),
             Buffer::Data(bytemuck::cast_slice(&maps.pd)),
             Buffer::Data(bytemuck::cast_slice(&masks)),
-            Buffer::Zeroed(16 * n as u64),
+            Buffer::Zeroed(largest_buffer_bytes(g.width, g.height)),
         ],
         &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
         5,

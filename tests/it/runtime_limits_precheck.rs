@@ -1,0 +1,69 @@
+//! `run skin` on a device checks every pass's buffers against the adapter's real limits before any work: a frame
+//! whose bloom buffer exceeds the storage-binding limit is refused at once (exit 2, the flags named, nothing
+//! written), not after rendering; the same frame without bloom passes the check.
+
+use crate::support::{gpu, rtbake};
+use rtbake::runtime::skin_passes::SkinPasses;
+use rtbake::runtime::skin_render::{check_frame_fits, SkinRenderSettings, SkinShader, StretchPreset};
+use std::time::Instant;
+
+/// The smallest frame, as wide as possible, whose bloom buffer (48 bytes per pixel) exceeds the adapter's
+/// storage-binding limit while its G-buffer still fits; `None` where no frame rtbake accepts does.
+fn frame_over_bloom_limit(limits: &wgpu::Limits) -> Option<(u32, u32)> {
+    let storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let edge = limits.max_texture_dimension_2d.min(rtbake::error::MAX_TEXTURE_EDGE);
+    let side = ((storage / 48) as f64).sqrt() as u64 + 1;
+    let (w, h) = if side <= edge as u64 { (side, side) } else { (edge as u64, (storage / 48 / edge as u64) + 1) };
+    (h <= edge as u64 && rtbake::runtime::bloom::largest_buffer_bytes(w as u32, h as u32) > storage)
+        .then_some((w as u32, h as u32))
+}
+
+fn settings(width: u32, height: u32) -> SkinRenderSettings {
+    SkinRenderSettings {
+        shader: SkinShader::Separable,
+        heads: 1,
+        distance_m: 0.6,
+        width,
+        height,
+        melanin: 0.02,
+        stretch: StretchPreset::Thesis,
+    }
+}
+
+#[test]
+fn a_frame_over_the_bloom_storage_limit_is_refused_before_any_work() {
+    let g = gpu();
+    let limits = g.device.limits();
+    let Some((w, h)) = frame_over_bloom_limit(&limits) else {
+        eprintln!(
+            "{}: storage-binding limit {} bytes is beyond any frame rtbake accepts; nothing to refuse",
+            g.describe(),
+            limits.max_storage_buffer_binding_size
+        );
+        return;
+    };
+    // The pre-check, without rendering: bloom is the culprit, the frame fits without it.
+    let s = settings(w, h);
+    let err = check_frame_fits(&limits, &s, &SkinPasses::default()).unwrap_err();
+    assert!(err.message.contains("bloom"), "{err}");
+    assert_eq!(check_frame_fits(&limits, &s, &SkinPasses::none()), Ok(()));
+    drop(g);
+
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("frame.png");
+    let (ws, hs) = (w.to_string(), h.to_string());
+    let start = Instant::now();
+    let o = rtbake(&["run", "skin", "--width", &ws, "--height", &hs, "--output", out.to_str().unwrap()]);
+    let took = start.elapsed().as_secs_f64();
+    let msg = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{w}x{h}: {msg}");
+    for flag in ["bloom", "--width", "--height", "--bloom off", "--cpu", "max_storage_buffer_binding_size"] {
+        assert!(msg.contains(flag), "{w}x{h}: the message must name {flag}: {msg}");
+    }
+    // Refused before rendering: device creation and asset loading only (a render of this size on a software
+    // adapter takes tens of seconds).
+    assert!(took < 10.0, "{w}x{h} refused after {took:.1} s: {msg}");
+    assert!(!out.exists(), "nothing may be written");
+    assert_eq!(std::fs::read_dir(t.path()).unwrap().count(), 0, "no stray file");
+    eprintln!("{w}x{h} refused in {took:.2} s: {msg}");
+}
