@@ -502,6 +502,12 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         Method::Importance => SssMethod::Importance,
     };
     let gpu = device(ctx, d.common.cpu)?;
+    if let Some(g) = gpu.as_ref().filter(|g| g.is_software()) {
+        ctx.check_time(
+            &format!("--width {} --height {} on a software adapter ({})", d.width, d.height, g.adapter_info.name),
+            demo::software_adapter_time_estimate_seconds(d.width, d.height),
+        )?;
+    }
     let t = Instant::now();
     let out = demo::render(gpu.as_ref(), d.width, d.height, &assets, method, aa.as_ref())?;
     let ms = t.elapsed().as_secs_f64() * 1e3;

@@ -313,6 +313,12 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     if let Some(g) = &gpu {
         // Every pass against the adapter's limits before any work (the CPU twins have none).
         skin_render::check_frame_fits(&g.device.limits(), &settings, &passes).map_err(usage)?;
+        if g.is_software() {
+            ctx.check_time(
+                &format!("--width {} --height {} on a software adapter ({})", a.width, a.height, g.adapter_info.name),
+                skin_render::software_adapter_time_estimate_seconds(&settings),
+            )?;
+        }
     }
     let t = Instant::now();
     let out = skin_render::render_with(gpu.as_ref(), &mesh, &settings, &passes, &assets)?;

@@ -25,6 +25,12 @@ impl Gpu {
     pub fn describe(&self) -> String {
         describe_adapter(&self.adapter_info)
     }
+
+    /// Whether the adapter is a software rasteriser (lavapipe, llvmpipe: `wgpu::DeviceType::Cpu`), whose time
+    /// estimates are its own (slower than a GPU's, and than the CPU twins' for some passes).
+    pub fn is_software(&self) -> bool {
+        self.adapter_info.device_type == wgpu::DeviceType::Cpu
+    }
 }
 
 /// One line describing an adapter: name, backend, device type, driver.

@@ -67,3 +67,49 @@ fn a_frame_over_the_bloom_storage_limit_is_refused_before_any_work() {
     assert_eq!(std::fs::read_dir(t.path()).unwrap().count(), 0, "no stray file");
     eprintln!("{w}x{h} refused in {took:.2} s: {msg}");
 }
+
+/// On a software adapter the GPU path is timed with the adapter's own estimate, once the device is known: a size
+/// the generic GPU estimate lets through but the software estimate puts over `--max-seconds` is refused before
+/// rendering, for `run skin` and `run demo`.
+#[test]
+fn a_frame_over_the_time_budget_on_a_software_adapter_is_refused_before_rendering() {
+    let g = gpu();
+    if !g.is_software() {
+        eprintln!("{}: not a software adapter; its GPU estimate is the generic one", g.describe());
+        return;
+    }
+    drop(g);
+    let (w, h) = (1024u32, 1024u32);
+    let budget = 2.0;
+    let s = settings(w, h);
+    assert!(rtbake::runtime::demo::time_estimate_seconds(w, h, false) + 0.5 < budget);
+    assert!(rtbake::runtime::skin_render::software_adapter_time_estimate_seconds(&s) > budget);
+    let (wd, hd) = (2048u32, 2048u32);
+    assert!(rtbake::runtime::demo::time_estimate_seconds(wd, hd, false) < budget);
+    assert!(rtbake::runtime::demo::software_adapter_time_estimate_seconds(wd, hd) > budget);
+    for (cmd, w, h) in [("skin", w, h), ("demo", wd, hd)] {
+        let t = tempfile::tempdir().unwrap();
+        let out = t.path().join("frame.png");
+        let (ws, hs, bs) = (w.to_string(), h.to_string(), budget.to_string());
+        let start = Instant::now();
+        let o = rtbake(&[
+            "run",
+            cmd,
+            "--width",
+            &ws,
+            "--height",
+            &hs,
+            "--max-seconds",
+            &bs,
+            "--output",
+            out.to_str().unwrap(),
+        ]);
+        let took = start.elapsed().as_secs_f64();
+        let msg = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "run {cmd} {w}x{h}: {msg}");
+        assert!(msg.contains("software adapter") && msg.contains("--max-seconds"), "run {cmd}: {msg}");
+        // Refused before rendering: well under the budget it would have overrun.
+        assert!(took < budget, "run {cmd} {w}x{h} refused after {took:.2} s: {msg}");
+        assert!(!out.exists() && std::fs::read_dir(t.path()).unwrap().count() == 0, "run {cmd}: nothing written");
+    }
+}
