@@ -115,8 +115,8 @@ pub fn time_estimate_seconds(w: u32, h: u32, cpu: bool) -> f64 {
 }
 
 /// Wall time of `run demo` at `w`×`h` on a software adapter (lavapipe, llvmpipe), an upper bound of what was
-/// measured with the debug build on the project's 2-core machine (lavapipe: llvmpipe 15 through Vulkan): 0.83 s at 512², 1.13 s at
-/// 1024² (and 45 s reported at 8192²); 1 s of start-up plus 0.8 µs per pixel.
+/// measured with the debug build on the project's 2-core machine (lavapipe: llvmpipe 15 through Vulkan): 0.83 s at
+/// 512², 1.13 s at 1024² (and 45 s reported at 8192²); 1 s of start-up plus 0.8 µs per pixel.
 pub fn software_adapter_time_estimate_seconds(w: u32, h: u32) -> f64 {
     1.0 + 0.8e-6 * w as f64 * h as f64
 }
