@@ -168,7 +168,8 @@ pub fn check_frame_fits(
 /// Wall time of `run skin` with `s` on a software adapter (lavapipe, llvmpipe), PNG included: an upper bound of what
 /// was measured with the debug build on the project's 2-core machine (lavapipe: llvmpipe 15 through Vulkan;
 /// separable shader and bloom unless named): 0.76 s at 512², 2.79 s at 1024², 2.94 s for 4 heads at 1024², `--shader ts` 2.73 s at 512² and
-/// 4.33 s at 1024², 7.79 s for 4 heads at 512² (1024² maps). 1.5 s of start-up, 3 µs per pixel and, for the
+/// 4.33 s at 1024², 7.79 s for 4 heads at 512², 30.4 s, 29.8 s and 35.1 s (no bloom) for 16 heads at 512², 1024²
+/// and 2880² (1024² maps). 1.5 s of start-up, 3 µs per pixel and, for the
 /// texture-space shader, 2.5 µs per irradiance-map texel per head.
 pub fn software_adapter_time_estimate_seconds(s: &SkinRenderSettings) -> f64 {
     let pixels = s.width as f64 * s.height as f64;
