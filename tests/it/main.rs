@@ -72,6 +72,7 @@ mod runtime_sss;
 mod separable_cli;
 mod separable_fit;
 mod separable_kernel;
+mod setup_build;
 mod skin_cli;
 mod skin_color;
 mod skin_layers;
