@@ -3,7 +3,7 @@
 
 use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::io::{self, atomic::write_atomic};
-use rtbake::mesh::framing::{frame_in_metres, head_height_units, MeshUnits, TapDistance};
+use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits, TapDistance};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
@@ -195,17 +195,11 @@ fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Re
         _ => return Err(usage_msg(format!("{name}: unknown extension; accepted .gltf, .glb, .obj"))),
     };
     let mesh = mesh.map_err(usage)?;
-    let flag = "--mesh-units";
-    let framed = match origin {
-        MeshOriginArg::Bounds => frame_in_metres(&mesh, units, flag),
-        MeshOriginArg::Authored => {
-            // Positions as authored, scaled about the file's own origin.
-            let height = head_height_units(&mesh);
-            let to_m = units.mm_per_unit(height) / 1000.0;
-            let positions = mesh.positions.iter().map(|p| p.map(|c| c * to_m)).collect();
-            Mesh::new(flag, positions, mesh.normals.clone(), mesh.uvs.clone(), mesh.indices.clone(), 1000.0)
-        }
+    let origin = match origin {
+        MeshOriginArg::Bounds => MeshOrigin::Head,
+        MeshOriginArg::Authored => MeshOrigin::Authored,
     };
+    let framed = to_metres(&mesh, units, origin, "--mesh-units");
     framed.map_err(usage)
 }
 

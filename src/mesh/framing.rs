@@ -147,6 +147,22 @@ impl Bounds {
 /// renderer's world unit; the units come from `units` (`auto` depends on [`head_height_units`]). Normals, UVs and
 /// indices are unchanged. Refuses a flat mesh (zero height) under `auto` units, naming `param`.
 pub fn frame_in_metres(mesh: &Mesh, units: MeshUnits, param: &str) -> Result<Mesh, InvalidInput> {
+    to_metres(mesh, units, MeshOrigin::Head, param)
+}
+
+/// Where a mesh's origin goes when it is put in metres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshOrigin {
+    /// The middle of its head ([`frame_in_metres`]).
+    Head,
+    /// The file's own origin: positions only scaled.
+    Authored,
+}
+
+/// The mesh in metres (`mm_per_unit` = 1000) with its origin as `origin` says; the units come from `units` (`auto`
+/// depends on [`head_height_units`]). Normals, UVs and indices are unchanged. Refuses, naming `param`, a flat mesh
+/// (zero height) under `auto` units.
+pub fn to_metres(mesh: &Mesh, units: MeshUnits, origin: MeshOrigin, param: &str) -> Result<Mesh, InvalidInput> {
     let b = Bounds::of(mesh);
     let height = head_height_units(mesh);
     if matches!(units, MeshUnits::HeadHeightMm(_)) && (height.is_nan() || height <= 0.0) {
@@ -156,9 +172,15 @@ pub fn frame_in_metres(mesh: &Mesh, units: MeshUnits, param: &str) -> Result<Mes
     if !(to_m.is_finite() && to_m > 0.0) {
         return Err(InvalidInput::new(param, format!("gives {to_m} m per unit; accepted: {}", MeshUnits::ACCEPTED)));
     }
-    // Centre on the head: the box's centre in x and z, the head's middle in y (the box's for a head alone).
-    let mut c = b.centre();
-    c[1] = b.max[1] - 0.5 * height;
+    let c = match origin {
+        // Centre on the head: the box's centre in x and z, the head's middle in y (the box's for a head alone).
+        MeshOrigin::Head => {
+            let mut c = b.centre();
+            c[1] = b.max[1] - 0.5 * height;
+            c
+        }
+        MeshOrigin::Authored => [0.0; 3],
+    };
     let positions = mesh.positions.iter().map(|p| [0, 1, 2].map(|i| (p[i] - c[i]) * to_m)).collect();
     Mesh::new(param, positions, mesh.normals.clone(), mesh.uvs.clone(), mesh.indices.clone(), 1000.0)
 }
