@@ -327,6 +327,8 @@ pub fn run(mut a: AaArgs, ctx: &Ctx) -> anyhow::Result<()> {
     // Only the requested formats were encoded.
     let mut files = files;
     a.zstd.apply(&mut files)?;
+    // Bevy's `.meta` settings beside every linear data texture, listed with the set.
+    rtbake::bake::add_bevy_meta_files(&mut files);
     prepare_out_dir("--out", &a.out)?;
     // The sha256 lines are hashed while the set is written (the write mostly waits for the page cache and the
     // disk flush): a rayon task beside the write, so with one thread (`RAYON_NUM_THREADS=1`) the process uses one

@@ -505,7 +505,9 @@ pub fn write_set(
     inputs: &[&Path],
 ) -> anyhow::Result<Vec<std::path::PathBuf>> {
     check_dir_name(flag, dir)?;
-    let list: Vec<(&str, &[u8])> = files.iter().map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
+    // Bevy's `.meta` settings go beside every linear data texture, as `bake` writes them.
+    let metas = rtbake::bake::bevy_meta_files(files);
+    let list: Vec<(&str, &[u8])> = files.iter().chain(&metas).map(|f| (f.path.as_str(), f.bytes.as_slice())).collect();
     ctx.with_wait(|w| rtbake::io::file_set::write_file_set(dir, &list, inputs, w))
         .map_err(|e| file_set_err(e).context(format!("{flag} {}", dir.display())))
 }

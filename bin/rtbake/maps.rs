@@ -195,6 +195,7 @@ fn write_files(
     zstd: &crate::cli::ZstdArg,
 ) -> Result<Vec<BakedFile>> {
     zstd.apply(&mut files)?;
+    rtbake::bake::add_bevy_meta_files(&mut files);
     prepare_out_dir(flag, dir)?;
     crate::cli::write_set(ctx, flag, dir, &files, inputs)?;
     Ok(files)

@@ -58,20 +58,29 @@ impl Asset {
 /// Adds a Bevy `<file>.meta` (`is_srgb: false`, [`io::bevy_meta`]) beside every linear data texture Bevy's image
 /// loader opens, so a Bevy app loads the file as linear data without loading code of its own.
 pub fn add_bevy_meta_files(files: &mut Vec<BakedFile>) {
-    let metas: Vec<BakedFile> = files
+    let metas = bevy_meta_files(files);
+    files.extend(metas);
+}
+
+/// The Bevy `<file>.meta` files a set of baked files needs ([`add_bevy_meta_files`]), leaving out those the set
+/// already holds: every command that writes textures (`bake`, `aa --out`, `maps … --out`, …) writes the same ones.
+pub fn bevy_meta_files(files: &[BakedFile]) -> Vec<BakedFile> {
+    let present: std::collections::HashSet<&str> = files.iter().map(|f| f.path.as_str()).collect();
+    files
         .iter()
         .filter(|f| io::bevy_meta::wants_meta(&f.meta.format, &f.meta.color_space))
-        .map(|f| {
+        .map(|f| io::bevy_meta::meta_path(&f.path))
+        .filter(|meta| !present.contains(meta.as_str()))
+        .map(|meta| {
             text_file(
-                &io::bevy_meta::meta_path(&f.path),
+                &meta,
                 io::bevy_meta::linear_image_meta(),
                 "bevy-meta",
                 "ron",
                 "Bevy asset settings for the texture of the same name (ImageLoader, is_srgb: false: linear data)",
             )
         })
-        .collect();
-    files.extend(metas);
+        .collect()
 }
 
 /// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).

@@ -93,14 +93,16 @@ fn variant_run_writes_requested_formats_and_json() {
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     let mut names = entries(&out);
     names.sort();
-    assert_eq!(names, vec!["Small.bin", "Small.png"]);
+    // The PNG holds linear data: Bevy's `.meta` (is_srgb: false) goes beside it, as `bake` writes it.
+    assert_eq!(names, vec!["Small.bin", "Small.png", "Small.png.meta"]);
     let bin = std::fs::read(out.join("Small.bin")).unwrap();
     // (5·4 + 4·5) × max(5·4·3, 4·5·2) texels, two channels.
     assert_eq!(bin.len(), 40 * 60 * 2);
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let files = json["files"].as_array().unwrap();
-    assert_eq!(files.len(), 2);
+    assert_eq!(files.len(), 3);
     assert_eq!(files[0]["bytes"], bin.len());
+    assert_eq!(files[2]["path"].as_str().map(|p| p.ends_with("Small.png.meta")), Some(true), "{}", files[2]);
     assert_eq!(files[0]["sha256"].as_str().unwrap().len(), 64);
 }
 
@@ -126,7 +128,7 @@ fn default_run_matches_the_library_and_writes_headers() {
     let mut names: Vec<String> =
         std::fs::read_dir(&only).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, ["AreaTex_MLAAv2.bin", "AreaTex_MLAAv2.png"]);
+    assert_eq!(names, ["AreaTex_MLAAv2.bin", "AreaTex_MLAAv2.png", "AreaTex_MLAAv2.png.meta"]);
 }
 
 #[test]

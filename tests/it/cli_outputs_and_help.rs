@@ -127,15 +127,19 @@ fn large_aa_tables_default_to_binary_formats() {
     let mut names: Vec<String> =
         std::fs::read_dir(t.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    // `dds` is the DX10 file and its legacy-header copy.
+    // `dds` is the DX10 file and its legacy-header copy; each texture has Bevy's `.meta` beside it.
     assert_eq!(
         names,
         [
             "AreaMap257_v1.4.bin",
             "AreaMap257_v1.4.dds",
+            "AreaMap257_v1.4.dds.meta",
             "AreaMap257_v1.4.ktx2",
+            "AreaMap257_v1.4.ktx2.meta",
             "AreaMap257_v1.4.png",
-            "AreaMap257_v1.4_dx9.dds"
+            "AreaMap257_v1.4.png.meta",
+            "AreaMap257_v1.4_dx9.dds",
+            "AreaMap257_v1.4_dx9.dds.meta"
         ]
     );
     assert!(text(&o.stderr).contains("--format h,rs"), "{}", text(&o.stderr));

@@ -265,3 +265,54 @@ fn every_committed_linear_texture_has_its_bevy_meta() {
     }
     assert!(n > 50, "{n}");
 }
+
+/// A Bevy user who writes textures with a command instead of `bake` (`aa … --out assets/`, `transmittance --out`,
+/// `maps synthetic` → `maps hemoglobin --out`) gets the same `.meta` beside every linear data texture; sRGB previews
+/// get none.
+#[test]
+fn commands_writing_textures_put_the_bevy_meta_beside_each_linear_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = |n: &str| tmp.path().join(n);
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let runs: Vec<Vec<String>> = vec![
+        vec![
+            "aa".into(),
+            "smaa-area".into(),
+            "--format".into(),
+            "ktx2,dds,png".into(),
+            "--out".into(),
+            s(&dir("area")),
+        ],
+        vec!["aa".into(), "mlaa-v1.4".into(), "--max-distance".into(), "9".into(), "--out".into(), s(&dir("mlaa"))],
+        vec!["transmittance".into(), "--samples".into(), "64".into(), "--out".into(), s(&dir("t"))],
+    ];
+    let mut metas = 0;
+    for args in &runs {
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = crate::support::rtbake(&argv);
+        assert_eq!(o.status.code(), Some(0), "{argv:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let out = std::path::Path::new(args.last().unwrap());
+        let mut textures = 0;
+        for e in std::fs::read_dir(out).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
+            if !matches!(ext.as_str(), "ktx2" | "dds" | "png") {
+                continue;
+            }
+            textures += 1;
+            let meta = out.join(format!("{name}.meta"));
+            // Previews and plots are sRGB pictures for people; everything else Bevy opens is linear data.
+            let srgb_picture = name.contains("preview") || name.contains("plot");
+            if srgb_picture {
+                assert!(!meta.exists(), "{argv:?}: {name} is an sRGB picture and has a .meta");
+            } else {
+                let text = std::fs::read(&meta).unwrap_or_else(|_| panic!("{argv:?}: {name} has no .meta"));
+                check_linear_meta(&name, &text);
+                metas += 1;
+            }
+        }
+        assert!(textures >= 2, "{argv:?}: only {textures} textures written");
+    }
+    assert!(metas >= 6, "only {metas} .meta files checked");
+}

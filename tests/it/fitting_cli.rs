@@ -126,10 +126,20 @@ fn transmittance_out_writes_table_files() {
     let mut names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    let expect: Vec<String> = [".exr", ".json", ".ktx2", "_f16.exr", "_linear16.png", "_preview_srgb.png"]
-        .iter()
-        .map(|s| format!("deon6_published{s}"))
-        .collect();
+    // The linear KTX2 and PNG carry Bevy's `.meta`; the sRGB preview does not.
+    let expect: Vec<String> = [
+        ".exr",
+        ".json",
+        ".ktx2",
+        ".ktx2.meta",
+        "_f16.exr",
+        "_linear16.png",
+        "_linear16.png.meta",
+        "_preview_srgb.png",
+    ]
+    .iter()
+    .map(|s| format!("deon6_published{s}"))
+    .collect();
     assert_eq!(names, expect);
     assert!(v["convention"].as_str().unwrap().contains("s = s_max*i/(n-1)"));
     let (img, _) = rtbake::io::exr::decode(&std::fs::read(out.join("deon6_published.exr")).unwrap(), "t").unwrap();

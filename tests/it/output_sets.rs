@@ -55,8 +55,8 @@ fn a_kill_anywhere_in_a_four_format_write_leaves_the_old_or_the_new_set() {
     let fresh = t.path().join("fresh");
     assert!(aa_four_formats(&fresh, "").status.success(), "reference write");
     let new_set = tree(&fresh);
-    // bin, dds (DX10) and its legacy-header copy, ktx2, png.
-    assert_eq!(new_set.len(), 5, "{:?}", new_set.iter().map(|f| &f.0).collect::<Vec<_>>());
+    // bin, dds (DX10) and its legacy-header copy, ktx2, png; Bevy's `.meta` beside the four textures.
+    assert_eq!(new_set.len(), 9, "{:?}", new_set.iter().map(|f| &f.0).collect::<Vec<_>>());
     for (step, committed) in [("locked", false), ("staged", false), ("before-swap", false), ("after-swap", true)] {
         let d = t.path().join(format!("D-{step}"));
         std::fs::create_dir_all(d.join("engine")).unwrap();
