@@ -502,6 +502,9 @@ fn run_demo(ctx: &Ctx, d: DemoArgs) -> anyhow::Result<()> {
         Method::Importance => SssMethod::Importance,
     };
     let gpu = device(ctx, d.common.cpu)?;
+    if let Some(g) = gpu.as_ref() {
+        demo::check_frame_fits(&g.device.limits(), d.width, d.height).map_err(usage)?;
+    }
     if let Some(g) = gpu.as_ref().filter(|g| g.is_software()) {
         ctx.check_time(
             &format!("--width {} --height {} on a software adapter ({})", d.width, d.height, g.adapter_info.name),

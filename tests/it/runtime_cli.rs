@@ -441,3 +441,44 @@ fn demo_rig_weights_from_json() {
         assert!(!out.exists());
     }
 }
+
+/// `run demo` checks the whole frame against the adapter's limits before any work: a frame over them exits 2 at
+/// once (no geometry, no pass run), naming `--width/--height`, the largest frame that fits and `--cpu`, and writes
+/// nothing.
+#[test]
+fn demo_over_the_adapter_limits_is_refused_before_any_work() {
+    let g = crate::support::gpu();
+    let limits = g.device.limits();
+    let side = limits.max_texture_dimension_2d.min(16384);
+    let Err(expected) = rtbake::runtime::skin::demo::check_frame_fits(&limits, side, side) else {
+        // A GPU whose buffers hold a 16-byte read-back of its largest texture has no over-limit frame in range.
+        eprintln!("SKIPPED: {} holds a {side}² demo frame: no over-limit frame to refuse", g.adapter_info.name);
+        assert!(!matches!(g.adapter_info.device_type, wgpu::DeviceType::Cpu), "lavapipe must refuse {side}²");
+        return;
+    };
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("demo.png");
+    let size = side.to_string();
+    let started = std::time::Instant::now();
+    let o = rtbake(&[
+        "run",
+        "demo",
+        "--output",
+        out.to_str().unwrap(),
+        "--width",
+        &size,
+        "--height",
+        &size,
+        "--max-memory",
+        "1024T",
+        "--max-seconds",
+        "1000000",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains(&expected.message) && stderr.contains("--width/--height"), "{stderr}");
+    assert!(stderr.contains("--cpu") && stderr.contains("largest frame"), "{stderr}");
+    // Refused before the geometry of a {side}² frame is built (seconds of work at this size).
+    assert!(started.elapsed().as_secs_f64() < 20.0, "took {:?}", started.elapsed());
+    assert!(!out.exists(), "a refused frame wrote {}", out.display());
+}

@@ -3,6 +3,7 @@
 //! [`crate::runtime::skin::lighting`]. The baked rig and H0 cover the frame (screen uv ∈ [0, 1]², as the
 //! skin-inputs pass samples them); the weights blend neutral with joy.
 
+use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::runtime::backend::Backend;
 use crate::runtime::chain::Antialiasing;
@@ -107,6 +108,40 @@ pub fn render<'g>(
     shade(gpu, lit, assets, Some(method), crate::runtime::aa::scene::render_shapes(w, h, 1), aa)
 }
 
+/// Bytes per pixel of the demo frame's largest GPU image: the skin-inputs pass reads back albedo and T(s)·E as
+/// RGBA f32 (16 bytes); the SSS passes' images (8) and the antialiasing's (4) are smaller, and there is no bloom.
+pub const LARGEST_BYTES_PER_PIXEL: u32 = 16;
+
+/// Checks the demo frame `w`×`h` against the adapter's `limits` before any work (the geometry, the lighting and
+/// every pass after it), so an over-limit frame is refused at once instead of after the passes before the one that
+/// does not fit: the 2-D texture edge and the largest read-back ([`LARGEST_BYTES_PER_PIXEL`]). The message names
+/// `--width/--height`, the largest frame of the same aspect that fits and `--cpu` (the CPU twins have no limit).
+pub fn check_frame_fits(limits: &wgpu::Limits, w: u32, h: u32) -> Result<(), InvalidInput> {
+    let edge = limits.max_texture_dimension_2d;
+    let fits = |w: u32, h: u32| {
+        w <= edge
+            && h <= edge
+            && crate::runtime::device::readback_bytes(w, h, LARGEST_BYTES_PER_PIXEL) <= limits.max_buffer_size
+    };
+    if fits(w, h) {
+        return Ok(());
+    }
+    let largest = match crate::runtime::skin::frame::largest_fitting(w, h, fits) {
+        Some((fw, fh)) => format!("--width {fw} --height {fh} is the largest frame of this aspect that fits"),
+        None => "no frame of this aspect fits".to_string(),
+    };
+    Err(InvalidInput::new(
+        "--width/--height",
+        format!(
+            "{w}x{h}: the skin-inputs pass needs {LARGEST_BYTES_PER_PIXEL} bytes per pixel (a {}-byte read-back), \
+             over this GPU's limits (max_texture_dimension_2d {edge}, max_buffer_size {}); {largest}; or --cpu \
+             (the CPU twins have no such limit)",
+            crate::runtime::device::readback_bytes(w, h, LARGEST_BYTES_PER_PIXEL),
+            limits.max_buffer_size
+        ),
+    ))
+}
+
 /// Wall time of [`render`] at `w`×`h` plus the PNG encoding (the budget check): 1 µs per pixel on the CPU
 /// path (0.94 s at 1024² on the project's 2-core machine, release), a tenth of it with a GPU, plus 0.5 s start-up.
 pub fn time_estimate_seconds(w: u32, h: u32, cpu: bool) -> f64 {
@@ -119,4 +154,30 @@ pub fn time_estimate_seconds(w: u32, h: u32, cpu: bool) -> f64 {
 /// 512², 1.13 s at 1024² (and 45 s reported at 8192²); 1 s of start-up plus 0.8 µs per pixel.
 pub fn software_adapter_time_estimate_seconds(w: u32, h: u32) -> f64 {
     1.0 + 0.8e-6 * w as f64 * h as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_demo_frame_over_the_limits_is_refused_before_any_work_naming_the_largest_that_fits() {
+        // 256 MiB buffers and 16384-texel textures (wgpu's defaults for the downlevel tiers are smaller).
+        let l = wgpu::Limits { max_buffer_size: 1 << 28, max_texture_dimension_2d: 16384, ..Default::default() };
+        assert_eq!(check_frame_fits(&l, 1920, 1080), Ok(()));
+        // 8192² needs a 1 GiB read-back of RGBA f32.
+        let err = check_frame_fits(&l, 8192, 8192).unwrap_err();
+        assert_eq!(err.param, "--width/--height");
+        for part in ["1073741824", "268435456", "--cpu", "max_buffer_size"] {
+            assert!(err.message.contains(part), "{part}: {err}");
+        }
+        let rest = &err.message[err.message.find("--width ").expect("a suggestion") + 8..];
+        let w: u32 = rest.split_whitespace().next().unwrap().parse().unwrap();
+        assert_eq!(check_frame_fits(&l, w, w), Ok(()), "the suggested {w}² fits");
+        assert!(check_frame_fits(&l, w + 1, w + 1).is_err(), "{w}² is not the largest");
+        // The texture edge alone.
+        let small = wgpu::Limits { max_texture_dimension_2d: 2048, ..l };
+        let err = check_frame_fits(&small, 4096, 1024).unwrap_err();
+        assert!(err.message.contains("--width 2048 --height 512"), "{err}");
+    }
 }

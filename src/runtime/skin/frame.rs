@@ -39,7 +39,7 @@ use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
 /// The largest `w`×`h` frame with `width`:`height`'s aspect (scaled down from it) for which `fits` holds.
-fn largest_fitting(width: u32, height: u32, fits: impl Fn(u32, u32) -> bool) -> Option<(u32, u32)> {
+pub(crate) fn largest_fitting(width: u32, height: u32, fits: impl Fn(u32, u32) -> bool) -> Option<(u32, u32)> {
     let (mut w, mut h) = (width, height);
     // Halve to a size that fits, then grow back in 1 % steps: a few dozen pure evaluations.
     while !fits(w, h) {
