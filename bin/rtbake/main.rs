@@ -144,6 +144,8 @@ fn main() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // Before any thread starts and before any command can open an adapter (`run`, `transport --gpu`).
+    run::ensure_runtime_dir();
     let raw: Vec<std::ffi::OsString> = std::env::args_os().collect();
     let json = cli::json_requested(&raw);
     let argv = match cli::expand_params_file::<Cli>(raw) {

@@ -179,7 +179,6 @@ pub struct DemoArgs {
 }
 
 pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
-    ensure_runtime_dir();
     match cmd {
         RunCommand::Smaa(s) if s.mode.is_some() => {
             let (cpu, baked) = (s.common.cpu, s.common.baked.clone());
@@ -201,17 +200,14 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
         }
         RunCommand::Sss(a) => sss(ctx, *a),
         RunCommand::Demo(d) => run_demo(ctx, d),
-        RunCommand::Skin(s) => {
-            ensure_runtime_dir();
-            crate::run_skin::run(ctx, *s)
-        }
+        RunCommand::Skin(s) => crate::run_skin::run(ctx, *s),
     }
 }
 
 /// Mesa's Vulkan and GL drivers print "XDG_RUNTIME_DIR is invalid or not set" when the session has none (SSH,
 /// containers, CI). Give this process a private one (`$TMPDIR/rtbake-runtime-UID`, mode 0700) in that case;
 /// a valid directory set by the session is kept.
-fn ensure_runtime_dir() {
+pub fn ensure_runtime_dir() {
     #[cfg(unix)]
     {
         use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};

@@ -166,17 +166,31 @@ fn help_describes_demo_size_and_stretch_parameters() {
     assert!(sss.contains("view-space depth") && sss.contains("single-channel (Y) file, else R"), "{sss}");
 }
 
-/// Point 7: GPU commands give Mesa a private runtime directory when the session has none.
+/// Point 7: every command that opens an adapter (`run …`, `transport --gpu`) gives the drivers a private runtime
+/// directory when the session has none or an invalid one, so their "XDG_RUNTIME_DIR is invalid" line never prints.
 #[test]
 fn gpu_commands_do_not_print_the_xdg_runtime_dir_warning() {
     let t = tempfile::tempdir().unwrap();
     let out = t.path().join("demo.png");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_rtbake"))
-        .args(["run", "demo", "--width", "32", "--height", "32", "--output", s(&out), "--baked-dir"])
-        .arg(crate_dir().join("baked"))
-        .env_remove("XDG_RUNTIME_DIR")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(!text(&o.stderr).contains("XDG_RUNTIME_DIR"), "{}", text(&o.stderr));
+    let demo: Vec<std::ffi::OsString> =
+        ["run", "demo", "--width", "32", "--height", "32", "--output", s(&out), "--baked-dir"]
+            .iter()
+            .map(Into::into)
+            .chain([crate_dir().join("baked").into_os_string()])
+            .collect();
+    let transport: Vec<std::ffi::OsString> =
+        ["transport", "--gpu", "--material", "skin1", "--photons", "2000", "--json"].iter().map(Into::into).collect();
+    for args in [&demo, &transport] {
+        for xdg in [None, Some("/nonexistent-runtime-dir")] {
+            let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_rtbake"));
+            c.args(args);
+            match xdg {
+                None => c.env_remove("XDG_RUNTIME_DIR"),
+                Some(d) => c.env("XDG_RUNTIME_DIR", d),
+            };
+            let o = c.output().unwrap();
+            assert!(o.status.success(), "{args:?} {xdg:?}: {}", text(&o.stderr));
+            assert!(!text(&o.stderr).contains("XDG_RUNTIME_DIR"), "{args:?} {xdg:?}: {}", text(&o.stderr));
+        }
+    }
 }
