@@ -5,7 +5,9 @@
 //! - Every writer of a directory holds its lock (`.NAME.rtbake-lock` beside the directory, an OS advisory lock
 //!   through `std::fs::File::lock`, released by the kernel when the process dies) for the whole stage → install;
 //!   readers that must see one consistent state (`verify`) hold it shared. A second writer waits or, with
-//!   `Wait::No`, fails with [`FileSetError::Busy`].
+//!   `Wait::No`, fails with [`FileSetError::Busy`]. The last holder unlinks the lock file while holding it; a
+//!   process that waited on an unlinked file re-locks the one the name points to (dev/inode compared), so nothing
+//!   stays beside the directory and two processes never hold it at once.
 //! - Leftovers (`.NAME.rtbake-stage-PID`, `.rtbake-tmp-`, journals) are removed only while holding the lock
 //!   exclusively: their owner held the same lock while it lived, so a leftover seen under the lock is dead.
 //!   Nothing is ever left inside a target directory by a probe: the writability probe is a staging directory.
@@ -156,7 +158,38 @@ pub struct DirLock {
     /// The resolved directory (see [`resolve_target`]).
     dir: PathBuf,
     mode: LockMode,
-    _file: Option<fs::File>,
+    /// The lock file and its path; None where a read-only parent needs no lock.
+    file: Option<(fs::File, PathBuf)>,
+}
+
+/// Whether `path` still names the open lock `file` (the last holder unlinks the lock file when it releases it, so
+/// a process that opened the old file and then waited holds a lock nobody else will ever take: it must reopen).
+#[cfg(unix)]
+fn still_names(path: &Path, file: &fs::File) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (fs::metadata(path), file.metadata()) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+#[cfg(not(unix))]
+fn still_names(_path: &Path, _file: &fs::File) -> bool {
+    true
+}
+
+impl Drop for DirLock {
+    /// Releases the lock. The last holder removes the lock file while it still holds it exclusively (a shared
+    /// holder first tries to become the only one), so no `.NAME.rtbake-lock` stays beside a directory after the
+    /// command, a read-only `verify` included; a process waiting on the removed file notices ([`still_names`]) and
+    /// takes a fresh one.
+    fn drop(&mut self) {
+        let Some((file, path)) = self.file.take() else { return };
+        let sole = self.mode == LockMode::Exclusive || file.try_lock().is_ok();
+        if cfg!(unix) && sole && still_names(&path, &file) {
+            let _ = fs::remove_file(&path);
+        }
+        drop(file);
+    }
 }
 
 impl DirLock {
@@ -174,7 +207,31 @@ impl DirLock {
     pub fn acquire(dir: &Path, mode: LockMode, wait: &Wait) -> Result<Self, FileSetError> {
         let resolved = resolve_target(dir)?;
         let path = lock_path(&resolved);
-        let file = match fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path) {
+        loop {
+            let Some(file) = Self::lock_file(&resolved, &path, mode, wait)? else {
+                return Ok(Self { dir: resolved, mode, file: None });
+            };
+            if !still_names(&path, &file) {
+                // The holder we waited for removed this file on release: lock the one that names the directory now.
+                continue;
+            }
+            if mode == LockMode::Exclusive {
+                // Who holds it, for the message of a waiting process (best effort).
+                let _ = file.set_len(0);
+                let _ = (&file).write_all(std::process::id().to_string().as_bytes());
+            }
+            // Staging directories of killed writers (they held this lock while they lived): removed by whoever
+            // locks the directory next, readers (`verify`) included.
+            remove_stale_stages(&resolved);
+            fault_point("locked");
+            return Ok(Self { dir: resolved, mode, file: Some((file, path)) });
+        }
+    }
+
+    /// Opens (creating) and locks the lock file at `path`, waiting per `wait`; None for a shared lock whose parent
+    /// is read-only.
+    fn lock_file(resolved: &Path, path: &Path, mode: LockMode, wait: &Wait) -> Result<Option<fs::File>, FileSetError> {
+        let file = match fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path) {
             Ok(f) => f,
             Err(e)
                 if mode == LockMode::Shared
@@ -183,9 +240,9 @@ impl DirLock {
                         std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::ReadOnlyFilesystem
                     ) =>
             {
-                return Ok(Self { dir: resolved, mode, _file: None });
+                return Ok(None);
             }
-            Err(e) => return Err(io_err(&path, e)),
+            Err(e) => return Err(io_err(path, e)),
         };
         let attempt = |f: &fs::File| match mode {
             LockMode::Shared => f.try_lock_shared(),
@@ -193,9 +250,9 @@ impl DirLock {
         };
         match attempt(&file) {
             Ok(()) => {}
-            Err(fs::TryLockError::Error(e)) => return Err(io_err(&path, e)),
+            Err(fs::TryLockError::Error(e)) => return Err(io_err(path, e)),
             Err(fs::TryLockError::WouldBlock) => {
-                let holder = match fs::read_to_string(&path) {
+                let holder = match fs::read_to_string(path) {
                     Ok(s) if !s.trim().is_empty() => format!(" (pid {})", s.trim()),
                     _ => String::new(),
                 };
@@ -211,21 +268,12 @@ impl DirLock {
                             LockMode::Shared => file.lock_shared(),
                             LockMode::Exclusive => file.lock(),
                         };
-                        r.map_err(|e| io_err(&path, e))?;
+                        r.map_err(|e| io_err(path, e))?;
                     }
                 }
             }
         }
-        if mode == LockMode::Exclusive {
-            // Who holds it, for the message of a waiting process (best effort).
-            let _ = file.set_len(0);
-            let _ = (&file).write_all(std::process::id().to_string().as_bytes());
-        }
-        // Staging directories of killed writers (they held this lock while they lived): removed by whoever locks
-        // the directory next, readers (`verify`) included.
-        remove_stale_stages(&resolved);
-        fault_point("locked");
-        Ok(Self { dir: resolved, mode, _file: Some(file) })
+        Ok(Some(file))
     }
 
     /// Upgrades a shared lock to exclusive (releases, then waits for exclusive).
@@ -794,6 +842,36 @@ mod tests {
         let _s2 = DirLock::acquire(&d, LockMode::Shared, &Wait::No).unwrap();
         assert!(matches!(DirLock::acquire(&d, LockMode::Exclusive, &Wait::No), Err(FileSetError::Busy { .. })));
         drop(s1);
+    }
+
+    #[test]
+    fn the_last_holder_removes_the_lock_file_and_a_waiter_relocks_a_fresh_one() {
+        let t = tempfile::tempdir().unwrap();
+        let d = t.path().join("d");
+        let lock = lock_path(&d);
+        // Readers: the last one out removes the file, the first one out leaves it to the other.
+        let r1 = DirLock::acquire(&d, LockMode::Shared, &Wait::No).unwrap();
+        let r2 = DirLock::acquire(&d, LockMode::Shared, &Wait::No).unwrap();
+        drop(r1);
+        assert!(lock.exists(), "removed while another reader held it");
+        drop(r2);
+        assert!(!lock.exists(), "the last reader left {}", lock.display());
+        // A writer waited on the file its predecessor then removed: it must lock the file that names the
+        // directory now, so a third process cannot hold the directory at the same time.
+        let first = DirLock::acquire(&d, LockMode::Exclusive, &Wait::No).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let d2 = d.clone();
+        let waiter = std::thread::spawn(move || {
+            let say = |_: &str| tx.send(()).unwrap();
+            let l = DirLock::acquire(&d2, LockMode::Exclusive, &Wait::Yes(&say)).unwrap();
+            let busy = DirLock::acquire(&d2, LockMode::Exclusive, &Wait::No);
+            assert!(matches!(busy, Err(FileSetError::Busy { .. })), "two exclusive holders");
+            drop(l);
+        });
+        rx.recv().unwrap(); // the waiter opened the old file and is blocked on it
+        drop(first);
+        waiter.join().unwrap();
+        assert!(!lock.exists(), "the waiter left {}", lock.display());
     }
 
     #[test]

@@ -243,3 +243,22 @@ fn verify_pin_rejects_a_consistently_edited_manifest() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("TAMPERED") && stderr(&o).contains("pinned"), "{}", stderr(&o));
 }
+
+/// Nothing of rtbake's stays beside a directory after a command: the lock file is removed by its last holder, after
+/// a bake, a read-only `verify` and a file set written into a user's directory alike.
+#[test]
+fn no_lock_file_stays_beside_a_directory_after_a_command() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path().join("baked");
+    let o = rtbake(&["bake", A, "--out", s(&d)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = rtbake(&["verify", "--dir", s(&d)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sets = t.path().join("tables");
+    let o = rtbake(&["aa", "smaa-search", "--format", "bin", "--out", s(&sets)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut left: Vec<String> =
+        std::fs::read_dir(t.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert_eq!(left, ["baked", "tables"]);
+}
