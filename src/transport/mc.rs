@@ -139,7 +139,7 @@ impl McSettings {
     /// bounds a software GPU adapter, `runtime::chain::transport_estimate`.)
     pub fn time_estimate_seconds(&self, threads: usize) -> f64 {
         let per_thread = if Path::detect() == Path::Portable { 150_000.0 } else { 600_000.0 };
-        3.0 * self.photons as f64 / (per_thread * threads.max(1) as f64)
+        BUILD_SLOWDOWN * 3.0 * self.photons as f64 / (per_thread * threads.max(1) as f64)
     }
 
     /// Wall time of [`simulate`] in `stack`, an upper estimate from the stack's optics (before any work): three
@@ -151,7 +151,7 @@ impl McSettings {
         let rate =
             if Path::detect() == Path::Portable { PORTABLE_INTERACTIONS_PER_SECOND } else { INTERACTIONS_PER_SECOND };
         let per_photon = interactions_per_photon_estimate(stack);
-        let t = 3.0 * self.photons as f64 * per_photon / (rate * threads.max(1) as f64);
+        let t = BUILD_SLOWDOWN * 3.0 * self.photons as f64 * per_photon / (rate * threads.max(1) as f64);
         t.max(self.time_estimate_seconds(threads))
     }
 
@@ -160,6 +160,12 @@ impl McSettings {
         (0..self.bins).map(|i| (i as f64 + 0.5) * self.bin_mm).collect()
     }
 }
+
+/// How much slower the engine runs in a build with debug assertions (the dev profile the README's `cargo run`
+/// uses: opt-level 1, where the lane engine's SIMD helpers are not inlined) than in the release build the rates
+/// below were measured with: a high-albedo slab (`transport --material marble --photons 100000`) took 24.6 CPU-s
+/// with the dev build against 1.46 with the release build on the project's 2-core machine (2026-11-26), 17×.
+pub const BUILD_SLOWDOWN: f64 = if cfg!(debug_assertions) { 20.0 } else { 1.0 };
 
 /// Interactions per thread and second assumed by [`McSettings::time_estimate_for_stack`] (AVX2 / AVX-512F paths):
 /// a third of the rate measured on the project's 2-core machine with the release build (`examples/bench_transport`
