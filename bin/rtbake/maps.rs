@@ -6,7 +6,7 @@
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use anyhow::Result;
 use rtbake::bake::facial::{self as bf, RigDescription, RigSource};
-use rtbake::bake::{BakedFile, FileMeta};
+use rtbake::bake::{BakedFile, FileFormat, FileKind, FileMeta};
 use rtbake::error::InvalidInput;
 use rtbake::facial::disk_stats::Border;
 use rtbake::facial::hemoglobin_rig::{self, RigSettings};
@@ -394,7 +394,7 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         read.push(dir.join(&m.bias_exr));
     }
     let read_refs: Vec<&Path> = read.iter().map(PathBuf::as_path).collect();
-    let file = BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text("map", "exr", "") };
+    let file = BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text(FileKind::Map, FileFormat::Exr, "") };
     crate::cli::write_set(ctx, "--out", out_dir, &[file], &read_refs)?;
     let used: Vec<String> = names.iter().zip(&weights).map(|(n, w)| format!("{n}={w}")).collect();
     ctx.info(format!("wrote {} ({w}x{h}) with weights {}", a.out.display(), used.join(",")));
@@ -447,7 +447,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
         files.extend(rtbake::bake::unorm8_texture_files(
             "wrinkle_difference",
             &img,
-            "lut",
+            FileKind::Lut,
             "difference normal map d = 0.5 + 0.5*(w - b) of unit normals (thesis 8.2.1), RGB = xyz, A = 1; add 2*d - 1 to the base normal and renormalise; DirectX green",
         )?);
         report["wrinkle"] = json!({"files": "wrinkle_difference.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8B8A8_UNORM", "range_clamped_texels": clamped});
@@ -472,7 +472,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
         ));
     }
     report["composition"] = json!("n = normalize(base.xy + sum_z mask_z * weight_z * wrinkle.xy, 1), texel.rg -> 2*rg - 1 (thesis Listing 8.1; read .rg, not .gr)");
-    files.push(rtbake::bake::json_file("wrinkles.json", &report, "json", "wrinkle conversion report"));
+    files.push(rtbake::bake::json_file("wrinkles.json", &report, FileKind::Json, "wrinkle conversion report"));
     let inputs_read: Vec<&Path> = std::iter::once(a.normal.as_path()).chain(a.base.as_deref()).collect();
     write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
     if ctx.json {
@@ -523,7 +523,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         files.extend(rtbake::bake::unorm8_texture_files(
             &format!("wrinkle_masks_{i}"),
             img,
-            "lut",
+            FileKind::Lut,
             &bf::mask_convention(i),
         )?);
     }
@@ -536,7 +536,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         "wrinkle_masks_1": {"r": "cyan", "g": "magenta", "b": "orange", "a": "gray"},
         "zones_given": given,
     });
-    files.push(rtbake::bake::json_file("wrinkle_masks.json", &report, "json", "wrinkle mask packing"));
+    files.push(rtbake::bake::json_file("wrinkle_masks.json", &report, FileKind::Json, "wrinkle mask packing"));
     let inputs_read: Vec<&Path> = a
         .zones
         .iter()
@@ -565,7 +565,7 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
     let mut files = Vec::new();
     for (name, img) in &set {
         let bytes = io::png::encode_u16(img)?;
-        files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text("input", "png", "") });
+        files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text(FileKind::Input, FileFormat::Png, "") });
     }
     let files = write_files(ctx, "--out", &a.out, files, &[], &Default::default())?;
     ctx.info(format!(

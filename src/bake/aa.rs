@@ -14,6 +14,7 @@
 //! RG textures are RGB with B = 0. `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2` are the same payloads named and stored
 //! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{parse_params, text_file, unorm8_texture_files_in, Asset, BakeError, BakedFile, TextureFormats};
 use crate::aa::mlaa_area::{mlaa_area_map_with_progress, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
@@ -212,7 +213,7 @@ pub fn mlaa_files_with_progress(
     let others = TextureFormats { bin: false, ..formats };
     let mut files = texture_with_sources(stem, &img, &convention, others, ("AREAMAP", "areaMapBytes"), from)?;
     if formats.bin {
-        files.insert(0, crate::bake::unorm8_bin_file(stem, img, "lut", &convention));
+        files.insert(0, crate::bake::unorm8_bin_file(stem, img, FileKind::Lut, &convention));
     }
     Ok(files)
 }
@@ -226,14 +227,14 @@ pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<B
     use crate::io::{self, ktx2::Supercompression, PixelFormat};
     let sc = Supercompression::Zstd(io::ktx2::BEVY_ZSTD_LEVEL);
     let meta = crate::manifest::FileMeta {
-        kind: "lut".into(),
-        format: "ktx2".into(),
+        kind: FileKind::Lut,
+        format: FileFormat::Ktx2,
         pixel_format: PixelFormat::unorm8_for(img.channels),
         width: img.width,
         height: img.height,
         channels: img.channels,
-        sample_type: "u8".into(),
-        color_space: "linear".into(),
+        sample_type: SampleType::U8,
+        color_space: ColorSpace::Linear,
         convention: format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it"),
         verify_tolerance: None,
         supercompression: Some(sc.label()),
@@ -249,16 +250,16 @@ fn texture_with_sources(
     (prefix, array): (&str, &str),
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let mut files = unorm8_texture_files_in(stem, img, "lut", convention, formats)?;
+    let mut files = unorm8_texture_files_in(stem, img, FileKind::Lut, convention, formats)?;
     let note = format!("{convention}; generated source, bytes identical to {stem}.bin");
     let notice = if prefix == "AREAMAP" { DataNotice::Mlaa } else { DataNotice::Smaa };
     if formats.c_header {
         let header = c_header_u8(prefix, array, img, from, notice);
-        files.push(text_file(&format!("{stem}.h"), header, "c-header", "c", &note));
+        files.push(text_file(&format!("{stem}.h"), header, FileKind::CHeader, FileFormat::C, &note));
     }
     if formats.rust_source {
         let rust = rust_source_u8(prefix, img, from, notice);
-        files.push(text_file(&format!("{stem}.rs"), rust, "rust-source", "rust", &note));
+        files.push(text_file(&format!("{stem}.rs"), rust, FileKind::RustSource, FileFormat::Rust, &note));
     }
     Ok(files)
 }
@@ -398,7 +399,7 @@ mod tests {
             assert!(!files.is_empty());
             for f in &files {
                 assert!(f.path.starts_with("aa/smaa/") || f.path.starts_with("aa/mlaa/"), "{}", f.path);
-                assert!(f.meta.color_space == "linear" || f.meta.color_space == "n/a");
+                assert!(matches!(f.meta.color_space, ColorSpace::Linear | ColorSpace::NotApplicable));
             }
             assert_eq!((a.bake)(&back).unwrap(), files, "{}: deterministic", a.name);
         }

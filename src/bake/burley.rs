@@ -20,6 +20,7 @@
 //! budgets in `kernel_samples` (default 40), as `rtbake importance-kernel --out` writes them
 //! (`burley/kernels/<case>_n<N>.{json,hlsl,glsl,wgsl}` and `_f32x8.bin`).
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::BURLEY_DIR;
 use crate::diffusion::burley::{Burley, RgbBurley, ShapeFit};
@@ -233,10 +234,10 @@ fn fit_case(case: &Case) -> Result<CaseResult, BakeError> {
 /// A one-panel plot as an sRGB PNG with its image metadata.
 fn png_plot_file(path: &str, plot: &LinePlot, convention: &str) -> Result<BakedFile, BakeError> {
     let img = plot.to_image(PLOT_WIDTH, PANEL_HEIGHT);
-    let mut meta = FileMeta::text("plot", "png", convention);
+    let mut meta = FileMeta::text(FileKind::Plot, FileFormat::Png, convention);
     (meta.width, meta.height, meta.channels) = (img.width, img.height, img.channels);
-    meta.sample_type = "u8".into();
-    meta.color_space = "srgb".into();
+    meta.sample_type = SampleType::U8;
+    meta.color_space = ColorSpace::Srgb;
     Ok(BakedFile {
         path: path.into(),
         bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
@@ -366,7 +367,7 @@ fn transmission_files(
     files.push(BakedFile {
         path: format!("{stem}.svg"),
         bytes: render(std::slice::from_ref(&plot), PlotFormat::Svg, reference)?,
-        meta: FileMeta::text("plot", "svg", CONVENTION),
+        meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, CONVENTION),
     });
     files.push(png_plot_file(&format!("{stem}.png"), &plot, CONVENTION)?);
     Ok(files)
@@ -390,7 +391,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         files.push(BakedFile {
             path: format!("{BURLEY_DIR}/{}.svg", case.name),
             bytes: render(std::slice::from_ref(&r.plot), PlotFormat::Svg, &r.record)?,
-            meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+            meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
         });
         if p.png_plots.contains(&case.name) {
             files.push(png_plot_file(&format!("{BURLEY_DIR}/{}.png", case.name), &r.plot, PLOT_CONVENTION)?);
@@ -416,14 +417,14 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(text_file(
         &format!("{BURLEY_DIR}/fits.csv"),
         csv,
-        "table",
-        "csv",
+        FileKind::Table,
+        FileFormat::Csv,
         "Burley fit (and artist mapping for materials) per case and channel: A, d (mm), errors in percent",
     ));
     files.push(json_file(
         &format!("{BURLEY_DIR}/fits.json"),
         &json!({"provenance": reference, "cases": results.iter().map(|r| r.record.clone()).collect::<Vec<_>>()}),
-        "table",
+        FileKind::Table,
         "Burley fits per case: fit and artist parameters with their errors against the target profile",
     ));
     Ok(files)

@@ -2,6 +2,7 @@
 //! synthetic maps (thesis ch. 7), the Table 8.1 wrinkle weights preset and an example wrinkle map / mask set
 //! (thesis ch. 8). Also the file encoders shared with `rtbake maps` (the CLI writes the same files).
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, unorm8_texture_files, Asset, BakeError, BakedFile, FileMeta};
 use crate::error::InvalidInput;
 use crate::facial::disk_stats::Border;
@@ -18,8 +19,8 @@ pub use crate::baked_layout::{RigDescription, RigH0Files, RigMapFiles, RigSource
 
 #[allow(clippy::too_many_arguments)]
 fn float_meta(
-    format: &str,
-    st: &str,
+    format: FileFormat,
+    st: SampleType,
     w: u32,
     h: u32,
     ch: u32,
@@ -28,14 +29,14 @@ fn float_meta(
     tol: f64,
 ) -> FileMeta {
     FileMeta {
-        kind: "lut".into(),
-        format: format.into(),
+        kind: FileKind::Lut,
+        format,
         pixel_format: pf,
         width: w,
         height: h,
         channels: ch,
-        sample_type: st.into(),
-        color_space: "linear".into(),
+        sample_type: st,
+        color_space: ColorSpace::Linear,
         convention: conv.into(),
         verify_tolerance: Some(tol),
         supercompression: None,
@@ -54,14 +55,14 @@ fn preview_file(
     let data = values.iter().map(|&v| wrinkles::encode_unorm8((v as f64 - lo) / (hi - lo))).collect();
     let bytes = io::png::encode_u8(&Image::from_vec(w, h, 1, data))?;
     let meta = FileMeta {
-        kind: "preview".into(),
-        format: "png".into(),
+        kind: FileKind::Preview,
+        format: FileFormat::Png,
         pixel_format: None,
         width: w,
         height: h,
         channels: 1,
-        sample_type: "u8".into(),
-        color_space: "linear".into(),
+        sample_type: SampleType::U8,
+        color_space: ColorSpace::Linear,
         convention: format!("viewing only: gray = ({what} - {lo}) / ({hi} - {lo}), clamped; not for sampling"),
         verify_tolerance: Some(1.0),
         supercompression: None,
@@ -80,17 +81,17 @@ fn exr_pair(dir: &str, stem: &str, w: u32, h: u32, v: &[f32], conv: &str) -> Res
         BakedFile {
             path: format!("{dir}{stem}_rgb.exr"),
             bytes: io::exr::encode(&rgb, ExrPrecision::F32)?,
-            meta: float_meta("exr", "f32", w, h, 3, None, &rgb_conv, 1e-6),
+            meta: float_meta(FileFormat::Exr, SampleType::F32, w, h, 3, None, &rgb_conv, 1e-6),
         },
         BakedFile {
             path: format!("{dir}{stem}.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F32)?,
-            meta: float_meta("exr", "f32", w, h, 1, None, conv, 1e-6),
+            meta: float_meta(FileFormat::Exr, SampleType::F32, w, h, 1, None, conv, 1e-6),
         },
         BakedFile {
             path: format!("{dir}{stem}_f16.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F16)?,
-            meta: float_meta("exr", "f16", w, h, 1, None, conv, 1e-3),
+            meta: float_meta(FileFormat::Exr, SampleType::F16, w, h, 1, None, conv, 1e-3),
         },
     ])
 }
@@ -125,7 +126,7 @@ pub fn hemoglobin_rig_files(
     files.push(BakedFile {
         path: format!("{dir}h0.ktx2"),
         bytes: io::ktx2::encode_f16(&h0_img)?,
-        meta: float_meta("ktx2", "f16", w, h, 1, Some(PixelFormat::R16Sfloat), h0_conv, 1e-3),
+        meta: float_meta(FileFormat::Ktx2, SampleType::F16, w, h, 1, Some(PixelFormat::R16Sfloat), h0_conv, 1e-3),
     });
     let amp = rig.h0.iter().fold(0.0f64, |a, &b| a.max((b as f64).abs())).max(1e-12);
     files.push(preview_file(format!("{dir}h0_preview.png"), w, h, &rig.h0, -amp, amp, "H0")?);
@@ -148,9 +149,7 @@ pub fn hemoglobin_rig_files(
         files.push(BakedFile {
             path: format!("{dir}{n}_scale_bias.ktx2"),
             bytes: io::ktx2::encode_f16(&Image::from_vec(rw, rh, 2, packed))?,
-            meta: float_meta(
-                "ktx2",
-                "f16",
+            meta: float_meta(FileFormat::Ktx2, SampleType::F16,
                 rw,
                 rh,
                 2,
@@ -212,7 +211,7 @@ pub fn hemoglobin_rig_files(
     files.push(json_file(
         &format!("{dir}{}", crate::baked_layout::path::RIG_FILE_NAME),
         &value,
-        "json",
+        FileKind::Json,
         &format!("hemoglobin rig description (schema {RIG_SCHEMA})"),
     ));
     Ok((files, desc))
@@ -262,14 +261,14 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             path: path.clone(),
             bytes: io::png::encode_u16(img)?,
             meta: FileMeta {
-                kind: "input".into(),
-                format: "png".into(),
+                kind: FileKind::Input,
+                format: FileFormat::Png,
                 pixel_format: None,
                 width: img.width,
                 height: img.height,
                 channels: 1,
-                sample_type: "u16".into(),
-                color_space: "linear".into(),
+                sample_type: SampleType::U16,
+                color_space: ColorSpace::Linear,
                 convention: "synthetic hemoglobin map: dermal volume fraction = sample / 65535".into(),
                 verify_tolerance: None,
                 supercompression: None,
@@ -347,14 +346,14 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         path: format!("{dir}input/wrinkle_normal.png"),
         bytes: io::png::encode_u8(&normal)?,
         meta: FileMeta {
-            kind: "input".into(),
-            format: "png".into(),
+            kind: FileKind::Input,
+            format: FileFormat::Png,
             pixel_format: None,
             width: p.size,
             height: p.size,
             channels: 3,
-            sample_type: "u8".into(),
-            color_space: "linear".into(),
+            sample_type: SampleType::U8,
+            color_space: ColorSpace::Linear,
             convention: "synthetic tangent-space normal map, n = 2*rgb/255 - 1, DirectX green convention".into(),
             verify_tolerance: None,
             supercompression: None,
@@ -379,7 +378,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);
     for (i, img) in packed.iter().enumerate() {
-        files.extend(unorm8_texture_files(&format!("{dir}wrinkle_masks_{i}"), img, "lut", &mask_convention(i))?);
+        files.extend(unorm8_texture_files(&format!("{dir}wrinkle_masks_{i}"), img, FileKind::Lut, &mask_convention(i))?);
     }
     let report = json!({
         "schema": crate::baked_layout::schema::WRINKLES,
@@ -391,7 +390,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "masks": {"files": ["wrinkle_masks_0.{bin,dds,ktx2,png}", "wrinkle_masks_1.{bin,dds,ktx2,png}"], "size": [p.mask_size.min(p.size), p.mask_size.min(p.size)], "format": "R8G8B8A8_UNORM", "zones": wrinkles::ZONES},
         "weights": "../expression_weights.json",
     });
-    files.push(json_file(&format!("{dir}wrinkles.json"), &report, "json", "wrinkle example description"));
+    files.push(json_file(&format!("{dir}wrinkles.json"), &report, FileKind::Json, "wrinkle example description"));
     Ok(files)
 }
 
@@ -399,7 +398,7 @@ fn bake_weights(_params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     Ok(vec![json_file(
         &format!("{WRINKLES_DIR}/expression_weights.json"),
         &wrinkles::table_8_1_json(),
-        "json",
+        FileKind::Json,
         "thesis Table 8.1 wrinkle weights per expression and zone (negative values cancel)",
     )])
 }
@@ -526,7 +525,7 @@ pub fn pd_wrinkle_files(
             files.extend(unorm8_texture_files(
                 &format!("{prefix}base_pd"),
                 &wrinkles::pd_to_rg8(w, h, &bpd.pd),
-                "lut",
+                FileKind::Lut,
                 PD_CONVENTION,
             )?);
             let report = json!({"files": "base_pd.{bin,dds,ktx2,png}", "size": [w, h], "format": "R8G8_UNORM",
@@ -540,7 +539,7 @@ pub fn pd_wrinkle_files(
     files.extend(unorm8_texture_files(
         &format!("{prefix}wrinkle_pd"),
         &wrinkles::pd_to_rg8(ow, oh, &small),
-        "lut",
+        FileKind::Lut,
         PD_CONVENTION,
     )?);
     let mut report = json!({"files": "wrinkle_pd.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8_UNORM"});

@@ -2,6 +2,7 @@
 //! presets (thesis Table 4.2) and a shared-variance 6-Gaussian fit of the Jensen 2001 skin1 dipole, each as JSON,
 //! HLSL / GLSL / WGSL includes and a plot (PNG + SVG) of r·R(r).
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::GAUSSIANS_DIR;
 use crate::diffusion::materials;
@@ -41,24 +42,24 @@ pub fn gaussian_files(
         obj.insert(k, v);
     }
     let name = stem.rsplit('/').next().unwrap_or(stem);
-    let mut files = vec![json_file(&format!("{stem}.json"), &Value::Object(obj), "json", JSON_CONVENTION)];
+    let mut files = vec![json_file(&format!("{stem}.json"), &Value::Object(obj), FileKind::Json, JSON_CONVENTION)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
             &format!("{stem}.{ext}"),
             ss.shader_include(lang, &format!("sum of Gaussians '{name}'")),
-            "shader-include",
-            ext,
+            FileKind::ShaderInclude,
+            lang.into(),
             "per-Gaussian constant arrays, index i = Gaussian i by ascending variance; float3 = (R, G, B)",
         ));
     }
     let img = plot.to_image(PLOT_WIDTH, PLOT_HEIGHT);
-    let mut png_meta = FileMeta::text("plot", "png", "r*R(r) per channel on a log10 r axis (mm); fit dashed");
+    let mut png_meta = FileMeta::text(FileKind::Plot, FileFormat::Png, "r*R(r) per channel on a log10 r axis (mm); fit dashed");
     png_meta.width = img.width;
     png_meta.height = img.height;
     png_meta.channels = 3;
-    png_meta.sample_type = "u8".into();
-    png_meta.color_space = "srgb".into();
+    png_meta.sample_type = SampleType::U8;
+    png_meta.color_space = ColorSpace::Srgb;
     files.push(BakedFile {
         path: format!("{stem}_plot.png"),
         bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
@@ -67,8 +68,8 @@ pub fn gaussian_files(
     files.push(text_file(
         &format!("{stem}_plot.svg"),
         plot.to_svg(PLOT_WIDTH, PLOT_HEIGHT),
-        "plot",
-        "svg",
+        FileKind::Plot,
+        FileFormat::Svg,
         "r*R(r) per channel on a log10 r axis (mm); fit dashed",
     ));
     Ok(files)

@@ -7,6 +7,7 @@
 //! HLSL / GLSL / WGSL includes and the raw `{name}_n{N}_f32x8.bin`. Burley profiles are sampled through their
 //! closed-form CDF, every other profile through the tabulated CDF.
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::baked_layout::{path, schema};
 use crate::diffusion::burley::RgbBurley;
@@ -224,14 +225,14 @@ pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Va
     let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
     let convention = "importance-sampled disk kernel: offsets in mm, weights normalised per channel";
     let mut files =
-        vec![json_file(&format!("{prefix}{stem}.json"), &kernel_json(k, provenance, source), "json", convention)];
+        vec![json_file(&format!("{prefix}{stem}.json"), &kernel_json(k, provenance, source), FileKind::Json, convention)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
             &format!("{prefix}{stem}.{ext}"),
             shader_include(k, lang, source),
-            "shader-include",
-            ext,
+            FileKind::ShaderInclude,
+            lang.into(),
             convention,
         ));
     }
@@ -240,14 +241,14 @@ pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Va
         path: format!("{prefix}{stem}_f32x8.bin"),
         bytes: f32x8_le_bytes(k),
         meta: crate::manifest::FileMeta {
-            kind: "kernel".into(),
-            format: "raw".into(),
+            kind: FileKind::Kernel,
+            format: FileFormat::Raw,
             pixel_format: None,
             width: n,
             height: 1,
             channels: 8,
-            sample_type: "f32".into(),
-            color_space: "n/a".into(),
+            sample_type: SampleType::F32,
+            color_space: ColorSpace::NotApplicable,
             convention: BINARY_LAYOUT.into(),
             verify_tolerance: None,
             supercompression: None,

@@ -24,6 +24,7 @@
 //! `rtbake profile` (200 radii log-spaced over [0.001, 100] mm), so `rtbake profile --material skin1 --json` prints
 //! the same numbers as `profiles/dipole/skin1.json`.
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::diffusion::layered::{Adding, LayerStack};
 use crate::diffusion::multipole::Series;
@@ -309,23 +310,23 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             let t = ProfileTable::compute(profile.as_ref(), &radii, provenance)?;
             let path = format!("profiles/{stem}");
             let mut files = vec![
-                text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION),
-                json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION),
+                text_file(&format!("{path}.csv"), t.to_csv(), FileKind::Csv, FileFormat::Csv, CSV_CONVENTION),
+                json_file(&format!("{path}.json"), &t.to_json(), FileKind::Json, JSON_CONVENTION),
             ];
             let panels = profile_panels(&t, None, title);
             let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
             files.push(BakedFile {
                 path: format!("{path}.svg"),
                 bytes: svg,
-                meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+                meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
             });
             if p.png_plots.iter().any(|s| s == stem) {
-                let mut meta = FileMeta::text("plot", "png", PLOT_CONVENTION);
+                let mut meta = FileMeta::text(FileKind::Plot, FileFormat::Png, PLOT_CONVENTION);
                 meta.width = PLOT_WIDTH;
                 meta.height = 2 * PANEL_HEIGHT;
                 meta.channels = 3;
-                meta.sample_type = "u8".into();
-                meta.color_space = "srgb".into();
+                meta.sample_type = SampleType::U8;
+                meta.color_space = ColorSpace::Srgb;
                 files.push(BakedFile {
                     path: format!("{path}.png"),
                     bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
@@ -347,8 +348,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(text_file(
         "profiles/totals.csv",
         totals,
-        "csv",
-        "csv",
+        FileKind::Csv,
+        FileFormat::Csv,
         "one row per baked profile (stem below profiles/): total_R = R^(0) = int 2 pi r R(r) dr, total_T = T^(0) per \
          channel (empty where the model has no T)",
     ));

@@ -8,6 +8,7 @@
 //! default objective (`sss/separable/fit_deon6.json`, with Table 6.1's objective value for comparison) and the
 //! fitted 17-tap kernel.
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::io::source::ShaderLang;
 use crate::separable::fit::{self, ObjectiveSpec, TargetKernel};
@@ -84,22 +85,22 @@ fn default_kernels_params() -> Value {
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
     let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
     let convention = kernel::LAYOUT_DOC;
-    let mut files = vec![json_file(&format!("{prefix}{stem}.json"), &k.to_json(sss_width, source), "json", convention)];
+    let mut files = vec![json_file(&format!("{prefix}{stem}.json"), &k.to_json(sss_width, source), FileKind::Json, convention)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
             &format!("{prefix}{stem}.{ext}"),
             k.shader_include(lang, source, sss_width),
-            "shader-include",
-            ext,
+            FileKind::ShaderInclude,
+            lang.into(),
             convention,
         ));
     }
     files.push(text_file(
         &format!("{prefix}{stem}_SeparableSSS.h"),
         k.separable_sss_h(source),
-        "shader-include",
-        "hlsl",
+        FileKind::ShaderInclude,
+        FileFormat::Hlsl,
         "SeparableSSS.h form: #define SSSS_N_SAMPLES N + static const float4 kernel[N] (rgb = weight, a = offset), \
          to replace the header's whole kernel section (#ifdef SSSS_N_SAMPLES to its #endif) for any N",
     ));
@@ -108,14 +109,14 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
         path: format!("{prefix}{stem}_f32x4.bin"),
         bytes: k.f32x4_le_bytes(),
         meta: crate::manifest::FileMeta {
-            kind: "kernel".into(),
-            format: "raw".into(),
+            kind: FileKind::Kernel,
+            format: FileFormat::Raw,
             pixel_format: Some(crate::io::PixelFormat::R32G32B32A32Sfloat),
             width: n,
             height: 1,
             channels: 4,
-            sample_type: "f32".into(),
-            color_space: "n/a".into(),
+            sample_type: SampleType::F32,
+            color_space: ColorSpace::NotApplicable,
             convention: format!("{convention}; little-endian f32 x 4 x {n}, no header (SeparableSSS.h runtime kernel)"),
             verify_tolerance: None,
             supercompression: None,
@@ -179,7 +180,7 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let mut files = vec![json_file(
         &format!("{DIR}/{stem}.json"),
         &report,
-        "json",
+        FileKind::Json,
         "fitted separable-SSS parameters (strength, falloff per channel; width fixed) and the objective definition",
     )];
     let spec = KernelSpec { precision: Precision::F32, ..KernelSpec::new(p.samples, rounded(&result.params)) };

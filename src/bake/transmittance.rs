@@ -1,5 +1,6 @@
 //! Transmittance table T(s) (thesis eq. 5.12) in `baked/transmittance/`, from d'Eon's 6-Gaussian skin preset.
 
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::{self, TransmittanceSidecar};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
@@ -34,13 +35,13 @@ pub fn table_files(
         y_label: if img.height > 1 { "identical rows".into() } else { String::new() },
         y_ticks: Vec::new(),
     };
-    let mut files = super::float_texture_files_with_preview(stem, &img, "lut", &convention, VERIFY_TOLERANCE, &axes)?;
-    let mut meta = FileMeta::text("lut", "png", &format!("{convention}; 16-bit linear: value = sample/65535"));
+    let mut files = super::float_texture_files_with_preview(stem, &img, FileKind::Lut, &convention, VERIFY_TOLERANCE, &axes)?;
+    let mut meta = FileMeta::text(FileKind::Lut, FileFormat::Png, &format!("{convention}; 16-bit linear: value = sample/65535"));
     meta.width = img.width;
     meta.height = img.height;
     meta.channels = img.channels;
-    meta.sample_type = "u16".into();
-    meta.color_space = "linear".into();
+    meta.sample_type = SampleType::U16;
+    meta.color_space = ColorSpace::Linear;
     meta.verify_tolerance = None;
     files.push(BakedFile { path: format!("{stem}_linear16.png"), bytes: crate::io::png::encode_linear16(&img)?, meta });
     let form = match settings.form {
@@ -72,7 +73,7 @@ pub fn table_files(
     files.push(json_file(
         &baked_layout::path::sidecar(&format!("{stem}.exr")),
         &serde_json::to_value(&sidecar).expect("sidecar serialises"),
-        "json",
+        FileKind::Json,
         "provenance of the transmittance table next to it",
     ));
     Ok(files)

@@ -13,6 +13,7 @@
 //! so it verifies byte for byte); standard errors are listed beside every number. For tighter figures bake with
 //! more `photons`.
 
+use crate::manifest::{FileFormat, FileKind};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path;
 use crate::diffusion::materials;
@@ -179,15 +180,15 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             files.push(BakedFile {
                 path: format!("{}/{name}.svg", path::TRANSPORT_DIR),
                 bytes: render(&panels, PlotFormat::Svg, &provenance)?,
-                meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+                meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
             });
         }
     }
-    files.push(text_file(path::TRANSPORT_REPORT_CSV, csv, "csv", "csv", CSV_CONVENTION));
+    files.push(text_file(path::TRANSPORT_REPORT_CSV, csv, FileKind::Csv, FileFormat::Csv, CSV_CONVENTION));
     files.push(json_file(
         &format!("{}/report.json", path::TRANSPORT_DIR),
         &json!({"provenance": provenance, "rows": rows}),
-        "json",
+        FileKind::Json,
         CSV_CONVENTION,
     ));
     let series = by_family
@@ -211,9 +212,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(BakedFile {
         path: format!("{}/difference_vs_albedo.svg", path::TRANSPORT_DIR),
         bytes: render(std::slice::from_ref(&plot), PlotFormat::Svg, &provenance)?,
-        meta: FileMeta::text(
-            "plot",
-            "svg",
+        meta: FileMeta::text(FileKind::Plot, FileFormat::Svg,
             "(diffusion - Monte Carlo)/Monte Carlo total diffuse R in % over the reduced albedo of the top layer, \
              every case and channel, sorted by albedo, one line per family",
         ),

@@ -21,7 +21,7 @@ use crate::baked_layout::{
     path, schema, GaussiansFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
 };
 use crate::io::PixelFormat;
-use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError};
+use crate::manifest::{sha256_hex, ColorSpace, Entry, FileFormat, Manifest, ManifestError, SampleType};
 use std::path::{Path, PathBuf};
 
 /// What a pass expects of one LUT.
@@ -177,7 +177,7 @@ impl BakedDir {
 /// Loads one LUT described by an already-parsed manifest.
 pub fn load_lut_with(dir: &Path, manifest: &Manifest, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
     let expect = Expect {
-        format: "raw",
+        format: FileFormat::Raw,
         pixel_format: Some(spec.pixel_format),
         size: Some((spec.width, spec.height)),
         channels: Some(spec.pixel_format.channels()),
@@ -195,12 +195,12 @@ enum DataKind {
 }
 
 /// What the runtime expects of one manifest entry (`None`: not checked here).
-struct Expect<'a> {
-    format: &'a str,
+struct Expect {
+    format: FileFormat,
     pixel_format: Option<PixelFormat>,
     size: Option<(u32, u32)>,
     channels: Option<u32>,
-    sample_type: &'a str,
+    sample_type: SampleType,
     data: DataKind,
 }
 
@@ -222,12 +222,13 @@ fn read_checked<'m>(
         expected,
         found,
     };
-    let colour_ok = m.color_space == "linear" || (expect.data == DataKind::Table && m.color_space == "n/a");
+    let colour_ok = m.color_space == ColorSpace::Linear
+        || (expect.data == DataKind::Table && m.color_space == ColorSpace::NotApplicable);
     if !colour_ok {
-        return Err(LutError::ColorSpace { path: path.to_string(), found: m.color_space.clone() });
+        return Err(LutError::ColorSpace { path: path.to_string(), found: m.color_space.to_string() });
     }
     if m.format != expect.format {
-        return Err(mismatch("format", format!("{:?}", expect.format), format!("{:?}", m.format)));
+        return Err(mismatch("format", format!("{:?}", expect.format.as_str()), format!("{:?}", m.format.as_str())));
     }
     if let Some(pf) = expect.pixel_format {
         if m.pixel_format != Some(pf) {
@@ -245,12 +246,12 @@ fn read_checked<'m>(
         }
     }
     if m.sample_type != expect.sample_type {
-        return Err(mismatch("sample_type", expect.sample_type.into(), m.sample_type.clone()));
+        return Err(mismatch("sample_type", expect.sample_type.to_string(), m.sample_type.to_string()));
     }
     let file = dir.join(path);
     let bytes = std::fs::read(&file).map_err(|e| LutError::Read { path: file.display().to_string(), source: e })?;
     // Raw texels: the length follows from the size and format; other containers: the manifest's size_bytes.
-    if let (true, Some(pf), Some((w, h))) = (expect.format == "raw", expect.pixel_format, expect.size) {
+    if let (true, Some(pf), Some((w, h))) = (expect.format == FileFormat::Raw, expect.pixel_format, expect.size) {
         let expected = (w * h * pf.bytes_per_texel()) as usize;
         if bytes.len() != expected {
             return Err(LutError::Size {
@@ -276,11 +277,11 @@ fn read_checked<'m>(
 }
 
 /// The manifest's `sample_type` for a pixel format.
-fn sample_type(pf: PixelFormat) -> &'static str {
+fn sample_type(pf: PixelFormat) -> SampleType {
     match pf {
-        PixelFormat::R8Unorm | PixelFormat::R8G8Unorm | PixelFormat::R8G8B8A8Unorm => "u8",
-        PixelFormat::R16Sfloat | PixelFormat::R16G16Sfloat | PixelFormat::R16G16B16A16Sfloat => "f16",
-        PixelFormat::R32Sfloat | PixelFormat::R32G32B32A32Sfloat => "f32",
+        PixelFormat::R8Unorm | PixelFormat::R8G8Unorm | PixelFormat::R8G8B8A8Unorm => SampleType::U8,
+        PixelFormat::R16Sfloat | PixelFormat::R16G16Sfloat | PixelFormat::R16G16B16A16Sfloat => SampleType::F16,
+        PixelFormat::R32Sfloat | PixelFormat::R32G32B32A32Sfloat => SampleType::F32,
     }
 }
 
@@ -300,11 +301,11 @@ fn content(path: &str, message: impl Into<String>) -> LutError {
 /// Reads a JSON table listed in the manifest (`format` json, `sample_type` text, colour space linear or n/a).
 fn load_json(dir: &Path, manifest: &Manifest, path: &str) -> Result<serde_json::Value, LutError> {
     let expect = Expect {
-        format: "json",
+        format: FileFormat::Json,
         pixel_format: None,
         size: None,
         channels: None,
-        sample_type: "text",
+        sample_type: SampleType::Text,
         data: DataKind::Table,
     };
     let (bytes, _) = read_checked(dir, manifest, path, &expect)?;
@@ -321,11 +322,11 @@ fn load_exr_f32(
     min_size: (u32, u32),
 ) -> Result<crate::image_buf::Image<f32>, LutError> {
     let expect = Expect {
-        format: "exr",
+        format: FileFormat::Exr,
         pixel_format: None,
         size: None,
         channels: Some(channels),
-        sample_type: "f32",
+        sample_type: SampleType::F32,
         data: DataKind::Texture,
     };
     let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
@@ -389,11 +390,11 @@ fn separable_kernel_f32x4_in(
     path: &str,
 ) -> Result<crate::runtime::sss::separable::SssKernel, LutError> {
     let expect = Expect {
-        format: "raw",
+        format: FileFormat::Raw,
         pixel_format: Some(PixelFormat::R32G32B32A32Sfloat),
         size: None,
         channels: Some(4),
-        sample_type: "f32",
+        sample_type: SampleType::F32,
         data: DataKind::Table,
     };
     let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
