@@ -19,14 +19,54 @@ pub mod path {
     pub const SMAA_DIR: &str = "aa/smaa";
     /// Folder of the Jimenez MLAA area maps.
     pub const MLAA_DIR: &str = "aa/mlaa";
-    /// SMAA area texture, raw RG8 160×560 (the runtime's copy; `.dds`/`.ktx2`/`.png` beside it).
+    /// File names of a texture's stem (the bakers write `{stem}.bin`, `.dds`, `.ktx2`, `.png`, `.h`, `.rs` …).
+    pub fn raw_texture(stem: &str) -> String {
+        format!("{stem}.bin")
+    }
+    /// A JSON file of `stem`.
+    pub fn json(stem: &str) -> String {
+        format!("{stem}.json")
+    }
+
+    /// Stem of the SMAA area texture (SMAA 2.8+, U-shape smoothing), the upstream name `AreaTex`.
+    pub const SMAA_AREA_STEM: &str = "aa/smaa/AreaTex";
+    /// Stem of the SMAA area texture as v2.8 made it (no U-shape smoothing).
+    pub const SMAA_AREA_V2_8_STEM: &str = "aa/smaa/AreaTex_v2.8";
+    /// Stem of the SMAA search texture, the upstream name `SearchTex`.
+    pub const SMAA_SEARCH_STEM: &str = "aa/smaa/SearchTex";
+    /// Stem of the SMAA v2.8 search table (66×33, values 0/1/2).
+    pub const SMAA_SEARCH_V2_8_STEM: &str = "aa/smaa/SearchTex_v2.8";
+    /// Stem of the SMAA search table before its crop (values 0/127/254).
+    pub const SMAA_SEARCH_PRECROP_STEM: &str = "aa/smaa/SearchTex_logical_precrop";
+    /// The area texture as Bevy's `bevy_anti_alias` ships it (KTX2, Zstandard level 15).
+    pub const SMAA_AREA_BEVY: &str = "aa/smaa/SMAAAreaLUT.ktx2";
+    /// The search texture as Bevy ships it.
+    pub const SMAA_SEARCH_BEVY: &str = "aa/smaa/SMAASearchLUT.ktx2";
+    /// SMAA area texture, raw RG8 160×560 (the runtime's copy; `.dds`/`.ktx2`/`.png` beside it):
+    /// [`raw_texture`] of [`SMAA_AREA_STEM`].
     pub const SMAA_AREA: &str = "aa/smaa/AreaTex.bin";
-    /// SMAA search texture, raw R8 64×16.
+    /// SMAA search texture, raw R8 64×16: [`raw_texture`] of [`SMAA_SEARCH_STEM`].
     pub const SMAA_SEARCH: &str = "aa/smaa/SearchTex.bin";
+
+    /// File stem (without folder) of an MLAA area map: upstream's names (`AreaMap{n}_v1.4`, `AreaTex_MLAAv2` for
+    /// v2's N = 15, `AreaTex{n}_MLAAv2` otherwise).
+    pub fn mlaa_area_name(version: crate::aa::mlaa_area::MlaaVersion, n: u32) -> String {
+        use crate::aa::mlaa_area::MlaaVersion;
+        match version {
+            MlaaVersion::V2 if n == 15 => "AreaTex_MLAAv2".into(),
+            MlaaVersion::V2 => format!("AreaTex{n}_MLAAv2"),
+            v => format!("AreaMap{n}_{}", v.label()),
+        }
+    }
+
+    /// Stem of an MLAA area map in the bake: [`MLAA_DIR`]/[`mlaa_area_name`].
+    pub fn mlaa_area_stem(version: crate::aa::mlaa_area::MlaaVersion, n: u32) -> String {
+        format!("{MLAA_DIR}/{}", mlaa_area_name(version, n))
+    }
 
     /// Jimenez MLAA v1.4 area map for maximum distance `n`, raw RG8 5n×5n.
     pub fn mlaa_area_v1_4(n: u32) -> String {
-        format!("{MLAA_DIR}/AreaMap{n}_v1.4.bin")
+        raw_texture(&mlaa_area_stem(crate::aa::mlaa_area::MlaaVersion::V1_4, n))
     }
 
     /// Folder of the Monte Carlo vs diffusion report (`transport-report`).
@@ -36,7 +76,12 @@ pub mod path {
 
     /// Folder of the sum-of-Gaussians fits and their screen-space parameters.
     pub const GAUSSIANS_DIR: &str = "sss/gaussians";
-    /// Default sum-of-Gaussians fit of the screen-space SSS (d'Eon's 6 Gaussians).
+    /// Stem of a named sum of Gaussians in [`GAUSSIANS_DIR`] (`.json`, `.hlsl`, `.glsl`, `.wgsl`, `_plot.*`).
+    pub fn gaussians_stem(name: &str) -> String {
+        format!("{GAUSSIANS_DIR}/{name}")
+    }
+    /// Default sum-of-Gaussians fit of the screen-space SSS (d'Eon's 6 Gaussians): [`json`] of
+    /// [`gaussians_stem`]`("deon6")`.
     pub const GAUSSIANS_DEFAULT: &str = "sss/gaussians/deon6.json";
     /// Folder of the separable-SSS kernels.
     pub const SEPARABLE_DIR: &str = "sss/separable";
@@ -58,7 +103,12 @@ pub mod path {
     pub const TRANSMITTANCE_DIR: &str = "transmittance";
     /// Burley fits, their plots and transmission profiles (asset `burley-profiles`).
     pub const BURLEY_DIR: &str = "burley";
-    /// Default transmittance table (EXR f32, RGB, node-inclusive); sidecar [`sidecar`] of it.
+    /// Stem of the transmittance table of a Gaussian preset in a form (`published` or `physical`).
+    pub fn transmittance_stem(preset: &str, form: &str) -> String {
+        format!("{TRANSMITTANCE_DIR}/{preset}_{form}")
+    }
+    /// Default transmittance table (EXR f32, RGB, node-inclusive; `.exr` of
+    /// [`transmittance_stem`]`("deon6", "published")`); sidecar [`sidecar`] of it.
     pub const TRANSMITTANCE_DEFAULT: &str = "transmittance/deon6_published.exr";
 
     /// Stem of the skin-colour LUT's texture files (`.exr`, `_f16.exr`, `.ktx2`, `_preview_srgb.png`).
@@ -78,13 +128,37 @@ pub mod path {
     pub const RIG_EXAMPLE: &str = "facial/hemoglobin/example/rig.json";
     /// File name of a rig description inside its folder.
     pub const RIG_FILE_NAME: &str = "rig.json";
+    /// The rig description in the folder `dir` (`dir/rig.json`; `dir` empty: the file name alone).
+    pub fn rig_description(dir: &str) -> String {
+        in_dir(dir, RIG_FILE_NAME)
+    }
     /// Folder of the wrinkle assets.
     pub const WRINKLES_DIR: &str = "facial/wrinkles";
-    /// The example's partial-derivative wrinkle map (raw R8G8_UNORM, `pd = 2·texel − 1`, thesis §8.2).
+    /// Folder of the wrinkle example.
+    pub const WRINKLE_EXAMPLE_DIR: &str = "facial/wrinkles/example";
+    /// Stem of the partial-derivative wrinkle map in the folder `dir` (`.bin`, `.png`, `.ktx2`, `.dds` …).
+    pub fn wrinkle_pd_stem(dir: &str) -> String {
+        in_dir(dir, "wrinkle_pd")
+    }
+    /// Stem of the `i`-th texture of packed zone masks in the folder `dir`.
+    pub fn wrinkle_masks_stem(dir: &str, i: usize) -> String {
+        in_dir(dir, &format!("wrinkle_masks_{i}"))
+    }
+    /// The example's partial-derivative wrinkle map (raw R8G8_UNORM, `pd = 2·texel − 1`, thesis §8.2):
+    /// [`raw_texture`] of [`wrinkle_pd_stem`] in [`WRINKLE_EXAMPLE_DIR`].
     pub const WRINKLE_PD_EXAMPLE: &str = "facial/wrinkles/example/wrinkle_pd.bin";
-    /// The example's zone masks (raw R8G8B8A8_UNORM: red, green, blue, brown; cyan, magenta, orange, gray).
+    /// The example's zone masks (raw R8G8B8A8_UNORM: red, green, blue, brown; cyan, magenta, orange, gray):
+    /// [`raw_texture`] of [`wrinkle_masks_stem`] in [`WRINKLE_EXAMPLE_DIR`].
     pub const WRINKLE_MASKS_EXAMPLE: [&str; 2] =
         ["facial/wrinkles/example/wrinkle_masks_0.bin", "facial/wrinkles/example/wrinkle_masks_1.bin"];
+
+    /// `name` in the folder `dir` (`dir` empty: `name` alone; a trailing `/` on `dir` is allowed).
+    pub fn in_dir(dir: &str, name: &str) -> String {
+        match dir.trim_end_matches('/') {
+            "" => name.to_string(),
+            d => format!("{d}/{name}"),
+        }
+    }
 
     /// The JSON sidecar next to a baked EXR (`x.exr` → `x.json`).
     pub fn sidecar(exr_path: &str) -> String {
@@ -92,6 +166,35 @@ pub mod path {
             Some(stem) => format!("{stem}.json"),
             None => format!("{exr_path}.json"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::path::*;
+    use crate::aa::mlaa_area::MlaaVersion;
+
+    /// Every full-path constant a reader uses is the composition the bakers write through (a renamed stem that
+    /// left its constant behind fails here, not in a reader).
+    #[test]
+    fn read_paths_are_the_bakers_compositions() {
+        assert_eq!(SMAA_AREA, raw_texture(SMAA_AREA_STEM));
+        assert_eq!(SMAA_SEARCH, raw_texture(SMAA_SEARCH_STEM));
+        assert_eq!(mlaa_area_v1_4(33), "aa/mlaa/AreaMap33_v1.4.bin");
+        assert_eq!(mlaa_area_stem(MlaaVersion::V2, 15), "aa/mlaa/AreaTex_MLAAv2");
+        assert_eq!(GAUSSIANS_DEFAULT, json(&gaussians_stem("deon6")));
+        assert_eq!(SEPARABLE_KERNEL_DEFAULT, json(&in_dir(SEPARABLE_DIR, "published_n17")));
+        assert_eq!(IMPORTANCE_KERNEL_DEFAULT, json(&in_dir(IMPORTANCE_DIR, &importance_kernel_stem("skin1_dipole", 40))));
+        assert_eq!(TRANSMITTANCE_DEFAULT, format!("{}.exr", transmittance_stem("deon6", "published")));
+        assert_eq!(SKIN_LUT, format!("{SKIN_LUT_STEM}.exr"));
+        assert_eq!(SKIN_LUT_SIDECAR, sidecar(SKIN_LUT));
+        assert_eq!(RIG_EXAMPLE, rig_description(RIG_EXAMPLE_DIR));
+        assert_eq!(rig_description(""), RIG_FILE_NAME);
+        assert_eq!(WRINKLE_PD_EXAMPLE, raw_texture(&wrinkle_pd_stem(WRINKLE_EXAMPLE_DIR)));
+        for (i, p) in WRINKLE_MASKS_EXAMPLE.iter().enumerate() {
+            assert_eq!(*p, raw_texture(&wrinkle_masks_stem(WRINKLE_EXAMPLE_DIR, i)));
+        }
+        assert_eq!(WRINKLE_EXAMPLE_DIR, in_dir(WRINKLES_DIR, "example"));
     }
 }
 

@@ -25,7 +25,7 @@ use crate::io::source::{c_header_u8, rust_source_u8, DataNotice};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-pub use crate::baked_layout::path::{MLAA_DIR, SMAA_DIR};
+pub use crate::baked_layout::path::{self, MLAA_DIR, SMAA_DIR};
 
 impl From<SmaaAreaError> for BakeError {
     fn from(e: SmaaAreaError) -> Self {
@@ -177,14 +177,8 @@ pub fn mlaa_convention(version: MlaaVersion, n: u32) -> String {
     )
 }
 
-/// Default file stem (without folder) of an MLAA map.
-pub fn mlaa_stem(version: MlaaVersion, n: u32) -> String {
-    match version {
-        MlaaVersion::V2 if n == 15 => "AreaTex_MLAAv2".into(),
-        MlaaVersion::V2 => format!("AreaTex{n}_MLAAv2"),
-        v => format!("AreaMap{n}_{}", v.label()),
-    }
-}
+/// Default file stem (without folder) of an MLAA map ([`crate::baked_layout::path::mlaa_area_name`]).
+pub use crate::baked_layout::path::mlaa_area_name as mlaa_stem;
 
 /// Files of an MLAA area map under `stem` in `formats`; the sources are `stem.h` (`AREAMAP_*`, `areaMapBytes`)
 /// and `stem.rs` (`AREAMAP_*`, `AREAMAP_BYTES`).
@@ -217,10 +211,6 @@ pub fn mlaa_files_with_progress(
     }
     Ok(files)
 }
-
-/// Bevy's file names for the SMAA LUTs (`bevy_anti_alias/src/smaa/`).
-pub const BEVY_AREA_LUT: &str = "SMAAAreaLUT.ktx2";
-pub const BEVY_SEARCH_LUT: &str = "SMAASearchLUT.ktx2";
 
 /// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`crate::io::ktx2::BEVY_ZSTD_LEVEL`]).
 pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<BakedFile, BakeError> {
@@ -286,7 +276,7 @@ fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<Ba
     }
     let mut files = Vec::new();
     for &n in &p.max_distances {
-        let stem = format!("{MLAA_DIR}/{}", mlaa_stem(version, n));
+        let stem = path::mlaa_area_stem(version, n);
         files.extend(mlaa_files(version, n, &stem, TextureFormats::BINARY, &from_line(asset))?);
     }
     Ok(files)
@@ -302,11 +292,11 @@ pub fn assets() -> Vec<Asset> {
                 let p: SmaaAreaParams = parse_params("smaa-area", v)?;
                 let img = smaa_area_texture(&p)?;
                 let convention = smaa_area_convention(&p, img.width, img.height);
-                let stem = format!("{SMAA_DIR}/AreaTex");
+                let stem = path::SMAA_AREA_STEM;
                 let names = ("AREATEX", "areaTexBytes");
                 let from = from_line("smaa-area");
-                let mut files = texture_with_sources(&stem, &img, &convention, TextureFormats::ALL, names, &from)?;
-                files.push(bevy_zstd_file(&format!("{SMAA_DIR}/{BEVY_AREA_LUT}"), &img, &convention)?);
+                let mut files = texture_with_sources(stem, &img, &convention, TextureFormats::ALL, names, &from)?;
+                files.push(bevy_zstd_file(path::SMAA_AREA_BEVY, &img, &convention)?);
                 Ok(files)
             },
         },
@@ -317,7 +307,7 @@ pub fn assets() -> Vec<Asset> {
             bake: |v| {
                 let p: SmaaAreaParams = parse_params("smaa-area-v2.8", v)?;
                 smaa_area_files(
-                    &format!("{SMAA_DIR}/AreaTex_v2.8"),
+                    path::SMAA_AREA_V2_8_STEM,
                     &p,
                     TextureFormats::BINARY,
                     &from_line("smaa-area-v2.8"),
@@ -332,13 +322,12 @@ pub fn assets() -> Vec<Asset> {
                 let _: NoParams = parse_params("smaa-search", v)?;
                 let mut files = search_files(
                     SearchKind::Current,
-                    &format!("{SMAA_DIR}/SearchTex"),
+                    path::SMAA_SEARCH_STEM,
                     TextureFormats::ALL,
                     &from_line("smaa-search"),
                 )?;
                 let convention = search_convention(SearchKind::Current);
-                let path = format!("{SMAA_DIR}/{BEVY_SEARCH_LUT}");
-                files.push(bevy_zstd_file(&path, &smaa_search::search_texture(), &convention)?);
+                files.push(bevy_zstd_file(path::SMAA_SEARCH_BEVY, &smaa_search::search_texture(), &convention)?);
                 Ok(files)
             },
         },
@@ -351,13 +340,13 @@ pub fn assets() -> Vec<Asset> {
                 let from = from_line("smaa-search-v2.8");
                 let mut f = search_files(
                     SearchKind::V2_8,
-                    &format!("{SMAA_DIR}/SearchTex_v2.8"),
+                    path::SMAA_SEARCH_V2_8_STEM,
                     TextureFormats::BINARY,
                     &from,
                 )?;
                 f.extend(search_files(
                     SearchKind::LogicalPrecrop,
-                    &format!("{SMAA_DIR}/SearchTex_logical_precrop"),
+                    path::SMAA_SEARCH_PRECROP_STEM,
                     TextureFormats::BINARY,
                     &from,
                 )?);

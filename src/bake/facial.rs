@@ -209,7 +209,7 @@ pub fn hemoglobin_rig_files(
     };
     let value = serde_json::to_value(&desc).map_err(|e| BakeError::Other(e.to_string()))?;
     files.push(json_file(
-        &format!("{dir}{}", crate::baked_layout::path::RIG_FILE_NAME),
+        &crate::baked_layout::path::rig_description(dir),
         &value,
         FileKind::Json,
         &format!("hemoglobin rig description (schema {RIG_SCHEMA})"),
@@ -340,7 +340,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     crate::error::check_range("wrinkle_size", p.wrinkle_size, 1, 4096, "texels")?;
     crate::error::check_range("mask_size", p.mask_size, 1, 4096, "texels")?;
     crate::error::check_range("strength", p.strength, 0.0, 10.0, "")?;
-    let dir = format!("{WRINKLES_DIR}/example/");
+    let dir = format!("{}/", crate::baked_layout::path::WRINKLE_EXAMPLE_DIR);
     let normal = synthetic::wrinkle_normal_map(p.size, p.strength);
     let mut files = vec![BakedFile {
         path: format!("{dir}input/wrinkle_normal.png"),
@@ -378,7 +378,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);
     for (i, img) in packed.iter().enumerate() {
-        files.extend(unorm8_texture_files(&format!("{dir}wrinkle_masks_{i}"), img, FileKind::Lut, &mask_convention(i))?);
+        files.extend(unorm8_texture_files(&crate::baked_layout::path::wrinkle_masks_stem(&dir, i), img, FileKind::Lut, &mask_convention(i))?);
     }
     let report = json!({
         "schema": crate::baked_layout::schema::WRINKLES,
@@ -537,7 +537,7 @@ pub fn pd_wrinkle_files(
     };
     let (ow, oh, small) = wrinkles::downsample(&values, w, h, 2, size);
     files.extend(unorm8_texture_files(
-        &format!("{prefix}wrinkle_pd"),
+        &crate::baked_layout::path::wrinkle_pd_stem(prefix),
         &wrinkles::pd_to_rg8(ow, oh, &small),
         FileKind::Lut,
         PD_CONVENTION,

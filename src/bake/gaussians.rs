@@ -100,7 +100,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             ),
         );
         let plot = fit_overlay_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
-        files.extend(gaussian_files(&format!("{GAUSSIANS_DIR}/{name}"), &sum, p.stretch, extra, &plot)?);
+        files.extend(gaussian_files(&crate::baked_layout::path::gaussians_stem(name), &sum, p.stretch, extra, &plot)?);
     }
     Ok(files)
 }

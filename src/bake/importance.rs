@@ -222,14 +222,14 @@ pub fn f32x8_le_bytes(k: &ImportanceKernel) -> Vec<u8> {
 /// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl` and `{stem}_f32x8.bin`. Pure;
 /// `rtbake importance-kernel --out` uses it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Value, source: &str) -> Vec<BakedFile> {
-    let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
+    let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = "importance-sampled disk kernel: offsets in mm, weights normalised per channel";
     let mut files =
-        vec![json_file(&format!("{prefix}{stem}.json"), &kernel_json(k, provenance, source), FileKind::Json, convention)];
+        vec![json_file(&crate::baked_layout::path::json(&stem), &kernel_json(k, provenance, source), FileKind::Json, convention)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
-            &format!("{prefix}{stem}.{ext}"),
+            &format!("{stem}.{ext}"),
             shader_include(k, lang, source),
             FileKind::ShaderInclude,
             lang.into(),
@@ -238,7 +238,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Va
     }
     let n = k.len() as u32;
     files.push(BakedFile {
-        path: format!("{prefix}{stem}_f32x8.bin"),
+        path: format!("{stem}_f32x8.bin"),
         bytes: f32x8_le_bytes(k),
         meta: crate::manifest::FileMeta {
             kind: FileKind::Kernel,

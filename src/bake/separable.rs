@@ -83,13 +83,13 @@ fn default_kernels_params() -> Value {
 /// `{stem}_f32x4.bin` (N taps of `[r, g, b, offset]`, the runtime upload path). Pure; `rtbake kernel --out` uses
 /// it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
-    let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
+    let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = kernel::LAYOUT_DOC;
-    let mut files = vec![json_file(&format!("{prefix}{stem}.json"), &k.to_json(sss_width, source), FileKind::Json, convention)];
+    let mut files = vec![json_file(&crate::baked_layout::path::json(&stem), &k.to_json(sss_width, source), FileKind::Json, convention)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
-            &format!("{prefix}{stem}.{ext}"),
+            &format!("{stem}.{ext}"),
             k.shader_include(lang, source, sss_width),
             FileKind::ShaderInclude,
             lang.into(),
@@ -97,7 +97,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
         ));
     }
     files.push(text_file(
-        &format!("{prefix}{stem}_SeparableSSS.h"),
+        &format!("{stem}_SeparableSSS.h"),
         k.separable_sss_h(source),
         FileKind::ShaderInclude,
         FileFormat::Hlsl,
@@ -106,7 +106,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
     ));
     let n = k.taps.len() as u32;
     files.push(BakedFile {
-        path: format!("{prefix}{stem}_f32x4.bin"),
+        path: format!("{stem}_f32x4.bin"),
         bytes: k.f32x4_le_bytes(),
         meta: crate::manifest::FileMeta {
             kind: FileKind::Kernel,

@@ -100,7 +100,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "d'Eon, Luebke, Enderton, EGSR 2007",
     );
     table_files(
-        &format!("{}/{}_{form}", baked_layout::path::TRANSMITTANCE_DIR, p.preset),
+        &baked_layout::path::transmittance_stem(&p.preset, form),
         &TransmittanceModel::Gaussians(RgbGaussians::from(&sog)),
         &p.table,
         source,
