@@ -204,7 +204,7 @@ pub mod schema {
     pub const MANIFEST: &str = "rtbake-manifest/1";
     /// A separable-SSS kernel file ([`crate::separable::kernel::Kernel::to_json`]).
     pub use crate::separable::kernel::JSON_SCHEMA as SEPARABLE_KERNEL;
-    /// An importance-sampled disk kernel (`crate::bake::importance::kernel_json`).
+    /// An importance-sampled disk kernel ([`super::ImportanceKernelFile`]).
     pub const IMPORTANCE_KERNEL: &str = "rtbake-importance-kernel/1";
     /// A hemoglobin rig description ([`super::RigDescription`]).
     pub const HEMOGLOBIN_RIG: &str = "rtbake-hemoglobin-rig/1";
@@ -264,6 +264,55 @@ impl TransmittanceSidecar {
     pub const TEXEL_CONVENTION: &'static str = "node-inclusive: texel i holds s = s_max*i/(n-1)";
     /// How a shader samples the table.
     pub const SHADER_LOOKUP: &'static str = "u = s/s_max*(n-1)/n + 0.5/n, linear filtering, clamp to edge";
+}
+
+/// An importance-sampled disk kernel (schema [`schema::IMPORTANCE_KERNEL`]; `sss/importance/*.json`,
+/// `burley/kernels/*.json`): what was sampled and how, the cut-off, the totals, the binary layout of the
+/// `_f32x8.bin` beside it and the samples. Written by `crate::bake::importance`, read by the runtime loader.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImportanceKernelFile {
+    pub schema: String,
+    /// What wrote it.
+    pub source: String,
+    /// Provenance of the sampled profile.
+    pub profile: Value,
+    /// Number of samples N (the length of `kernel`).
+    pub samples: usize,
+    /// `red`, `green` or `blue`: the channel whose radial CDF is sampled.
+    pub sampled_channel: String,
+    pub sampled_channel_rule: String,
+    /// Mean radius of each channel's normalised radial density, mm.
+    pub mean_radius_mm: [f64; 3],
+    /// How the CDF is inverted (closed form or tabulated).
+    pub inversion: String,
+    pub quantiles: String,
+    pub angles: String,
+    pub pdf: String,
+    pub weights: String,
+    /// Σ of the unnormalised weights per channel (the estimated total diffuse reflectance).
+    pub estimated_totals: [f64; 3],
+    /// The profile's own totals per channel.
+    pub profile_totals: [f64; 3],
+    pub cutoff_quantile: f64,
+    /// Radius beyond which the profile is cut, mm.
+    pub cutoff_mm: f64,
+    pub binary_layout: String,
+    pub kernel: Vec<ImportanceKernelSample>,
+}
+
+/// One sample of an [`ImportanceKernelFile`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImportanceKernelSample {
+    pub r_mm: f64,
+    pub theta_rad: f64,
+    pub x_mm: f64,
+    pub y_mm: f64,
+    /// Area density of the sampled channel at r, mm⁻².
+    pub pdf_per_mm2: f64,
+    /// Weights normalised per channel (each channel sums to 1).
+    pub weight: [f64; 3],
+    /// R_c(r)/pdf/N (sums to the estimated total).
+    pub weight_unnormalised: [f64; 3],
 }
 
 /// Sidecar of the skin-colour LUT ([`path::SKIN_LUT_SIDECAR`]).

@@ -124,7 +124,7 @@ pub fn run(args: ImportanceKernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if let Some(dir) = &args.out {
         prepare_out_dir("--out", dir)?;
     }
-    let stem = format!("{}_n{n}", resolved.stem);
+    let stem = rtbake::baked_layout::path::importance_kernel_stem(&resolved.stem, n);
     let source = format!("rtbake importance-kernel ({}, N = {n})", resolved.stem);
     let files = rtbake::bake::importance::kernel_files("", &stem, &k, &resolved.provenance, &source);
     if let Some(dir) = &args.out {

@@ -18,7 +18,7 @@
 //! place to change when the bake layout moves.
 
 use crate::baked_layout::{
-    path, schema, GaussiansFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
+    path, schema, GaussiansFile, ImportanceKernelFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
 };
 use crate::io::PixelFormat;
 use crate::manifest::{sha256_hex, ColorSpace, Entry, FileFormat, Manifest, ManifestError, SampleType};
@@ -467,20 +467,7 @@ pub fn importance_kernel_from_json(
     if found != schema::IMPORTANCE_KERNEL {
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::IMPORTANCE_KERNEL)));
     }
-    #[derive(serde::Deserialize)]
-    struct Sample {
-        x_mm: f64,
-        y_mm: f64,
-        r_mm: f64,
-        weight: [f64; 3],
-    }
-    #[derive(serde::Deserialize)]
-    struct File {
-        samples: usize,
-        cutoff_mm: f64,
-        kernel: Vec<Sample>,
-    }
-    let file: File = typed(v.clone(), path)?;
+    let file: ImportanceKernelFile = typed(v.clone(), path)?;
     if file.kernel.len() != file.samples {
         return Err(content(path, format!("\"samples\" = {} but \"kernel\" has {}", file.samples, file.kernel.len())));
     }
