@@ -202,8 +202,10 @@ mod tests {
 pub mod schema {
     /// `baked/manifest.json`.
     pub const MANIFEST: &str = "rtbake-manifest/1";
-    /// A separable-SSS kernel file ([`crate::separable::kernel::Kernel::to_json`]).
-    pub use crate::separable::kernel::JSON_SCHEMA as SEPARABLE_KERNEL;
+    /// A separable-SSS kernel file ([`super::separable_kernel_json`]).
+    pub const SEPARABLE_KERNEL: &str = "rtbake-separable-kernel/1";
+    /// The wrinkle weights of Table 8.1 (`crate::facial::wrinkles::table_8_1_json`).
+    pub const WRINKLE_WEIGHTS: &str = "rtbake-wrinkle-weights/1";
     /// An importance-sampled disk kernel ([`super::ImportanceKernelFile`]).
     pub const IMPORTANCE_KERNEL: &str = "rtbake-importance-kernel/1";
     /// A hemoglobin rig description ([`super::RigDescription`]).
@@ -440,6 +442,15 @@ pub struct RigMapFiles {
 /// The separable-SSS kernel file: defined with the kernel it serialises (so the model does not import the
 /// contract), re-exported here with the other files of the contract.
 pub use crate::separable::kernel::SeparableKernelFile;
+
+/// A separable-SSS kernel's file under [`schema::SEPARABLE_KERNEL`], as JSON.
+pub fn separable_kernel_json(
+    k: &crate::separable::kernel::Kernel,
+    sss_width: Option<f64>,
+    source: &str,
+) -> serde_json::Value {
+    serde_json::to_value(k.to_file(schema::SEPARABLE_KERNEL, sss_width, source)).expect("kernel file serialises")
+}
 
 /// The sum-of-Gaussians / screen-space parameter file, likewise defined with the parameters it serialises.
 pub use crate::fitting::screen_space::{GaussiansFile, LodThresholds};

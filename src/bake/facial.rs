@@ -397,7 +397,7 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
 fn bake_weights(_params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     Ok(vec![json_file(
         &format!("{WRINKLES_DIR}/expression_weights.json"),
-        &wrinkles::table_8_1_json(),
+        &wrinkles::table_8_1_json(crate::baked_layout::schema::WRINKLE_WEIGHTS),
         FileKind::Json,
         "thesis Table 8.1 wrinkle weights per expression and zone (negative values cancel)",
     )])

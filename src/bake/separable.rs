@@ -85,7 +85,7 @@ fn default_kernels_params() -> Value {
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
     let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = kernel::LAYOUT_DOC;
-    let mut files = vec![json_file(&crate::baked_layout::path::json(&stem), &k.to_json(sss_width, source), FileKind::Json, convention)];
+    let mut files = vec![json_file(&crate::baked_layout::path::json(&stem), &crate::baked_layout::separable_kernel_json(k, sss_width, source), FileKind::Json, convention)];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(
