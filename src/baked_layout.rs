@@ -210,8 +210,10 @@ pub mod schema {
     pub const IMPORTANCE_KERNEL: &str = "rtbake-importance-kernel/1";
     /// A hemoglobin rig description ([`super::RigDescription`]).
     pub const HEMOGLOBIN_RIG: &str = "rtbake-hemoglobin-rig/1";
-    /// The wrinkle example's report.
+    /// The report of a wrinkle conversion (`rtbake maps wrinkles`, `crate::bake::wrinkle_maps`).
     pub const WRINKLES: &str = "rtbake-wrinkles/1";
+    /// The report of packed wrinkle zone masks (`rtbake maps wrinkle-masks`).
+    pub const WRINKLE_MASKS: &str = "rtbake-wrinkle-masks/1";
 }
 
 /// Sidecar of a transmittance table T(s) (`transmittance/*.json`): provenance and the lookup convention.

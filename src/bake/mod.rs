@@ -120,6 +120,7 @@ pub mod separable;
 pub mod skin;
 pub mod transmittance;
 pub mod transport;
+pub mod wrinkle_maps;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS (DX10 `{stem}.dds` and legacy-header `{stem}_dx9.dds`), KTX2
 /// and PNG (`{stem}.bin`, …). `convention` describes the

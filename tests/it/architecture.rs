@@ -336,8 +336,6 @@ fn is_schema_id(s: &str) -> bool {
 /// Schema ids written where `baked_layout.rs` cannot be imported (a model below the contract) or by code that
 /// another branch moves: (path, id, why).
 const SCHEMA_EXCEPTIONS: &[(&str, &str, &str)] = &[
-    ("bin/rtbake/maps.rs", "rtbake-wrinkles/1", "the wrinkle report, written in bin/ today"),
-    ("bin/rtbake/maps.rs", "rtbake-wrinkle-masks/1", "the mask report, written in bin/ today"),
 ];
 
 /// Schema ids only in `src/baked_layout.rs` (and [`SCHEMA_EXCEPTIONS`]).
