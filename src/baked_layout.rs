@@ -414,6 +414,86 @@ pub struct RigDescription {
     pub previews: String,
 }
 
+/// The one reader of a hemoglobin rig: rebuilds it from its description (`rig.json`, [`RigDescription`]) and the
+/// EXR files it names, for `rtbake maps rig-eval` and the runtime's loader. `read(file)` returns the bytes of a file
+/// named relative to the rig's folder (the caller does the I/O, and may check each file against a manifest first);
+/// checked here: the schema, the sizes, at least one map and the neutral map first (eq. 7.6 blends targets over
+/// it), every map single-channel at the size the description states with finite values. Errors name `param` (the
+/// flag the user gave, or the file's path) and the file. A renderer adds only its own limits (the number of
+/// targets a pass holds, the hemoglobin range its LUT indexes).
+pub fn rig_from_description(
+    param: &str,
+    desc: &RigDescription,
+    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, crate::error::InvalidInput>,
+) -> Result<crate::facial::hemoglobin_rig::HemoglobinRig, crate::error::InvalidInput> {
+    if desc.schema != schema::HEMOGLOBIN_RIG {
+        return Err(crate::error::InvalidInput::new(
+            param,
+            format!("schema '{}', expected '{}'", desc.schema, schema::HEMOGLOBIN_RIG),
+        ));
+    }
+    let [w, h] = desc.full_size;
+    let [rw, rh] = desc.rig_size;
+    crate::error::check_size(&format!("{param} full_size"), w as u64, h as u64)?;
+    crate::error::check_size(&format!("{param} rig_size"), rw as u64, rh as u64)?;
+    match desc.maps.first() {
+        None => return Err(crate::error::InvalidInput::new(param, "lists no maps; a rig needs the neutral map first")),
+        Some(m) if m.name != "neutral" => {
+            return Err(crate::error::InvalidInput::new(
+                param,
+                format!("maps[0] is {:?}; eq. 7.6 needs the neutral map first", m.name),
+            ))
+        }
+        Some(_) => {}
+    }
+    let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, crate::error::InvalidInput> {
+        let bytes = read(file)?;
+        let (img, _) = crate::io::exr::decode(&bytes, file).map_err(|e| crate::error::InvalidInput::new(param, e.to_string()))?;
+        if (img.width, img.height, img.channels) != (mw, mh, 1) {
+            return Err(crate::error::InvalidInput::new(
+                param,
+                format!("{file} is {}x{}x{}, the rig says {mw}x{mh}x1", img.width, img.height, img.channels),
+            ));
+        }
+        if let Some(i) = img.data.iter().position(|v| !v.is_finite()) {
+            return Err(crate::error::InvalidInput::new(
+                param,
+                format!(
+                    "{file}: texel ({}, {}) is {}; a rig map must be finite",
+                    i % mw as usize,
+                    i / mw as usize,
+                    img.data[i]
+                ),
+            ));
+        }
+        Ok(img.data)
+    };
+    let h0 = map(&desc.h0.exr, (w, h))?;
+    let mut maps = Vec::with_capacity(desc.maps.len());
+    for m in &desc.maps {
+        maps.push(crate::facial::hemoglobin_rig::RigMap {
+            name: m.name.clone(),
+            scale: map(&m.scale_exr, (rw, rh))?,
+            bias: map(&m.bias_exr, (rw, rh))?,
+        });
+    }
+    Ok(crate::facial::hemoglobin_rig::HemoglobinRig {
+        width: w,
+        height: h,
+        rig_width: rw,
+        rig_height: rh,
+        settings: crate::facial::hemoglobin_rig::RigSettings {
+            radius_texels: desc.radius_texels,
+            border: desc.border,
+            sigma_floor: desc.sigma_floor,
+            rig_size: rw.max(rh),
+        },
+        h0,
+        maps,
+        sigma_floored_texels: desc.sigma_floored_texels,
+    })
+}
+
 /// Files of H0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RigH0Files {

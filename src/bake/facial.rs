@@ -4,7 +4,6 @@
 
 use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, unorm8_texture_files, Asset, BakeError, BakedFile, FileMeta};
-use crate::error::InvalidInput;
 use crate::facial::disk_stats::Border;
 use crate::facial::hemoglobin_rig::{self, HemoglobinRig, RigSettings};
 use crate::facial::{synthetic, wrinkles};
@@ -15,7 +14,7 @@ use serde_json::{json, Value};
 
 pub use crate::baked_layout::path::{RIG_EXAMPLE_DIR, WRINKLES_DIR};
 pub use crate::baked_layout::schema::HEMOGLOBIN_RIG as RIG_SCHEMA;
-pub use crate::baked_layout::{RigDescription, RigH0Files, RigMapFiles, RigSource};
+pub use crate::baked_layout::{rig_from_description, RigDescription, RigH0Files, RigMapFiles, RigSource};
 
 #[allow(clippy::too_many_arguments)]
 fn float_meta(
@@ -426,82 +425,6 @@ pub fn assets() -> Vec<Asset> {
     ]
 }
 
-/// The one reader of a hemoglobin rig: rebuilds it from its description (`rig.json`, [`RigDescription`]) and the
-/// EXR files it names, for `rtbake maps rig-eval` and the runtime's loader. `read(file)` returns the bytes of a file
-/// named relative to the rig's folder (the caller does the I/O, and may check each file against a manifest first);
-/// checked here: the schema, the sizes, at least one map and the neutral map first (eq. 7.6 blends targets over
-/// it), every map single-channel at the size the description states with finite values. Errors name `param` (the
-/// flag the user gave, or the file's path) and the file. A renderer adds only its own limits (the number of
-/// targets a pass holds, the hemoglobin range its LUT indexes).
-pub fn rig_from_description(
-    param: &str,
-    desc: &RigDescription,
-    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, InvalidInput>,
-) -> Result<HemoglobinRig, InvalidInput> {
-    if desc.schema != RIG_SCHEMA {
-        return Err(InvalidInput::new(param, format!("schema '{}', expected '{RIG_SCHEMA}'", desc.schema)));
-    }
-    let [w, h] = desc.full_size;
-    let [rw, rh] = desc.rig_size;
-    crate::error::check_size(&format!("{param} full_size"), w as u64, h as u64)?;
-    crate::error::check_size(&format!("{param} rig_size"), rw as u64, rh as u64)?;
-    match desc.maps.first() {
-        None => return Err(InvalidInput::new(param, "lists no maps; a rig needs the neutral map first")),
-        Some(m) if m.name != "neutral" => {
-            return Err(InvalidInput::new(
-                param,
-                format!("maps[0] is {:?}; eq. 7.6 needs the neutral map first", m.name),
-            ))
-        }
-        Some(_) => {}
-    }
-    let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, InvalidInput> {
-        let bytes = read(file)?;
-        let (img, _) = io::exr::decode(&bytes, file).map_err(|e| InvalidInput::new(param, e.to_string()))?;
-        if (img.width, img.height, img.channels) != (mw, mh, 1) {
-            return Err(InvalidInput::new(
-                param,
-                format!("{file} is {}x{}x{}, the rig says {mw}x{mh}x1", img.width, img.height, img.channels),
-            ));
-        }
-        if let Some(i) = img.data.iter().position(|v| !v.is_finite()) {
-            return Err(InvalidInput::new(
-                param,
-                format!(
-                    "{file}: texel ({}, {}) is {}; a rig map must be finite",
-                    i % mw as usize,
-                    i / mw as usize,
-                    img.data[i]
-                ),
-            ));
-        }
-        Ok(img.data)
-    };
-    let h0 = map(&desc.h0.exr, (w, h))?;
-    let mut maps = Vec::with_capacity(desc.maps.len());
-    for m in &desc.maps {
-        maps.push(hemoglobin_rig::RigMap {
-            name: m.name.clone(),
-            scale: map(&m.scale_exr, (rw, rh))?,
-            bias: map(&m.bias_exr, (rw, rh))?,
-        });
-    }
-    Ok(HemoglobinRig {
-        width: w,
-        height: h,
-        rig_width: rw,
-        rig_height: rh,
-        settings: RigSettings {
-            radius_texels: desc.radius_texels,
-            border: desc.border,
-            sigma_floor: desc.sigma_floor,
-            rig_size: rw.max(rh),
-        },
-        h0,
-        maps,
-        sigma_floored_texels: desc.sigma_floored_texels,
-    })
-}
 
 /// A partial-derivative wrinkle map (thesis ch. 8) from decoded unit normals: PD conversion (cone handling
 /// `cone`), optional difference against a base map's PD, area downsampling to `size` and the 8-bit texture

@@ -663,41 +663,49 @@ fn hemoglobin_rig_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<Bake
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::HEMOGLOBIN_RIG)));
     }
     let desc: RigDescription = typed(v, path)?;
-    let folder = path.rsplit_once('/').map(|(d, _)| format!("{d}/")).unwrap_or_default();
-    let [rw, rh] = desc.rig_size;
-    let [fw, fh] = desc.full_size;
-    let maps = &desc.maps;
-    if maps.is_empty() || maps.len() > MAX_RIG_TARGETS {
-        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", maps.len())));
+    if desc.maps.len() > MAX_RIG_TARGETS {
+        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", desc.maps.len())));
     }
-    let map1 = |file: &str, (w, h): (u32, u32)| -> Result<Vec<f32>, LutError> {
-        let p = format!("{folder}{file}");
-        let img = load_exr_f32(dir, manifest, &p, 1, (1, 1))?;
-        if (img.width, img.height) != (w, h) {
-            return Err(content(&p, format!("{}x{}, the rig says {w}x{h}", img.width, img.height)));
-        }
-        Ok(img.data)
+    let folder = path.rsplit_once('/').map(|(d, _)| d).unwrap_or_default();
+    // Each map through the manifest checks; the first refusal is returned as itself (its LutError kind), not as
+    // the reader's message.
+    let mut refused: Option<LutError> = None;
+    let expect = Expect {
+        format: FileFormat::Exr,
+        pixel_format: None,
+        size: None,
+        channels: Some(1),
+        sample_type: SampleType::F32,
+        data: DataKind::Texture,
     };
-    let (mut targets, mut names) = (Vec::new(), Vec::new());
-    for (i, m) in maps.iter().enumerate() {
-        let name = m.name.clone();
-        if i == 0 && name != "neutral" {
-            return Err(content(path, format!("maps[0] is {name:?}; eq. 7.6 needs the neutral map first")));
-        }
-        let scale = map1(&m.scale_exr, (rw, rh))?;
-        let bias = map1(&m.bias_exr, (rw, rh))?;
-        if let Some(b) = bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
+    let read = &mut |file: &str| {
+        let p = path::in_dir(folder, file);
+        read_checked(dir, manifest, &p, &expect).map(|(bytes, _)| bytes).map_err(|e| {
+            let message = e.to_string();
+            refused.get_or_insert(e);
+            crate::error::InvalidInput::new(p.as_str(), message)
+        })
+    };
+    let rig = crate::baked_layout::rig_from_description(path, &desc, read);
+    if let Some(e) = refused {
+        return Err(e);
+    }
+    let rig = rig.map_err(|e| content(path, e.message))?;
+    let mut names = Vec::with_capacity(rig.maps.len());
+    let mut targets = Vec::with_capacity(rig.maps.len());
+    for m in &rig.maps {
+        if let Some(b) = m.bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
             return Err(content(
                 path,
-                format!("{name}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)"),
+                format!("{}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)", m.name),
             ));
         }
-        targets.push(scale.into_iter().zip(bias).map(|(s, b)| [s, b]).collect());
-        names.push(name);
+        targets.push(m.scale.iter().zip(&m.bias).map(|(&s, &b)| [s, b]).collect());
+        names.push(m.name.clone());
     }
-    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&desc.h0.exr, (fw, fh))?);
+    let h0 = crate::image_buf::Image::from_vec(rig.width, rig.height, 1, rig.h0);
     let global_scales = desc.global_scales.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
-    let rig = RigScaleBiasMaps { width: rw, height: rh, targets };
+    let rig = RigScaleBiasMaps { width: rig.rig_width, height: rig.rig_height, targets };
     rig.validate().map_err(|e| content(path, e.to_string()))?;
     Ok(BakedRig { rig, names, h0, global_scales })
 }
