@@ -125,12 +125,9 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
 fn burley(a: &EvaluateArgs, albedo: &str) -> anyhow::Result<(RgbBurley, Value)> {
     let albedo = parse_rgb("--burley-albedo", albedo)?;
     let named_err = |e: rtbake::error::InvalidInput| {
-        let flag = if e.param.starts_with("albedo") {
-            "--burley-albedo"
-        } else if e.param.starts_with("d_mm") {
-            "--burley-d-mm"
-        } else {
-            "--burley-mfp-mm"
+        let flag = match crate::flags::flag_of(&e.param) {
+            Some(f @ ("--burley-albedo" | "--burley-d-mm")) => f,
+            _ => "--burley-mfp-mm",
         };
         usage(anyhow::anyhow!("{flag}: {e}"))
     };

@@ -86,11 +86,11 @@ impl ResolvedProfile {
             (None, None) => unreachable!("resolved"),
         };
         ImportanceKernel::new(sampled, samples).map_err(|e| {
-            let flag = match e.param.as_str() {
-                "samples" => "--samples".to_string(),
-                p if p.starts_with("albedo") => format!("--burley-albedo {p}"),
-                "profile" => "profile".to_string(),
-                p => format!("profile ({p})"),
+            let flag = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+                (_, Some(f @ "--samples")) => f.to_string(),
+                (p, Some(f @ "--burley-albedo")) => format!("{f} {p}"),
+                ("profile", _) => "profile".to_string(),
+                (p, _) => format!("profile ({p})"),
             };
             usage(anyhow::anyhow!("{flag} {}", e.message))
         })

@@ -112,20 +112,17 @@ pub struct ProfileArgs {
 
 /// Renames library parameter names to the flags a user typed.
 fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
-    let param = match e.param.as_str() {
-        "material" => "--material".to_string(),
-        "profile_preset" => "--profile-preset".to_string(),
-        "thickness_mm" => "--thickness-mm".to_string(),
-        "radii" => "--radii".to_string(),
-        "r_min_mm" => "--r-min-mm".to_string(),
-        "r_max_mm" => "--r-max-mm".to_string(),
-        "count" => "--count".to_string(),
-        "--count" => "--overlay-fit".to_string(),
-        p if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
+    const PROFILE_FLAGS: [&str; 7] =
+        ["--material", "--profile-preset", "--thickness-mm", "--radii", "--r-min-mm", "--r-max-mm", "--count"];
+    let param = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+        (p, Some(f)) if PROFILE_FLAGS.contains(&f) && !p.contains('[') => f.to_string(),
+        // The overlay fit's count, which `fit_overlay_plot` names by its own flag.
+        ("--count", _) => "--overlay-fit".to_string(),
+        (p, _) if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
         },
-        p => p.to_string(),
+        (p, _) => p.to_string(),
     };
     usage(InvalidInput::new(param, e.message))
 }

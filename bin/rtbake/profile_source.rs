@@ -74,9 +74,8 @@ impl McArgs {
             self.seed.unwrap_or(1),
         )
         .map_err(|e| {
-            let flag = match e.param.as_str() {
-                "g" => "--g",
-                "photons" => "--photons",
+            let flag = match crate::flags::flag_of(&e.param) {
+                Some(f @ ("--g" | "--photons")) => f,
                 _ => "--model mc",
             };
             usage(anyhow::anyhow!("{flag}: {}", e.message))
@@ -256,9 +255,8 @@ pub fn physiological_skin(
 ) -> anyhow::Result<(ProfileSource, Value)> {
     physiological_skin_source(&SkinPhysiology::default(), &projection, cm, chd, adding, series, fdr, transport).map_err(
         |e| {
-            let flag = match e.param.as_str() {
-                "melanin_fraction" => "--skin-melanin",
-                "hemoglobin_fraction" => "--skin-hemoglobin",
+            let flag = match crate::flags::flag_of(&e.param) {
+                Some(f @ ("--skin-melanin" | "--skin-hemoglobin")) => f,
                 _ => "--skin-melanin/--skin-hemoglobin",
             };
             usage(anyhow::anyhow!("{flag}: {e}"))
@@ -351,7 +349,10 @@ impl BurleyArgs {
         let (albedo, mean_free_path_mm) = (three("--burley-albedo", albedo)?, three("--burley-mfp-mm", mfp)?);
         let fit = ShapeFit::from(self.burley_fit);
         let profile = RgbBurley::from_mean_free_path(albedo, mean_free_path_mm, fit).map_err(|e| {
-            let flag = if e.param.starts_with("albedo") { "--burley-albedo" } else { "--burley-mfp-mm" };
+            let flag = match crate::flags::flag_of(&e.param) {
+                Some(f @ "--burley-albedo") => f,
+                _ => "--burley-mfp-mm",
+            };
             usage(InvalidInput::new(flag, format!("{}: {}", e.param, e.message)))
         })?;
         Ok(Some((profile, ProfileSource::Burley { albedo, mean_free_path_mm, fit })))

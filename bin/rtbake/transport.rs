@@ -78,13 +78,10 @@ pub struct TransportArgs {
 
 /// Library parameter names → the flags a user typed.
 fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
-    let param = match e.param.as_str() {
-        "photons" => "--photons".to_string(),
-        "batches" => "--batches".to_string(),
-        "bin_mm" => "--bin-mm".to_string(),
-        "bins" => "--bins".to_string(),
-        "g" => "--g".to_string(),
-        p => match layers_file {
+    const TRANSPORT_FLAGS: [&str; 5] = ["--photons", "--batches", "--bin-mm", "--bins", "--g"];
+    let param = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+        (p, Some(f)) if TRANSPORT_FLAGS.contains(&f) && !p.contains('[') => f.to_string(),
+        (p, _) => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
         },
