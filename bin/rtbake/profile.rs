@@ -11,7 +11,7 @@ use rtbake::diffusion::table::{self, ProfileTable};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings};
-use rtbake::plot::profile::{profile_panels, render, PlotFormat};
+use rtbake::plot::profile::{profile_panels, render};
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -227,20 +227,8 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => table::log_radii(args.r_min_mm, args.r_max_mm, args.count).map_err(|e| flag_error(e, None))?,
     };
 
-    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
-    crate::profile_source::check_distinct_outputs(&outputs)?;
-    for (flag, path) in outputs {
-        if let Some(p) = path {
-            check_output_file(flag, p)?;
-            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
-            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
-                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
-        }
-    }
-    let plot_format = match &args.plot {
-        Some(path) => Some(PlotFormat::from_path("--plot", path).map_err(usage)?),
-        None => None,
-    };
+    let plot_format =
+        crate::profile_source::check_table_outputs(&args.csv, &args.out, &args.plot, args.layers.as_slice())?;
     let fit_settings =
         args.overlay_fit.map(|count| FitSettings { count, shared_variances: true, normalize: false, starts: 8 });
     if let Some(s) = &fit_settings {

@@ -99,6 +99,30 @@ pub fn add_standard_errors(provenance: &mut Value, profile: &dyn RadialProfile) 
     rtbake::diffusion::source::add_built_provenance(provenance, profile);
 }
 
+/// Checks the `--csv`, `--out` and `--plot` files of a profile-table command before any work (distinct, writable,
+/// none of them one of the `--layers` inputs) and returns the plot's format.
+pub fn check_table_outputs(
+    csv: &Option<PathBuf>,
+    out: &Option<PathBuf>,
+    plot: &Option<PathBuf>,
+    layers: &[PathBuf],
+) -> anyhow::Result<Option<rtbake::plot::profile::PlotFormat>> {
+    let outputs = [("--csv", csv), ("--out", out), ("--plot", plot)];
+    check_distinct_outputs(&outputs)?;
+    for (flag, path) in outputs {
+        if let Some(p) = path {
+            crate::profile::check_output_file(flag, p)?;
+            let inputs: Vec<&std::path::Path> = layers.iter().map(PathBuf::as_path).collect();
+            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
+                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
+        }
+    }
+    match plot {
+        Some(path) => Ok(Some(rtbake::plot::profile::PlotFormat::from_path("--plot", path).map_err(usage)?)),
+        None => Ok(None),
+    }
+}
+
 /// Refuses (exit 2) two output flags naming the same file (`--csv X --out X` would leave only the last write).
 /// Paths are compared after resolving their directories, so `./x` and `x` collide.
 pub fn check_distinct_outputs(outputs: &[(&str, &Option<PathBuf>)]) -> anyhow::Result<()> {

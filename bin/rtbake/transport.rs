@@ -3,13 +3,12 @@
 //! against rtbake's diffusion model of the same stack. Parsing and validation only.
 
 use crate::cli::{usage, usage_msg, Ctx};
-use crate::profile::check_output_file;
 use rtbake::diffusion::materials::{self, JENSEN_2001_ETA};
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::source::ProfileSource;
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
-use rtbake::plot::profile::{render, PlotFormat};
+use rtbake::plot::profile::render;
 use rtbake::runtime::chain;
 use rtbake::runtime::device::create_headless;
 use rtbake::runtime::RuntimeError;
@@ -161,20 +160,8 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
     // g: `McSettings::time_estimate_for_stack`), on either path.
     let seconds = seconds.max(settings.time_estimate_for_stack(&stack, rayon::current_num_threads()));
     ctx.check_time(&format!("--photons {} in this stack (its albedo and g)", args.photons), seconds)?;
-    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
-    crate::profile_source::check_distinct_outputs(&outputs)?;
-    for (flag, path) in outputs {
-        if let Some(p) = path {
-            check_output_file(flag, p)?;
-            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
-            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
-                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
-        }
-    }
-    let plot_format = match &args.plot {
-        Some(path) => Some(PlotFormat::from_path("--plot", path).map_err(usage)?),
-        None => None,
-    };
+    let plot_format =
+        crate::profile_source::check_table_outputs(&args.csv, &args.out, &args.plot, args.layers.as_slice())?;
     provenance["model"] = json!("monte-carlo (MCML, Wang, Jacques & Zheng 1995)");
     let gpu = if args.gpu {
         let g = create_headless(&Default::default()).map_err(|e| usage(anyhow::anyhow!("--gpu: {e}")))?;

@@ -14,7 +14,7 @@
 //! RG textures are RGB with B = 0. `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2` are the same payloads named and stored
 //! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
+use crate::manifest::{FileFormat, FileKind};
 use super::{parse_params, text_file, unorm8_texture_files_in, Asset, BakeError, BakedFile, TextureFormats};
 use crate::aa::mlaa_area::{mlaa_area_map_with_progress, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
@@ -214,21 +214,11 @@ pub fn mlaa_files_with_progress(
 
 /// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`crate::io::ktx2::BEVY_ZSTD_LEVEL`]).
 pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<BakedFile, BakeError> {
-    use crate::io::{self, ktx2::Supercompression, PixelFormat};
+    use crate::io::{self, ktx2::Supercompression};
     let sc = Supercompression::Zstd(io::ktx2::BEVY_ZSTD_LEVEL);
-    let meta = crate::manifest::FileMeta {
-        kind: FileKind::Lut,
-        format: FileFormat::Ktx2,
-        pixel_format: PixelFormat::unorm8_for(img.channels),
-        width: img.width,
-        height: img.height,
-        channels: img.channels,
-        sample_type: SampleType::U8,
-        color_space: ColorSpace::Linear,
-        convention: format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it"),
-        verify_tolerance: None,
-        supercompression: Some(sc.label()),
-    };
+    let mut meta = super::unorm8_meta(img, FileKind::Lut, convention, FileFormat::Ktx2);
+    meta.convention = format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it");
+    meta.supercompression = Some(sc.label());
     Ok(BakedFile { path: path.into(), bytes: io::ktx2::encode_u8_with(img, sc)?, meta })
 }
 
@@ -377,6 +367,7 @@ pub fn assets() -> Vec<Asset> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::manifest::ColorSpace;
 
     #[test]
     fn every_asset_bakes_its_defaults_under_aa_and_params_round_trip() {

@@ -41,12 +41,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// One physiological two-layer skin point.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SkinPoint {
-    melanin_fraction: f64,
-    hemoglobin_fraction: f64,
-}
+use super::SkinPoint;
 
 /// The transmission-profile tables.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -113,12 +108,7 @@ fn artist_mapping(m: &materials::Material, totals: [f64; 3]) -> Result<RgbBurley
 fn cases(p: &Params) -> Result<Vec<Case>, BakeError> {
     let mut v = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let source = ProfileSource::Material {
             name: m.name.into(),
             model: MaterialModel::Dipole,

@@ -74,6 +74,30 @@ pub fn add_bevy_meta_files(files: &mut Vec<BakedFile>) {
     files.extend(metas);
 }
 
+/// One physiological skin point of an asset's parameters (the two-layer skin's concentrations).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkinPoint {
+    /// Cm, 0..=0.5.
+    pub(crate) melanin_fraction: f64,
+    /// Chd, 0..=0.32.
+    pub(crate) hemoglobin_fraction: f64,
+}
+
+/// The Jensen 2001 material `name` of the asset parameter `param` (e.g. `materials`), refused naming the known ones.
+pub(crate) fn jensen_material(
+    param: &str,
+    name: &str,
+) -> Result<&'static crate::diffusion::materials::Material, crate::error::InvalidInput> {
+    use crate::diffusion::materials;
+    materials::find(name).ok_or_else(|| {
+        crate::error::InvalidInput::new(
+            param,
+            format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
+        )
+    })
+}
+
 /// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).
 fn split_zstd_param(asset: &str, params: &Value) -> Result<(Option<i32>, Value), BakeError> {
     let Some(obj) = params.as_object() else { return Ok((None, params.clone())) };

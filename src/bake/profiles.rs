@@ -49,14 +49,7 @@ struct Grid {
 }
 
 /// One point of the physiological two-layer skin.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SkinPoint {
-    /// Cm, 0..=0.5.
-    melanin_fraction: f64,
-    /// Chd, 0..=0.32.
-    hemoglobin_fraction: f64,
-}
+use super::SkinPoint;
 
 /// The transport model of the skins' profiles: `{"model": "multipole"}` (default) or
 /// `{"model": "mc", "g": 0.8, "photons": 100000, "seed": 1}` (Monte Carlo, `transport::profile`; each wavelength
@@ -194,12 +187,7 @@ fn check_name(param: &str, name: &str) -> Result<(), InvalidInput> {
 fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Value)>, InvalidInput> {
     let mut out = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let src = ProfileSource::Material {
             name: m.name.into(),
             model: MaterialModel::Dipole,
