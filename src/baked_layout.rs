@@ -184,7 +184,10 @@ mod tests {
         assert_eq!(mlaa_area_stem(MlaaVersion::V2, 15), "aa/mlaa/AreaTex_MLAAv2");
         assert_eq!(GAUSSIANS_DEFAULT, json(&gaussians_stem("deon6")));
         assert_eq!(SEPARABLE_KERNEL_DEFAULT, json(&in_dir(SEPARABLE_DIR, "published_n17")));
-        assert_eq!(IMPORTANCE_KERNEL_DEFAULT, json(&in_dir(IMPORTANCE_DIR, &importance_kernel_stem("skin1_dipole", 40))));
+        assert_eq!(
+            IMPORTANCE_KERNEL_DEFAULT,
+            json(&in_dir(IMPORTANCE_DIR, &importance_kernel_stem("skin1_dipole", 40)))
+        );
         assert_eq!(TRANSMITTANCE_DEFAULT, format!("{}.exr", transmittance_stem("deon6", "published")));
         assert_eq!(SKIN_LUT, format!("{SKIN_LUT_STEM}.exr"));
         assert_eq!(SKIN_LUT_SIDECAR, sidecar(SKIN_LUT));
@@ -448,7 +451,8 @@ pub fn rig_from_description(
     }
     let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, crate::error::InvalidInput> {
         let bytes = read(file)?;
-        let (img, _) = crate::io::exr::decode(&bytes, file).map_err(|e| crate::error::InvalidInput::new(param, e.to_string()))?;
+        let (img, _) =
+            crate::io::exr::decode(&bytes, file).map_err(|e| crate::error::InvalidInput::new(param, e.to_string()))?;
         if (img.width, img.height, img.channels) != (mw, mh, 1) {
             return Err(crate::error::InvalidInput::new(
                 param,

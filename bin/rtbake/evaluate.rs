@@ -125,10 +125,8 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
 fn burley(a: &EvaluateArgs, albedo: &str) -> anyhow::Result<(RgbBurley, Value)> {
     let albedo = parse_rgb("--burley-albedo", albedo)?;
     let named_err = |e: rtbake::error::InvalidInput| {
-        let flag = match crate::flags::flag_of(&e.param) {
-            Some(f @ ("--burley-albedo" | "--burley-d-mm")) => f,
-            _ => "--burley-mfp-mm",
-        };
+        let flag =
+            crate::flags::flag_among(&e.param, &["--burley-albedo", "--burley-d-mm"]).unwrap_or("--burley-mfp-mm");
         usage(anyhow::anyhow!("{flag}: {e}"))
     };
     if let Some(d) = &a.burley_d_mm {

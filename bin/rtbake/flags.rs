@@ -38,6 +38,11 @@ pub fn flag_of(param: &str) -> Option<&'static str> {
     FIELD_FLAGS.iter().find(|(f, _)| *f == field).map(|(_, flag)| *flag)
 }
 
+/// [`flag_of`] where the flag is one of those the command has (`allowed`); `None` otherwise.
+pub fn flag_among(param: &str, allowed: &[&'static str]) -> Option<&'static str> {
+    flag_of(param).filter(|f| allowed.contains(f))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,11 +8,11 @@ use anyhow::Result;
 use rtbake::bake::facial::{self as bf, RigDescription, RigSource};
 use rtbake::bake::wrinkle_maps::{self, WrinkleConversion, WrinkleOutput};
 use rtbake::bake::{BakedFile, FileFormat, FileKind, FileMeta};
-use rtbake::facial::wrinkles::WrinkleEncoding;
 use rtbake::error::InvalidInput;
 use rtbake::facial::disk_stats::Border;
 use rtbake::facial::hemoglobin_rig::{self, RigSettings};
 use rtbake::facial::inputs::{self, ValueRange};
+use rtbake::facial::wrinkles::WrinkleEncoding;
 use rtbake::facial::{synthetic, wrinkles};
 use rtbake::image_buf::Image;
 use rtbake::io;
@@ -396,7 +396,8 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         read.push(dir.join(&m.bias_exr));
     }
     let read_refs: Vec<&Path> = read.iter().map(PathBuf::as_path).collect();
-    let file = BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text(FileKind::Map, FileFormat::Exr, "") };
+    let file =
+        BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text(FileKind::Map, FileFormat::Exr, "") };
     crate::cli::write_set(ctx, "--out", out_dir, &[file], &read_refs)?;
     let used: Vec<String> = names.iter().zip(&weights).map(|(n, w)| format!("{n}={w}")).collect();
     ctx.info(format!("wrote {} ({w}x{h}) with weights {}", a.out.display(), used.join(",")));
@@ -506,7 +507,11 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
     let mut files = Vec::new();
     for (name, img) in &set {
         let bytes = io::png::encode_u16(img)?;
-        files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text(FileKind::Input, FileFormat::Png, "") });
+        files.push(BakedFile {
+            path: format!("{name}.png"),
+            bytes,
+            meta: FileMeta::text(FileKind::Input, FileFormat::Png, ""),
+        });
     }
     let files = write_files(ctx, "--out", &a.out, files, &[], &Default::default())?;
     ctx.info(format!(

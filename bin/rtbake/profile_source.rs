@@ -74,10 +74,7 @@ impl McArgs {
             self.seed.unwrap_or(1),
         )
         .map_err(|e| {
-            let flag = match crate::flags::flag_of(&e.param) {
-                Some(f @ ("--g" | "--photons")) => f,
-                _ => "--model mc",
-            };
+            let flag = crate::flags::flag_among(&e.param, &["--g", "--photons"]).unwrap_or("--model mc");
             usage(anyhow::anyhow!("{flag}: {}", e.message))
         })
     }
@@ -279,10 +276,8 @@ pub fn physiological_skin(
 ) -> anyhow::Result<(ProfileSource, Value)> {
     physiological_skin_source(&SkinPhysiology::default(), &projection, cm, chd, adding, series, fdr, transport).map_err(
         |e| {
-            let flag = match crate::flags::flag_of(&e.param) {
-                Some(f @ ("--skin-melanin" | "--skin-hemoglobin")) => f,
-                _ => "--skin-melanin/--skin-hemoglobin",
-            };
+            let flag = crate::flags::flag_among(&e.param, &["--skin-melanin", "--skin-hemoglobin"])
+                .unwrap_or("--skin-melanin/--skin-hemoglobin");
             usage(anyhow::anyhow!("{flag}: {e}"))
         },
     )
@@ -373,10 +368,7 @@ impl BurleyArgs {
         let (albedo, mean_free_path_mm) = (three("--burley-albedo", albedo)?, three("--burley-mfp-mm", mfp)?);
         let fit = ShapeFit::from(self.burley_fit);
         let profile = RgbBurley::from_mean_free_path(albedo, mean_free_path_mm, fit).map_err(|e| {
-            let flag = match crate::flags::flag_of(&e.param) {
-                Some(f @ "--burley-albedo") => f,
-                _ => "--burley-mfp-mm",
-            };
+            let flag = crate::flags::flag_among(&e.param, &["--burley-albedo"]).unwrap_or("--burley-mfp-mm");
             usage(InvalidInput::new(flag, format!("{}: {}", e.param, e.message)))
         })?;
         Ok(Some((profile, ProfileSource::Burley { albedo, mean_free_path_mm, fit })))

@@ -14,7 +14,6 @@
 //! RG textures are RGB with B = 0. `SMAAAreaLUT.ktx2` / `SMAASearchLUT.ktx2` are the same payloads named and stored
 //! as Bevy (`bevy_anti_alias`) ships them: KTX2 with Zstandard supercompression at level 15. The same file builders serve `rtbake aa` (variants).
 
-use crate::manifest::{FileFormat, FileKind};
 use super::{parse_params, text_file, unorm8_texture_files_in, Asset, BakeError, BakedFile, TextureFormats};
 use crate::aa::mlaa_area::{mlaa_area_map_with_progress, MlaaAreaError, MlaaVersion};
 use crate::aa::smaa_area::{smaa_area_texture, SmaaAreaError, SmaaAreaParams};
@@ -22,6 +21,7 @@ use crate::aa::smaa_search;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::io::source::{c_header_u8, rust_source_u8, DataNotice};
+use crate::manifest::{FileFormat, FileKind};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -296,12 +296,7 @@ pub fn assets() -> Vec<Asset> {
             default_params: || json(SmaaAreaParams::v2_8()),
             bake: |v| {
                 let p: SmaaAreaParams = parse_params("smaa-area-v2.8", v)?;
-                smaa_area_files(
-                    path::SMAA_AREA_V2_8_STEM,
-                    &p,
-                    TextureFormats::BINARY,
-                    &from_line("smaa-area-v2.8"),
-                )
+                smaa_area_files(path::SMAA_AREA_V2_8_STEM, &p, TextureFormats::BINARY, &from_line("smaa-area-v2.8"))
             },
         },
         Asset {
@@ -328,12 +323,7 @@ pub fn assets() -> Vec<Asset> {
             bake: |v| {
                 let _: NoParams = parse_params("smaa-search-v2.8", v)?;
                 let from = from_line("smaa-search-v2.8");
-                let mut f = search_files(
-                    SearchKind::V2_8,
-                    path::SMAA_SEARCH_V2_8_STEM,
-                    TextureFormats::BINARY,
-                    &from,
-                )?;
+                let mut f = search_files(SearchKind::V2_8, path::SMAA_SEARCH_V2_8_STEM, TextureFormats::BINARY, &from)?;
                 f.extend(search_files(
                     SearchKind::LogicalPrecrop,
                     path::SMAA_SEARCH_PRECROP_STEM,

@@ -20,7 +20,6 @@
 //! budgets in `kernel_samples` (default 40), as `rtbake importance-kernel --out` writes them
 //! (`burley/kernels/<case>_n<N>.{json,hlsl,glsl,wgsl}` and `_f32x8.bin`).
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::BURLEY_DIR;
 use crate::diffusion::burley::{Burley, RgbBurley, ShapeFit};
@@ -31,6 +30,7 @@ use crate::error::InvalidInput;
 use crate::fitting::burley_fit::fit_burley;
 use crate::fitting::evaluate::{compare_profiles, ProfileErrors};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::{overlay_plot, render, PlotFormat, CHANNEL_COLORS, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::plot::{Curve, LinePlot};
 use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};

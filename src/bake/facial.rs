@@ -2,13 +2,13 @@
 //! synthetic maps (thesis ch. 7), the Table 8.1 wrinkle weights preset and an example wrinkle map / mask set
 //! (thesis ch. 8). Also the file encoders shared with `rtbake maps` (the CLI writes the same files).
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, unorm8_texture_files, Asset, BakeError, BakedFile, FileMeta};
 use crate::facial::disk_stats::Border;
 use crate::facial::hemoglobin_rig::{self, HemoglobinRig, RigSettings};
 use crate::facial::{synthetic, wrinkles};
 use crate::image_buf::Image;
 use crate::io::{self, exr::ExrPrecision, PixelFormat};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -148,7 +148,9 @@ pub fn hemoglobin_rig_files(
         files.push(BakedFile {
             path: format!("{dir}{n}_scale_bias.ktx2"),
             bytes: io::ktx2::encode_f16(&Image::from_vec(rw, rh, 2, packed))?,
-            meta: float_meta(FileFormat::Ktx2, SampleType::F16,
+            meta: float_meta(
+                FileFormat::Ktx2,
+                SampleType::F16,
                 rw,
                 rh,
                 2,
@@ -377,7 +379,12 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);
     for (i, img) in packed.iter().enumerate() {
-        files.extend(unorm8_texture_files(&crate::baked_layout::path::wrinkle_masks_stem(&dir, i), img, FileKind::Lut, &mask_convention(i))?);
+        files.extend(unorm8_texture_files(
+            &crate::baked_layout::path::wrinkle_masks_stem(&dir, i),
+            img,
+            FileKind::Lut,
+            &mask_convention(i),
+        )?);
     }
     let report = json!({
         "schema": crate::baked_layout::schema::WRINKLES,
@@ -424,7 +431,6 @@ pub fn assets() -> Vec<Asset> {
         },
     ]
 }
-
 
 /// A partial-derivative wrinkle map (thesis ch. 8) from decoded unit normals: PD conversion (cone handling
 /// `cone`), optional difference against a base map's PD, area downsampling to `size` and the 8-bit texture

@@ -2,7 +2,6 @@
 //! presets (thesis Table 4.2) and a shared-variance 6-Gaussian fit of the Jensen 2001 skin1 dipole, each as JSON,
 //! HLSL / GLSL / WGSL includes and a plot (PNG + SVG) of r·R(r).
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::GAUSSIANS_DIR;
 use crate::diffusion::materials;
@@ -13,6 +12,7 @@ use crate::error::InvalidInput;
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings, NormalizedProfile, RgbGaussians};
 use crate::io::source::ShaderLang;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::fit_overlay_plot;
 use crate::plot::LinePlot;
 use serde::{Deserialize, Serialize};
@@ -54,7 +54,8 @@ pub fn gaussian_files(
         ));
     }
     let img = plot.to_image(PLOT_WIDTH, PLOT_HEIGHT);
-    let mut png_meta = FileMeta::text(FileKind::Plot, FileFormat::Png, "r*R(r) per channel on a log10 r axis (mm); fit dashed");
+    let mut png_meta =
+        FileMeta::text(FileKind::Plot, FileFormat::Png, "r*R(r) per channel on a log10 r axis (mm); fit dashed");
     png_meta.width = img.width;
     png_meta.height = img.height;
     png_meta.channels = 3;

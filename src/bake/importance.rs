@@ -7,12 +7,12 @@
 //! HLSL / GLSL / WGSL includes and the raw `{name}_n{N}_f32x8.bin`. Burley profiles are sampled through their
 //! closed-form CDF, every other profile through the tabulated CDF.
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::baked_layout::{path, schema, ImportanceKernelFile, ImportanceKernelSample};
 use crate::diffusion::burley::RgbBurley;
 use crate::diffusion::source::ProfileSource;
 use crate::io::source::{ShaderInclude, ShaderLang};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::sss_sampling::disk::{self, ImportanceKernel, SampledProfile, CUTOFF_QUANTILE};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -230,8 +230,12 @@ pub fn f32x8_le_bytes(k: &ImportanceKernel) -> Vec<u8> {
 pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Value, source: &str) -> Vec<BakedFile> {
     let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = "importance-sampled disk kernel: offsets in mm, weights normalised per channel";
-    let mut files =
-        vec![json_file(&crate::baked_layout::path::json(&stem), &kernel_json(k, provenance, source), FileKind::Json, convention)];
+    let mut files = vec![json_file(
+        &crate::baked_layout::path::json(&stem),
+        &kernel_json(k, provenance, source),
+        FileKind::Json,
+        convention,
+    )];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(

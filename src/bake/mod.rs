@@ -289,19 +289,24 @@ pub fn float_texture_files_with_preview(
     tolerance: f64,
     axes: &crate::plot::preview::PreviewAxes,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let meta = |format: FileFormat, pf: Option<PixelFormat>, st: SampleType, cs: ColorSpace, tol: Option<f64>| FileMeta {
-        kind,
-        format,
-        pixel_format: pf,
-        width: img.width,
-        height: img.height,
-        channels: if format == FileFormat::Ktx2 { pf.map(|p| p.channels()).unwrap_or(img.channels) } else { img.channels },
-        sample_type: st,
-        color_space: cs,
-        convention: convention.into(),
-        verify_tolerance: tol,
-        supercompression: None,
-    };
+    let meta =
+        |format: FileFormat, pf: Option<PixelFormat>, st: SampleType, cs: ColorSpace, tol: Option<f64>| FileMeta {
+            kind,
+            format,
+            pixel_format: pf,
+            width: img.width,
+            height: img.height,
+            channels: if format == FileFormat::Ktx2 {
+                pf.map(|p| p.channels()).unwrap_or(img.channels)
+            } else {
+                img.channels
+            },
+            sample_type: st,
+            color_space: cs,
+            convention: convention.into(),
+            verify_tolerance: tol,
+            supercompression: None,
+        };
     let half_tol = tolerance.max(1e-3);
     let preview_img = crate::plot::preview::labelled_preview(&io::png::srgb_preview_pixels(img), axes);
     let mut preview = meta(FileFormat::Png, None, SampleType::U8, ColorSpace::Srgb, Some(1.0));
@@ -330,7 +335,13 @@ pub fn float_texture_files_with_preview(
         BakedFile {
             path: format!("{stem}.ktx2"),
             bytes: ktx2?,
-            meta: meta(FileFormat::Ktx2, PixelFormat::f16_for(img.channels), SampleType::F16, ColorSpace::Linear, Some(half_tol)),
+            meta: meta(
+                FileFormat::Ktx2,
+                PixelFormat::f16_for(img.channels),
+                SampleType::F16,
+                ColorSpace::Linear,
+                Some(half_tol),
+            ),
         },
         BakedFile { path: format!("{stem}_preview_srgb.png"), bytes: png?, meta: preview },
     ])

@@ -24,7 +24,6 @@
 //! `rtbake profile` (200 radii log-spaced over [0.001, 100] mm), so `rtbake profile --material skin1 --json` prints
 //! the same numbers as `profiles/dipole/skin1.json`.
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::diffusion::layered::{Adding, LayerStack};
 use crate::diffusion::multipole::Series;
@@ -32,6 +31,7 @@ use crate::diffusion::source::{MaterialModel, ProfileSource, TransportModel};
 use crate::diffusion::table::{self, ProfileTable};
 use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};
 use rayon::prelude::*;

@@ -8,9 +8,9 @@
 //! default objective (`sss/separable/fit_deon6.json`, with Table 6.1's objective value for comparison) and the
 //! fitted 17-tap kernel.
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::io::source::ShaderLang;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::separable::fit::{self, ObjectiveSpec, TargetKernel};
 use crate::separable::kernel::{self, Kernel, KernelSpec, Precision};
 use crate::separable::{SeparableParams, PUBLISHED, PUBLISHED_SSS_WIDTH, TABLE_6_1, TABLE_6_1_WIDTH};
@@ -85,7 +85,12 @@ fn default_kernels_params() -> Value {
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
     let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = kernel::LAYOUT_DOC;
-    let mut files = vec![json_file(&crate::baked_layout::path::json(&stem), &crate::baked_layout::separable_kernel_json(k, sss_width, source), FileKind::Json, convention)];
+    let mut files = vec![json_file(
+        &crate::baked_layout::path::json(&stem),
+        &crate::baked_layout::separable_kernel_json(k, sss_width, source),
+        FileKind::Json,
+        convention,
+    )];
     for lang in ShaderLang::ALL {
         let ext = lang.extension();
         files.push(text_file(

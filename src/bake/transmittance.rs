@@ -1,11 +1,11 @@
 //! Transmittance table T(s) (thesis eq. 5.12) in `baked/transmittance/`, from d'Eon's 6-Gaussian skin preset.
 
-use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use super::{json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::{self, TransmittanceSidecar};
 use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -35,8 +35,10 @@ pub fn table_files(
         y_label: if img.height > 1 { "identical rows".into() } else { String::new() },
         y_ticks: Vec::new(),
     };
-    let mut files = super::float_texture_files_with_preview(stem, &img, FileKind::Lut, &convention, VERIFY_TOLERANCE, &axes)?;
-    let mut meta = FileMeta::text(FileKind::Lut, FileFormat::Png, &format!("{convention}; 16-bit linear: value = sample/65535"));
+    let mut files =
+        super::float_texture_files_with_preview(stem, &img, FileKind::Lut, &convention, VERIFY_TOLERANCE, &axes)?;
+    let mut meta =
+        FileMeta::text(FileKind::Lut, FileFormat::Png, &format!("{convention}; 16-bit linear: value = sample/65535"));
     meta.width = img.width;
     meta.height = img.height;
     meta.channels = img.channels;

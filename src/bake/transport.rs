@@ -13,11 +13,11 @@
 //! so it verifies byte for byte); standard errors are listed beside every number. For tighter figures bake with
 //! more `photons`.
 
-use crate::manifest::{FileFormat, FileKind};
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path;
 use crate::diffusion::materials;
 use crate::error::InvalidInput;
+use crate::manifest::{FileFormat, FileKind};
 use crate::plot::profile::{render, PlotFormat, CHANNEL_COLORS};
 use crate::plot::{Curve, LinePlot};
 use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology, SkinProjection};
@@ -212,7 +212,9 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(BakedFile {
         path: format!("{}/difference_vs_albedo.svg", path::TRANSPORT_DIR),
         bytes: render(std::slice::from_ref(&plot), PlotFormat::Svg, &provenance)?,
-        meta: FileMeta::text(FileKind::Plot, FileFormat::Svg,
+        meta: FileMeta::text(
+            FileKind::Plot,
+            FileFormat::Svg,
             "(diffusion - Monte Carlo)/Monte Carlo total diffuse R in % over the reduced albedo of the top layer, \
              every case and channel, sorted by albedo, one line per family",
         ),

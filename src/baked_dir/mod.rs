@@ -83,7 +83,6 @@ fn list_files(dir: &Path) -> Result<BTreeSet<String>, BakeDirError> {
 #[cfg(test)]
 mod tests {
     use super::verify::compare;
-    use crate::manifest::{FileFormat, FileKind};
     use super::*;
     use crate::bake::Asset;
     use crate::bake::BakedFile;
@@ -93,6 +92,7 @@ mod tests {
     use crate::manifest::sha256_hex;
     use crate::manifest::Manifest;
     use crate::manifest::MANIFEST_NAME;
+    use crate::manifest::{FileFormat, FileKind};
     use serde_json::Value;
 
     fn ramp(params: &Value) -> Result<Vec<BakedFile>, BakeError> {

@@ -18,7 +18,8 @@
 //! place to change when the bake layout moves.
 
 use crate::baked_layout::{
-    path, schema, GaussiansFile, ImportanceKernelFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
+    path, schema, GaussiansFile, ImportanceKernelFile, RigDescription, SeparableKernelFile, SkinLutSidecar,
+    TransmittanceSidecar,
 };
 use crate::io::PixelFormat;
 use crate::manifest::{sha256_hex, ColorSpace, Entry, FileFormat, Manifest, ManifestError, SampleType};
