@@ -3,7 +3,7 @@
 //! against rtbake's diffusion model of the same stack. Parsing and validation only.
 
 use crate::cli::{usage, usage_msg, Ctx};
-use rtbake::diffusion::materials::{self, JENSEN_2001_ETA};
+use rtbake::diffusion::materials::JENSEN_2001_ETA;
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::source::ProfileSource;
 use rtbake::diffusion::FdrForm;
@@ -108,12 +108,8 @@ fn resolve(args: &TransportArgs) -> anyhow::Result<(McStack, Value, String)> {
         if args.skin_melanin.is_some() {
             return Err(usage_msg("--material and --skin-melanin are exclusive"));
         }
-        let m = materials::find(name).ok_or_else(|| {
-            usage_msg(format!(
-                "--material: '{name}' is not a known material; expected one of {}",
-                materials::names().join(", ")
-            ))
-        })?;
+        let m = rtbake::diffusion::source::jensen_material("--material", name)
+            .map_err(|e| usage_msg(format!("--material: {}", e.message)))?;
         let g = args.g;
         let stack = match args.thickness_mm {
             None => McStack::semi_infinite(m.sigma_a_per_mm, m.sigma_s_prime_per_mm, g, JENSEN_2001_ETA),

@@ -4,11 +4,8 @@
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::GAUSSIANS_DIR;
-use crate::diffusion::materials;
 use crate::diffusion::source::{with_reference, MaterialModel, ProfileSource};
-use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
-use crate::error::InvalidInput;
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings, NormalizedProfile, RgbGaussians};
 use crate::io::source::ShaderLang;
@@ -88,9 +85,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: PresetParams = parse_params("sss-gaussians", params)?;
     let mut files = Vec::new();
     for name in &p.presets {
-        let sog = preset(name).ok_or_else(|| {
-            InvalidInput::new("presets", format!("unknown preset '{name}' (known: {})", PRESET_NAMES.join(", ")))
-        })?;
+        let sog = crate::diffusion::source::gaussian_preset("presets", name)?;
         let sum = RgbGaussians::from(&sog);
         let mut extra = serde_json::Map::new();
         extra.insert(
@@ -134,12 +129,7 @@ pub fn fit_provenance(source: Value, settings: &FitSettings) -> Value {
 
 fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: FitParams = parse_params("sss-gaussians-fit", params)?;
-    let m = materials::find(&p.material).ok_or_else(|| {
-        InvalidInput::new(
-            "material",
-            format!("unknown material '{}' (known: {})", p.material, materials::names().join(", ")),
-        )
-    })?;
+    let m = super::jensen_material("material", &p.material)?;
     let profile = m.dipole(FdrForm::Dj05);
     let fit = fit_sum_of_gaussians(&profile, &p.fit).map_err(|e| match e {
         crate::fitting::GaussianFitError::Invalid(i) => BakeError::Invalid(i),

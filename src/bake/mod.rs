@@ -84,19 +84,7 @@ pub(crate) struct SkinPoint {
     pub(crate) hemoglobin_fraction: f64,
 }
 
-/// The Jensen 2001 material `name` of the asset parameter `param` (e.g. `materials`), refused naming the known ones.
-pub(crate) fn jensen_material(
-    param: &str,
-    name: &str,
-) -> Result<&'static crate::diffusion::materials::Material, crate::error::InvalidInput> {
-    use crate::diffusion::materials;
-    materials::find(name).ok_or_else(|| {
-        crate::error::InvalidInput::new(
-            param,
-            format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-        )
-    })
-}
+pub(crate) use crate::diffusion::source::jensen_material;
 
 /// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).
 fn split_zstd_param(asset: &str, params: &Value) -> Result<(Option<i32>, Value), BakeError> {

@@ -203,15 +203,7 @@ fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Val
     }
     for name in &p.presets {
         let lower = name.to_ascii_lowercase();
-        if sum_of_gaussians::preset(&lower).is_none() {
-            return Err(InvalidInput::new(
-                "presets",
-                format!(
-                    "'{name}' is not a known preset; expected one of {}",
-                    sum_of_gaussians::PRESET_NAMES.join(", ")
-                ),
-            ));
-        }
+        crate::diffusion::source::gaussian_preset("presets", name)?;
         out.push((
             format!("presets/{lower}"),
             format!("{lower} (sum of Gaussians)"),

@@ -165,12 +165,7 @@ fn default_fit_params() -> Value {
 
 fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: FitParams = parse_params("sss-separable-fit", params)?;
-    let profile = crate::diffusion::sum_of_gaussians::preset(&p.profile).ok_or_else(|| {
-        crate::error::InvalidInput::new(
-            "sss-separable-fit.profile",
-            format!("must be one of {:?}, got {:?}", crate::diffusion::sum_of_gaussians::PRESET_NAMES, p.profile),
-        )
-    })?;
+    let profile = crate::diffusion::source::gaussian_preset("sss-separable-fit.profile", &p.profile)?;
     let description = format!("{} profile preset (sum of Gaussians)", p.profile);
     let map = |e: fit::SeparableFitError| match e {
         fit::SeparableFitError::Invalid(i) => BakeError::Invalid(i),

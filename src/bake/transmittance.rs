@@ -2,8 +2,6 @@
 
 use super::{json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::{self, TransmittanceSidecar};
-use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
-use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
 use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
@@ -90,9 +88,7 @@ struct Params {
 
 fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: Params = parse_params("transmittance", params)?;
-    let sog = preset(&p.preset).ok_or_else(|| {
-        InvalidInput::new("preset", format!("unknown preset '{}' (known: {})", p.preset, PRESET_NAMES.join(", ")))
-    })?;
+    let sog = crate::diffusion::source::gaussian_preset("preset", &p.preset)?;
     let form = match p.table.form {
         TransmittanceForm::Published => "published",
         TransmittanceForm::Physical => "physical",

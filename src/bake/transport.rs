@@ -88,12 +88,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     crate::error::check_non_negative("far_r_mm", p.far_r_mm, "mm")?;
     let mut cases: Vec<(String, McStack)> = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let stack = McStack::semi_infinite(m.sigma_a_per_mm, m.sigma_s_prime_per_mm, p.g, materials::JENSEN_2001_ETA)?;
         cases.push((format!("dipole/{}", m.name), stack));
     }
