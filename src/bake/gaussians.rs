@@ -8,7 +8,6 @@ use crate::diffusion::source::{with_reference, MaterialModel, ProfileSource};
 use crate::diffusion::{FdrForm, RadialProfile};
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings, NormalizedProfile, RgbGaussians};
-use crate::io::source::ShaderLang;
 use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::fit_overlay_plot;
 use crate::plot::LinePlot;
@@ -40,16 +39,11 @@ pub fn gaussian_files(
     }
     let name = stem.rsplit('/').next().unwrap_or(stem);
     let mut files = vec![json_file(&format!("{stem}.json"), &Value::Object(obj), FileKind::Json, JSON_CONVENTION)];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{stem}.{ext}"),
-            ss.shader_include(lang, &format!("sum of Gaussians '{name}'")),
-            FileKind::ShaderInclude,
-            lang.into(),
-            "per-Gaussian constant arrays, index i = Gaussian i by ascending variance; float3 = (R, G, B)",
-        ));
-    }
+    files.extend(super::shader_include_files(
+        stem,
+        "per-Gaussian constant arrays, index i = Gaussian i by ascending variance; float3 = (R, G, B)",
+        |lang| ss.shader_include(lang, &format!("sum of Gaussians '{name}'")),
+    ));
     let img = plot.to_image(PLOT_WIDTH, PLOT_HEIGHT);
     let mut png_meta =
         FileMeta::text(FileKind::Plot, FileFormat::Png, "r*R(r) per channel on a log10 r axis (mm); fit dashed");

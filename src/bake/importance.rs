@@ -7,7 +7,7 @@
 //! HLSL / GLSL / WGSL includes and the raw `{name}_n{N}_f32x8.bin`. Burley profiles are sampled through their
 //! closed-form CDF, every other profile through the tabulated CDF.
 
-use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
+use super::{json_file, parse_params, Asset, BakeError, BakedFile};
 use crate::baked_layout::{path, schema, ImportanceKernelFile, ImportanceKernelSample};
 use crate::diffusion::burley::RgbBurley;
 use crate::diffusion::source::ProfileSource;
@@ -236,16 +236,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Va
         FileKind::Json,
         convention,
     )];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{stem}.{ext}"),
-            shader_include(k, lang, source),
-            FileKind::ShaderInclude,
-            lang.into(),
-            convention,
-        ));
-    }
+    files.extend(super::shader_include_files(&stem, convention, |lang| shader_include(k, lang, source)));
     let n = k.len() as u32;
     files.push(BakedFile {
         path: format!("{stem}_f32x8.bin"),

@@ -360,6 +360,22 @@ pub fn json_file(path: &str, value: &Value, kind: FileKind, convention: &str) ->
     BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, FileFormat::Json, convention) }
 }
 
+/// The HLSL, GLSL and WGSL includes of `stem` (`{stem}.hlsl`, `{stem}.glsl`, `{stem}.wgsl`), each the text
+/// `include(lang)`.
+pub fn shader_include_files(
+    stem: &str,
+    convention: &str,
+    include: impl Fn(io::source::ShaderLang) -> String,
+) -> Vec<BakedFile> {
+    io::source::ShaderLang::ALL
+        .into_iter()
+        .map(|lang| {
+            let path = format!("{stem}.{}", lang.extension());
+            text_file(&path, include(lang), FileKind::ShaderInclude, lang.into(), convention)
+        })
+        .collect()
+}
+
 /// A text file (source, CSV, SVG …).
 pub fn text_file(path: &str, text: String, kind: FileKind, format: FileFormat, convention: &str) -> BakedFile {
     BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, format, convention) }

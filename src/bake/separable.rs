@@ -9,7 +9,6 @@
 //! fitted 17-tap kernel.
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
-use crate::io::source::ShaderLang;
 use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::separable::fit::{self, ObjectiveSpec, TargetKernel};
 use crate::separable::kernel::{self, Kernel, KernelSpec, Precision};
@@ -91,16 +90,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, s
         FileKind::Json,
         convention,
     )];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{stem}.{ext}"),
-            k.shader_include(lang, source, sss_width),
-            FileKind::ShaderInclude,
-            lang.into(),
-            convention,
-        ));
-    }
+    files.extend(super::shader_include_files(&stem, convention, |lang| k.shader_include(lang, source, sss_width)));
     files.push(text_file(
         &format!("{stem}_SeparableSSS.h"),
         k.separable_sss_h(source),
