@@ -1,11 +1,11 @@
 //! Benchmark of the hemoglobin rig bake (thesis eq. 7.1-7.6): neutral + 8 targets at 4096², r = 32 texels,
-//! scale/bias stored at 256². Anchor (issue 5): <= 10 s on 2 cores; issue 17 goal: <= 2.5 s (2× its load/FP bound).
+//! scale/bias stored at 256². Anchor (the first rig bake): <= 10 s on 2 cores; performance goal: <= 2.5 s (2× its load/FP bound).
 //!
 //! `cargo run --release --example bench_facial [-- SIZE RADIUS RUNS]`; set RAYON_NUM_THREADS=2 to match the anchor.
 //! Inputs are the project's synthetic maps (512² tiles repeated; content does not affect the run time).
 //!
 //! Measured on the project's 2-core AMD EPYC machine (other builds running, load average 1–1.4),
-//! RAYON_NUM_THREADS=2, 5 runs, 2026-11-24, before and after issue 17 alternately (before = commit e7a7600): wall
+//! RAYON_NUM_THREADS=2, 5 runs, 2026-11-24, before and after the performance work alternately (before = commit e7a7600): wall
 //! median 3.15–3.23 s before (min 3.10, max 3.25; CPU 5.63–5.73 s), 1.48–1.49 s after (min 1.44, max 1.51; CPU
 //! 2.81–2.83 s): 2.2× faster, 0.59–0.60× the 2.5 s goal.
 

@@ -1,4 +1,4 @@
-//! Benchmark of the sum-of-Gaussians fitter (issue 3 anchor: a 6-Gaussian shared fit must take ≤ 0.5 s).
+//! Benchmark of the sum-of-Gaussians fitter (anchor: a 6-Gaussian shared fit must take ≤ 0.5 s).
 //!
 //! `cargo run --release --example bench_fitting [-- RUNS]` prints, for each case, the median wall time of RUNS
 //! (default 7, at least 5) runs and its ratio to the 0.5 s anchor, and checks that every run returns identical

@@ -1,6 +1,6 @@
 //! Benchmark: a three-layer skin-like profile (epidermis 0.25 mm, upper dermis 0.5 mm, dermis 20 mm; air above)
 //! evaluated at 1000 log-spaced radii in [0.001, 100] mm × 3 channels, R(r) and T(r), exact image series,
-//! symmetric adding — construction (k-space sampling) included. Goal (issue 3): ≤ 20 ms.
+//! symmetric adding — construction (k-space sampling) included. Goal (layered profiles): ≤ 20 ms.
 //!
 //! `cargo run --release --example bench_layered` prints the median wall time of 9 runs, the ratio to the 20 ms goal,
 //! the CPU time per run (all threads; wall time on a loaded machine overstates the work) and a checksum that must

@@ -1,4 +1,4 @@
-//! Benchmark of issue 11's profile tools against the existing Gaussian fit, measured side by side in one run.
+//! Benchmark of the profile tools (tabulated, Burley, layered) against the existing Gaussian fit, measured side by side in one run.
 //!
 //! `cargo run --release --example bench_profiles [-- RUNS]` prints, for each job, the median and min–max wall time
 //! of RUNS (default 7, at least 5) runs and its ratio to the anchor: the existing 6-Gaussian shared fit of the skin1

@@ -1,5 +1,5 @@
-//! Benchmark of the skin-colour LUT bake (issue 5; issue 17's goal): 256×256 at 1 nm, anchor ≤ 0.5 s on 2 cores,
-//! issue 17 goal ≤ 30 ms (2× its SIMD bound).
+//! Benchmark of the skin-colour LUT bake (anchor and performance goal): 256×256 at 1 nm, anchor ≤ 0.5 s on 2 cores,
+//! performance goal ≤ 30 ms (2× its SIMD bound).
 //!
 //! `cargo run --release --example bench_skin [-- RUNS THREADS]` (defaults 7 runs, 2 threads). Prints the median
 //! (and min–max) wall time and process CPU time (Linux `/proc/self/stat`) of (a) the table itself (`bake_lut`,
@@ -9,7 +9,7 @@
 //! the 30 ms goal.
 //!
 //! Measured on the project's 2-core AMD EPYC machine (other builds running, load average 1.3–1.5), 2 threads, 7 runs,
-//! 2026-11-24, before and after issue 17 alternately (before = commit e7a7600): table 0.163–0.164 s before (CPU
+//! 2026-11-24, before and after the performance work alternately (before = commit e7a7600): table 0.163–0.164 s before (CPU
 //! 0.32 s), 0.0332–0.0339 s after (min 0.0328, max 0.0401; CPU 0.06 s; 1 thread 0.064 s), 4.9× faster, of which the
 //! epidermis tables 0.011 s; 1.11–1.13× the 30 ms goal, not reached: a third of the time is the exact-series set-up
 //! (401 × 515 epidermis nodes, 256 × 401 dermis rows), which the vectorised loop does not touch. Whole asset 0.205 s
@@ -37,7 +37,7 @@ use rtbake::skin_color::SkinColorParams;
 use std::time::Instant;
 
 const ANCHOR_S: f64 = 0.5;
-/// Issue 17's goal for the table.
+/// The performance goal for the table.
 const GOAL_S: f64 = 0.030;
 
 /// User + system CPU seconds of this process (Linux), or NaN.

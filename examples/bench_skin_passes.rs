@@ -1,4 +1,4 @@
-//! Cost of the passes issue 14 part B adds to `run skin` (the rig's eq. 7.6 at the mesh's uv, the wrinkle pass of
+//! Cost of the rig and wrinkle passes added to `run skin` (the rig's eq. 7.6 at the mesh's uv, the wrinkle pass of
 //! Listing 8.1, bloom, the 4× MSAA G-buffer) at 1280×720 with the default head: each pass alone (its inputs
 //! prepared outside the timing, the host upload and read-back inside, as the chain runs it), then whole SS Full
 //! frames with no pass, the defaults (bloom on) and every pass. Median and min–max of 5 runs after a warm-up; the

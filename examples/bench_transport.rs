@@ -2,7 +2,7 @@
 //! MCML 2.0's `samples/sample1/sample1.mci` (Wang, Jacques & Zheng 1995):
 //! (a) van de Hulst's slab: μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0.75, n = 1, d = 0.02 cm, air both sides;
 //! (b) a semi-infinite medium: μa = 10 cm⁻¹, μs = 90 cm⁻¹, g = 0, n = 1.5 under air.
-//! The issue's goal is ≥ 2× MCML per core; issue 12's GPU goal is ≥ 10⁹ interaction steps/s on an H100.
+//! The goal is ≥ 2× MCML per core; the GPU transport's goal is ≥ 10⁹ interaction steps/s on an H100.
 //!
 //! `cargo run --release --example bench_transport` runs each case in rounds (5, or `RTBAKE_BENCH_ROUNDS`) of
 //! rtbake on 1 thread, MCML (when `RTBAKE_MCML` names an MCML 2.0 binary: one channel, its own tallies at the

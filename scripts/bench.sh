@@ -2,9 +2,9 @@
 # Runs every benchmark (release build) and prints, after their own reports (medians with min–max and the ratio to
 # each issue's anchor), the heavy jobs next to bounds measured on THIS machine by `bench_bounds` (memory bandwidth
 # by STREAM's triad, the f64 FLOP rate of the widest FMA path), the SIMD path each job takes here, and the ratio.
-# A bound is the job's work (fixed by issue 17's analysis) divided by this machine's rate:
+# A bound is the job's work (fixed by the performance analysis) divided by this machine's rate:
 #   skin LUT 0.95 GFLOP (15 ms at 63.5 GFLOP/s), hemoglobin rig 79 GFLOP (1.25 s at 63.5 GFLOP/s, its loads counted
-#   as flops), CPU SMAA 44.9 MB moved (2.3 ms at 19.5 GB/s) — the rates of the AVX-512F AMD EPYC issue 17 used.
+#   as flops), CPU SMAA 44.9 MB moved (2.3 ms at 19.5 GB/s) — the rates of the AVX-512F AMD EPYC the performance analysis used.
 #   scripts/bench.sh [BENCH ...]     (default: all; logs in bench-out/<bench>.txt)
 # Run it on an idle machine: the figures are wall-clock medians.
 set -euo pipefail
@@ -39,7 +39,7 @@ rig=$(sed -n 's/.*wall median \([0-9.]*\) s of.*/\1/p' "$OUT/bench_facial.txt" 2
 smaa=$(sed -n 's/^CPU reference SMAA 1x 1920x1080, 2 threads: \([0-9.]*\) ms.*/\1/p' "$OUT/bench_runtime.txt" 2>/dev/null)
 smaa_reused=$(sed -n 's/^CPU reference SMAA 1x 1920x1080, 2 threads, buffers reused: \([0-9.]*\) ms.*/\1/p' \
     "$OUT/bench_runtime.txt" 2>/dev/null)
-echo "== heavy jobs vs this machine's bounds ($gbps GB/s, $gflops GFLOP/s; issue 17's machine: 19.5 GB/s, 63.5 GFLOP/s)"
+echo "== heavy jobs vs this machine's bounds ($gbps GB/s, $gflops GFLOP/s; the analysis machine: 19.5 GB/s, 63.5 GFLOP/s)"
 printf '%-44s %12s %13s %8s\n' "job" "median" "bound" "ratio"
 row "skin LUT 256x256 at 1 nm (FLOP bound)" "$skin" "$(bound 952.5 "$gflops")" 2 "$(path skin-lut)"
 row "hemoglobin rig 4096x4096, 9 maps, r = 32 (FP)" "$rig" "$(bound 79375 "$gflops")" 2 "$(path rig)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CLI-level benchmarks of issue 17, side by side with an anchor binary.
+"""CLI-level benchmarks of the performance work, side by side with an anchor binary.
 
 usage: scripts/bench_cli.py [--anchor OLD_RTBAKE] [--runs N] [RTBAKE]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 15's trial, repeatable: concurrent bakes and verifies of one directory, and a kill at every step of the
+# The reliability trial, repeatable: concurrent bakes and verifies of one directory, and a kill at every step of the
 # bake's stage-and-swap; prints the counts of corrupt outcomes (must be 0).
 #   scripts/trial_reliability.sh [RTBAKE] [ROUNDS]     (defaults: target/debug/rtbake, 24)
 #   TRIAL_A / TRIAL_B name the two assets (defaults transmittance, smaa-search: a few ms each; burley-profiles and

@@ -29,20 +29,20 @@ pub const CARGO_LOCK: &str = env!("RTBAKE_CARGO_LOCK");
 /// Metadata recorded in the manifest for one file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FileMeta {
-    /// What the file is: `lut`, `preview`, `c-header`, `rust-source`, `shader-include`, `json`, `csv`, `plot`.
-    pub kind: String,
-    /// Container: `raw`, `dds`, `ktx2`, `png`, `exr`, `c`, `rust`, `hlsl`, `glsl`, `wgsl`, `json`, `csv`, `svg`.
-    pub format: String,
+    /// What the file is.
+    pub kind: FileKind,
+    /// Its container.
+    pub format: FileFormat,
     /// GPU texel format of the payload where it has one.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub pixel_format: Option<PixelFormat>,
     pub width: u32,
     pub height: u32,
     pub channels: u32,
-    /// `u8`, `u16`, `f16`, `f32`, or `text`.
-    pub sample_type: String,
+    /// The payload's sample type.
+    pub sample_type: SampleType,
     /// `linear` for every data texture; `srgb` only for labelled viewing previews; `n/a` for text.
-    pub color_space: String,
+    pub color_space: ColorSpace,
     /// Texel / index convention (how a shader maps coordinates to parameters), in words and formulas.
     pub convention: String,
     /// Absolute tolerance used by `verify` for float payloads (None: must be byte-identical).
@@ -55,19 +55,138 @@ pub struct FileMeta {
 
 impl FileMeta {
     /// Metadata of a text file (sources, JSON, CSV).
-    pub fn text(kind: &str, format: &str, convention: &str) -> Self {
+    pub fn text(kind: FileKind, format: FileFormat, convention: &str) -> Self {
         Self {
-            kind: kind.into(),
-            format: format.into(),
+            kind,
+            format,
             pixel_format: None,
             width: 0,
             height: 0,
             channels: 0,
-            sample_type: "text".into(),
-            color_space: "n/a".into(),
+            sample_type: SampleType::Text,
+            color_space: ColorSpace::NotApplicable,
             convention: convention.into(),
             verify_tolerance: None,
             supercompression: None,
+        }
+    }
+}
+
+/// Declares a closed vocabulary of the manifest: an enum serialised as the listed strings, with `as_str` and
+/// `Display` giving the same string (messages print what the manifest holds).
+macro_rules! vocabulary {
+    ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident = $text:literal,)+ }) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        pub enum $name {
+            $($(#[$vdoc])* #[serde(rename = $text)] $variant,)+
+        }
+
+        impl $name {
+            /// Every value, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant),+];
+
+            /// The string the manifest holds.
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $($name::$variant => $text,)+
+                }
+            }
+        }
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+    };
+}
+
+vocabulary! {
+    /// What a baked file is (the manifest's `kind`).
+    FileKind {
+        /// A data texture or table a shader samples.
+        Lut = "lut",
+        /// An sRGB-encoded picture of a table, for viewing only.
+        Preview = "preview",
+        /// A C header with a texture's bytes.
+        CHeader = "c-header",
+        /// A Rust source with a texture's bytes.
+        RustSource = "rust-source",
+        /// A shader include (HLSL, GLSL, WGSL).
+        ShaderInclude = "shader-include",
+        /// Bevy asset settings beside a texture.
+        BevyMeta = "bevy-meta",
+        /// A JSON description, report or parameter file.
+        Json = "json",
+        /// A CSV table.
+        Csv = "csv",
+        /// A plot (SVG or PNG).
+        Plot = "plot",
+        /// A sampling kernel's float payload.
+        Kernel = "kernel",
+        /// A float table that is not a texture.
+        Table = "table",
+        /// An input a command was given, kept beside its output.
+        Input = "input",
+        /// A map written by `rtbake maps`.
+        Map = "map",
+        /// A rendered frame (`rtbake run smaa --mode`).
+        Frame = "frame",
+    }
+}
+
+vocabulary! {
+    /// A baked file's container (the manifest's `format`).
+    FileFormat {
+        Raw = "raw",
+        Dds = "dds",
+        Ktx2 = "ktx2",
+        Png = "png",
+        Exr = "exr",
+        C = "c",
+        Rust = "rust",
+        Hlsl = "hlsl",
+        Glsl = "glsl",
+        Wgsl = "wgsl",
+        Json = "json",
+        Csv = "csv",
+        Svg = "svg",
+        Ron = "ron",
+    }
+}
+
+vocabulary! {
+    /// The type of a payload's samples (the manifest's `sample_type`).
+    SampleType {
+        U8 = "u8",
+        U16 = "u16",
+        F16 = "f16",
+        F32 = "f32",
+        /// Not a sampled payload.
+        Text = "text",
+    }
+}
+
+vocabulary! {
+    /// How a payload's values are encoded (the manifest's `color_space`).
+    ColorSpace {
+        /// Linear data: every data texture.
+        Linear = "linear",
+        /// sRGB-encoded: labelled viewing previews only.
+        Srgb = "srgb",
+        /// Text.
+        NotApplicable = "n/a",
+    }
+}
+
+impl From<crate::io::source::ShaderLang> for FileFormat {
+    fn from(lang: crate::io::source::ShaderLang) -> Self {
+        use crate::io::source::ShaderLang;
+        match lang {
+            ShaderLang::Hlsl => Self::Hlsl,
+            ShaderLang::Glsl => Self::Glsl,
+            ShaderLang::Wgsl => Self::Wgsl,
         }
     }
 }
@@ -231,5 +350,33 @@ impl Manifest {
 
     pub fn asset_params(&self, name: &str) -> Option<&Value> {
         self.assets.iter().find(|a| a.name == name).map(|a| &a.params)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each closed vocabulary serialises as the string `as_str` names, reads it back, and refuses a word outside it
+    /// (the manifest's bytes depend on these strings).
+    #[test]
+    fn vocabularies_serialise_as_their_manifest_strings() {
+        fn check<T: Copy + PartialEq + std::fmt::Debug + Serialize + serde::de::DeserializeOwned>(
+            all: &[T],
+            as_str: fn(T) -> &'static str,
+        ) {
+            for &v in all {
+                let json = serde_json::to_string(&v).unwrap();
+                assert_eq!(json, format!("\"{}\"", as_str(v)));
+                assert_eq!(serde_json::from_str::<T>(&json).unwrap(), v);
+            }
+            assert!(serde_json::from_str::<T>("\"not-a-word\"").is_err());
+        }
+        check(FileKind::ALL, FileKind::as_str);
+        check(FileFormat::ALL, FileFormat::as_str);
+        check(SampleType::ALL, SampleType::as_str);
+        check(ColorSpace::ALL, ColorSpace::as_str);
+        assert_eq!(ColorSpace::NotApplicable.to_string(), "n/a");
+        assert_eq!(FileKind::ShaderInclude.as_str(), "shader-include");
     }
 }

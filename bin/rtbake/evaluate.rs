@@ -10,9 +10,9 @@ use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::source::ProfileSource;
 use rtbake::diffusion::{FdrForm, RadialProfile};
 use rtbake::fitting::evaluate::compare_profiles;
-use rtbake::plot::line::{Curve, LinePlot};
-use rtbake::plot::profile::{overlay_plot, render, PlotFormat, CHANNEL_COLORS};
-use rtbake::separable::fit::{kernel_errors, model_row, ObjectiveSpec, TargetKernel};
+use rtbake::plot::profile::{overlay_plot, render, PlotFormat};
+use rtbake::plot::separable::separable_kernel_plot;
+use rtbake::separable::fit::{kernel_errors, ObjectiveSpec, TargetKernel};
 use rtbake::separable::SeparableParams;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -125,13 +125,8 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
 fn burley(a: &EvaluateArgs, albedo: &str) -> anyhow::Result<(RgbBurley, Value)> {
     let albedo = parse_rgb("--burley-albedo", albedo)?;
     let named_err = |e: rtbake::error::InvalidInput| {
-        let flag = if e.param.starts_with("albedo") {
-            "--burley-albedo"
-        } else if e.param.starts_with("d_mm") {
-            "--burley-d-mm"
-        } else {
-            "--burley-mfp-mm"
-        };
+        let flag =
+            crate::flags::flag_among(&e.param, &["--burley-albedo", "--burley-d-mm"]).unwrap_or("--burley-mfp-mm");
         usage(anyhow::anyhow!("{flag}: {e}"))
     };
     if let Some(d) = &a.burley_d_mm {
@@ -209,7 +204,7 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
             "metric": "pixel-filtered 2-D kernel on the fit grid of `rtbake fit separable`: sqrt(sum (S - s x s)^2 / sum S^2) and max |S - s x s| / max S, percent; both kernels have unit total",
             "total_difference": [0.0, 0.0, 0.0],
         });
-        let plot = plot_format.map(|_| separable_plot(&tk, &params, &target_label));
+        let plot = plot_format.map(|_| separable_kernel_plot(&tk, &params, &target_label));
         (report, plot, worst)
     } else {
         let (candidate, provenance): (Box<dyn RadialProfile>, Value) = if let Some(path) = &a.gaussians {
@@ -308,37 +303,5 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
             Err(anyhow::anyhow!("worst relative L2 error {worst:.3} % exceeds --max-error {m} %"))
         }
         _ => Ok(()),
-    }
-}
-
-/// The pixel-filtered target kernel S̃(x, 0) and the separable model s̃(x)·s̃(0) along the x axis, per channel.
-fn separable_plot(tk: &TargetKernel, params: &SeparableParams, label: &str) -> LinePlot {
-    let n = tk.nodes_mm.len();
-    let half = n / 2;
-    let names = ["R", "G", "B"];
-    let mut series = Vec::new();
-    for c in 0..3 {
-        let s = model_row(&tk.spec, params, c, &tk.nodes_mm);
-        let row: Vec<(f64, f64)> = (half..n).map(|i| (tk.nodes_mm[i], tk.values[c][i * n + half])).collect();
-        series.push(Curve {
-            label: format!("target {}", names[c]),
-            color: CHANNEL_COLORS[c],
-            dashed: false,
-            points: row,
-        });
-        series.push(Curve {
-            label: format!("separable {}", names[c]),
-            color: CHANNEL_COLORS[c].map(|v| v / 2),
-            dashed: true,
-            points: (half..n).map(|i| (tk.nodes_mm[i], s[i] * s[half])).collect(),
-        });
-    }
-    LinePlot {
-        title: format!("separable kernel vs {label} (pixel-filtered, y = 0)"),
-        x_label: "x (mm)".into(),
-        y_label: "kernel (1/mm^2)".into(),
-        log_x: false,
-        log_y: true,
-        series,
     }
 }

@@ -128,7 +128,12 @@ pub fn run(args: FitSeparableArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     }
     if let Some(dir) = &args.out {
-        files.push(rtbake::bake::json_file(&format!("fit_{name}.json"), &report, "json", "separable fit report"));
+        files.push(rtbake::bake::json_file(
+            &format!("fit_{name}.json"),
+            &report,
+            rtbake::bake::FileKind::Json,
+            "separable fit report",
+        ));
         let inputs: Vec<&std::path::Path> =
             args.layered.layers.iter().chain(&args.layered.profile_csv).map(|p| p.as_path()).collect();
         crate::cli::write_set(ctx, "--out", dir, &files, &inputs)?;

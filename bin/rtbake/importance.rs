@@ -86,11 +86,11 @@ impl ResolvedProfile {
             (None, None) => unreachable!("resolved"),
         };
         ImportanceKernel::new(sampled, samples).map_err(|e| {
-            let flag = match e.param.as_str() {
-                "samples" => "--samples".to_string(),
-                p if p.starts_with("albedo") => format!("--burley-albedo {p}"),
-                "profile" => "profile".to_string(),
-                p => format!("profile ({p})"),
+            let flag = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+                (_, Some(f @ "--samples")) => f.to_string(),
+                (p, Some(f @ "--burley-albedo")) => format!("{f} {p}"),
+                ("profile", _) => "profile".to_string(),
+                (p, _) => format!("profile ({p})"),
             };
             usage(anyhow::anyhow!("{flag} {}", e.message))
         })
@@ -124,7 +124,7 @@ pub fn run(args: ImportanceKernelArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if let Some(dir) = &args.out {
         prepare_out_dir("--out", dir)?;
     }
-    let stem = format!("{}_n{n}", resolved.stem);
+    let stem = rtbake::baked_layout::path::importance_kernel_stem(&resolved.stem, n);
     let source = format!("rtbake importance-kernel ({}, N = {n})", resolved.stem);
     let files = rtbake::bake::importance::kernel_files("", &stem, &k, &resolved.provenance, &source);
     if let Some(dir) = &args.out {

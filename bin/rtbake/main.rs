@@ -9,6 +9,7 @@ mod bake;
 mod cli;
 mod evaluate;
 mod fit;
+mod flags;
 mod importance;
 mod kernel;
 mod maps;

@@ -6,11 +6,13 @@
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use anyhow::Result;
 use rtbake::bake::facial::{self as bf, RigDescription, RigSource};
-use rtbake::bake::{BakedFile, FileMeta};
+use rtbake::bake::wrinkle_maps::{self, WrinkleConversion, WrinkleOutput};
+use rtbake::bake::{BakedFile, FileFormat, FileKind, FileMeta};
 use rtbake::error::InvalidInput;
 use rtbake::facial::disk_stats::Border;
 use rtbake::facial::hemoglobin_rig::{self, RigSettings};
 use rtbake::facial::inputs::{self, ValueRange};
+use rtbake::facial::wrinkles::WrinkleEncoding;
 use rtbake::facial::{synthetic, wrinkles};
 use rtbake::image_buf::Image;
 use rtbake::io;
@@ -395,7 +397,8 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
         read.push(dir.join(&m.bias_exr));
     }
     let read_refs: Vec<&Path> = read.iter().map(PathBuf::as_path).collect();
-    let file = BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text("map", "exr", "") };
+    let file =
+        BakedFile { path: out_name, bytes, meta: rtbake::manifest::FileMeta::text(FileKind::Map, FileFormat::Exr, "") };
     crate::cli::write_set(ctx, "--out", out_dir, &[file], &read_refs)?;
     let used: Vec<String> = names.iter().zip(&weights).map(|(n, w)| format!("{n}={w}")).collect();
     ctx.info(format!("wrote {} ({w}x{h}) with weights {}", a.out.display(), used.join(",")));
@@ -429,51 +432,13 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
             Some(img)
         }
     };
-    let (w, h) = (normal.width, normal.height);
-    let mut files = Vec::new();
-    let mut report = json!({
-        "schema": "rtbake-wrinkles/1",
-        "input": file_name(&a.normal),
-        "input_green": a.green,
-        "output_green": "directx",
-        "encoding": a.encoding,
-    });
-    if a.encoding == "difference" {
-        let Some(base) = &base else {
-            return Err(usage_msg("--base is required with --encoding difference (d = 0.5 + 0.5 (w - b))"));
-        };
-        let (d, clamped) = wrinkles::difference_map(&normal, base, green);
-        let (ow, oh, small) = wrinkles::downsample(&d, w, h, 3, a.size);
-        let img = wrinkles::difference_to_rgba8(ow, oh, &small);
-        files.extend(rtbake::bake::unorm8_texture_files(
-            "wrinkle_difference",
-            &img,
-            "lut",
-            "difference normal map d = 0.5 + 0.5*(w - b) of unit normals (thesis 8.2.1), RGB = xyz, A = 1; add 2*d - 1 to the base normal and renormalise; DirectX green",
-        )?);
-        report["wrinkle"] = json!({"files": "wrinkle_difference.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8B8A8_UNORM", "range_clamped_texels": clamped});
-        ctx.info(format!("difference map {ow}x{oh}: {clamped} texels had components outside [-1, 1] and were clamped"));
-    } else {
-        let (pd_files, mut wrinkle, base_report) =
-            bf::pd_wrinkle_files("", &normal, base.as_ref(), green, cone, a.size)?;
-        files.extend(pd_files);
-        let count = |v: &serde_json::Value, k: &str| v[k].as_u64().unwrap_or(0);
-        let cone_clamped = count(&wrinkle, "cone_clamped_texels")
-            + base_report.as_ref().map(|b| count(b, "cone_clamped_texels")).unwrap_or(0);
-        let range_clamped = count(&wrinkle, "range_clamped_texels");
-        wrinkle["relative_to_base"] = json!(base.is_some());
-        wrinkle["range_clamped_texels"] = json!(range_clamped);
-        if let Some(b) = base_report {
-            report["base"] = b;
-        }
-        let (ow, oh) = (wrinkle["size"][0].as_u64().unwrap_or(0), wrinkle["size"][1].as_u64().unwrap_or(0));
-        report["wrinkle"] = wrinkle;
-        ctx.info(format!(
-            "PD wrinkle map {ow}x{oh}: {cone_clamped} texels clamped to the 45-degree cone, {range_clamped} clamped to [-1, 1]"
-        ));
+    let encoding = if a.encoding == "difference" { WrinkleEncoding::Difference } else { WrinkleEncoding::Pd };
+    if encoding == WrinkleEncoding::Difference && base.is_none() {
+        return Err(usage_msg("--base is required with --encoding difference (d = 0.5 + 0.5 (w - b))"));
     }
-    report["composition"] = json!("n = normalize(base.xy + sum_z mask_z * weight_z * wrinkle.xy, 1), texel.rg -> 2*rg - 1 (thesis Listing 8.1; read .rg, not .gr)");
-    files.push(rtbake::bake::json_file("wrinkles.json", &report, "json", "wrinkle conversion report"));
+    let conversion = WrinkleConversion { input_name: file_name(&a.normal), green, cone, encoding, size: a.size };
+    let WrinkleOutput { files, report, summary } = wrinkle_maps::wrinkle_files(&normal, base.as_ref(), &conversion)?;
+    ctx.info(summary);
     let inputs_read: Vec<&Path> = std::iter::once(a.normal.as_path()).chain(a.base.as_deref()).collect();
     write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
     if ctx.json {
@@ -518,26 +483,8 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         masks[i] = Some(img.data.iter().map(|&v| v as f64).collect());
     }
     let (w, h, _) = dims.expect("clap requires at least one --zone");
-    let packed = wrinkles::pack_zone_masks(&masks, w, h, a.size);
-    let mut files = Vec::new();
-    for (i, img) in packed.iter().enumerate() {
-        files.extend(rtbake::bake::unorm8_texture_files(
-            &format!("wrinkle_masks_{i}"),
-            img,
-            "lut",
-            &bf::mask_convention(i),
-        )?);
-    }
-    let given: Vec<&str> = wrinkles::ZONES.iter().zip(&masks).filter(|(_, m)| m.is_some()).map(|(z, _)| *z).collect();
-    let report = json!({
-        "schema": "rtbake-wrinkle-masks/1",
-        "size": [packed[0].width, packed[0].height],
-        "format": "R8G8B8A8_UNORM",
-        "wrinkle_masks_0": {"r": "red", "g": "green", "b": "blue", "a": "brown"},
-        "wrinkle_masks_1": {"r": "cyan", "g": "magenta", "b": "orange", "a": "gray"},
-        "zones_given": given,
-    });
-    files.push(rtbake::bake::json_file("wrinkle_masks.json", &report, "json", "wrinkle mask packing"));
+    let (files, report, packed) = wrinkle_maps::mask_files(&masks, w, h, a.size)?;
+    let given = report["zones_given"].as_array().map_or(0, Vec::len);
     let inputs_read: Vec<&Path> = a
         .zones
         .iter()
@@ -545,12 +492,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         .filter_map(|z| z.split_once('=').map(|(_, f)| Path::new(f)))
         .collect();
     write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
-    ctx.info(format!(
-        "packed {} zone masks into 2 RGBA8 textures {}x{}",
-        given.len(),
-        packed[0].width,
-        packed[0].height
-    ));
+    ctx.info(format!("packed {given} zone masks into 2 RGBA8 textures {}x{}", packed[0], packed[1]));
     if ctx.json {
         ctx.emit_json(&report);
     }
@@ -566,7 +508,11 @@ fn run_synthetic(a: SyntheticArgs, ctx: &Ctx) -> Result<()> {
     let mut files = Vec::new();
     for (name, img) in &set {
         let bytes = io::png::encode_u16(img)?;
-        files.push(BakedFile { path: format!("{name}.png"), bytes, meta: FileMeta::text("input", "png", "") });
+        files.push(BakedFile {
+            path: format!("{name}.png"),
+            bytes,
+            meta: FileMeta::text(FileKind::Input, FileFormat::Png, ""),
+        });
     }
     let files = write_files(ctx, "--out", &a.out, files, &[], &Default::default())?;
     ctx.info(format!(

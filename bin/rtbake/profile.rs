@@ -11,7 +11,7 @@ use rtbake::diffusion::table::{self, ProfileTable};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::fitting::{fit_sum_of_gaussians, FitSettings};
-use rtbake::plot::profile::{profile_panels, render, PlotFormat};
+use rtbake::plot::profile::{profile_panels, render};
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -112,20 +112,17 @@ pub struct ProfileArgs {
 
 /// Renames library parameter names to the flags a user typed.
 fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
-    let param = match e.param.as_str() {
-        "material" => "--material".to_string(),
-        "profile_preset" => "--profile-preset".to_string(),
-        "thickness_mm" => "--thickness-mm".to_string(),
-        "radii" => "--radii".to_string(),
-        "r_min_mm" => "--r-min-mm".to_string(),
-        "r_max_mm" => "--r-max-mm".to_string(),
-        "count" => "--count".to_string(),
-        "--count" => "--overlay-fit".to_string(),
-        p if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
+    const PROFILE_FLAGS: [&str; 7] =
+        ["--material", "--profile-preset", "--thickness-mm", "--radii", "--r-min-mm", "--r-max-mm", "--count"];
+    let param = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+        (p, Some(f)) if PROFILE_FLAGS.contains(&f) && !p.contains('[') => f.to_string(),
+        // The overlay fit's count, which `fit_overlay_plot` names by its own flag.
+        ("--count", _) => "--overlay-fit".to_string(),
+        (p, _) if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
         },
-        p => p.to_string(),
+        (p, _) => p.to_string(),
     };
     usage(InvalidInput::new(param, e.message))
 }
@@ -230,20 +227,8 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
         None => table::log_radii(args.r_min_mm, args.r_max_mm, args.count).map_err(|e| flag_error(e, None))?,
     };
 
-    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
-    crate::profile_source::check_distinct_outputs(&outputs)?;
-    for (flag, path) in outputs {
-        if let Some(p) = path {
-            check_output_file(flag, p)?;
-            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
-            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
-                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
-        }
-    }
-    let plot_format = match &args.plot {
-        Some(path) => Some(PlotFormat::from_path("--plot", path).map_err(usage)?),
-        None => None,
-    };
+    let plot_format =
+        crate::profile_source::check_table_outputs(&args.csv, &args.out, &args.plot, args.layers.as_slice())?;
     let fit_settings =
         args.overlay_fit.map(|count| FitSettings { count, shared_variances: true, normalize: false, starts: 8 });
     if let Some(s) = &fit_settings {

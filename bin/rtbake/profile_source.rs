@@ -74,11 +74,7 @@ impl McArgs {
             self.seed.unwrap_or(1),
         )
         .map_err(|e| {
-            let flag = match e.param.as_str() {
-                "g" => "--g",
-                "photons" => "--photons",
-                _ => "--model mc",
-            };
+            let flag = crate::flags::flag_among(&e.param, &["--g", "--photons"]).unwrap_or("--model mc");
             usage(anyhow::anyhow!("{flag}: {}", e.message))
         })
     }
@@ -98,6 +94,30 @@ pub fn check_source_time(ctx: &Ctx, source: &ProfileSource, radii: usize) -> any
 /// (`total_R_se`) and the negative mass a spectral projection clipped (`clipped_negative_mass`).
 pub fn add_standard_errors(provenance: &mut Value, profile: &dyn RadialProfile) {
     rtbake::diffusion::source::add_built_provenance(provenance, profile);
+}
+
+/// Checks the `--csv`, `--out` and `--plot` files of a profile-table command before any work (distinct, writable,
+/// none of them one of the `--layers` inputs) and returns the plot's format.
+pub fn check_table_outputs(
+    csv: &Option<PathBuf>,
+    out: &Option<PathBuf>,
+    plot: &Option<PathBuf>,
+    layers: &[PathBuf],
+) -> anyhow::Result<Option<rtbake::plot::profile::PlotFormat>> {
+    let outputs = [("--csv", csv), ("--out", out), ("--plot", plot)];
+    check_distinct_outputs(&outputs)?;
+    for (flag, path) in outputs {
+        if let Some(p) = path {
+            crate::profile::check_output_file(flag, p)?;
+            let inputs: Vec<&std::path::Path> = layers.iter().map(PathBuf::as_path).collect();
+            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
+                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
+        }
+    }
+    match plot {
+        Some(path) => Ok(Some(rtbake::plot::profile::PlotFormat::from_path("--plot", path).map_err(usage)?)),
+        None => Ok(None),
+    }
 }
 
 /// Refuses (exit 2) two output flags naming the same file (`--csv X --out X` would leave only the last write).
@@ -256,11 +276,8 @@ pub fn physiological_skin(
 ) -> anyhow::Result<(ProfileSource, Value)> {
     physiological_skin_source(&SkinPhysiology::default(), &projection, cm, chd, adding, series, fdr, transport).map_err(
         |e| {
-            let flag = match e.param.as_str() {
-                "melanin_fraction" => "--skin-melanin",
-                "hemoglobin_fraction" => "--skin-hemoglobin",
-                _ => "--skin-melanin/--skin-hemoglobin",
-            };
+            let flag = crate::flags::flag_among(&e.param, &["--skin-melanin", "--skin-hemoglobin"])
+                .unwrap_or("--skin-melanin/--skin-hemoglobin");
             usage(anyhow::anyhow!("{flag}: {e}"))
         },
     )
@@ -351,7 +368,7 @@ impl BurleyArgs {
         let (albedo, mean_free_path_mm) = (three("--burley-albedo", albedo)?, three("--burley-mfp-mm", mfp)?);
         let fit = ShapeFit::from(self.burley_fit);
         let profile = RgbBurley::from_mean_free_path(albedo, mean_free_path_mm, fit).map_err(|e| {
-            let flag = if e.param.starts_with("albedo") { "--burley-albedo" } else { "--burley-mfp-mm" };
+            let flag = crate::flags::flag_among(&e.param, &["--burley-albedo"]).unwrap_or("--burley-mfp-mm");
             usage(InvalidInput::new(flag, format!("{}: {}", e.param, e.message)))
         })?;
         Ok(Some((profile, ProfileSource::Burley { albedo, mean_free_path_mm, fit })))

@@ -4,7 +4,7 @@
 use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::image_buf::Image;
 use rtbake::io;
-use rtbake::manifest::{BakedFile, FileMeta};
+use rtbake::manifest::{BakedFile, ColorSpace, FileFormat, FileKind, FileMeta, SampleType};
 use rtbake::runtime::chain::SmaaSequence;
 use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
 use rtbake::runtime::smaa_modes::{self, ModeFrame, SmaaMode, TemporalResolve};
@@ -99,14 +99,14 @@ fn read_user_frames(dir: &Path, mode: SmaaMode) -> anyhow::Result<(u32, u32, Vec
 fn frame_file(n: u64, w: u32, h: u32, rgba: Vec<u8>) -> anyhow::Result<BakedFile> {
     let bytes = io::png::encode_u8_frame(&Image::from_vec(w, h, 4, rgba))?;
     let meta = FileMeta {
-        kind: "frame".into(),
-        format: "png".into(),
+        kind: FileKind::Frame,
+        format: FileFormat::Png,
         pixel_format: None,
         width: w,
         height: h,
         channels: 4,
-        sample_type: "u8".into(),
-        color_space: "srgb".into(),
+        sample_type: SampleType::U8,
+        color_space: ColorSpace::Srgb,
         convention: "RGBA8 sRGB-encoded, top row first".into(),
         verify_tolerance: None,
         supercompression: None,

@@ -3,13 +3,12 @@
 //! against rtbake's diffusion model of the same stack. Parsing and validation only.
 
 use crate::cli::{usage, usage_msg, Ctx};
-use crate::profile::check_output_file;
-use rtbake::diffusion::materials::{self, JENSEN_2001_ETA};
+use rtbake::diffusion::materials::JENSEN_2001_ETA;
 use rtbake::diffusion::multipole::Series;
 use rtbake::diffusion::source::ProfileSource;
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
-use rtbake::plot::profile::{render, PlotFormat};
+use rtbake::plot::profile::render;
 use rtbake::runtime::chain;
 use rtbake::runtime::device::create_headless;
 use rtbake::runtime::RuntimeError;
@@ -78,13 +77,10 @@ pub struct TransportArgs {
 
 /// Library parameter names → the flags a user typed.
 fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
-    let param = match e.param.as_str() {
-        "photons" => "--photons".to_string(),
-        "batches" => "--batches".to_string(),
-        "bin_mm" => "--bin-mm".to_string(),
-        "bins" => "--bins".to_string(),
-        "g" => "--g".to_string(),
-        p => match layers_file {
+    const TRANSPORT_FLAGS: [&str; 5] = ["--photons", "--batches", "--bin-mm", "--bins", "--g"];
+    let param = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
+        (p, Some(f)) if TRANSPORT_FLAGS.contains(&f) && !p.contains('[') => f.to_string(),
+        (p, _) => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
         },
@@ -112,12 +108,8 @@ fn resolve(args: &TransportArgs) -> anyhow::Result<(McStack, Value, String)> {
         if args.skin_melanin.is_some() {
             return Err(usage_msg("--material and --skin-melanin are exclusive"));
         }
-        let m = materials::find(name).ok_or_else(|| {
-            usage_msg(format!(
-                "--material: '{name}' is not a known material; expected one of {}",
-                materials::names().join(", ")
-            ))
-        })?;
+        let m = rtbake::diffusion::source::jensen_material("--material", name)
+            .map_err(|e| usage_msg(format!("--material: {}", e.message)))?;
         let g = args.g;
         let stack = match args.thickness_mm {
             None => McStack::semi_infinite(m.sigma_a_per_mm, m.sigma_s_prime_per_mm, g, JENSEN_2001_ETA),
@@ -164,20 +156,8 @@ pub fn run(args: TransportArgs, ctx: &Ctx) -> anyhow::Result<()> {
     // g: `McSettings::time_estimate_for_stack`), on either path.
     let seconds = seconds.max(settings.time_estimate_for_stack(&stack, rayon::current_num_threads()));
     ctx.check_time(&format!("--photons {} in this stack (its albedo and g)", args.photons), seconds)?;
-    let outputs = [("--csv", &args.csv), ("--out", &args.out), ("--plot", &args.plot)];
-    crate::profile_source::check_distinct_outputs(&outputs)?;
-    for (flag, path) in outputs {
-        if let Some(p) = path {
-            check_output_file(flag, p)?;
-            let inputs: Vec<&Path> = args.layers.iter().map(PathBuf::as_path).collect();
-            rtbake::io::file_set::check_outputs_not_inputs(std::slice::from_ref(p), &inputs)
-                .map_err(|e| usage(anyhow::anyhow!("{flag}: {e}")))?;
-        }
-    }
-    let plot_format = match &args.plot {
-        Some(path) => Some(PlotFormat::from_path("--plot", path).map_err(usage)?),
-        None => None,
-    };
+    let plot_format =
+        crate::profile_source::check_table_outputs(&args.csv, &args.out, &args.plot, args.layers.as_slice())?;
     provenance["model"] = json!("monte-carlo (MCML, Wang, Jacques & Zheng 1995)");
     let gpu = if args.gpu {
         let g = create_headless(&Default::default()).map_err(|e| usage(anyhow::anyhow!("--gpu: {e}")))?;

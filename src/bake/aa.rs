@@ -21,10 +21,11 @@ use crate::aa::smaa_search;
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::io::source::{c_header_u8, rust_source_u8, DataNotice};
+use crate::manifest::{FileFormat, FileKind};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-pub use crate::baked_layout::path::{MLAA_DIR, SMAA_DIR};
+pub use crate::baked_layout::path::{self, MLAA_DIR, SMAA_DIR};
 
 impl From<SmaaAreaError> for BakeError {
     fn from(e: SmaaAreaError) -> Self {
@@ -176,14 +177,8 @@ pub fn mlaa_convention(version: MlaaVersion, n: u32) -> String {
     )
 }
 
-/// Default file stem (without folder) of an MLAA map.
-pub fn mlaa_stem(version: MlaaVersion, n: u32) -> String {
-    match version {
-        MlaaVersion::V2 if n == 15 => "AreaTex_MLAAv2".into(),
-        MlaaVersion::V2 => format!("AreaTex{n}_MLAAv2"),
-        v => format!("AreaMap{n}_{}", v.label()),
-    }
-}
+/// Default file stem (without folder) of an MLAA map ([`crate::baked_layout::path::mlaa_area_name`]).
+pub use crate::baked_layout::path::mlaa_area_name as mlaa_stem;
 
 /// Files of an MLAA area map under `stem` in `formats`; the sources are `stem.h` (`AREAMAP_*`, `areaMapBytes`)
 /// and `stem.rs` (`AREAMAP_*`, `AREAMAP_BYTES`).
@@ -212,32 +207,18 @@ pub fn mlaa_files_with_progress(
     let others = TextureFormats { bin: false, ..formats };
     let mut files = texture_with_sources(stem, &img, &convention, others, ("AREAMAP", "areaMapBytes"), from)?;
     if formats.bin {
-        files.insert(0, crate::bake::unorm8_bin_file(stem, img, "lut", &convention));
+        files.insert(0, crate::bake::unorm8_bin_file(stem, img, FileKind::Lut, &convention));
     }
     Ok(files)
 }
 
-/// Bevy's file names for the SMAA LUTs (`bevy_anti_alias/src/smaa/`).
-pub const BEVY_AREA_LUT: &str = "SMAAAreaLUT.ktx2";
-pub const BEVY_SEARCH_LUT: &str = "SMAASearchLUT.ktx2";
-
 /// The KTX2 file Bevy embeds for this texture: same payload, Zstandard level 15 ([`crate::io::ktx2::BEVY_ZSTD_LEVEL`]).
 pub fn bevy_zstd_file(path: &str, img: &Image<u8>, convention: &str) -> Result<BakedFile, BakeError> {
-    use crate::io::{self, ktx2::Supercompression, PixelFormat};
+    use crate::io::{self, ktx2::Supercompression};
     let sc = Supercompression::Zstd(io::ktx2::BEVY_ZSTD_LEVEL);
-    let meta = crate::manifest::FileMeta {
-        kind: "lut".into(),
-        format: "ktx2".into(),
-        pixel_format: PixelFormat::unorm8_for(img.channels),
-        width: img.width,
-        height: img.height,
-        channels: img.channels,
-        sample_type: "u8".into(),
-        color_space: "linear".into(),
-        convention: format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it"),
-        verify_tolerance: None,
-        supercompression: Some(sc.label()),
-    };
+    let mut meta = super::unorm8_meta(img, FileKind::Lut, convention, FileFormat::Ktx2);
+    meta.convention = format!("{convention}; named and supercompressed as Bevy's bevy_anti_alias ships it");
+    meta.supercompression = Some(sc.label());
     Ok(BakedFile { path: path.into(), bytes: io::ktx2::encode_u8_with(img, sc)?, meta })
 }
 
@@ -249,16 +230,16 @@ fn texture_with_sources(
     (prefix, array): (&str, &str),
     from: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let mut files = unorm8_texture_files_in(stem, img, "lut", convention, formats)?;
+    let mut files = unorm8_texture_files_in(stem, img, FileKind::Lut, convention, formats)?;
     let note = format!("{convention}; generated source, bytes identical to {stem}.bin");
     let notice = if prefix == "AREAMAP" { DataNotice::Mlaa } else { DataNotice::Smaa };
     if formats.c_header {
         let header = c_header_u8(prefix, array, img, from, notice);
-        files.push(text_file(&format!("{stem}.h"), header, "c-header", "c", &note));
+        files.push(text_file(&format!("{stem}.h"), header, FileKind::CHeader, FileFormat::C, &note));
     }
     if formats.rust_source {
         let rust = rust_source_u8(prefix, img, from, notice);
-        files.push(text_file(&format!("{stem}.rs"), rust, "rust-source", "rust", &note));
+        files.push(text_file(&format!("{stem}.rs"), rust, FileKind::RustSource, FileFormat::Rust, &note));
     }
     Ok(files)
 }
@@ -285,7 +266,7 @@ fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<Ba
     }
     let mut files = Vec::new();
     for &n in &p.max_distances {
-        let stem = format!("{MLAA_DIR}/{}", mlaa_stem(version, n));
+        let stem = path::mlaa_area_stem(version, n);
         files.extend(mlaa_files(version, n, &stem, TextureFormats::BINARY, &from_line(asset))?);
     }
     Ok(files)
@@ -301,11 +282,11 @@ pub fn assets() -> Vec<Asset> {
                 let p: SmaaAreaParams = parse_params("smaa-area", v)?;
                 let img = smaa_area_texture(&p)?;
                 let convention = smaa_area_convention(&p, img.width, img.height);
-                let stem = format!("{SMAA_DIR}/AreaTex");
+                let stem = path::SMAA_AREA_STEM;
                 let names = ("AREATEX", "areaTexBytes");
                 let from = from_line("smaa-area");
-                let mut files = texture_with_sources(&stem, &img, &convention, TextureFormats::ALL, names, &from)?;
-                files.push(bevy_zstd_file(&format!("{SMAA_DIR}/{BEVY_AREA_LUT}"), &img, &convention)?);
+                let mut files = texture_with_sources(stem, &img, &convention, TextureFormats::ALL, names, &from)?;
+                files.push(bevy_zstd_file(path::SMAA_AREA_BEVY, &img, &convention)?);
                 Ok(files)
             },
         },
@@ -315,12 +296,7 @@ pub fn assets() -> Vec<Asset> {
             default_params: || json(SmaaAreaParams::v2_8()),
             bake: |v| {
                 let p: SmaaAreaParams = parse_params("smaa-area-v2.8", v)?;
-                smaa_area_files(
-                    &format!("{SMAA_DIR}/AreaTex_v2.8"),
-                    &p,
-                    TextureFormats::BINARY,
-                    &from_line("smaa-area-v2.8"),
-                )
+                smaa_area_files(path::SMAA_AREA_V2_8_STEM, &p, TextureFormats::BINARY, &from_line("smaa-area-v2.8"))
             },
         },
         Asset {
@@ -331,13 +307,12 @@ pub fn assets() -> Vec<Asset> {
                 let _: NoParams = parse_params("smaa-search", v)?;
                 let mut files = search_files(
                     SearchKind::Current,
-                    &format!("{SMAA_DIR}/SearchTex"),
+                    path::SMAA_SEARCH_STEM,
                     TextureFormats::ALL,
                     &from_line("smaa-search"),
                 )?;
                 let convention = search_convention(SearchKind::Current);
-                let path = format!("{SMAA_DIR}/{BEVY_SEARCH_LUT}");
-                files.push(bevy_zstd_file(&path, &smaa_search::search_texture(), &convention)?);
+                files.push(bevy_zstd_file(path::SMAA_SEARCH_BEVY, &smaa_search::search_texture(), &convention)?);
                 Ok(files)
             },
         },
@@ -348,15 +323,10 @@ pub fn assets() -> Vec<Asset> {
             bake: |v| {
                 let _: NoParams = parse_params("smaa-search-v2.8", v)?;
                 let from = from_line("smaa-search-v2.8");
-                let mut f = search_files(
-                    SearchKind::V2_8,
-                    &format!("{SMAA_DIR}/SearchTex_v2.8"),
-                    TextureFormats::BINARY,
-                    &from,
-                )?;
+                let mut f = search_files(SearchKind::V2_8, path::SMAA_SEARCH_V2_8_STEM, TextureFormats::BINARY, &from)?;
                 f.extend(search_files(
                     SearchKind::LogicalPrecrop,
-                    &format!("{SMAA_DIR}/SearchTex_logical_precrop"),
+                    path::SMAA_SEARCH_PRECROP_STEM,
                     TextureFormats::BINARY,
                     &from,
                 )?);
@@ -387,6 +357,7 @@ pub fn assets() -> Vec<Asset> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::manifest::ColorSpace;
 
     #[test]
     fn every_asset_bakes_its_defaults_under_aa_and_params_round_trip() {
@@ -398,7 +369,7 @@ mod tests {
             assert!(!files.is_empty());
             for f in &files {
                 assert!(f.path.starts_with("aa/smaa/") || f.path.starts_with("aa/mlaa/"), "{}", f.path);
-                assert!(f.meta.color_space == "linear" || f.meta.color_space == "n/a");
+                assert!(matches!(f.meta.color_space, ColorSpace::Linear | ColorSpace::NotApplicable));
             }
             assert_eq!((a.bake)(&back).unwrap(), files, "{}: deterministic", a.name);
         }

@@ -30,6 +30,7 @@ use crate::error::InvalidInput;
 use crate::fitting::burley_fit::fit_burley;
 use crate::fitting::evaluate::{compare_profiles, ProfileErrors};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::{overlay_plot, render, PlotFormat, CHANNEL_COLORS, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::plot::{Curve, LinePlot};
 use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};
@@ -40,12 +41,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// One physiological two-layer skin point.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SkinPoint {
-    melanin_fraction: f64,
-    hemoglobin_fraction: f64,
-}
+use super::SkinPoint;
 
 /// The transmission-profile tables.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -112,12 +108,7 @@ fn artist_mapping(m: &materials::Material, totals: [f64; 3]) -> Result<RgbBurley
 fn cases(p: &Params) -> Result<Vec<Case>, BakeError> {
     let mut v = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let source = ProfileSource::Material {
             name: m.name.into(),
             model: MaterialModel::Dipole,
@@ -233,10 +224,10 @@ fn fit_case(case: &Case) -> Result<CaseResult, BakeError> {
 /// A one-panel plot as an sRGB PNG with its image metadata.
 fn png_plot_file(path: &str, plot: &LinePlot, convention: &str) -> Result<BakedFile, BakeError> {
     let img = plot.to_image(PLOT_WIDTH, PANEL_HEIGHT);
-    let mut meta = FileMeta::text("plot", "png", convention);
+    let mut meta = FileMeta::text(FileKind::Plot, FileFormat::Png, convention);
     (meta.width, meta.height, meta.channels) = (img.width, img.height, img.channels);
-    meta.sample_type = "u8".into();
-    meta.color_space = "srgb".into();
+    meta.sample_type = SampleType::U8;
+    meta.color_space = ColorSpace::Srgb;
     Ok(BakedFile {
         path: path.into(),
         bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
@@ -366,7 +357,7 @@ fn transmission_files(
     files.push(BakedFile {
         path: format!("{stem}.svg"),
         bytes: render(std::slice::from_ref(&plot), PlotFormat::Svg, reference)?,
-        meta: FileMeta::text("plot", "svg", CONVENTION),
+        meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, CONVENTION),
     });
     files.push(png_plot_file(&format!("{stem}.png"), &plot, CONVENTION)?);
     Ok(files)
@@ -390,7 +381,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         files.push(BakedFile {
             path: format!("{BURLEY_DIR}/{}.svg", case.name),
             bytes: render(std::slice::from_ref(&r.plot), PlotFormat::Svg, &r.record)?,
-            meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+            meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
         });
         if p.png_plots.contains(&case.name) {
             files.push(png_plot_file(&format!("{BURLEY_DIR}/{}.png", case.name), &r.plot, PLOT_CONVENTION)?);
@@ -416,14 +407,14 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(text_file(
         &format!("{BURLEY_DIR}/fits.csv"),
         csv,
-        "table",
-        "csv",
+        FileKind::Table,
+        FileFormat::Csv,
         "Burley fit (and artist mapping for materials) per case and channel: A, d (mm), errors in percent",
     ));
     files.push(json_file(
         &format!("{BURLEY_DIR}/fits.json"),
         &json!({"provenance": reference, "cases": results.iter().map(|r| r.record.clone()).collect::<Vec<_>>()}),
-        "table",
+        FileKind::Table,
         "Burley fits per case: fit and artist parameters with their errors against the target profile",
     ));
     Ok(files)

@@ -3,23 +3,23 @@
 //! (thesis ch. 8). Also the file encoders shared with `rtbake maps` (the CLI writes the same files).
 
 use super::{json_file, parse_params, unorm8_texture_files, Asset, BakeError, BakedFile, FileMeta};
-use crate::error::InvalidInput;
 use crate::facial::disk_stats::Border;
 use crate::facial::hemoglobin_rig::{self, HemoglobinRig, RigSettings};
 use crate::facial::{synthetic, wrinkles};
 use crate::image_buf::Image;
 use crate::io::{self, exr::ExrPrecision, PixelFormat};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 pub use crate::baked_layout::path::{RIG_EXAMPLE_DIR, WRINKLES_DIR};
 pub use crate::baked_layout::schema::HEMOGLOBIN_RIG as RIG_SCHEMA;
-pub use crate::baked_layout::{RigDescription, RigH0Files, RigMapFiles, RigSource};
+pub use crate::baked_layout::{rig_from_description, RigDescription, RigH0Files, RigMapFiles, RigSource};
 
 #[allow(clippy::too_many_arguments)]
 fn float_meta(
-    format: &str,
-    st: &str,
+    format: FileFormat,
+    st: SampleType,
     w: u32,
     h: u32,
     ch: u32,
@@ -28,14 +28,14 @@ fn float_meta(
     tol: f64,
 ) -> FileMeta {
     FileMeta {
-        kind: "lut".into(),
-        format: format.into(),
+        kind: FileKind::Lut,
+        format,
         pixel_format: pf,
         width: w,
         height: h,
         channels: ch,
-        sample_type: st.into(),
-        color_space: "linear".into(),
+        sample_type: st,
+        color_space: ColorSpace::Linear,
         convention: conv.into(),
         verify_tolerance: Some(tol),
         supercompression: None,
@@ -54,14 +54,14 @@ fn preview_file(
     let data = values.iter().map(|&v| wrinkles::encode_unorm8((v as f64 - lo) / (hi - lo))).collect();
     let bytes = io::png::encode_u8(&Image::from_vec(w, h, 1, data))?;
     let meta = FileMeta {
-        kind: "preview".into(),
-        format: "png".into(),
+        kind: FileKind::Preview,
+        format: FileFormat::Png,
         pixel_format: None,
         width: w,
         height: h,
         channels: 1,
-        sample_type: "u8".into(),
-        color_space: "linear".into(),
+        sample_type: SampleType::U8,
+        color_space: ColorSpace::Linear,
         convention: format!("viewing only: gray = ({what} - {lo}) / ({hi} - {lo}), clamped; not for sampling"),
         verify_tolerance: Some(1.0),
         supercompression: None,
@@ -80,17 +80,17 @@ fn exr_pair(dir: &str, stem: &str, w: u32, h: u32, v: &[f32], conv: &str) -> Res
         BakedFile {
             path: format!("{dir}{stem}_rgb.exr"),
             bytes: io::exr::encode(&rgb, ExrPrecision::F32)?,
-            meta: float_meta("exr", "f32", w, h, 3, None, &rgb_conv, 1e-6),
+            meta: float_meta(FileFormat::Exr, SampleType::F32, w, h, 3, None, &rgb_conv, 1e-6),
         },
         BakedFile {
             path: format!("{dir}{stem}.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F32)?,
-            meta: float_meta("exr", "f32", w, h, 1, None, conv, 1e-6),
+            meta: float_meta(FileFormat::Exr, SampleType::F32, w, h, 1, None, conv, 1e-6),
         },
         BakedFile {
             path: format!("{dir}{stem}_f16.exr"),
             bytes: io::exr::encode(&img, ExrPrecision::F16)?,
-            meta: float_meta("exr", "f16", w, h, 1, None, conv, 1e-3),
+            meta: float_meta(FileFormat::Exr, SampleType::F16, w, h, 1, None, conv, 1e-3),
         },
     ])
 }
@@ -125,7 +125,7 @@ pub fn hemoglobin_rig_files(
     files.push(BakedFile {
         path: format!("{dir}h0.ktx2"),
         bytes: io::ktx2::encode_f16(&h0_img)?,
-        meta: float_meta("ktx2", "f16", w, h, 1, Some(PixelFormat::R16Sfloat), h0_conv, 1e-3),
+        meta: float_meta(FileFormat::Ktx2, SampleType::F16, w, h, 1, Some(PixelFormat::R16Sfloat), h0_conv, 1e-3),
     });
     let amp = rig.h0.iter().fold(0.0f64, |a, &b| a.max((b as f64).abs())).max(1e-12);
     files.push(preview_file(format!("{dir}h0_preview.png"), w, h, &rig.h0, -amp, amp, "H0")?);
@@ -149,8 +149,8 @@ pub fn hemoglobin_rig_files(
             path: format!("{dir}{n}_scale_bias.ktx2"),
             bytes: io::ktx2::encode_f16(&Image::from_vec(rw, rh, 2, packed))?,
             meta: float_meta(
-                "ktx2",
-                "f16",
+                FileFormat::Ktx2,
+                SampleType::F16,
                 rw,
                 rh,
                 2,
@@ -210,9 +210,9 @@ pub fn hemoglobin_rig_files(
     };
     let value = serde_json::to_value(&desc).map_err(|e| BakeError::Other(e.to_string()))?;
     files.push(json_file(
-        &format!("{dir}{}", crate::baked_layout::path::RIG_FILE_NAME),
+        &crate::baked_layout::path::rig_description(dir),
         &value,
-        "json",
+        FileKind::Json,
         &format!("hemoglobin rig description (schema {RIG_SCHEMA})"),
     ));
     Ok((files, desc))
@@ -262,14 +262,14 @@ fn bake_rig_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             path: path.clone(),
             bytes: io::png::encode_u16(img)?,
             meta: FileMeta {
-                kind: "input".into(),
-                format: "png".into(),
+                kind: FileKind::Input,
+                format: FileFormat::Png,
                 pixel_format: None,
                 width: img.width,
                 height: img.height,
                 channels: 1,
-                sample_type: "u16".into(),
-                color_space: "linear".into(),
+                sample_type: SampleType::U16,
+                color_space: ColorSpace::Linear,
                 convention: "synthetic hemoglobin map: dermal volume fraction = sample / 65535".into(),
                 verify_tolerance: None,
                 supercompression: None,
@@ -341,20 +341,20 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     crate::error::check_range("wrinkle_size", p.wrinkle_size, 1, 4096, "texels")?;
     crate::error::check_range("mask_size", p.mask_size, 1, 4096, "texels")?;
     crate::error::check_range("strength", p.strength, 0.0, 10.0, "")?;
-    let dir = format!("{WRINKLES_DIR}/example/");
+    let dir = format!("{}/", crate::baked_layout::path::WRINKLE_EXAMPLE_DIR);
     let normal = synthetic::wrinkle_normal_map(p.size, p.strength);
     let mut files = vec![BakedFile {
         path: format!("{dir}input/wrinkle_normal.png"),
         bytes: io::png::encode_u8(&normal)?,
         meta: FileMeta {
-            kind: "input".into(),
-            format: "png".into(),
+            kind: FileKind::Input,
+            format: FileFormat::Png,
             pixel_format: None,
             width: p.size,
             height: p.size,
             channels: 3,
-            sample_type: "u8".into(),
-            color_space: "linear".into(),
+            sample_type: SampleType::U8,
+            color_space: ColorSpace::Linear,
             convention: "synthetic tangent-space normal map, n = 2*rgb/255 - 1, DirectX green convention".into(),
             verify_tolerance: None,
             supercompression: None,
@@ -379,7 +379,12 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let masks: [Option<Vec<f64>>; 8] = std::array::from_fn(|i| Some(masks[i].clone()));
     let packed = wrinkles::pack_zone_masks(&masks, p.size, p.size, p.mask_size);
     for (i, img) in packed.iter().enumerate() {
-        files.extend(unorm8_texture_files(&format!("{dir}wrinkle_masks_{i}"), img, "lut", &mask_convention(i))?);
+        files.extend(unorm8_texture_files(
+            &crate::baked_layout::path::wrinkle_masks_stem(&dir, i),
+            img,
+            FileKind::Lut,
+            &mask_convention(i),
+        )?);
     }
     let report = json!({
         "schema": crate::baked_layout::schema::WRINKLES,
@@ -391,15 +396,15 @@ fn bake_wrinkle_example(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "masks": {"files": ["wrinkle_masks_0.{bin,dds,ktx2,png}", "wrinkle_masks_1.{bin,dds,ktx2,png}"], "size": [p.mask_size.min(p.size), p.mask_size.min(p.size)], "format": "R8G8B8A8_UNORM", "zones": wrinkles::ZONES},
         "weights": "../expression_weights.json",
     });
-    files.push(json_file(&format!("{dir}wrinkles.json"), &report, "json", "wrinkle example description"));
+    files.push(json_file(&format!("{dir}wrinkles.json"), &report, FileKind::Json, "wrinkle example description"));
     Ok(files)
 }
 
 fn bake_weights(_params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     Ok(vec![json_file(
         &format!("{WRINKLES_DIR}/expression_weights.json"),
-        &wrinkles::table_8_1_json(),
-        "json",
+        &wrinkles::table_8_1_json(crate::baked_layout::schema::WRINKLE_WEIGHTS),
+        FileKind::Json,
         "thesis Table 8.1 wrinkle weights per expression and zone (negative values cancel)",
     )])
 }
@@ -427,83 +432,6 @@ pub fn assets() -> Vec<Asset> {
     ]
 }
 
-/// The one reader of a hemoglobin rig: rebuilds it from its description (`rig.json`, [`RigDescription`]) and the
-/// EXR files it names, for `rtbake maps rig-eval` and the runtime's loader. `read(file)` returns the bytes of a file
-/// named relative to the rig's folder (the caller does the I/O, and may check each file against a manifest first);
-/// checked here: the schema, the sizes, at least one map and the neutral map first (eq. 7.6 blends targets over
-/// it), every map single-channel at the size the description states with finite values. Errors name `param` (the
-/// flag the user gave, or the file's path) and the file. A renderer adds only its own limits (the number of
-/// targets a pass holds, the hemoglobin range its LUT indexes).
-pub fn rig_from_description(
-    param: &str,
-    desc: &RigDescription,
-    read: &mut dyn FnMut(&str) -> Result<Vec<u8>, InvalidInput>,
-) -> Result<HemoglobinRig, InvalidInput> {
-    if desc.schema != RIG_SCHEMA {
-        return Err(InvalidInput::new(param, format!("schema '{}', expected '{RIG_SCHEMA}'", desc.schema)));
-    }
-    let [w, h] = desc.full_size;
-    let [rw, rh] = desc.rig_size;
-    crate::error::check_size(&format!("{param} full_size"), w as u64, h as u64)?;
-    crate::error::check_size(&format!("{param} rig_size"), rw as u64, rh as u64)?;
-    match desc.maps.first() {
-        None => return Err(InvalidInput::new(param, "lists no maps; a rig needs the neutral map first")),
-        Some(m) if m.name != "neutral" => {
-            return Err(InvalidInput::new(
-                param,
-                format!("maps[0] is {:?}; eq. 7.6 needs the neutral map first", m.name),
-            ))
-        }
-        Some(_) => {}
-    }
-    let mut map = |file: &str, (mw, mh): (u32, u32)| -> Result<Vec<f32>, InvalidInput> {
-        let bytes = read(file)?;
-        let (img, _) = io::exr::decode(&bytes, file).map_err(|e| InvalidInput::new(param, e.to_string()))?;
-        if (img.width, img.height, img.channels) != (mw, mh, 1) {
-            return Err(InvalidInput::new(
-                param,
-                format!("{file} is {}x{}x{}, the rig says {mw}x{mh}x1", img.width, img.height, img.channels),
-            ));
-        }
-        if let Some(i) = img.data.iter().position(|v| !v.is_finite()) {
-            return Err(InvalidInput::new(
-                param,
-                format!(
-                    "{file}: texel ({}, {}) is {}; a rig map must be finite",
-                    i % mw as usize,
-                    i / mw as usize,
-                    img.data[i]
-                ),
-            ));
-        }
-        Ok(img.data)
-    };
-    let h0 = map(&desc.h0.exr, (w, h))?;
-    let mut maps = Vec::with_capacity(desc.maps.len());
-    for m in &desc.maps {
-        maps.push(hemoglobin_rig::RigMap {
-            name: m.name.clone(),
-            scale: map(&m.scale_exr, (rw, rh))?,
-            bias: map(&m.bias_exr, (rw, rh))?,
-        });
-    }
-    Ok(HemoglobinRig {
-        width: w,
-        height: h,
-        rig_width: rw,
-        rig_height: rh,
-        settings: RigSettings {
-            radius_texels: desc.radius_texels,
-            border: desc.border,
-            sigma_floor: desc.sigma_floor,
-            rig_size: rw.max(rh),
-        },
-        h0,
-        maps,
-        sigma_floored_texels: desc.sigma_floored_texels,
-    })
-}
-
 /// A partial-derivative wrinkle map (thesis ch. 8) from decoded unit normals: PD conversion (cone handling
 /// `cone`), optional difference against a base map's PD, area downsampling to `size` and the 8-bit texture
 /// files `{prefix}wrinkle_pd.*` (and `{prefix}base_pd.*` with a base). Returns the files, the `"wrinkle"` report
@@ -526,7 +454,7 @@ pub fn pd_wrinkle_files(
             files.extend(unorm8_texture_files(
                 &format!("{prefix}base_pd"),
                 &wrinkles::pd_to_rg8(w, h, &bpd.pd),
-                "lut",
+                FileKind::Lut,
                 PD_CONVENTION,
             )?);
             let report = json!({"files": "base_pd.{bin,dds,ktx2,png}", "size": [w, h], "format": "R8G8_UNORM",
@@ -538,9 +466,9 @@ pub fn pd_wrinkle_files(
     };
     let (ow, oh, small) = wrinkles::downsample(&values, w, h, 2, size);
     files.extend(unorm8_texture_files(
-        &format!("{prefix}wrinkle_pd"),
+        &crate::baked_layout::path::wrinkle_pd_stem(prefix),
         &wrinkles::pd_to_rg8(ow, oh, &small),
-        "lut",
+        FileKind::Lut,
         PD_CONVENTION,
     )?);
     let mut report = json!({"files": "wrinkle_pd.{bin,dds,ktx2,png}", "size": [ow, oh], "format": "R8G8_UNORM"});

@@ -4,14 +4,11 @@
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::path::GAUSSIANS_DIR;
-use crate::diffusion::materials;
 use crate::diffusion::source::{with_reference, MaterialModel, ProfileSource};
-use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
 use crate::diffusion::{FdrForm, RadialProfile};
-use crate::error::InvalidInput;
 use crate::fitting::screen_space::{ScreenSpaceParams, StretchParams};
 use crate::fitting::{fit_sum_of_gaussians, FitSettings, NormalizedProfile, RgbGaussians};
-use crate::io::source::ShaderLang;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::fit_overlay_plot;
 use crate::plot::LinePlot;
 use serde::{Deserialize, Serialize};
@@ -41,24 +38,20 @@ pub fn gaussian_files(
         obj.insert(k, v);
     }
     let name = stem.rsplit('/').next().unwrap_or(stem);
-    let mut files = vec![json_file(&format!("{stem}.json"), &Value::Object(obj), "json", JSON_CONVENTION)];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{stem}.{ext}"),
-            ss.shader_include(lang, &format!("sum of Gaussians '{name}'")),
-            "shader-include",
-            ext,
-            "per-Gaussian constant arrays, index i = Gaussian i by ascending variance; float3 = (R, G, B)",
-        ));
-    }
+    let mut files = vec![json_file(&format!("{stem}.json"), &Value::Object(obj), FileKind::Json, JSON_CONVENTION)];
+    files.extend(super::shader_include_files(
+        stem,
+        "per-Gaussian constant arrays, index i = Gaussian i by ascending variance; float3 = (R, G, B)",
+        |lang| ss.shader_include(lang, &format!("sum of Gaussians '{name}'")),
+    ));
     let img = plot.to_image(PLOT_WIDTH, PLOT_HEIGHT);
-    let mut png_meta = FileMeta::text("plot", "png", "r*R(r) per channel on a log10 r axis (mm); fit dashed");
+    let mut png_meta =
+        FileMeta::text(FileKind::Plot, FileFormat::Png, "r*R(r) per channel on a log10 r axis (mm); fit dashed");
     png_meta.width = img.width;
     png_meta.height = img.height;
     png_meta.channels = 3;
-    png_meta.sample_type = "u8".into();
-    png_meta.color_space = "srgb".into();
+    png_meta.sample_type = SampleType::U8;
+    png_meta.color_space = ColorSpace::Srgb;
     files.push(BakedFile {
         path: format!("{stem}_plot.png"),
         bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
@@ -67,8 +60,8 @@ pub fn gaussian_files(
     files.push(text_file(
         &format!("{stem}_plot.svg"),
         plot.to_svg(PLOT_WIDTH, PLOT_HEIGHT),
-        "plot",
-        "svg",
+        FileKind::Plot,
+        FileFormat::Svg,
         "r*R(r) per channel on a log10 r axis (mm); fit dashed",
     ));
     Ok(files)
@@ -86,9 +79,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: PresetParams = parse_params("sss-gaussians", params)?;
     let mut files = Vec::new();
     for name in &p.presets {
-        let sog = preset(name).ok_or_else(|| {
-            InvalidInput::new("presets", format!("unknown preset '{name}' (known: {})", PRESET_NAMES.join(", ")))
-        })?;
+        let sog = crate::diffusion::source::gaussian_preset("presets", name)?;
         let sum = RgbGaussians::from(&sog);
         let mut extra = serde_json::Map::new();
         extra.insert(
@@ -99,7 +90,7 @@ fn bake_presets(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             ),
         );
         let plot = fit_overlay_plot(&sum, None, &format!("{name}: r R(r), sum of Gaussians"));
-        files.extend(gaussian_files(&format!("{GAUSSIANS_DIR}/{name}"), &sum, p.stretch, extra, &plot)?);
+        files.extend(gaussian_files(&crate::baked_layout::path::gaussians_stem(name), &sum, p.stretch, extra, &plot)?);
     }
     Ok(files)
 }
@@ -132,12 +123,7 @@ pub fn fit_provenance(source: Value, settings: &FitSettings) -> Value {
 
 fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: FitParams = parse_params("sss-gaussians-fit", params)?;
-    let m = materials::find(&p.material).ok_or_else(|| {
-        InvalidInput::new(
-            "material",
-            format!("unknown material '{}' (known: {})", p.material, materials::names().join(", ")),
-        )
-    })?;
+    let m = super::jensen_material("material", &p.material)?;
     let profile = m.dipole(FdrForm::Dj05);
     let fit = fit_sum_of_gaussians(&profile, &p.fit).map_err(|e| match e {
         crate::fitting::GaussianFitError::Invalid(i) => BakeError::Invalid(i),

@@ -7,14 +7,15 @@
 //! HLSL / GLSL / WGSL includes and the raw `{name}_n{N}_f32x8.bin`. Burley profiles are sampled through their
 //! closed-form CDF, every other profile through the tabulated CDF.
 
-use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
-use crate::baked_layout::{path, schema};
+use super::{json_file, parse_params, Asset, BakeError, BakedFile};
+use crate::baked_layout::{path, schema, ImportanceKernelFile, ImportanceKernelSample};
 use crate::diffusion::burley::RgbBurley;
 use crate::diffusion::source::ProfileSource;
 use crate::io::source::{ShaderInclude, ShaderLang};
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::sss_sampling::disk::{self, ImportanceKernel, SampledProfile, CUTOFF_QUANTILE};
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 pub use crate::baked_layout::path::IMPORTANCE_DIR as DIR;
 
@@ -136,45 +137,51 @@ fn r9(x: f64) -> f64 {
 
 const CHANNELS: [&str; 3] = ["red", "green", "blue"];
 
-/// The kernel file (schema `rtbake-importance-kernel/1`): what was sampled and how, the cut-off, the totals, the
-/// binary layout and the samples `{r_mm, theta_rad, x_mm, y_mm, pdf_per_mm2, weight, weight_unnormalised}`.
-pub fn kernel_json(k: &ImportanceKernel, provenance: &Value, source: &str) -> Value {
-    let samples: Vec<Value> = k
+/// The kernel file ([`ImportanceKernelFile`], schema [`schema::IMPORTANCE_KERNEL`]): what was sampled and how, the
+/// cut-off, the totals, the binary layout and the samples.
+pub fn kernel_file(k: &ImportanceKernel, provenance: &Value, source: &str) -> ImportanceKernelFile {
+    let kernel = k
         .samples
         .iter()
         .map(|s| {
             let [x, y] = s.offset_mm();
-            json!({
-                "r_mm": r9(s.r_mm),
-                "theta_rad": r9(s.theta_rad),
-                "x_mm": r9(x),
-                "y_mm": r9(y),
-                "pdf_per_mm2": r9(s.pdf_per_mm2),
-                "weight": s.weight.map(r9),
-                "weight_unnormalised": s.weight_unnormalised.map(r9),
-            })
+            ImportanceKernelSample {
+                r_mm: r9(s.r_mm),
+                theta_rad: r9(s.theta_rad),
+                x_mm: r9(x),
+                y_mm: r9(y),
+                pdf_per_mm2: r9(s.pdf_per_mm2),
+                weight: s.weight.map(r9),
+                weight_unnormalised: s.weight_unnormalised.map(r9),
+            }
         })
         .collect();
-    json!({
-        "schema": schema::IMPORTANCE_KERNEL,
-        "source": source,
-        "profile": provenance,
-        "samples": k.len(),
-        "sampled_channel": CHANNELS[k.sampled_channel],
-        "sampled_channel_rule": "the channel with the largest mean radius of its normalised radial density",
-        "mean_radius_mm": k.mean_radius_mm.map(r9),
-        "inversion": k.inversion.name(),
-        "quantiles": "u_i = (i + 0.5)/N of the sampled channel's radial CDF F(r) = int_0^r 2 pi r' R(r') dr' / total",
-        "angles": "theta_i = i * pi * (3 - sqrt(5)) (golden angle), offset = r_i (cos theta_i, sin theta_i) mm",
-        "pdf": "area density of the sampled channel R_s(r)/A_s, mm^-2",
-        "weights": "w_c,i = R_c(r_i)/pdf(r_i)/N (weight_unnormalised, sums to the estimated total); weight = w / sum_i w per channel",
-        "estimated_totals": k.estimated_totals.map(r9),
-        "profile_totals": k.profile_totals.map(r9),
-        "cutoff_quantile": CUTOFF_QUANTILE,
-        "cutoff_mm": r9(k.cutoff_mm),
-        "binary_layout": BINARY_LAYOUT,
-        "kernel": samples,
-    })
+    ImportanceKernelFile {
+        schema: schema::IMPORTANCE_KERNEL.into(),
+        source: source.into(),
+        profile: provenance.clone(),
+        samples: k.len(),
+        sampled_channel: CHANNELS[k.sampled_channel].into(),
+        sampled_channel_rule: "the channel with the largest mean radius of its normalised radial density".into(),
+        mean_radius_mm: k.mean_radius_mm.map(r9),
+        inversion: k.inversion.name().into(),
+        quantiles: "u_i = (i + 0.5)/N of the sampled channel's radial CDF F(r) = int_0^r 2 pi r' R(r') dr' / total"
+            .into(),
+        angles: "theta_i = i * pi * (3 - sqrt(5)) (golden angle), offset = r_i (cos theta_i, sin theta_i) mm".into(),
+        pdf: "area density of the sampled channel R_s(r)/A_s, mm^-2".into(),
+        weights: "w_c,i = R_c(r_i)/pdf(r_i)/N (weight_unnormalised, sums to the estimated total); weight = w / sum_i w per channel".into(),
+        estimated_totals: k.estimated_totals.map(r9),
+        profile_totals: k.profile_totals.map(r9),
+        cutoff_quantile: CUTOFF_QUANTILE,
+        cutoff_mm: r9(k.cutoff_mm),
+        binary_layout: BINARY_LAYOUT.into(),
+        kernel,
+    }
+}
+
+/// [`kernel_file`] as a JSON value (the file's content; `rtbake importance-kernel --json` adds its `files`).
+pub fn kernel_json(k: &ImportanceKernel, provenance: &Value, source: &str) -> Value {
+    serde_json::to_value(kernel_file(k, provenance, source)).expect("the kernel file always serialises")
 }
 
 /// HLSL / GLSL / WGSL include: `SSS_IMPORTANCE_N_SAMPLES`, `SSS_IMPORTANCE_CUTOFF_MM`, the float4 array
@@ -221,33 +228,28 @@ pub fn f32x8_le_bytes(k: &ImportanceKernel) -> Vec<u8> {
 /// Files of one kernel: `{dir}/{stem}.json`, `.hlsl`, `.glsl`, `.wgsl` and `{stem}_f32x8.bin`. Pure;
 /// `rtbake importance-kernel --out` uses it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Value, source: &str) -> Vec<BakedFile> {
-    let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
+    let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = "importance-sampled disk kernel: offsets in mm, weights normalised per channel";
-    let mut files =
-        vec![json_file(&format!("{prefix}{stem}.json"), &kernel_json(k, provenance, source), "json", convention)];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{prefix}{stem}.{ext}"),
-            shader_include(k, lang, source),
-            "shader-include",
-            ext,
-            convention,
-        ));
-    }
+    let mut files = vec![json_file(
+        &crate::baked_layout::path::json(&stem),
+        &kernel_json(k, provenance, source),
+        FileKind::Json,
+        convention,
+    )];
+    files.extend(super::shader_include_files(&stem, convention, |lang| shader_include(k, lang, source)));
     let n = k.len() as u32;
     files.push(BakedFile {
-        path: format!("{prefix}{stem}_f32x8.bin"),
+        path: format!("{stem}_f32x8.bin"),
         bytes: f32x8_le_bytes(k),
         meta: crate::manifest::FileMeta {
-            kind: "kernel".into(),
-            format: "raw".into(),
+            kind: FileKind::Kernel,
+            format: FileFormat::Raw,
             pixel_format: None,
             width: n,
             height: 1,
             channels: 8,
-            sample_type: "f32".into(),
-            color_space: "n/a".into(),
+            sample_type: SampleType::F32,
+            color_space: ColorSpace::NotApplicable,
             convention: BINARY_LAYOUT.into(),
             verify_tolerance: None,
             supercompression: None,
@@ -259,6 +261,7 @@ pub fn kernel_files(dir: &str, stem: &str, k: &ImportanceKernel, provenance: &Va
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn importance_asset_bakes_every_profile_and_budget_deterministically() {

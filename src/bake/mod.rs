@@ -11,7 +11,7 @@ use crate::image_buf::Image;
 use crate::io::{self, exr::ExrPrecision, PixelFormat};
 use serde_json::Value;
 
-pub use crate::manifest::{BakedFile, FileMeta};
+pub use crate::manifest::{BakedFile, ColorSpace, FileFormat, FileKind, FileMeta, SampleType};
 
 /// Errors while baking an asset.
 #[derive(Debug, thiserror::Error)]
@@ -68,20 +68,32 @@ pub fn bevy_meta_files(files: &[BakedFile]) -> Vec<BakedFile> {
     let present: std::collections::HashSet<&str> = files.iter().map(|f| f.path.as_str()).collect();
     files
         .iter()
-        .filter(|f| io::bevy_meta::wants_meta(&f.meta.format, &f.meta.color_space))
+        .filter(|f| io::bevy_meta::wants_meta(f.meta.format.as_str(), f.meta.color_space.as_str()))
         .map(|f| io::bevy_meta::meta_path(&f.path))
         .filter(|meta| !present.contains(meta.as_str()))
         .map(|meta| {
             text_file(
                 &meta,
                 io::bevy_meta::linear_image_meta(),
-                "bevy-meta",
-                "ron",
+                FileKind::BevyMeta,
+                FileFormat::Ron,
                 "Bevy asset settings for the texture of the same name (ImageLoader, is_srgb: false: linear data)",
             )
         })
         .collect()
 }
+
+/// One physiological skin point of an asset's parameters (the two-layer skin's concentrations).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkinPoint {
+    /// Cm, 0..=0.5.
+    pub(crate) melanin_fraction: f64,
+    /// Chd, 0..=0.32.
+    pub(crate) hemoglobin_fraction: f64,
+}
+
+pub(crate) use crate::diffusion::source::jensen_material;
 
 /// Splits the common `ktx2_zstd` key off an asset's parameters (validated: an integer level 1..=22).
 fn split_zstd_param(asset: &str, params: &Value) -> Result<(Option<i32>, Value), BakeError> {
@@ -129,6 +141,7 @@ pub mod separable;
 pub mod skin;
 pub mod transmittance;
 pub mod transport;
+pub mod wrinkle_maps;
 
 /// Writes an 8-bit UNORM texture as raw `.bin`, DDS (DX10 `{stem}.dds` and legacy-header `{stem}_dx9.dds`), KTX2
 /// and PNG (`{stem}.bin`, …). `convention` describes the
@@ -136,7 +149,7 @@ pub mod transport;
 pub fn unorm8_texture_files(
     stem: &str,
     img: &Image<u8>,
-    kind: &str,
+    kind: FileKind,
     convention: &str,
 ) -> Result<Vec<BakedFile>, BakeError> {
     unorm8_texture_files_in(stem, img, kind, convention, TextureFormats::BINARY)
@@ -168,21 +181,21 @@ impl TextureFormats {
 }
 
 /// The manifest metadata of an 8-bit UNORM texture file in `format` (`raw`, `dds`, `ktx2`, `png`).
-fn unorm8_meta(img: &Image<u8>, kind: &str, convention: &str, format: &str) -> FileMeta {
+fn unorm8_meta(img: &Image<u8>, kind: FileKind, convention: &str, format: FileFormat) -> FileMeta {
     let mut meta = FileMeta {
-        kind: kind.into(),
-        format: format.into(),
+        kind,
+        format,
         pixel_format: PixelFormat::unorm8_for(img.channels),
         width: img.width,
         height: img.height,
         channels: img.channels,
-        sample_type: "u8".into(),
-        color_space: "linear".into(),
+        sample_type: SampleType::U8,
+        color_space: ColorSpace::Linear,
         convention: convention.into(),
         verify_tolerance: None,
         supercompression: None,
     };
-    if format == "png" && img.channels == 2 {
+    if format == FileFormat::Png && img.channels == 2 {
         meta.convention = format!("{convention}; PNG stores RGB with R, G in red and green and B = 0");
         meta.channels = 3;
         meta.pixel_format = None;
@@ -192,8 +205,8 @@ fn unorm8_meta(img: &Image<u8>, kind: &str, convention: &str, format: &str) -> F
 
 /// The raw `{stem}.bin` of an 8-bit UNORM texture, taking the texture's bytes without a copy (a large MLAA map is
 /// 52 MB: `rtbake aa … --format bin` encodes the other formats first, then moves the map into this file).
-pub fn unorm8_bin_file(stem: &str, img: Image<u8>, kind: &str, convention: &str) -> BakedFile {
-    let meta = unorm8_meta(&img, kind, convention, "raw");
+pub fn unorm8_bin_file(stem: &str, img: Image<u8>, kind: FileKind, convention: &str) -> BakedFile {
+    let meta = unorm8_meta(&img, kind, convention, FileFormat::Raw);
     BakedFile { path: format!("{stem}.bin"), bytes: img.data, meta }
 }
 
@@ -202,11 +215,11 @@ pub fn unorm8_bin_file(stem: &str, img: Image<u8>, kind: &str, convention: &str)
 pub fn unorm8_texture_files_in(
     stem: &str,
     img: &Image<u8>,
-    kind: &str,
+    kind: FileKind,
     convention: &str,
     formats: TextureFormats,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let meta = |format: &str| unorm8_meta(img, kind, convention, format);
+    let meta = |format: FileFormat| unorm8_meta(img, kind, convention, format);
     // The encoders are independent: PNG compression (the costly one) runs beside the containers.
     let (png, (dds, ktx2)) = rayon::join(
         || formats.png.then(|| io::png::encode_u8(img)).transpose(),
@@ -219,14 +232,14 @@ pub fn unorm8_texture_files_in(
     );
     let mut files = Vec::new();
     if formats.bin {
-        files.push(BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta("raw") });
+        files.push(BakedFile { path: format!("{stem}.bin"), bytes: img.data.clone(), meta: meta(FileFormat::Raw) });
     }
     if let Some(bytes) = dds? {
-        files.push(BakedFile { path: format!("{stem}.dds"), bytes, meta: meta("dds") });
+        files.push(BakedFile { path: format!("{stem}.dds"), bytes, meta: meta(FileFormat::Dds) });
         // The legacy-header copy for readers without DX10 support (ImageMagick 6, OpenImageIO 2.4).
         let (name, ..) = io::dds::legacy_format(img.channels)
             .ok_or_else(|| BakeError::Other(format!("{stem}: no legacy DDS format for {} channels", img.channels)))?;
-        let mut legacy = meta("dds");
+        let mut legacy = meta(FileFormat::Dds);
         legacy.convention = format!(
             "{}; legacy DDS header, {name}{}",
             legacy.convention,
@@ -239,10 +252,10 @@ pub fn unorm8_texture_files_in(
         files.push(BakedFile { path: format!("{stem}_dx9.dds"), bytes: io::dds::encode_u8_legacy(img)?, meta: legacy });
     }
     if let Some(bytes) = ktx2? {
-        files.push(BakedFile { path: format!("{stem}.ktx2"), bytes, meta: meta("ktx2") });
+        files.push(BakedFile { path: format!("{stem}.ktx2"), bytes, meta: meta(FileFormat::Ktx2) });
     }
     if let Some(bytes) = png? {
-        files.push(BakedFile { path: format!("{stem}.png"), bytes, meta: meta("png") });
+        files.push(BakedFile { path: format!("{stem}.png"), bytes, meta: meta(FileFormat::Png) });
     }
     Ok(files)
 }
@@ -253,7 +266,7 @@ pub fn unorm8_texture_files_in(
 pub fn float_texture_files(
     stem: &str,
     img: &Image<f32>,
-    kind: &str,
+    kind: FileKind,
     convention: &str,
     tolerance: f64,
 ) -> Result<Vec<BakedFile>, BakeError> {
@@ -268,28 +281,33 @@ pub fn float_texture_files(
 pub fn float_texture_files_with_preview(
     stem: &str,
     img: &Image<f32>,
-    kind: &str,
+    kind: FileKind,
     convention: &str,
     tolerance: f64,
     axes: &crate::plot::preview::PreviewAxes,
 ) -> Result<Vec<BakedFile>, BakeError> {
-    let meta = |format: &str, pf: Option<PixelFormat>, st: &str, cs: &str, tol: Option<f64>| FileMeta {
-        kind: kind.into(),
-        format: format.into(),
-        pixel_format: pf,
-        width: img.width,
-        height: img.height,
-        channels: if format == "ktx2" { pf.map(|p| p.channels()).unwrap_or(img.channels) } else { img.channels },
-        sample_type: st.into(),
-        color_space: cs.into(),
-        convention: convention.into(),
-        verify_tolerance: tol,
-        supercompression: None,
-    };
+    let meta =
+        |format: FileFormat, pf: Option<PixelFormat>, st: SampleType, cs: ColorSpace, tol: Option<f64>| FileMeta {
+            kind,
+            format,
+            pixel_format: pf,
+            width: img.width,
+            height: img.height,
+            channels: if format == FileFormat::Ktx2 {
+                pf.map(|p| p.channels()).unwrap_or(img.channels)
+            } else {
+                img.channels
+            },
+            sample_type: st,
+            color_space: cs,
+            convention: convention.into(),
+            verify_tolerance: tol,
+            supercompression: None,
+        };
     let half_tol = tolerance.max(1e-3);
     let preview_img = crate::plot::preview::labelled_preview(&io::png::srgb_preview_pixels(img), axes);
-    let mut preview = meta("png", None, "u8", "srgb", Some(1.0));
-    preview.kind = "preview".into();
+    let mut preview = meta(FileFormat::Png, None, SampleType::U8, ColorSpace::Srgb, Some(1.0));
+    preview.kind = FileKind::Preview;
     (preview.width, preview.height, preview.channels) = (preview_img.width, preview_img.height, 3);
     preview.convention = format!(
         "{convention}; preview for viewing only (do not sample): the table's colours sRGB-encoded (alpha dropped), \
@@ -304,17 +322,23 @@ pub fn float_texture_files_with_preview(
         BakedFile {
             path: format!("{stem}.exr"),
             bytes: exr_f32?,
-            meta: meta("exr", None, "f32", "linear", Some(tolerance)),
+            meta: meta(FileFormat::Exr, None, SampleType::F32, ColorSpace::Linear, Some(tolerance)),
         },
         BakedFile {
             path: format!("{stem}_f16.exr"),
             bytes: exr_f16?,
-            meta: meta("exr", None, "f16", "linear", Some(half_tol)),
+            meta: meta(FileFormat::Exr, None, SampleType::F16, ColorSpace::Linear, Some(half_tol)),
         },
         BakedFile {
             path: format!("{stem}.ktx2"),
             bytes: ktx2?,
-            meta: meta("ktx2", PixelFormat::f16_for(img.channels), "f16", "linear", Some(half_tol)),
+            meta: meta(
+                FileFormat::Ktx2,
+                PixelFormat::f16_for(img.channels),
+                SampleType::F16,
+                ColorSpace::Linear,
+                Some(half_tol),
+            ),
         },
         BakedFile { path: format!("{stem}_preview_srgb.png"), bytes: png?, meta: preview },
     ])
@@ -328,7 +352,7 @@ pub fn supercompress_ktx2(files: &mut [BakedFile], level: i32) -> Result<(), Bak
     // Independent files, compressed side by side (the first error in file order is reported).
     let results: Vec<Result<(), BakeError>> = files
         .par_iter_mut()
-        .filter(|f| f.meta.format == "ktx2" && f.meta.supercompression.is_none())
+        .filter(|f| f.meta.format == FileFormat::Ktx2 && f.meta.supercompression.is_none())
         .map(|f| {
             f.bytes = io::ktx2::supercompress(&f.bytes, &f.path, level)?;
             f.meta.supercompression = Some(io::ktx2::Supercompression::Zstd(level).label());
@@ -339,14 +363,30 @@ pub fn supercompress_ktx2(files: &mut [BakedFile], level: i32) -> Result<(), Bak
 }
 
 /// A pretty-printed JSON file (stable key order, trailing newline).
-pub fn json_file(path: &str, value: &Value, kind: &str, convention: &str) -> BakedFile {
+pub fn json_file(path: &str, value: &Value, kind: FileKind, convention: &str) -> BakedFile {
     let mut text = serde_json::to_string_pretty(value).expect("JSON values always serialise");
     text.push('\n');
-    BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, "json", convention) }
+    BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, FileFormat::Json, convention) }
+}
+
+/// The HLSL, GLSL and WGSL includes of `stem` (`{stem}.hlsl`, `{stem}.glsl`, `{stem}.wgsl`), each the text
+/// `include(lang)`.
+pub fn shader_include_files(
+    stem: &str,
+    convention: &str,
+    include: impl Fn(io::source::ShaderLang) -> String,
+) -> Vec<BakedFile> {
+    io::source::ShaderLang::ALL
+        .into_iter()
+        .map(|lang| {
+            let path = format!("{stem}.{}", lang.extension());
+            text_file(&path, include(lang), FileKind::ShaderInclude, lang.into(), convention)
+        })
+        .collect()
 }
 
 /// A text file (source, CSV, SVG …).
-pub fn text_file(path: &str, text: String, kind: &str, format: &str, convention: &str) -> BakedFile {
+pub fn text_file(path: &str, text: String, kind: FileKind, format: FileFormat, convention: &str) -> BakedFile {
     BakedFile { path: path.into(), bytes: text.into_bytes(), meta: FileMeta::text(kind, format, convention) }
 }
 

@@ -31,6 +31,7 @@ use crate::diffusion::source::{MaterialModel, ProfileSource, TransportModel};
 use crate::diffusion::table::{self, ProfileTable};
 use crate::diffusion::{materials, sum_of_gaussians, FdrForm};
 use crate::error::InvalidInput;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::plot::profile::{profile_panels, render, PlotFormat, PANEL_HEIGHT, PLOT_WIDTH};
 use crate::spectral::skin_layers::{physiological_skin_source, SkinPhysiology, SkinProjection};
 use rayon::prelude::*;
@@ -48,14 +49,7 @@ struct Grid {
 }
 
 /// One point of the physiological two-layer skin.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SkinPoint {
-    /// Cm, 0..=0.5.
-    melanin_fraction: f64,
-    /// Chd, 0..=0.32.
-    hemoglobin_fraction: f64,
-}
+use super::SkinPoint;
 
 /// The transport model of the skins' profiles: `{"model": "multipole"}` (default) or
 /// `{"model": "mc", "g": 0.8, "photons": 100000, "seed": 1}` (Monte Carlo, `transport::profile`; each wavelength
@@ -193,12 +187,7 @@ fn check_name(param: &str, name: &str) -> Result<(), InvalidInput> {
 fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Value)>, InvalidInput> {
     let mut out = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let src = ProfileSource::Material {
             name: m.name.into(),
             model: MaterialModel::Dipole,
@@ -214,15 +203,7 @@ fn sources(p: &ProfilesParams) -> Result<Vec<(String, String, ProfileSource, Val
     }
     for name in &p.presets {
         let lower = name.to_ascii_lowercase();
-        if sum_of_gaussians::preset(&lower).is_none() {
-            return Err(InvalidInput::new(
-                "presets",
-                format!(
-                    "'{name}' is not a known preset; expected one of {}",
-                    sum_of_gaussians::PRESET_NAMES.join(", ")
-                ),
-            ));
-        }
+        crate::diffusion::source::gaussian_preset("presets", name)?;
         out.push((
             format!("presets/{lower}"),
             format!("{lower} (sum of Gaussians)"),
@@ -309,23 +290,23 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             let t = ProfileTable::compute(profile.as_ref(), &radii, provenance)?;
             let path = format!("profiles/{stem}");
             let mut files = vec![
-                text_file(&format!("{path}.csv"), t.to_csv(), "csv", "csv", CSV_CONVENTION),
-                json_file(&format!("{path}.json"), &t.to_json(), "json", JSON_CONVENTION),
+                text_file(&format!("{path}.csv"), t.to_csv(), FileKind::Csv, FileFormat::Csv, CSV_CONVENTION),
+                json_file(&format!("{path}.json"), &t.to_json(), FileKind::Json, JSON_CONVENTION),
             ];
             let panels = profile_panels(&t, None, title);
             let svg = render(&panels, PlotFormat::Svg, &t.provenance)?;
             files.push(BakedFile {
                 path: format!("{path}.svg"),
                 bytes: svg,
-                meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+                meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
             });
             if p.png_plots.iter().any(|s| s == stem) {
-                let mut meta = FileMeta::text("plot", "png", PLOT_CONVENTION);
+                let mut meta = FileMeta::text(FileKind::Plot, FileFormat::Png, PLOT_CONVENTION);
                 meta.width = PLOT_WIDTH;
                 meta.height = 2 * PANEL_HEIGHT;
                 meta.channels = 3;
-                meta.sample_type = "u8".into();
-                meta.color_space = "srgb".into();
+                meta.sample_type = SampleType::U8;
+                meta.color_space = ColorSpace::Srgb;
                 files.push(BakedFile {
                     path: format!("{path}.png"),
                     bytes: render(&panels, PlotFormat::Png, &t.provenance)?,
@@ -347,8 +328,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     files.push(text_file(
         "profiles/totals.csv",
         totals,
-        "csv",
-        "csv",
+        FileKind::Csv,
+        FileFormat::Csv,
         "one row per baked profile (stem below profiles/): total_R = R^(0) = int 2 pi r R(r) dr, total_T = T^(0) per \
          channel (empty where the model has no T)",
     ));

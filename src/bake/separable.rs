@@ -9,7 +9,7 @@
 //! fitted 17-tap kernel.
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
-use crate::io::source::ShaderLang;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::separable::fit::{self, ObjectiveSpec, TargetKernel};
 use crate::separable::kernel::{self, Kernel, KernelSpec, Precision};
 use crate::separable::{SeparableParams, PUBLISHED, PUBLISHED_SSS_WIDTH, TABLE_6_1, TABLE_6_1_WIDTH};
@@ -82,40 +82,36 @@ fn default_kernels_params() -> Value {
 /// `{stem}_f32x4.bin` (N taps of `[r, g, b, offset]`, the runtime upload path). Pure; `rtbake kernel --out` uses
 /// it too.
 pub fn kernel_files(dir: &str, stem: &str, k: &Kernel, sss_width: Option<f64>, source: &str) -> Vec<BakedFile> {
-    let prefix = if dir.is_empty() { String::new() } else { format!("{dir}/") };
+    let stem = crate::baked_layout::path::in_dir(dir, stem);
     let convention = kernel::LAYOUT_DOC;
-    let mut files = vec![json_file(&format!("{prefix}{stem}.json"), &k.to_json(sss_width, source), "json", convention)];
-    for lang in ShaderLang::ALL {
-        let ext = lang.extension();
-        files.push(text_file(
-            &format!("{prefix}{stem}.{ext}"),
-            k.shader_include(lang, source, sss_width),
-            "shader-include",
-            ext,
-            convention,
-        ));
-    }
+    let mut files = vec![json_file(
+        &crate::baked_layout::path::json(&stem),
+        &crate::baked_layout::separable_kernel_json(k, sss_width, source),
+        FileKind::Json,
+        convention,
+    )];
+    files.extend(super::shader_include_files(&stem, convention, |lang| k.shader_include(lang, source, sss_width)));
     files.push(text_file(
-        &format!("{prefix}{stem}_SeparableSSS.h"),
+        &format!("{stem}_SeparableSSS.h"),
         k.separable_sss_h(source),
-        "shader-include",
-        "hlsl",
+        FileKind::ShaderInclude,
+        FileFormat::Hlsl,
         "SeparableSSS.h form: #define SSSS_N_SAMPLES N + static const float4 kernel[N] (rgb = weight, a = offset), \
          to replace the header's whole kernel section (#ifdef SSSS_N_SAMPLES to its #endif) for any N",
     ));
     let n = k.taps.len() as u32;
     files.push(BakedFile {
-        path: format!("{prefix}{stem}_f32x4.bin"),
+        path: format!("{stem}_f32x4.bin"),
         bytes: k.f32x4_le_bytes(),
         meta: crate::manifest::FileMeta {
-            kind: "kernel".into(),
-            format: "raw".into(),
+            kind: FileKind::Kernel,
+            format: FileFormat::Raw,
             pixel_format: Some(crate::io::PixelFormat::R32G32B32A32Sfloat),
             width: n,
             height: 1,
             channels: 4,
-            sample_type: "f32".into(),
-            color_space: "n/a".into(),
+            sample_type: SampleType::F32,
+            color_space: ColorSpace::NotApplicable,
             convention: format!("{convention}; little-endian f32 x 4 x {n}, no header (SeparableSSS.h runtime kernel)"),
             verify_tolerance: None,
             supercompression: None,
@@ -159,12 +155,7 @@ fn default_fit_params() -> Value {
 
 fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: FitParams = parse_params("sss-separable-fit", params)?;
-    let profile = crate::diffusion::sum_of_gaussians::preset(&p.profile).ok_or_else(|| {
-        crate::error::InvalidInput::new(
-            "sss-separable-fit.profile",
-            format!("must be one of {:?}, got {:?}", crate::diffusion::sum_of_gaussians::PRESET_NAMES, p.profile),
-        )
-    })?;
+    let profile = crate::diffusion::source::gaussian_preset("sss-separable-fit.profile", &p.profile)?;
     let description = format!("{} profile preset (sum of Gaussians)", p.profile);
     let map = |e: fit::SeparableFitError| match e {
         fit::SeparableFitError::Invalid(i) => BakeError::Invalid(i),
@@ -179,7 +170,7 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let mut files = vec![json_file(
         &format!("{DIR}/{stem}.json"),
         &report,
-        "json",
+        FileKind::Json,
         "fitted separable-SSS parameters (strength, falloff per channel; width fixed) and the objective definition",
     )];
     let spec = KernelSpec { precision: Precision::F32, ..KernelSpec::new(p.samples, rounded(&result.params)) };

@@ -1,6 +1,7 @@
 //! Skin-colour assets in `baked/skin/`: the melanin × hemoglobin lookup table (thesis §7.6, eq. 7.7, Fig. 7.9).
 
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
+use crate::manifest::{FileFormat, FileKind};
 use crate::skin_color::lut::{bake_lut_with_progress, IndexForm, LutLayout};
 use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
@@ -94,17 +95,29 @@ pub fn skin_color_lut_files_with_progress(
     let model = p.model().map_err(invalid)?;
     let img = bake_lut_with_progress(&model, &layout, p.lut_evaluation, progress).map_err(invalid)?;
     let conv = convention(&layout);
-    let mut files =
-        super::float_texture_files_with_preview(LUT_STEM, &img, "lut", &conv, LUT_TOLERANCE, &lut_axes(&layout))?;
-    files.push(json_file(SIDECAR_PATH, &sidecar(p, &layout, &img), "json", &conv));
+    let mut files = super::float_texture_files_with_preview(
+        LUT_STEM,
+        &img,
+        FileKind::Lut,
+        &conv,
+        LUT_TOLERANCE,
+        &lut_axes(&layout),
+    )?;
+    files.push(json_file(SIDECAR_PATH, &sidecar(p, &layout, &img), FileKind::Json, &conv));
     let samples_conv = "skin colour samples evaluated directly by the spectral model (not read from the table); \
         linear = linear sRGB albedo, srgb8 = IEC 61966-2-1 encoded 8-bit";
-    files.push(text_file(SAMPLES_PATH, samples_csv(&model, &layout).map_err(invalid)?, "csv", "csv", samples_conv));
+    files.push(text_file(
+        SAMPLES_PATH,
+        samples_csv(&model, &layout).map_err(invalid)?,
+        FileKind::Csv,
+        FileFormat::Csv,
+        samples_conv,
+    ));
     files.push(text_file(
         SPECTRA_PATH,
         spectra_csv(&model).map_err(invalid)?,
-        "csv",
-        "csv",
+        FileKind::Csv,
+        FileFormat::Csv,
         "total diffuse reflectance R(lambda) of the two-layer stack (before colorimetry), one column per (Cm, Chd)",
     ));
     Ok(files)

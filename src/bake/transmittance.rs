@@ -2,9 +2,8 @@
 
 use super::{json_file, parse_params, Asset, BakeError, BakedFile, FileMeta};
 use crate::baked_layout::{self, TransmittanceSidecar};
-use crate::diffusion::sum_of_gaussians::{preset, PRESET_NAMES};
-use crate::error::InvalidInput;
 use crate::fitting::RgbGaussians;
+use crate::manifest::{ColorSpace, FileFormat, FileKind, SampleType};
 use crate::transmittance::{TableSettings, TransmittanceForm, TransmittanceModel};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -34,13 +33,15 @@ pub fn table_files(
         y_label: if img.height > 1 { "identical rows".into() } else { String::new() },
         y_ticks: Vec::new(),
     };
-    let mut files = super::float_texture_files_with_preview(stem, &img, "lut", &convention, VERIFY_TOLERANCE, &axes)?;
-    let mut meta = FileMeta::text("lut", "png", &format!("{convention}; 16-bit linear: value = sample/65535"));
+    let mut files =
+        super::float_texture_files_with_preview(stem, &img, FileKind::Lut, &convention, VERIFY_TOLERANCE, &axes)?;
+    let mut meta =
+        FileMeta::text(FileKind::Lut, FileFormat::Png, &format!("{convention}; 16-bit linear: value = sample/65535"));
     meta.width = img.width;
     meta.height = img.height;
     meta.channels = img.channels;
-    meta.sample_type = "u16".into();
-    meta.color_space = "linear".into();
+    meta.sample_type = SampleType::U16;
+    meta.color_space = ColorSpace::Linear;
     meta.verify_tolerance = None;
     files.push(BakedFile { path: format!("{stem}_linear16.png"), bytes: crate::io::png::encode_linear16(&img)?, meta });
     let form = match settings.form {
@@ -72,7 +73,7 @@ pub fn table_files(
     files.push(json_file(
         &baked_layout::path::sidecar(&format!("{stem}.exr")),
         &serde_json::to_value(&sidecar).expect("sidecar serialises"),
-        "json",
+        FileKind::Json,
         "provenance of the transmittance table next to it",
     ));
     Ok(files)
@@ -87,9 +88,7 @@ struct Params {
 
 fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     let p: Params = parse_params("transmittance", params)?;
-    let sog = preset(&p.preset).ok_or_else(|| {
-        InvalidInput::new("preset", format!("unknown preset '{}' (known: {})", p.preset, PRESET_NAMES.join(", ")))
-    })?;
+    let sog = crate::diffusion::source::gaussian_preset("preset", &p.preset)?;
     let form = match p.table.form {
         TransmittanceForm::Published => "published",
         TransmittanceForm::Physical => "physical",
@@ -99,7 +98,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         "d'Eon, Luebke, Enderton, EGSR 2007",
     );
     table_files(
-        &format!("{}/{}_{form}", baked_layout::path::TRANSMITTANCE_DIR, p.preset),
+        &baked_layout::path::transmittance_stem(&p.preset, form),
         &TransmittanceModel::Gaussians(RgbGaussians::from(&sog)),
         &p.table,
         source,

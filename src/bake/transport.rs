@@ -17,6 +17,7 @@ use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile, Fil
 use crate::baked_layout::path;
 use crate::diffusion::materials;
 use crate::error::InvalidInput;
+use crate::manifest::{FileFormat, FileKind};
 use crate::plot::profile::{render, PlotFormat, CHANNEL_COLORS};
 use crate::plot::{Curve, LinePlot};
 use crate::spectral::skin_layers::{physiological_skin_source, RgbReduction, SkinPhysiology, SkinProjection};
@@ -87,12 +88,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     crate::error::check_non_negative("far_r_mm", p.far_r_mm, "mm")?;
     let mut cases: Vec<(String, McStack)> = Vec::new();
     for name in &p.materials {
-        let m = materials::find(name).ok_or_else(|| {
-            InvalidInput::new(
-                "materials",
-                format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-            )
-        })?;
+        let m = super::jensen_material("materials", name)?;
         let stack = McStack::semi_infinite(m.sigma_a_per_mm, m.sigma_s_prime_per_mm, p.g, materials::JENSEN_2001_ETA)?;
         cases.push((format!("dipole/{}", m.name), stack));
     }
@@ -179,15 +175,15 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
             files.push(BakedFile {
                 path: format!("{}/{name}.svg", path::TRANSPORT_DIR),
                 bytes: render(&panels, PlotFormat::Svg, &provenance)?,
-                meta: FileMeta::text("plot", "svg", PLOT_CONVENTION),
+                meta: FileMeta::text(FileKind::Plot, FileFormat::Svg, PLOT_CONVENTION),
             });
         }
     }
-    files.push(text_file(path::TRANSPORT_REPORT_CSV, csv, "csv", "csv", CSV_CONVENTION));
+    files.push(text_file(path::TRANSPORT_REPORT_CSV, csv, FileKind::Csv, FileFormat::Csv, CSV_CONVENTION));
     files.push(json_file(
         &format!("{}/report.json", path::TRANSPORT_DIR),
         &json!({"provenance": provenance, "rows": rows}),
-        "json",
+        FileKind::Json,
         CSV_CONVENTION,
     ));
     let series = by_family
@@ -212,8 +208,8 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         path: format!("{}/difference_vs_albedo.svg", path::TRANSPORT_DIR),
         bytes: render(std::slice::from_ref(&plot), PlotFormat::Svg, &provenance)?,
         meta: FileMeta::text(
-            "plot",
-            "svg",
+            FileKind::Plot,
+            FileFormat::Svg,
             "(diffusion - Monte Carlo)/Monte Carlo total diffuse R in % over the reduced albedo of the top layer, \
              every case and channel, sorted by albedo, one line per family",
         ),

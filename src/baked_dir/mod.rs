@@ -92,6 +92,7 @@ mod tests {
     use crate::manifest::sha256_hex;
     use crate::manifest::Manifest;
     use crate::manifest::MANIFEST_NAME;
+    use crate::manifest::{FileFormat, FileKind};
     use serde_json::Value;
 
     fn ramp(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
@@ -102,10 +103,10 @@ mod tests {
         let p: P = parse_params("ramp", params)?;
         let (w, h) = crate::error::check_size("size", p.size as u64, p.size as u64)?;
         let img = Image::from_vec(w, h, 2, (0..w * h * 2).map(|i| (i % 251) as u8).collect());
-        let mut files = crate::bake::unorm8_texture_files("test/ramp", &img, "lut", "test ramp")?;
+        let mut files = crate::bake::unorm8_texture_files("test/ramp", &img, FileKind::Lut, "test ramp")?;
         let f = Image::from_vec(w, h, 1, (0..w * h).map(|i| i as f32 / 7.0).collect());
-        files.extend(crate::bake::float_texture_files("test/ramp_f", &f, "lut", "test", 1e-6)?);
-        files.push(json_file("test/ramp.json", params, "json", "params"));
+        files.extend(crate::bake::float_texture_files("test/ramp_f", &f, FileKind::Lut, "test", 1e-6)?);
+        files.push(json_file("test/ramp.json", params, FileKind::Json, "params"));
         Ok(files)
     }
 
@@ -301,7 +302,7 @@ mod tests {
 
     #[test]
     fn float_files_compare_within_tolerance() {
-        let meta = FileMeta::text("json", "json", "");
+        let meta = FileMeta::text(FileKind::Json, FileFormat::Json, "");
         let mut meta = meta;
         assert!(compare(&meta, "x.json", b"[1.0, 2.0]", b"[1.0, 2.0000001]").is_err());
         meta.verify_tolerance = Some(1e-6);

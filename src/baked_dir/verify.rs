@@ -5,7 +5,7 @@ use super::{io_err, list_files, BakeDirError};
 use crate::bake::{Asset, BakeError, BakedFile};
 use crate::io;
 use crate::io::file_set::{self, DirLock, LockMode, Wait};
-use crate::manifest::{sha256_hex, Manifest, MANIFEST_NAME};
+use crate::manifest::{sha256_hex, FileFormat, Manifest, SampleType, MANIFEST_NAME};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
@@ -314,20 +314,20 @@ pub(super) fn compare(meta: &crate::manifest::FileMeta, path: &str, disk: &[u8],
 
 /// Decodes a file's samples as f64 for tolerant comparison.
 fn decode_samples(meta: &crate::manifest::FileMeta, path: &str, bytes: &[u8]) -> Result<Vec<f64>, String> {
-    match meta.format.as_str() {
-        "exr" => io::exr::decode(bytes, path)
+    match meta.format {
+        FileFormat::Exr => io::exr::decode(bytes, path)
             .map(|(img, _)| img.data.iter().map(|&v| v as f64).collect())
             .map_err(|e| e.to_string()),
-        "ktx2" => {
+        FileFormat::Ktx2 => {
             let (_, _, _, data, _) = io::ktx2::decode(bytes, path).map_err(|e| e.to_string())?;
-            Ok(payload_samples(&data, &meta.sample_type))
+            Ok(payload_samples(&data, meta.sample_type))
         }
-        "dds" => {
+        FileFormat::Dds => {
             let (_, _, _, data) = io::dds::decode(bytes, path).map_err(|e| e.to_string())?;
-            Ok(payload_samples(&data, &meta.sample_type))
+            Ok(payload_samples(&data, meta.sample_type))
         }
-        "raw" => Ok(payload_samples(bytes, &meta.sample_type)),
-        "png" => match io::png::decode(bytes, path).map_err(|e| e.to_string())? {
+        FileFormat::Raw => Ok(payload_samples(bytes, meta.sample_type)),
+        FileFormat::Png => match io::png::decode(bytes, path).map_err(|e| e.to_string())? {
             io::png::DecodedPng::U8(i) => Ok(i.data.iter().map(|&v| v as f64).collect()),
             io::png::DecodedPng::U16(i) => Ok(i.data.iter().map(|&v| v as f64).collect()),
         },
@@ -335,11 +335,11 @@ fn decode_samples(meta: &crate::manifest::FileMeta, path: &str, bytes: &[u8]) ->
     }
 }
 
-fn payload_samples(data: &[u8], sample_type: &str) -> Vec<f64> {
+fn payload_samples(data: &[u8], sample_type: SampleType) -> Vec<f64> {
     match sample_type {
-        "f16" => data.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f64()).collect(),
-        "f32" => data.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64).collect(),
-        "u16" => data.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]]) as f64).collect(),
+        SampleType::F16 => data.chunks_exact(2).map(|c| half::f16::from_le_bytes([c[0], c[1]]).to_f64()).collect(),
+        SampleType::F32 => data.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64).collect(),
+        SampleType::U16 => data.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]]) as f64).collect(),
         _ => data.iter().map(|&v| v as f64).collect(),
     }
 }

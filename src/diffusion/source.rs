@@ -270,12 +270,7 @@ impl ProfileSource {
     pub fn build(&self) -> Result<Box<dyn RadialProfile + Send>, InvalidInput> {
         match self {
             ProfileSource::Material { name, model, fdr, series } => {
-                let m = materials::find(name).ok_or_else(|| {
-                    InvalidInput::new(
-                        "material",
-                        format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
-                    )
-                })?;
+                let m = jensen_material("material", name)?;
                 match model {
                     MaterialModel::Dipole => {
                         for c in 0..3 {
@@ -300,15 +295,7 @@ impl ProfileSource {
                 }
             }
             ProfileSource::Preset(name) => {
-                sum_of_gaussians::preset(name).map(|p| Box::new(p) as Box<dyn RadialProfile + Send>).ok_or_else(|| {
-                    InvalidInput::new(
-                        "profile_preset",
-                        format!(
-                            "'{name}' is not a known profile preset; expected one of {}",
-                            sum_of_gaussians::PRESET_NAMES.join(", ")
-                        ),
-                    )
-                })
+                gaussian_preset("profile_preset", name).map(|p| Box::new(p) as Box<dyn RadialProfile + Send>)
             }
             ProfileSource::Layers { stack, adding, series, fdr, transport } => {
                 transport.build_stack(stack, *adding, *series, *fdr, 0)
@@ -435,6 +422,31 @@ impl ProfileSource {
             }),
         }
     }
+}
+
+/// The one lookup of a Jensen 2001 material by name (Jensen et al., SIGGRAPH 2001, Table 2); `param` names the
+/// field or flag that gave it, and a refusal lists the known names.
+pub fn jensen_material(param: &str, name: &str) -> Result<&'static materials::Material, InvalidInput> {
+    materials::find(name).ok_or_else(|| {
+        InvalidInput::new(
+            param,
+            format!("'{name}' is not a known material; expected one of {}", materials::names().join(", ")),
+        )
+    })
+}
+
+/// The one lookup of a sum-of-Gaussians preset by name (case-insensitive; d'Eon et al. 2007); `param` names the
+/// field or flag that gave it, and a refusal lists the known names.
+pub fn gaussian_preset(param: &str, name: &str) -> Result<sum_of_gaussians::SumOfGaussians, InvalidInput> {
+    sum_of_gaussians::preset(name).ok_or_else(|| {
+        InvalidInput::new(
+            param,
+            format!(
+                "'{name}' is not a known profile preset; expected one of {}",
+                sum_of_gaussians::PRESET_NAMES.join(", ")
+            ),
+        )
+    })
 }
 
 /// Adds what only a built profile knows to its provenance: `total_R_se` (Monte Carlo standard errors of the

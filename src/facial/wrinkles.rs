@@ -262,8 +262,9 @@ pub fn wrinkled_normal(base_pd: [f64; 2], wrinkle_pd: [f64; 2], masks: [f64; 8],
     from_pd(xy)
 }
 
-/// The Table 8.1 preset as JSON (schema `rtbake-wrinkle-weights/1`).
-pub fn table_8_1_json() -> serde_json::Value {
+/// The Table 8.1 preset as JSON under the schema id `schema` (the contract's
+/// `crate::baked_layout::schema::WRINKLE_WEIGHTS`).
+pub fn table_8_1_json(schema: &str) -> serde_json::Value {
     let mut expr = serde_json::Map::new();
     let mut f4 = serde_json::Map::new();
     for (name, row) in TABLE_8_1 {
@@ -271,7 +272,7 @@ pub fn table_8_1_json() -> serde_json::Value {
         f4.insert(name.into(), serde_json::json!([&row[..4], &row[4..]]));
     }
     serde_json::json!({
-        "schema": "rtbake-wrinkle-weights/1",
+        "schema": schema,
         "source": "J. Jimenez, PhD thesis (2012), Table 8.1; Jimenez, Echevarria, Oat, Gutierrez, \"Practical and Realistic Facial Wrinkles Animation\", GPU Pro 2 (2011)",
         "zones": ZONES,
         "mask_packing": {

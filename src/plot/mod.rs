@@ -7,6 +7,7 @@ pub mod line;
 pub mod preference;
 pub mod preview;
 pub mod profile;
+pub mod separable;
 pub mod transport;
 
 pub use line::{panels_to_image, panels_to_svg, Curve, LinePlot, LOG_Y_DECADES};

@@ -18,10 +18,11 @@
 //! place to change when the bake layout moves.
 
 use crate::baked_layout::{
-    path, schema, GaussiansFile, RigDescription, SeparableKernelFile, SkinLutSidecar, TransmittanceSidecar,
+    path, schema, GaussiansFile, ImportanceKernelFile, RigDescription, SeparableKernelFile, SkinLutSidecar,
+    TransmittanceSidecar,
 };
 use crate::io::PixelFormat;
-use crate::manifest::{sha256_hex, Entry, Manifest, ManifestError};
+use crate::manifest::{sha256_hex, ColorSpace, Entry, FileFormat, Manifest, ManifestError, SampleType};
 use std::path::{Path, PathBuf};
 
 /// What a pass expects of one LUT.
@@ -177,7 +178,7 @@ impl BakedDir {
 /// Loads one LUT described by an already-parsed manifest.
 pub fn load_lut_with(dir: &Path, manifest: &Manifest, spec: &LutSpec) -> Result<Vec<u8>, LutError> {
     let expect = Expect {
-        format: "raw",
+        format: FileFormat::Raw,
         pixel_format: Some(spec.pixel_format),
         size: Some((spec.width, spec.height)),
         channels: Some(spec.pixel_format.channels()),
@@ -195,12 +196,12 @@ enum DataKind {
 }
 
 /// What the runtime expects of one manifest entry (`None`: not checked here).
-struct Expect<'a> {
-    format: &'a str,
+struct Expect {
+    format: FileFormat,
     pixel_format: Option<PixelFormat>,
     size: Option<(u32, u32)>,
     channels: Option<u32>,
-    sample_type: &'a str,
+    sample_type: SampleType,
     data: DataKind,
 }
 
@@ -222,12 +223,13 @@ fn read_checked<'m>(
         expected,
         found,
     };
-    let colour_ok = m.color_space == "linear" || (expect.data == DataKind::Table && m.color_space == "n/a");
+    let colour_ok = m.color_space == ColorSpace::Linear
+        || (expect.data == DataKind::Table && m.color_space == ColorSpace::NotApplicable);
     if !colour_ok {
-        return Err(LutError::ColorSpace { path: path.to_string(), found: m.color_space.clone() });
+        return Err(LutError::ColorSpace { path: path.to_string(), found: m.color_space.to_string() });
     }
     if m.format != expect.format {
-        return Err(mismatch("format", format!("{:?}", expect.format), format!("{:?}", m.format)));
+        return Err(mismatch("format", format!("{:?}", expect.format.as_str()), format!("{:?}", m.format.as_str())));
     }
     if let Some(pf) = expect.pixel_format {
         if m.pixel_format != Some(pf) {
@@ -245,12 +247,12 @@ fn read_checked<'m>(
         }
     }
     if m.sample_type != expect.sample_type {
-        return Err(mismatch("sample_type", expect.sample_type.into(), m.sample_type.clone()));
+        return Err(mismatch("sample_type", expect.sample_type.to_string(), m.sample_type.to_string()));
     }
     let file = dir.join(path);
     let bytes = std::fs::read(&file).map_err(|e| LutError::Read { path: file.display().to_string(), source: e })?;
     // Raw texels: the length follows from the size and format; other containers: the manifest's size_bytes.
-    if let (true, Some(pf), Some((w, h))) = (expect.format == "raw", expect.pixel_format, expect.size) {
+    if let (true, Some(pf), Some((w, h))) = (expect.format == FileFormat::Raw, expect.pixel_format, expect.size) {
         let expected = (w * h * pf.bytes_per_texel()) as usize;
         if bytes.len() != expected {
             return Err(LutError::Size {
@@ -276,11 +278,11 @@ fn read_checked<'m>(
 }
 
 /// The manifest's `sample_type` for a pixel format.
-fn sample_type(pf: PixelFormat) -> &'static str {
+fn sample_type(pf: PixelFormat) -> SampleType {
     match pf {
-        PixelFormat::R8Unorm | PixelFormat::R8G8Unorm | PixelFormat::R8G8B8A8Unorm => "u8",
-        PixelFormat::R16Sfloat | PixelFormat::R16G16Sfloat | PixelFormat::R16G16B16A16Sfloat => "f16",
-        PixelFormat::R32Sfloat | PixelFormat::R32G32B32A32Sfloat => "f32",
+        PixelFormat::R8Unorm | PixelFormat::R8G8Unorm | PixelFormat::R8G8B8A8Unorm => SampleType::U8,
+        PixelFormat::R16Sfloat | PixelFormat::R16G16Sfloat | PixelFormat::R16G16B16A16Sfloat => SampleType::F16,
+        PixelFormat::R32Sfloat | PixelFormat::R32G32B32A32Sfloat => SampleType::F32,
     }
 }
 
@@ -300,11 +302,11 @@ fn content(path: &str, message: impl Into<String>) -> LutError {
 /// Reads a JSON table listed in the manifest (`format` json, `sample_type` text, colour space linear or n/a).
 fn load_json(dir: &Path, manifest: &Manifest, path: &str) -> Result<serde_json::Value, LutError> {
     let expect = Expect {
-        format: "json",
+        format: FileFormat::Json,
         pixel_format: None,
         size: None,
         channels: None,
-        sample_type: "text",
+        sample_type: SampleType::Text,
         data: DataKind::Table,
     };
     let (bytes, _) = read_checked(dir, manifest, path, &expect)?;
@@ -321,11 +323,11 @@ fn load_exr_f32(
     min_size: (u32, u32),
 ) -> Result<crate::image_buf::Image<f32>, LutError> {
     let expect = Expect {
-        format: "exr",
+        format: FileFormat::Exr,
         pixel_format: None,
         size: None,
         channels: Some(channels),
-        sample_type: "f32",
+        sample_type: SampleType::F32,
         data: DataKind::Texture,
     };
     let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
@@ -389,11 +391,11 @@ fn separable_kernel_f32x4_in(
     path: &str,
 ) -> Result<crate::runtime::sss::separable::SssKernel, LutError> {
     let expect = Expect {
-        format: "raw",
+        format: FileFormat::Raw,
         pixel_format: Some(PixelFormat::R32G32B32A32Sfloat),
         size: None,
         channels: Some(4),
-        sample_type: "f32",
+        sample_type: SampleType::F32,
         data: DataKind::Table,
     };
     let (bytes, entry) = read_checked(dir, manifest, path, &expect)?;
@@ -466,20 +468,7 @@ pub fn importance_kernel_from_json(
     if found != schema::IMPORTANCE_KERNEL {
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::IMPORTANCE_KERNEL)));
     }
-    #[derive(serde::Deserialize)]
-    struct Sample {
-        x_mm: f64,
-        y_mm: f64,
-        r_mm: f64,
-        weight: [f64; 3],
-    }
-    #[derive(serde::Deserialize)]
-    struct File {
-        samples: usize,
-        cutoff_mm: f64,
-        kernel: Vec<Sample>,
-    }
-    let file: File = typed(v.clone(), path)?;
+    let file: ImportanceKernelFile = typed(v.clone(), path)?;
     if file.kernel.len() != file.samples {
         return Err(content(path, format!("\"samples\" = {} but \"kernel\" has {}", file.samples, file.kernel.len())));
     }
@@ -675,41 +664,49 @@ fn hemoglobin_rig_in(dir: &Path, manifest: &Manifest, path: &str) -> Result<Bake
         return Err(content(path, format!("schema {found:?}, the runtime reads {:?}", schema::HEMOGLOBIN_RIG)));
     }
     let desc: RigDescription = typed(v, path)?;
-    let folder = path.rsplit_once('/').map(|(d, _)| format!("{d}/")).unwrap_or_default();
-    let [rw, rh] = desc.rig_size;
-    let [fw, fh] = desc.full_size;
-    let maps = &desc.maps;
-    if maps.is_empty() || maps.len() > MAX_RIG_TARGETS {
-        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", maps.len())));
+    if desc.maps.len() > MAX_RIG_TARGETS {
+        return Err(content(path, format!("{} maps; the pass takes 1..={MAX_RIG_TARGETS}", desc.maps.len())));
     }
-    let map1 = |file: &str, (w, h): (u32, u32)| -> Result<Vec<f32>, LutError> {
-        let p = format!("{folder}{file}");
-        let img = load_exr_f32(dir, manifest, &p, 1, (1, 1))?;
-        if (img.width, img.height) != (w, h) {
-            return Err(content(&p, format!("{}x{}, the rig says {w}x{h}", img.width, img.height)));
-        }
-        Ok(img.data)
+    let folder = path.rsplit_once('/').map(|(d, _)| d).unwrap_or_default();
+    // Each map through the manifest checks; the first refusal is returned as itself (its LutError kind), not as
+    // the reader's message.
+    let mut refused: Option<LutError> = None;
+    let expect = Expect {
+        format: FileFormat::Exr,
+        pixel_format: None,
+        size: None,
+        channels: Some(1),
+        sample_type: SampleType::F32,
+        data: DataKind::Texture,
     };
-    let (mut targets, mut names) = (Vec::new(), Vec::new());
-    for (i, m) in maps.iter().enumerate() {
-        let name = m.name.clone();
-        if i == 0 && name != "neutral" {
-            return Err(content(path, format!("maps[0] is {name:?}; eq. 7.6 needs the neutral map first")));
-        }
-        let scale = map1(&m.scale_exr, (rw, rh))?;
-        let bias = map1(&m.bias_exr, (rw, rh))?;
-        if let Some(b) = bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
+    let read = &mut |file: &str| {
+        let p = path::in_dir(folder, file);
+        read_checked(dir, manifest, &p, &expect).map(|(bytes, _)| bytes).map_err(|e| {
+            let message = e.to_string();
+            refused.get_or_insert(e);
+            crate::error::InvalidInput::new(p.as_str(), message)
+        })
+    };
+    let rig = crate::baked_layout::rig_from_description(path, &desc, read);
+    if let Some(e) = refused {
+        return Err(e);
+    }
+    let rig = rig.map_err(|e| content(path, e.message))?;
+    let mut names = Vec::with_capacity(rig.maps.len());
+    let mut targets = Vec::with_capacity(rig.maps.len());
+    for m in &rig.maps {
+        if let Some(b) = m.bias.iter().find(|b| !(-0.01..=0.5).contains(*b)) {
             return Err(content(
                 path,
-                format!("{name}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)"),
+                format!("{}: bias {b} is not a dermal hemoglobin volume fraction (LUT range 0..0.32)", m.name),
             ));
         }
-        targets.push(scale.into_iter().zip(bias).map(|(s, b)| [s, b]).collect());
-        names.push(name);
+        targets.push(m.scale.iter().zip(&m.bias).map(|(&s, &b)| [s, b]).collect());
+        names.push(m.name.clone());
     }
-    let h0 = crate::image_buf::Image::from_vec(fw, fh, 1, map1(&desc.h0.exr, (fw, fh))?);
+    let h0 = crate::image_buf::Image::from_vec(rig.width, rig.height, 1, rig.h0);
     let global_scales = desc.global_scales.iter().filter_map(|(k, g)| g.as_f64().map(|g| (k.clone(), g))).collect();
-    let rig = RigScaleBiasMaps { width: rw, height: rh, targets };
+    let rig = RigScaleBiasMaps { width: rig.rig_width, height: rig.rig_height, targets };
     rig.validate().map_err(|e| content(path, e.to_string()))?;
     Ok(BakedRig { rig, names, h0, global_scales })
 }

@@ -499,6 +499,27 @@ pub fn kernel_errors(target: &TargetKernel, params: &SeparableParams) -> ([f64; 
     (l2, max)
 }
 
+/// One channel of the target and the model along the x axis (y = 0) from the centre outwards: the pixel-filtered
+/// target kernel S̃(x, 0) and the separable model's s̃(x)·s̃(0) (eq. 6.1), as `(x mm, value mm⁻²)` points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisRows {
+    pub target: Vec<(f64, f64)>,
+    pub model: Vec<(f64, f64)>,
+}
+
+/// [`AxisRows`] of each channel of `target` for the separable parameters `params`.
+pub fn axis_rows(target: &TargetKernel, params: &SeparableParams) -> [AxisRows; 3] {
+    let n = target.nodes_mm.len();
+    let half = n / 2;
+    std::array::from_fn(|c| {
+        let s = model_row(&target.spec, params, c, &target.nodes_mm);
+        AxisRows {
+            target: (half..n).map(|i| (target.nodes_mm[i], target.values[c][i * n + half])).collect(),
+            model: (half..n).map(|i| (target.nodes_mm[i], s[i] * s[half])).collect(),
+        }
+    })
+}
+
 /// The separable model's pixel-filtered 1-D kernel s̃(x) at `nodes_mm` (for plots next to the target's row).
 pub fn model_row(spec: &ObjectiveSpec, params: &SeparableParams, channel: usize, nodes_mm: &[f64]) -> Vec<f64> {
     Model::new(spec).filtered(nodes_mm, params.strength[channel], params.falloff[channel])
@@ -785,5 +806,21 @@ mod tests {
             assert!((e - 1.0).abs() < 1e-12 && (share - 1.0).abs() < 1e-6, "{e} {share}");
         }
         assert!(objective(&t, &TABLE_6_1).iter().all(|v| *v == 0.0));
+    }
+
+    /// For a target that is itself separable, the plotted x-axis rows of target and model coincide, start at the
+    /// centre and cover the positive half of the grid.
+    #[test]
+    fn axis_rows_of_a_separable_target_coincide() {
+        let spec = ObjectiveSpec::default();
+        let t = TargetKernel::from_separable(&TABLE_6_1, &spec).unwrap();
+        for rows in axis_rows(&t, &TABLE_6_1) {
+            assert_eq!(rows.target.len(), t.nodes_mm.len() - t.nodes_mm.len() / 2);
+            assert_eq!(rows.target[0].0, 0.0);
+            for (a, b) in rows.target.iter().zip(&rows.model) {
+                assert_eq!(a.0, b.0);
+                assert!((a.1 - b.1).abs() <= 1e-12 * a.1.abs().max(1e-300), "{a:?} {b:?}");
+            }
+        }
     }
 }

@@ -315,10 +315,7 @@ fn rounded(v: f64, precision: Precision) -> f64 {
     }
 }
 
-/// Kernel JSON schema identifier.
-pub const JSON_SCHEMA: &str = "rtbake-separable-kernel/1";
-
-/// A separable-SSS kernel file (schema [`JSON_SCHEMA`]). Numbers are already rounded to the kernel's
+/// A separable-SSS kernel file (its schema id is the contract's, `crate::baked_layout::schema::SEPARABLE_KERNEL`). Numbers are already rounded to the kernel's
 /// arithmetic precision by the writer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SeparableKernelFile {
@@ -348,13 +345,13 @@ impl Kernel {
             .expect("finite taps serialise")
     }
 
-    /// The kernel file: `{"schema", "samples", "range", "exponent", "step_divisor", "precision", "strength",
-    /// "falloff", "sss_width", "layout", "kernel": [[r, g, b, offset], …]}` (see the module docs).
-    /// `sss_width` is the width the parameters were made for (world units), if known.
-    pub fn to_json(&self, sss_width: Option<f64>, source: &str) -> Value {
+    /// The kernel file under the schema id `schema`: `{"schema", "samples", "range", "exponent", "step_divisor",
+    /// "precision", "strength", "falloff", "sss_width", "layout", "kernel": [[r, g, b, offset], …]}` (see the module
+    /// docs). `sss_width` is the width the parameters were made for (world units), if known.
+    pub fn to_file(&self, schema: &str, sss_width: Option<f64>, source: &str) -> SeparableKernelFile {
         let p = self.spec.precision;
-        let file = SeparableKernelFile {
-            schema: JSON_SCHEMA.into(),
+        SeparableKernelFile {
+            schema: schema.into(),
             source: source.into(),
             samples: self.spec.samples,
             range: rounded(self.range, p),
@@ -366,8 +363,7 @@ impl Kernel {
             sss_width,
             layout: LAYOUT_DOC.into(),
             kernel: self.taps.iter().map(|t| t.map(|v| rounded(v, p))).collect(),
-        };
-        serde_json::to_value(&file).expect("kernel file serialises")
+        }
     }
 
     /// HLSL / GLSL / WGSL include: `SSSS_KERNEL_N_SAMPLES`, `SSSS_KERNEL_RANGE`, `SSSS_KERNEL_EXPONENT`,

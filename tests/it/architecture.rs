@@ -333,23 +333,12 @@ fn is_schema_id(s: &str) -> bool {
         && version.chars().all(|c| c.is_ascii_digit())
 }
 
-/// Schema ids written where `baked_layout.rs` cannot be imported (a model below the contract) or by code that
-/// another branch moves: (path, id, why).
-const SCHEMA_EXCEPTIONS: &[(&str, &str, &str)] = &[
-    ("src/separable/kernel.rs", "rtbake-separable-kernel/1", "a model: baked_layout re-exports it"),
-    ("src/facial/wrinkles.rs", "rtbake-wrinkle-weights/1", "a model's Table 8.1 file"),
-    ("bin/rtbake/maps.rs", "rtbake-wrinkles/1", "the wrinkle report, written in bin/ today"),
-    ("bin/rtbake/maps.rs", "rtbake-wrinkle-masks/1", "the mask report, written in bin/ today"),
-];
-
-/// Schema ids only in `src/baked_layout.rs` (and [`SCHEMA_EXCEPTIONS`]).
+/// Schema ids only in `src/baked_layout.rs` (a model that writes one takes it from its caller).
 fn schema_ids(tree: &Tree) -> Vec<String> {
     let mut bad = Vec::new();
     for (p, lits) in tree.literals().filter(|(p, _)| *p != "src/baked_layout.rs") {
         for l in lits.iter().filter(|l| is_schema_id(l)) {
-            if !SCHEMA_EXCEPTIONS.iter().any(|(f, id, _)| *f == p && id == l) {
-                bad.push(format!("{p}: schema id {l:?} outside src/baked_layout.rs"));
-            }
+            bad.push(format!("{p}: schema id {l:?} outside src/baked_layout.rs"));
         }
     }
     bad

@@ -230,7 +230,7 @@ fn every_linear_texture_bevy_loads_has_a_meta_with_is_srgb_false() {
         for f in &files {
             let meta = by_path.get(format!("{}.meta", f.path).as_str());
             let bevy_opens = matches!(f.meta.format.as_str(), "ktx2" | "dds" | "png");
-            if bevy_opens && f.meta.color_space == "linear" {
+            if bevy_opens && f.meta.color_space.as_str() == "linear" {
                 let m = meta.unwrap_or_else(|| panic!("{name}: {} has no .meta", f.path));
                 assert_eq!((m.meta.format.as_str(), m.meta.kind.as_str()), ("ron", "bevy-meta"));
                 check_linear_meta(&f.path, &m.bytes);
@@ -256,7 +256,7 @@ fn every_committed_linear_texture_has_its_bevy_meta() {
     let m = rtbake::manifest::Manifest::load(&baked_dir()).unwrap();
     let mut n = 0;
     for e in &m.files {
-        if matches!(e.meta.format.as_str(), "ktx2" | "dds" | "png") && e.meta.color_space == "linear" {
+        if matches!(e.meta.format.as_str(), "ktx2" | "dds" | "png") && e.meta.color_space.as_str() == "linear" {
             let p = format!("{}.meta", e.path);
             assert!(m.entry(&p).is_some(), "{p} not in the manifest");
             check_linear_meta(&e.path, &std::fs::read(baked_dir().join(&p)).unwrap());

@@ -47,7 +47,7 @@ fn legacy_copies(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>, u32
 fn every_8_bit_dds_has_a_legacy_copy_with_exact_d3d9_masks() {
     let files = baked_files_of_format("dds");
     let legacy: Vec<_> = files.iter().filter(|(p, _)| is_legacy(p)).collect();
-    for (path, e) in files.iter().filter(|(p, e)| !is_legacy(p) && e.meta.sample_type == "u8") {
+    for (path, e) in files.iter().filter(|(p, e)| !is_legacy(p) && e.meta.sample_type.as_str() == "u8") {
         let copy = path.to_string_lossy().replace(".dds", "_dx9.dds");
         let (_, le) = legacy.iter().find(|(p, _)| p.to_string_lossy() == copy).unwrap_or_else(|| panic!("{copy}"));
         let b = std::fs::read(&copy).unwrap();

@@ -21,7 +21,7 @@ fn float_table_previews_are_framed_readable_pictures_of_the_table() {
     let mut checked = 0;
     for asset in ["transmittance", "skin-color-lut"] {
         let files = bake(asset);
-        for f in files.iter().filter(|f| f.meta.kind == "preview") {
+        for f in files.iter().filter(|f| f.meta.kind.as_str() == "preview") {
             let img = image::load_from_memory(&f.bytes).unwrap().to_rgb8();
             assert_eq!((img.width(), img.height()), (f.meta.width, f.meta.height), "{}: manifest size", f.path);
             assert!(img.height() >= 100 && img.width() >= 512, "{}: {}x{}", f.path, img.width(), img.height());

@@ -4,7 +4,7 @@ use crate::support::*;
 use rtbake::bake::BakedFile;
 use rtbake::baked_layout::path;
 use rtbake::image_buf::Image;
-use rtbake::manifest::Manifest;
+use rtbake::manifest::{ColorSpace, Manifest};
 use std::path::Path;
 use std::process::Command;
 
@@ -49,10 +49,10 @@ fn demo_tables() -> Vec<String> {
 }
 
 /// A bake directory holding copies of the committed tables, the SMAA area texture declared `area_color_space`.
-fn copied_bake(dir: &Path, area_color_space: &str) {
+fn copied_bake(dir: &Path, area_color_space: ColorSpace) {
     let paths = demo_tables();
     let mut files = committed(&paths.iter().map(String::as_str).collect::<Vec<_>>());
-    files[0].meta.color_space = area_color_space.into();
+    files[0].meta.color_space = area_color_space;
     write_bake(dir, &files);
 }
 
@@ -71,7 +71,7 @@ fn read_rgba(p: &Path) -> Vec<u8> {
 #[test]
 fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
     let t = tempfile::tempdir().unwrap();
-    copied_bake(t.path(), "linear");
+    copied_bake(t.path(), ColorSpace::Linear);
     let (w, h) = (160, 120);
     let input = Image::from_vec(w, h, 4, rtbake::runtime::scene::render_shapes(w, h, 1));
     let inp = t.path().join("in.png");
@@ -108,7 +108,7 @@ fn smaa_and_mlaa_on_a_png_gpu_and_cpu() {
 #[test]
 fn demo_writes_a_png() {
     let t = tempfile::tempdir().unwrap();
-    copied_bake(t.path(), "linear");
+    copied_bake(t.path(), ColorSpace::Linear);
     let out = t.path().join("demo.png");
     let o = rtbake(&[
         "run",
@@ -132,7 +132,7 @@ fn demo_writes_a_png() {
 #[test]
 fn bad_input_exits_2_and_writes_nothing() {
     let t = tempfile::tempdir().unwrap();
-    copied_bake(t.path(), "linear");
+    copied_bake(t.path(), ColorSpace::Linear);
     let baked = t.path().to_str().unwrap();
     let out = t.path().join("out.png");
     let outs = out.to_str().unwrap();
@@ -175,7 +175,7 @@ fn bad_input_exits_2_and_writes_nothing() {
 #[test]
 fn srgb_declared_lut_is_refused() {
     let t = tempfile::tempdir().unwrap();
-    copied_bake(t.path(), "srgb");
+    copied_bake(t.path(), ColorSpace::Srgb);
     let inp = t.path().join("in.png");
     std::fs::write(&inp, rtbake::io::png::encode_u8(&Image::from_vec(4, 4, 4, vec![9u8; 64])).unwrap()).unwrap();
     let out = t.path().join("out.png");
@@ -199,7 +199,7 @@ fn srgb_declared_lut_is_refused() {
 #[test]
 fn demo_gpu_and_cpu_agree_and_sss_runs_on_exr() {
     let t = tempfile::tempdir().unwrap();
-    copied_bake(t.path(), "linear");
+    copied_bake(t.path(), ColorSpace::Linear);
     let baked = t.path().to_str().unwrap();
     let (g, c) = (t.path().join("g.png"), t.path().join("c.png"));
     for (out, cpu) in [(&g, false), (&c, true)] {
@@ -308,7 +308,7 @@ fn demo_importance_gpu_and_cpu_agree() {
     }
     let (frac, _) = within(&read_rgba(&g), &read_rgba(&c), 2);
     assert!(frac >= 0.99, "importance demo GPU vs CPU: {frac}");
-    copied_bake(t.path(), "linear");
+    copied_bake(t.path(), ColorSpace::Linear);
     let out = t.path().join("x.png");
     let o = rtbake(&[
         "run",
@@ -361,7 +361,7 @@ fn sss_reads_baked_kernels_and_gaussians() {
         committed(&[path::SEPARABLE_KERNEL_DEFAULT, "sss/separable/published_n11.json", path::GAUSSIANS_DEFAULT]);
     let mut srgb = files[1].clone();
     srgb.path = "sss/separable/srgb.json".into();
-    srgb.meta.color_space = "srgb".into();
+    srgb.meta.color_space = ColorSpace::Srgb;
     files.push(srgb);
     let bake = t.path().join("bake");
     write_bake(&bake, &files);

@@ -3,20 +3,20 @@
 use rtbake::bake::{BakedFile, FileMeta};
 use rtbake::baked_layout::path;
 use rtbake::io::PixelFormat;
-use rtbake::manifest::Manifest;
+use rtbake::manifest::{ColorSpace, FileFormat, FileKind, Manifest, SampleType};
 use rtbake::runtime::loader::{self, LutError, LutSpec};
 use std::path::Path;
 
-fn meta(pf: PixelFormat, w: u32, h: u32, color_space: &str) -> FileMeta {
+fn meta(pf: PixelFormat, w: u32, h: u32, color_space: ColorSpace) -> FileMeta {
     FileMeta {
-        kind: "lut".into(),
-        format: "raw".into(),
+        kind: FileKind::Lut,
+        format: FileFormat::Raw,
         pixel_format: Some(pf),
         width: w,
         height: h,
         channels: pf.channels(),
-        sample_type: "u8".into(),
-        color_space: color_space.into(),
+        sample_type: SampleType::U8,
+        color_space,
         convention: "test".into(),
         verify_tolerance: None,
         supercompression: None,
@@ -28,12 +28,12 @@ fn bake_dir(dir: &Path, tweak: impl FnOnce(&mut BakedFile)) {
     let mut area = BakedFile {
         path: path::SMAA_AREA.into(),
         bytes: (0..160 * 560 * 2).map(|i| (i % 251) as u8).collect(),
-        meta: meta(PixelFormat::R8G8Unorm, 160, 560, "linear"),
+        meta: meta(PixelFormat::R8G8Unorm, 160, 560, ColorSpace::Linear),
     };
     let search = BakedFile {
         path: path::SMAA_SEARCH.into(),
         bytes: vec![7u8; 64 * 16],
-        meta: meta(PixelFormat::R8Unorm, 64, 16, "linear"),
+        meta: meta(PixelFormat::R8Unorm, 64, 16, ColorSpace::Linear),
     };
     tweak(&mut area);
     let mut m = Manifest::new();
@@ -58,7 +58,7 @@ fn accepts_a_matching_bake() {
 #[test]
 fn refuses_srgb_lut() {
     let t = tempfile::tempdir().unwrap();
-    bake_dir(t.path(), |f| f.meta.color_space = "srgb".into());
+    bake_dir(t.path(), |f| f.meta.color_space = ColorSpace::Srgb);
     let e = loader::load_smaa_textures(t.path()).unwrap_err();
     assert!(matches!(e, LutError::ColorSpace { .. }), "{e}");
     assert!(e.to_string().contains("AreaTex.bin") && e.to_string().contains("srgb"), "{e}");
@@ -87,7 +87,7 @@ fn refuses_wrong_pixel_format() {
 #[test]
 fn refuses_wrong_container() {
     let t = tempfile::tempdir().unwrap();
-    bake_dir(t.path(), |f| f.meta.format = "png".into());
+    bake_dir(t.path(), |f| f.meta.format = FileFormat::Png);
     let e = loader::load_smaa_textures(t.path()).unwrap_err();
     assert!(matches!(e, LutError::Mismatch { field: "format", .. }), "{e}");
 }
@@ -136,9 +136,9 @@ fn float_lut_checks_sample_type() {
     let mut f = BakedFile {
         path: spec.path.clone(),
         bytes: vec![0u8; 4 * 2 * 8],
-        meta: meta(PixelFormat::R16G16B16A16Sfloat, 4, 2, "linear"),
+        meta: meta(PixelFormat::R16G16B16A16Sfloat, 4, 2, ColorSpace::Linear),
     };
-    f.meta.sample_type = "f16".into();
+    f.meta.sample_type = SampleType::F16;
     let write = |f: &BakedFile| {
         let mut m = Manifest::new();
         m.set_asset("skin", serde_json::json!({}), std::slice::from_ref(f));
@@ -149,7 +149,7 @@ fn float_lut_checks_sample_type() {
     };
     write(&f);
     assert_eq!(loader::load_lut(t.path(), &spec).unwrap().len(), 64);
-    f.meta.sample_type = "f32".into();
+    f.meta.sample_type = SampleType::F32;
     write(&f);
     let e = loader::load_lut(t.path(), &spec).unwrap_err();
     assert!(matches!(e, LutError::Mismatch { field: "sample_type", .. }), "{e}");

@@ -5,7 +5,7 @@
 use rtbake::bake::BakedFile;
 use rtbake::baked_layout::path;
 use rtbake::diffusion::sum_of_gaussians::deon6;
-use rtbake::manifest::Manifest;
+use rtbake::manifest::{ColorSpace, FileFormat, Manifest, SampleType};
 use rtbake::runtime::loader::{self, LutError};
 use std::path::{Path, PathBuf};
 
@@ -95,7 +95,7 @@ fn copies_of_the_committed_tables_are_accepted() {
 fn tables_declared_srgb_are_refused() {
     for (path, paths, load) in cases() {
         let t = tempfile::tempdir().unwrap();
-        bake_dir(t.path(), files(&paths), |f| f[0].meta.color_space = "srgb".into());
+        bake_dir(t.path(), files(&paths), |f| f[0].meta.color_space = ColorSpace::Srgb);
         let e = load(t.path()).unwrap_err();
         assert!(matches!(e, LutError::ColorSpace { .. }), "{path}: {e}");
         assert!(e.to_string().contains(path) && e.to_string().contains("srgb"), "{e}");
@@ -148,11 +148,11 @@ fn float_tables_declared_with_the_wrong_size_are_refused() {
 fn float_tables_declared_half_or_wrong_format_are_refused() {
     for (path, paths, load) in cases().into_iter().filter(|c| c.0.ends_with(".exr")) {
         let t = tempfile::tempdir().unwrap();
-        bake_dir(t.path(), files(&paths), |f| f[0].meta.sample_type = "f16".into());
+        bake_dir(t.path(), files(&paths), |f| f[0].meta.sample_type = SampleType::F16);
         let e = load(t.path()).unwrap_err();
         assert!(matches!(e, LutError::Mismatch { field: "sample_type", .. }), "{path}: {e}");
         let t = tempfile::tempdir().unwrap();
-        bake_dir(t.path(), files(&paths), |f| f[0].meta.format = "ktx2".into());
+        bake_dir(t.path(), files(&paths), |f| f[0].meta.format = FileFormat::Ktx2);
         let e = load(t.path()).unwrap_err();
         assert!(matches!(e, LutError::Mismatch { field: "format", .. }), "{path}: {e}");
         let t = tempfile::tempdir().unwrap();
@@ -270,7 +270,7 @@ fn hemoglobin_rig_map_declared_srgb_or_corrupted_is_refused() {
     let bias = "facial/hemoglobin/example/joy_bias.exr";
     let i = paths.iter().position(|p| p == bias).unwrap();
     let t = tempfile::tempdir().unwrap();
-    bake_dir(t.path(), files(&paths), |f| f[i].meta.color_space = "srgb".into());
+    bake_dir(t.path(), files(&paths), |f| f[i].meta.color_space = ColorSpace::Srgb);
     let e = loader::load_hemoglobin_rig(t.path(), path::RIG_EXAMPLE).unwrap_err();
     assert!(matches!(e, LutError::ColorSpace { .. }) && e.to_string().contains(bias), "{e}");
     let t = tempfile::tempdir().unwrap();

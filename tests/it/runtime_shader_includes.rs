@@ -13,7 +13,7 @@ fn includes() -> Vec<(String, String)> {
     let v: Vec<(String, String)> = m
         .files
         .iter()
-        .filter(|e| e.meta.format == "wgsl")
+        .filter(|e| e.meta.format.as_str() == "wgsl")
         .map(|e| {
             let bytes = std::fs::read(dir.join(&e.path)).unwrap();
             assert_eq!(sha256_hex(&bytes), e.sha256, "{}: sha256 differs from the manifest", e.path);

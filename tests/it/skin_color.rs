@@ -289,6 +289,6 @@ fn default_asset_round_trips_its_parameters_and_decodes() {
     assert_eq!(sidecar["parameters"]["width"], 3);
     assert_eq!(sidecar["index"]["hemoglobin_max"], 0.32);
     let png = files.iter().find(|f| f.path == "skin/skin_color_lut_preview_srgb.png").unwrap();
-    assert_eq!(png.meta.color_space, "srgb");
-    assert!(files.iter().filter(|f| f.meta.kind == "lut").all(|f| f.meta.color_space == "linear"));
+    assert_eq!(png.meta.color_space.as_str(), "srgb");
+    assert!(files.iter().filter(|f| f.meta.kind.as_str() == "lut").all(|f| f.meta.color_space.as_str() == "linear"));
 }

@@ -203,7 +203,7 @@ pub fn tool_available(what: &str, cmd: &str, args: &[&str], install: &str) -> bo
 pub fn baked_files_of_format(format: &str) -> Vec<(PathBuf, rtbake::manifest::Entry)> {
     let dir = baked_dir();
     let manifest = rtbake::manifest::Manifest::load(&dir).expect("baked/manifest.json");
-    manifest.files.into_iter().filter(|e| e.meta.format == format).map(|e| (dir.join(&e.path), e)).collect()
+    manifest.files.into_iter().filter(|e| e.meta.format.as_str() == format).map(|e| (dir.join(&e.path), e)).collect()
 }
 
 /// Mean absolute error (0..255 scale, RGB) of RGBA8 `img` against `truth` over the pixels selected by `mask`
