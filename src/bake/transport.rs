@@ -513,10 +513,9 @@ fn group_values(rows: &[Row], key: (&str, &str, f64)) -> (Vec<f64>, Vec<f64>, f6
         }
         for (model, all, _) in row.models.iter().filter(|m| m.0 == key.1) {
             debug_assert_eq!(*model, key.1);
-            for c in 0..3 {
-                diff.push(all[c].total_r_difference_percent);
-                rr.extend(all[c].rr_error_percent);
-                let e = row.reference.total_r[c];
+            for (d, e) in all.iter().zip(&row.reference.total_r) {
+                diff.push(d.total_r_difference_percent);
+                rr.extend(d.rr_error_percent);
                 max_se = max_se.max(100.0 * e.se / e.mean);
             }
         }
@@ -525,9 +524,9 @@ fn group_values(rows: &[Row], key: (&str, &str, f64)) -> (Vec<f64>, Vec<f64>, f6
 }
 
 fn summary_markdown(rows: &[Row], p: &ReportParams) -> String {
-    let mut s = format!(
+    let mut s = String::from(
         "| family | model | g | total R vs Monte Carlo (min .. max, %) | r R(r) error (median / max, %) | MC SE (max, %) |\n\
-         | --- | --- | --- | --- | --- | --- |\n"
+         | --- | --- | --- | --- | --- | --- |\n",
     );
     for key in groups(rows) {
         let (mut diff, mut rr, max_se) = group_values(rows, key);
@@ -574,10 +573,10 @@ fn accuracy_panels(rows: &[Row]) -> [LinePlot; 2] {
             let mut pts = Vec::new();
             for row in rows.iter().filter(|r| r.g == key.2 && (r.fractions.is_some() == (key.0 == "skin"))) {
                 for (_, all, _) in row.models.iter().filter(|m| m.0 == key.1) {
-                    for c in 0..3 {
-                        let y = if rr { all[c].rr_error_percent } else { Some(all[c].total_r_difference_percent) };
+                    for (d, e) in all.iter().zip(&row.reference.total_r) {
+                        let y = if rr { d.rr_error_percent } else { Some(d.total_r_difference_percent) };
                         if let Some(y) = y {
-                            pts.push((row.reference.total_r[c].mean, y));
+                            pts.push((e.mean, y));
                         }
                     }
                 }
