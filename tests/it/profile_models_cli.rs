@@ -206,3 +206,37 @@ fn evaluate_against_takes_the_model_flags() {
     assert_usage(&run(&[f, "--model", "mc", "--photons", "0"]), &["--photons", "1..="]);
     assert_usage(&run(&[f, "--g", "0.5"]), &["--model mc"]);
 }
+
+/// Every profile consumer refuses a Henyey–Greenstein g outside (−1, 1) and a photon count of 0 with exit 2 naming
+/// the flag and the range, before any work (nothing written where it writes files).
+#[test]
+fn every_profile_consumer_refuses_bad_model_flags() {
+    let t = tempfile::tempdir().unwrap();
+    let file = t.path().join("stack.json");
+    std::fs::write(&file, STACK).unwrap();
+    let f = file.to_str().unwrap();
+    let out = t.path().join("k");
+    let o = out.to_str().unwrap();
+    let consumers: [Vec<&str>; 9] = [
+        vec!["profile", "--layers", f, "--json"],
+        vec!["fit", "gaussians", "--layers", f, "--json"],
+        vec!["fit", "separable", "--layers", f, "--json"],
+        vec!["fit", "burley", "--layers", f, "--json"],
+        vec!["transmittance", "--layers", f, "--s", "0.5,1", "--json"],
+        vec!["importance-kernel", "--layers", f, "--samples", "16", "--json"],
+        vec!["kernel", "--layers", f, "--samples", "11", "--out", o, "--name", "bad"],
+        vec!["evaluate", "--burley-albedo", "0.8,0.5,0.3", "--burley-d-mm", "1,0.5,0.25", "--against", f],
+        vec!["profile", "--skin-melanin", "0.1", "--skin-hemoglobin", "0.1", "--json"],
+    ];
+    for cmd in &consumers {
+        for (bad, needles) in [
+            (["--g", "1.5"], ["--g", "(-1, 1)"]),
+            (["--g", "-1"], ["--g", "(-1, 1)"]),
+            (["--photons", "0"], ["--photons", "1..="]),
+        ] {
+            let args: Vec<&str> = cmd.iter().copied().chain(["--model", "mc"]).chain(bad).collect();
+            assert_usage(&rtbake(&args), &needles);
+        }
+    }
+    assert!(!out.exists(), "nothing written");
+}
