@@ -153,6 +153,8 @@ vocabulary! {
         Csv = "csv",
         Svg = "svg",
         Ron = "ron",
+        /// A Markdown text (a report's summary table).
+        Md = "md",
     }
 }
 

@@ -7,7 +7,7 @@ use crate::profile_source::{named, physiological_skin, BurleyFitArg, Named};
 use rtbake::diffusion::burley::{Burley, RgbBurley, ShapeFit};
 use rtbake::diffusion::layered::{Adding, LayerStack};
 use rtbake::diffusion::multipole::Series;
-use rtbake::diffusion::source::ProfileSource;
+use rtbake::diffusion::source::{ProfileSource, TransportModel};
 use rtbake::diffusion::{FdrForm, RadialProfile};
 use rtbake::fitting::evaluate::compare_profiles;
 use rtbake::plot::profile::{overlay_plot, render, PlotFormat};
@@ -46,6 +46,11 @@ pub struct EvaluateArgs {
     /// layer-stack JSON file.
     #[arg(long, value_name = "TARGET")]
     against: String,
+    /// Model of a skin:CM,CHD or layer-stack target: multipole (diffusion) or mc (Monte Carlo transport).
+    #[arg(long, value_enum, default_value = "multipole")]
+    model: crate::profile_source::TransportArg,
+    #[command(flatten)]
+    mc: crate::profile_source::McArgs,
     /// Compare shapes only: divide both profiles by their own totals first (Gaussians and Burley).
     #[arg(long)]
     normalize: bool,
@@ -71,8 +76,19 @@ const TARGET_FORMS: &str =
     "a Jensen 2001 material (e.g. skin1), a preset (deon6, deon4), skin:CM,CHD, a profile .csv or a layer-stack .json";
 
 /// Resolves `--against`: (profile, provenance, label).
-fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
+fn target(text: &str, transport: TransportModel, ctx: &Ctx) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
     let path = Path::new(text);
+    let takes_model = text.starts_with("skin:") || text.to_ascii_lowercase().ends_with(".json");
+    if transport != TransportModel::Multipole && !takes_model {
+        return Err(usage_msg(format!(
+            "--model mc applies to --against skin:CM,CHD and layer-stack .json targets, got '{text}'"
+        )));
+    }
+    // The time budget of a Monte Carlo target (profiles evaluated at up to 4096 radii).
+    let checked_build = |src: &ProfileSource| -> anyhow::Result<Box<dyn RadialProfile + Send>> {
+        crate::profile_source::check_source_time(ctx, src, 4096)?;
+        src.build().map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))
+    };
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if matches!(ext.as_deref(), Some("csv") | Some("json")) {
         let body =
@@ -89,10 +105,12 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
             adding: Adding::Symmetric,
             series: Series::Exact,
             fdr: FdrForm::Dj05,
-            transport: Default::default(),
+            transport,
         };
-        let p = src.build().map_err(|e| usage(anyhow::anyhow!("--against {text}: {e}")))?;
-        return Ok((p, src.provenance(), text.to_string()));
+        let p = checked_build(&src)?;
+        let mut provenance = src.provenance();
+        crate::profile_source::add_standard_errors(&mut provenance, p.as_ref());
+        return Ok((p, provenance, text.to_string()));
     }
     if let Some(rest) = text.strip_prefix("skin:") {
         let v = parse_f64_list("--against skin:CM,CHD", rest)?;
@@ -105,11 +123,13 @@ fn target(text: &str) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)>
             Adding::Symmetric,
             Series::Exact,
             FdrForm::Dj05,
-            Default::default(),
+            transport,
             Default::default(),
         )?;
-        let p = src.build().map_err(usage)?;
-        return Ok((p, src.provenance(), format!("skin Cm {} Chd {}", v[0], v[1])));
+        let p = checked_build(&src)?;
+        let mut provenance = src.provenance();
+        crate::profile_source::add_standard_errors(&mut provenance, p.as_ref());
+        return Ok((p, provenance, format!("skin Cm {} Chd {}", v[0], v[1])));
     }
     // Names resolve only through the library's `ProfileSource`: a preset, else a Jensen material.
     let (src, p, _) = named(Named::Preset { flag: "--against", name: text })
@@ -181,7 +201,8 @@ pub fn run(a: EvaluateArgs, ctx: &Ctx) -> anyhow::Result<()> {
             "--normalize applies to --gaussians and --burley-albedo (the separable kernel has unit total)",
         ));
     }
-    let (target_profile, target_provenance, target_label) = target(&a.against)?;
+    let transport = a.mc.transport(a.model)?;
+    let (target_profile, target_provenance, target_label) = target(&a.against, transport, ctx)?;
 
     let (report, plot, worst) = if let Some(text) = &a.separable {
         let params = separable_params(text)?;

@@ -121,11 +121,14 @@ impl TransportModel {
     }
 }
 
-/// How far the spectral multipole of the physiological skins is from Monte Carlo transport (measured for the
-/// three baked skins, 20 000 photons per wavelength, 41 wavelengths; README, "Skins: spectral profiles and Monte
-/// Carlo"); recorded in the provenance of every spectral multipole profile.
+/// How far the spectral multipole of the physiological skins is from Monte Carlo transport (the three baked skins
+/// at 20 000 photons per wavelength; the two-layer skins of the baked `transport-report`, a 4 × 4 melanin ×
+/// hemoglobin grid and the baked skins; README, "Skins: spectral profiles and Monte Carlo"); recorded in the
+/// provenance of every spectral multipole profile.
 pub const SKIN_MULTIPOLE_ERROR: &str = "total R above Monte Carlo transport (same sigma_s'): +18 to +43 % at g = 0, \
-    +30 to +199 % at g = 0.8 (darker skins worst) for the baked skins; --model mc gives the transport solution";
+    +30 to +199 % at g = 0.8 for the baked skins; +15 to +50 % at g = 0 and +20 to +243 % at g = 0.8 over the \
+    transport-report's skins (Cm 0.01-0.45, Chd 0.01-0.3; darker skins worst); --model mc gives the transport \
+    solution";
 
 /// A spectral material as per-wavelength layer stacks, three wavelengths per stack (channel k of stack j is
 /// wavelength `wavelengths_nm[j][k]`), projected onto linear sRGB with `weights[j][k][c]`

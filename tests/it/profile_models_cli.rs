@@ -180,3 +180,63 @@ fn transport_outputs_must_differ_and_window_is_finite() {
     assert_eq!(w[0].as_f64(), Some(0.0));
     assert_eq!(w[1].as_f64(), Some(40.0 * 0.05));
 }
+
+/// `evaluate --against` takes the model flags for the targets that have a transport model (skin:CM,CHD and
+/// layer-stack files): the target's provenance records the Monte Carlo and its standard errors; a named material
+/// or preset with `--model mc`, g outside (−1, 1) and zero photons are refused with exit 2 naming the flag.
+#[test]
+fn evaluate_against_takes_the_model_flags() {
+    let t = tempfile::tempdir().unwrap();
+    let file = t.path().join("stack.json");
+    std::fs::write(&file, STACK).unwrap();
+    let f = file.to_str().unwrap();
+    let base = ["--json", "evaluate", "--burley-albedo", "0.8,0.5,0.3", "--burley-d-mm", "1,0.5,0.25", "--against"];
+    let run = |extra: &[&str]| rtbake(&base.iter().chain(extra).copied().collect::<Vec<_>>());
+    for target in [f, "skin:0.1,0.1"] {
+        let o = run(&[target, "--model", "mc", "--photons", "200", "--g", "0.5"]);
+        assert!(o.status.success(), "{target}: {}", String::from_utf8_lossy(&o.stderr));
+        let v = json(&o);
+        assert_eq!(v["target"]["transport_model"], "monte-carlo", "{v}");
+        assert_eq!(v["target"]["g"], 0.5);
+        assert!(v["target"]["total_R_se"].as_array().unwrap().iter().all(|x| x.as_f64().unwrap() > 0.0), "{v}");
+    }
+    assert_usage(&run(&["skin1", "--model", "mc"]), &["--model mc", "skin1"]);
+    assert_usage(&run(&["deon6", "--model", "mc"]), &["--model mc", "deon6"]);
+    assert_usage(&run(&["skin:0.1,0.1", "--model", "mc", "--g", "-1"]), &["--g", "(-1, 1)"]);
+    assert_usage(&run(&[f, "--model", "mc", "--photons", "0"]), &["--photons", "1..="]);
+    assert_usage(&run(&[f, "--g", "0.5"]), &["--model mc"]);
+}
+
+/// Every profile consumer refuses a Henyey–Greenstein g outside (−1, 1) and a photon count of 0 with exit 2 naming
+/// the flag and the range, before any work (nothing written where it writes files).
+#[test]
+fn every_profile_consumer_refuses_bad_model_flags() {
+    let t = tempfile::tempdir().unwrap();
+    let file = t.path().join("stack.json");
+    std::fs::write(&file, STACK).unwrap();
+    let f = file.to_str().unwrap();
+    let out = t.path().join("k");
+    let o = out.to_str().unwrap();
+    let consumers: [Vec<&str>; 9] = [
+        vec!["profile", "--layers", f, "--json"],
+        vec!["fit", "gaussians", "--layers", f, "--json"],
+        vec!["fit", "separable", "--layers", f, "--json"],
+        vec!["fit", "burley", "--layers", f, "--json"],
+        vec!["transmittance", "--layers", f, "--s", "0.5,1", "--json"],
+        vec!["importance-kernel", "--layers", f, "--samples", "16", "--json"],
+        vec!["kernel", "--layers", f, "--samples", "11", "--out", o, "--name", "bad"],
+        vec!["evaluate", "--burley-albedo", "0.8,0.5,0.3", "--burley-d-mm", "1,0.5,0.25", "--against", f],
+        vec!["profile", "--skin-melanin", "0.1", "--skin-hemoglobin", "0.1", "--json"],
+    ];
+    for cmd in &consumers {
+        for (bad, needles) in [
+            (["--g", "1.5"], ["--g", "(-1, 1)"]),
+            (["--g", "-1"], ["--g", "(-1, 1)"]),
+            (["--photons", "0"], ["--photons", "1..="]),
+        ] {
+            let args: Vec<&str> = cmd.iter().copied().chain(["--model", "mc"]).chain(bad).collect();
+            assert_usage(&rtbake(&args), &needles);
+        }
+    }
+    assert!(!out.exists(), "nothing written");
+}
