@@ -2,11 +2,13 @@
 //! `rtbake::mesh`).
 
 use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::facial::wrinkles::GreenConvention;
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits, TapDistance};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
+use rtbake::runtime::skin::surface_maps::SurfaceMaps;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
 use rtbake::runtime::texture_space::{TsSettings, DEFAULT_MAP_SIZE};
@@ -133,8 +135,75 @@ pub struct SkinArgs {
     /// Samples per pixel of the mesh G-buffer: 1 or 4 (MSAA, the standard 4× pattern; edges blended by coverage).
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     msaa: u32,
+    /// Albedo map (PNG or JPEG, sRGB, RGB or RGBA) read at the mesh's uv and applied after the diffusion
+    /// (post-scatter texturing, thesis §7.6), replacing the skin LUT's albedo. Default: the glTF material's
+    /// base-colour texture when --mesh has one.
+    #[arg(long, value_name = "FILE")]
+    albedo: Option<PathBuf>,
+    /// Tangent-space normal map (PNG or JPEG, linear, RGB or RGBA, c = 0.5 + 0.5·n) in the mesh's MikkTSpace frame.
+    /// Default: the glTF material's normal texture when --mesh has one.
+    #[arg(long, value_name = "FILE")]
+    normal_map: Option<PathBuf>,
+    /// Green channel of the normal map: opengl (+y up the texture: glTF's convention and the three.js scan's) or
+    /// directx (+y down the texture).
+    #[arg(long, value_enum, default_value = "opengl")]
+    normal_green: GreenArg,
     #[command(flatten)]
     common: crate::run::Common,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum GreenArg {
+    Opengl,
+    Directx,
+}
+
+/// A map file of `flag` decoded with its own channel count (exit 2 naming the flag and the file).
+fn read_picture(flag: &str, path: &Path) -> anyhow::Result<rtbake::image_buf::ImageU8> {
+    let name = format!("{flag} {}", path.display());
+    let len = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?.len();
+    if len > MAX_MESH_FILE_BYTES {
+        return Err(usage_msg(format!("{name}: {len} bytes; accepted at most {MAX_MESH_FILE_BYTES}")));
+    }
+    let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+    io::picture::decode_u8(flag, &path.display().to_string(), &bytes).map_err(usage)
+}
+
+/// The surface maps of --albedo / --normal-map, or the glTF material's own textures where a flag is absent
+/// (exit 2 naming the flag or the mesh); None when there are none.
+fn surface_maps(a: &SkinArgs) -> anyhow::Result<Option<SurfaceMaps>> {
+    use rtbake::runtime::skin::surface_maps::{ALBEDO_FLAG, NORMAL_MAP_FLAG};
+    let mut albedo = a.albedo.as_deref().map(|p| read_picture(ALBEDO_FLAG, p)).transpose()?;
+    let mut normal = a.normal_map.as_deref().map(|p| read_picture(NORMAL_MAP_FLAG, p)).transpose()?;
+    let gltf = a.mesh.as_deref().filter(|p| {
+        matches!(p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(), Some("gltf" | "glb"))
+    });
+    if let (Some(path), true) = (gltf, albedo.is_none() || normal.is_none()) {
+        let name = format!("--mesh {}", path.display());
+        let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let images = rtbake::mesh::gltf::material_images(&name, &bytes, &|uri: &str| {
+            std::fs::read(dir.join(uri)).map_err(|e| format!("{uri}: {e}"))
+        })
+        .map_err(usage)?;
+        let decode = |flag: &str, img: &rtbake::mesh::gltf::EncodedImage| {
+            io::picture::decode_u8(flag, &format!("{name}: {}", img.origin), &img.bytes).map_err(usage)
+        };
+        if albedo.is_none() {
+            albedo = images.base_color.as_ref().map(|i| decode(ALBEDO_FLAG, i)).transpose()?;
+        }
+        if normal.is_none() {
+            normal = images.normal.as_ref().map(|i| decode(NORMAL_MAP_FLAG, i)).transpose()?;
+        }
+    }
+    if albedo.is_none() && normal.is_none() {
+        return Ok(None);
+    }
+    let green = match a.normal_green {
+        GreenArg::Opengl => GreenConvention::OpenGl,
+        GreenArg::Directx => GreenConvention::DirectX,
+    };
+    Ok(Some(SurfaceMaps::from_pictures(albedo.as_ref(), normal.as_ref(), green).map_err(usage)?))
 }
 
 /// A JSON argument given inline (starting with `{`) or as a file name (exit 2 naming `flag`).
@@ -274,7 +343,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         return Err(usage_msg("--ts-map-size and --ts-opt apply to --shader ts only".to_string()));
     }
     settings.validate().map_err(usage)?;
-    let inputs: Vec<&Path> = a.mesh.iter().map(|p| p.as_path()).collect();
+    let inputs: Vec<&Path> = a.mesh.iter().chain(&a.albedo).chain(&a.normal_map).map(|p| p.as_path()).collect();
     crate::run::check_output_of(&a.output, &inputs)?;
     ctx.check_budget(
         &format!("--width {} --height {}", a.width, a.height),
@@ -302,7 +371,8 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     settings.distance_m = distance_m;
     settings.validate().map_err(usage)?;
     let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
-    let passes = passes(&a, &assets)?;
+    let mut passes = passes(&a, &assets)?;
+    passes.surface_maps = surface_maps(&a)?;
     let gpu = crate::run::device(ctx, a.common.cpu)?;
     if let Some(g) = &gpu {
         // Every pass against the adapter's limits before any work (the CPU twins have none).
@@ -353,6 +423,12 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
                     "gamma": if p.gamma == f32::MAX { None } else { Some(p.gamma) },
                 })
             }),
+            "surface_maps": passes.surface_maps.as_ref().map(|m| serde_json::json!({
+                "albedo": m.albedo.as_ref().map(|t| [t.width, t.height]),
+                "normal_map": m.normal.as_ref().map(|t| [t.width, t.height]),
+                "tangents": "mikktspace",
+                "texturing": "post-scatter (thesis 7.6)",
+            })),
             "wall_ms": ms,
         }));
     }

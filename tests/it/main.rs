@@ -79,6 +79,7 @@ mod skin_layers;
 mod skin_passes;
 mod skin_render;
 mod skin_spectral_data;
+mod skin_surface_maps;
 mod skin_ts;
 mod smaa_edges;
 mod smaa_modes;

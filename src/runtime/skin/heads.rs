@@ -166,10 +166,26 @@ pub(crate) fn geometry(
 ) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
     let (w, h, msaa) = (s.width, s.height, passes.msaa);
-    let mut g = gpu.run(
-        |d| mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, w, h, msaa),
-        || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
-    )?;
+    let mut g = match &passes.surface_maps {
+        // A normal map is baked in MikkTSpace: the mesh's frame, with vertices split where its corners disagree.
+        Some(_) => {
+            let (split, t) = crate::mesh::tangents::mikktspace_tangents(mesh);
+            gpu.run(
+                |d| mesh_raster::rasterise_with_tangents(&d.device, &d.queue, &split, &t, &cam, w, h, msaa),
+                || Ok(mesh_raster_cpu::rasterise_with_tangents(&split, &t, &cam, w, h, msaa)?),
+            )?
+        }
+        None => gpu.run(
+            |d| mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, w, h, msaa),
+            || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
+        )?,
+    };
+    let mut albedo = None;
+    if let Some(maps) = &passes.surface_maps {
+        let px = crate::runtime::chain::surface_pixels_for(gpu, &g, maps)?;
+        g.normal_view = px.normals;
+        albedo = px.albedo;
+    }
     if let Some(w) = &passes.wrinkles {
         g.normal_view = crate::runtime::chain::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
     }
@@ -208,7 +224,7 @@ pub(crate) fn geometry(
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
     let skin = g.covered.clone();
-    Ok((Geometry { frame, depth, skin, specular: Some(specular) }, g, shadow))
+    Ok((Geometry { frame, depth, skin, specular: Some(specular), albedo }, g, shadow))
 }
 
 /// MSAA: partly covered pixels of `frame` blend the shaded skin with the background by their `coverage`, in linear

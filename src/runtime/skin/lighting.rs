@@ -165,6 +165,9 @@ pub(crate) struct Geometry {
     /// Specular radiance per pixel under the key light (white), added after the SSS pass so it is never blurred
     /// (TAP 2009 §4: diffuse and specular in separate render targets); None: no specular layer (the demo).
     pub(crate) specular: Option<Vec<f32>>,
+    /// Linear albedo per pixel from a scan's albedo map ([`crate::runtime::skin::surface_maps`]), replacing the skin
+    /// LUT's on skin pixels; None: the LUT's.
+    pub(crate) albedo: Option<Vec<[f32; 3]>>,
 }
 
 /// Radiance scale of the key light (the diffuse layer's E = KEY_LIGHT_INTENSITY · N·L + ambient).
@@ -210,8 +213,14 @@ pub(crate) fn lit_geometry(gpu: Backend<'_>, geo: Geometry, assets: &DemoAssets)
         |g| SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?.run(&g.device, &g.queue, &geo.frame, weights, back),
         || Ok(crate::runtime::skin::inputs_cpu::skin_inputs(&geo.frame, luts, rig, weights, back)),
     )?;
-    // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let n = (w * h) as usize;
+    let mut albedo = albedo;
+    if let Some(map) = &geo.albedo {
+        for i in (0..n).filter(|&i| geo.skin[i]) {
+            albedo[4 * i..4 * i + 3].copy_from_slice(&map[i]);
+        }
+    }
+    // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let mut diffuse = vec![0.0f32; 4 * n];
     for i in 0..n {
         if !geo.skin[i] {
