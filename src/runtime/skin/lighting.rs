@@ -62,6 +62,44 @@ pub struct DemoAssets {
     /// the albedo multiplies it afterwards, so skin colour is not blurred; false (the demo): the pass blurs
     /// albedo · irradiance (pre-scatter texturing, as the screen-space passes of ch. 4 take a rendered image).
     pub post_scatter_albedo: bool,
+    /// The key light (Lambert, specular) and the light whose transmittance the back of the head lets through
+    /// (shadow-map thickness, eq. 5.13), view space; [`SceneLights::default`]: the demo's fixed pair.
+    pub lights: SceneLights,
+}
+
+/// Directions to the lights, view space, unit length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneLights {
+    /// To the key light: Lambert diffuse and the specular layer.
+    pub key_view: [f32; 3],
+    /// To the light seen through the head: the shadow map's thickness and E = max(0.3 − N·L, 0) of eq. 5.13.
+    pub back_view: [f32; 3],
+}
+
+impl Default for SceneLights {
+    /// The demo's fixed lights: a key light above left in front, a back light behind right.
+    fn default() -> Self {
+        SceneLights { key_view: key_light_view(), back_view: back_light_view() }
+    }
+}
+
+impl SceneLights {
+    /// TAP 2009 §6's single light (their stimuli: "a single light source") at azimuth ϕ and elevation θ around the
+    /// head ([`crate::mesh::framing::light_direction`]: 0° in front of the head, on the camera's side), seen by
+    /// `camera`: it is both the key light and the light transmitted through thin parts (thesis §5.3 uses the one
+    /// light for both). Out-of-range angles are refused naming `--light-azimuth` / `--light-elevation`.
+    pub fn single(
+        azimuth_deg: f32,
+        elevation_deg: f32,
+        camera: &crate::mesh::camera::Camera,
+    ) -> Result<Self, InvalidInput> {
+        let w =
+            crate::mesh::framing::light_direction(azimuth_deg, elevation_deg, "--light-azimuth", "--light-elevation")?;
+        let view = camera.view();
+        let r = view.fixed_view::<3, 3>(0, 0) * nalgebra::Vector3::from(w);
+        let v = normalise([r.x, r.y, r.z]);
+        Ok(SceneLights { key_view: v, back_view: v })
+    }
 }
 
 impl DemoAssets {
@@ -110,6 +148,7 @@ impl DemoAssets {
             importance_params: ImportanceSssParams::default(),
             bloom: None,
             post_scatter_albedo: false,
+            lights: SceneLights::default(),
         })
     }
 }
@@ -208,7 +247,7 @@ pub(crate) fn lit_geometry(gpu: Backend<'_>, geo: Geometry, assets: &DemoAssets)
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
-    let (key, back) = (key_light_view(), back_light_view());
+    let (key, back) = (assets.lights.key_view, assets.lights.back_view);
     let (albedo, transmitted) = gpu.run(
         |g| SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?.run(&g.device, &g.queue, &geo.frame, weights, back),
         || Ok(crate::runtime::skin::inputs_cpu::skin_inputs(&geo.frame, luts, rig, weights, back)),

@@ -25,6 +25,7 @@ pub mod passes;
 pub mod settings;
 pub mod surface_maps;
 pub mod surface_maps_cpu;
+pub mod tap_grid;
 pub mod texture_space;
 pub mod texture_space_cpu;
 pub mod wrinkles;
