@@ -8,7 +8,7 @@ use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits,
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
-use rtbake::runtime::skin::lighting::SceneLights;
+use rtbake::runtime::skin::lighting::{SceneLights, TransmittanceMode};
 use rtbake::runtime::skin::surface_maps::SurfaceMaps;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
@@ -147,8 +147,20 @@ pub struct SkinArgs {
     /// --light-azimuth is given).
     #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
     light_elevation: Option<f32>,
+    /// Light seen through thin parts, with the thickness from the back light's shadow map (Listing 5.1):
+    /// shadow-map (the baked T(s) of eq. 5.12, the translucent-shadow-map path), green (Green's Beer-Lambert
+    /// T(s) = exp(-s sigma_t) with Jensen 2001's skin1 sigma_t', thesis 5.3) or off.
+    #[arg(long, value_enum, default_value = "shadow-map")]
+    transmittance: TransmittanceArg,
     #[command(flatten)]
     common: crate::run::Common,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TransmittanceArg {
+    Off,
+    Green,
+    ShadowMap,
 }
 
 /// A scanned head's maps (shared by `run skin` and `run tap-grid`).
@@ -396,6 +408,11 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     settings.distance_m = distance_m;
     settings.validate().map_err(usage)?;
     let mut assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
+    assets.set_transmittance(match a.transmittance {
+        TransmittanceArg::Off => TransmittanceMode::Off,
+        TransmittanceArg::Green => TransmittanceMode::green_skin1(),
+        TransmittanceArg::ShadowMap => TransmittanceMode::ShadowMap,
+    });
     if let Some((az, el)) = single_light {
         assets.lights = SceneLights::single(az, el, &settings.camera()).map_err(usage)?;
     }
@@ -467,6 +484,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
                 "tangents": "mikktspace",
                 "texturing": "post-scatter (thesis 7.6)",
             })),
+            "transmittance": format!("{:?}", a.transmittance).to_lowercase(),
             "wall_ms": ms,
         }));
     }

@@ -81,6 +81,7 @@ mod skin_render;
 mod skin_spectral_data;
 mod skin_surface_maps;
 mod skin_tap_grid;
+mod skin_transmittance;
 mod skin_ts;
 mod smaa_edges;
 mod smaa_modes;

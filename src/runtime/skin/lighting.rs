@@ -153,7 +153,48 @@ impl DemoAssets {
     }
 }
 
+/// Where the light seen through thin parts comes from (`run skin --transmittance`, thesis §5.3 and §5.6 compare
+/// these): every mode reads the thickness s from the back light's shadow map (Listing 5.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum TransmittanceMode {
+    /// The baked T(s) of the skin's sum of Gaussians (thesis eq. 5.12, the translucent-shadow-map path).
+    #[default]
+    ShadowMap,
+    /// Green's Beer–Lambert T(s) = exp(−s·σt) (GPU Gems ch. 16, thesis §5.3) through the same thickness.
+    Green(crate::transmittance::BeerLambert),
+    /// No transmitted light.
+    Off,
+}
+
+impl TransmittanceMode {
+    /// Green's law with Jensen et al. 2001's skin1: σt′ = σa + σs′ = (0.772, 1.05, 1.49) mm⁻¹.
+    pub fn green_skin1() -> Self {
+        let m = crate::diffusion::materials::find("skin1").expect("Jensen 2001 lists skin1");
+        let b = crate::transmittance::BeerLambert::from_reduced(
+            "--transmittance",
+            m.sigma_a_per_mm,
+            m.sigma_s_prime_per_mm,
+        )
+        .expect("skin1's coefficients are in range");
+        TransmittanceMode::Green(b)
+    }
+}
+
 impl DemoAssets {
+    /// Replaces the T(s) table the skin-inputs pass reads (same layout: s = s_max·i/(n−1)) by `mode`'s.
+    pub fn set_transmittance(&mut self, mode: TransmittanceMode) {
+        let n = self.luts.transmittance.len();
+        let s_max = self.luts.s_max_mm as f64;
+        match mode {
+            TransmittanceMode::ShadowMap => {}
+            TransmittanceMode::Off => self.luts.transmittance = vec![[0.0; 3]; n],
+            TransmittanceMode::Green(b) => {
+                self.luts.transmittance =
+                    (0..n).map(|i| b.at(s_max * i as f64 / (n.max(2) - 1) as f64).map(|t| t as f32)).collect();
+            }
+        }
+    }
+
     /// Sets the rig weights from a JSON object `{"target name": weight, …}` (`--rig-weights`): every name must
     /// be a target of the rig, weights finite, and their sum 1 ± 1e-3 (eq. 7.6 blends the targets); targets not
     /// named get 0.
