@@ -100,10 +100,11 @@ pub struct SkinArgs {
     /// framed) or authored (the file's own origin).
     #[arg(long, value_enum, default_value = "bounds")]
     mesh_origin: MeshOriginArg,
-    /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ), tap2009 (α = 11, β = 800, no clamp of
-    /// the depth derivative, TAP 2009 §4) — both stated for a 20° field of view and scaled to the camera's — or
-    /// physical (α from the camera: each Gaussian at its width in mm, as TS and SS Jittered).
-    #[arg(long, value_enum, default_value = "thesis")]
+    /// Stretch parameters of --shader ss-full: tap2009 (α = 11, β = 800, no clamp of the depth derivative, TAP
+    /// 2009 §4; the default, closest to TS on the scanned head), thesis (the bake's α, β, γ) — both stated for a
+    /// 20° field of view and scaled to the camera's — or physical (α from the camera: each Gaussian at its width
+    /// in mm, as TS and SS Jittered).
+    #[arg(long, value_enum, default_value = "tap2009")]
     stretch: StretchArg,
     /// Irradiance map edge of --shader ts, texels, 32..=2048 (T_max with --ts-opt depth; default 1024).
     #[arg(long, allow_negative_numbers = true, value_name = "TEXELS")]
@@ -474,6 +475,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
                 let v = p.for_viewport_height(out.height);
                 serde_json::json!({
                     "preset": format!("{:?}", a.stretch).to_lowercase(),
+                    "alpha_stated_for": {"fov_y_deg": rtbake::runtime::skin_render::ALPHA_FOV_DEG, "viewport_height": 720},
                     "alpha_at_720px": p.alpha, "alpha_at_viewport": v.alpha, "beta": p.beta,
                     "gamma": if p.gamma == f32::MAX { None } else { Some(p.gamma) },
                 })

@@ -198,3 +198,38 @@ fn tap_grid_bad_input_exits_2_and_writes_nothing() {
         assert!(!out.exists(), "{extra:?} created the folder");
     }
 }
+
+/// SS Full's default stretch is TAP's (α = 11, β = 800, no clamp, stated for a 20° camera at 720 px), and `--json`
+/// prints what was used: α at 720 px and at the viewport, β, γ, the field of view and the viewport.
+#[test]
+fn ss_full_defaults_to_taps_stretch_and_json_states_the_camera() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("f.png");
+    let o = rtbake(&[
+        "--json",
+        "run",
+        "skin",
+        "--cpu",
+        "--shader",
+        "ss-full",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let st = &v["ss_full_stretch"];
+    assert_eq!(st["preset"], "tap2009", "{v}");
+    assert_eq!((st["beta"].as_f64(), st["gamma"].is_null()), (Some(800.0), true), "{st}");
+    assert_eq!(st["alpha_stated_for"]["fov_y_deg"], 20.0);
+    let fov = v["camera"]["fov_y_deg"].as_f64().unwrap();
+    assert_eq!(fov, 30.0);
+    let want = 11.0 * (10f64.to_radians().tan() / (fov / 2.0).to_radians().tan());
+    let a720 = st["alpha_at_720px"].as_f64().unwrap();
+    assert!((a720 - want).abs() < 1e-4, "{a720} vs {want}");
+    assert!((st["alpha_at_viewport"].as_f64().unwrap() - a720 * 36.0 / 720.0).abs() < 1e-4, "{st}");
+    assert_eq!(v["camera"]["viewport"], serde_json::json!([64, 36]));
+}
