@@ -138,7 +138,7 @@ pub fn surface_pixels(
     let flat = SurfaceMap { width: 1, height: 1, texels: vec![[0.0, 0.0, 1.0, 0.0]] };
     let a = maps.albedo.as_ref().unwrap_or(&flat);
     let nm = maps.normal.as_ref().unwrap_or(&flat);
-    maps.check_fits(device.limits().max_storage_buffer_binding_size as u64)?;
+    maps.check_fits(device.limits().max_storage_buffer_binding_size)?;
     let params = Params {
         size: [g.width as f32, g.height as f32, a.width as f32, a.height as f32],
         normal: [
