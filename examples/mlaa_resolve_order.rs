@@ -11,8 +11,9 @@ fn main() {
     let nums: Vec<u32> = args.iter().filter_map(|a| a.parse().ok()).collect();
     let (w, h) = (nums.first().copied().unwrap_or(1280), nums.get(1).copied().unwrap_or(720));
     let baked = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("baked");
-    let bytes = rtbake::runtime::loader::load_mlaa_area(&baked, 32).expect("the bake's MLAA area map");
-    let map = rtbake::runtime::mlaa::MlaaAreaMap::new(32, bytes).expect("a valid area map");
+    let n = rtbake::runtime::mlaa::DEFAULT_MAX_DISTANCE;
+    let bytes = rtbake::runtime::loader::load_mlaa_area(&baked, n).expect("the bake's MLAA area map");
+    let map = rtbake::runtime::mlaa::MlaaAreaMap::new(n, bytes).expect("a valid area map");
     let gpu = if cpu { None } else { Some(create_headless(&Default::default()).expect("a GPU adapter")) };
     println!("adapter: {}", gpu.as_ref().map(|g| g.describe()).unwrap_or_else(|| "CPU twins".into()));
     let e = compare(gpu.as_ref(), w, h, &map).expect("the comparison");

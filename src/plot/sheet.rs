@@ -103,15 +103,17 @@ mod tests {
         assert_eq!(difference_colour(0.0), [0, 0, 0]);
         assert_eq!(difference_colour(1.0), [255, 255, 255]);
         assert_eq!(difference_colour(1.0 / 3.0), [255, 0, 0]);
-        let a = Image::from_vec(96, 48, 4, [100u8, 100, 100, 255].repeat(96 * 48));
+        let a = Image::from_vec(160, 48, 4, [100u8, 100, 100, 255].repeat(160 * 48));
         let mut b = a.clone();
         b.data[0] = 108; // pixel (0, 0): |d| = 8/255, ×8 → 0.25 of the ramp
         let d = difference_image(&a, &b, 8.0);
-        assert_eq!((d.width, d.height, d.channels), (96, 48, 3));
+        assert_eq!((d.width, d.height, d.channels), (160, 48, 3));
         assert_eq!(&d.data[..3], &difference_colour(64.0 / 255.0));
         assert_eq!(&d.data[3..6], &[0, 0, 0]);
-        // The legend strip at the bottom holds the ramp's white end and label text.
-        let bottom = &d.data[(3 * 96 * 40) as usize..];
+        // The legend strip at the bottom holds the ramp's white end and label text; too narrow a frame has none.
+        let narrow = Image::from_vec(32, 48, 4, [100u8, 100, 100, 255].repeat(32 * 48));
+        assert!(difference_image(&narrow, &narrow, 8.0).data.iter().all(|&v| v == 0));
+        let bottom = &d.data[(3 * 160 * 40) as usize..];
         assert!(bottom.chunks(3).any(|p| p == [255, 255, 255]));
     }
 
