@@ -197,6 +197,13 @@ fn tap_grid_bad_input_exits_2_and_writes_nothing() {
         assert!(err.contains(flag), "{extra:?}: {err}");
         assert!(!out.exists(), "{extra:?} created the folder");
     }
+    // The 54 frames' estimated time is checked against the budget before any work.
+    let o =
+        rtbake(&["--max-seconds", "1", "run", "tap-grid", "--cpu", "--width", "1280", "--height", "720", "--out", o_s]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("54 frames") && err.contains("--max-seconds"), "{err}");
+    assert!(!out.exists());
 }
 
 /// SS Full's default stretch is TAP's (α = 11, β = 800, no clamp, stated for a 20° camera at 720 px), and `--json`
