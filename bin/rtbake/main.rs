@@ -20,6 +20,7 @@ mod run;
 mod run_edges;
 mod run_skin;
 mod run_smaa_modes;
+mod run_tap_grid;
 mod skin_color;
 mod transmittance;
 mod transport;

@@ -31,6 +31,10 @@ pub enum RunCommand {
     /// Render heads from a mesh (the procedural head, or --mesh glTF/OBJ) through the skin chain: shadow-map
     /// thickness, skin colour, no SSS / sum-of-Gaussians / separable SSS, transmittance; writes a PNG.
     Skin(Box<crate::run_skin::SkinArgs>),
+    /// Render TAP 2009's stimulus grid (TS, SS Full, SS Jittered, No SSS × light azimuths 0/60/110/150° at 45° ×
+    /// zoom/near/far) and the α/β sweep of its Fig. 4 into a folder: frames, differences against TS, RMSE table
+    /// (CSV + JSON), contact sheets.
+    TapGrid(Box<crate::run_tap_grid::TapGridArgs>),
 }
 
 #[derive(clap::Args)]
@@ -200,6 +204,7 @@ pub fn run(cmd: RunCommand, ctx: &Ctx) -> anyhow::Result<()> {
         }
         RunCommand::Sss(a) => sss(ctx, *a),
         RunCommand::Demo(d) => run_demo(ctx, d),
+        RunCommand::TapGrid(s) => crate::run_tap_grid::run(ctx, *s),
         RunCommand::Skin(s) => crate::run_skin::run(ctx, *s),
     }
 }

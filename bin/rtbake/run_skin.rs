@@ -2,11 +2,14 @@
 //! `rtbake::mesh`).
 
 use crate::cli::{usage, usage_msg, Ctx};
+use rtbake::facial::wrinkles::GreenConvention;
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits, TapDistance};
 use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
+use rtbake::runtime::skin::lighting::{SceneLights, TransmittanceMode};
+use rtbake::runtime::skin::surface_maps::SurfaceMaps;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
 use rtbake::runtime::skin_render::{self, SkinRenderSettings, SkinShader, StretchPreset};
 use rtbake::runtime::texture_space::{TsSettings, DEFAULT_MAP_SIZE};
@@ -97,10 +100,11 @@ pub struct SkinArgs {
     /// framed) or authored (the file's own origin).
     #[arg(long, value_enum, default_value = "bounds")]
     mesh_origin: MeshOriginArg,
-    /// Stretch parameters of --shader ss-full: thesis (the bake's α, β, γ), tap2009 (α = 11, β = 800, no clamp of
-    /// the depth derivative, TAP 2009 §4) — both stated for a 20° field of view and scaled to the camera's — or
-    /// physical (α from the camera: each Gaussian at its width in mm, as TS and SS Jittered).
-    #[arg(long, value_enum, default_value = "thesis")]
+    /// Stretch parameters of --shader ss-full: tap2009 (α = 11, β = 800, no clamp of the depth derivative, TAP
+    /// 2009 §4; the default, closest to TS on the scanned head), thesis (the bake's α, β, γ) — both stated for a
+    /// 20° field of view and scaled to the camera's — or physical (α from the camera: each Gaussian at its width
+    /// in mm, as TS and SS Jittered).
+    #[arg(long, value_enum, default_value = "tap2009")]
     stretch: StretchArg,
     /// Irradiance map edge of --shader ts, texels, 32..=2048 (T_max with --ts-opt depth; default 1024).
     #[arg(long, allow_negative_numbers = true, value_name = "TEXELS")]
@@ -134,7 +138,102 @@ pub struct SkinArgs {
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     msaa: u32,
     #[command(flatten)]
+    maps: MapArgs,
+    /// TAP 2009's single light (key light and transmitted light at once): azimuth around the head in degrees,
+    /// -180..=180 (0 in front of the face on the camera's side, positive towards +x; TAP used 0, 60, 110, 150).
+    /// Giving this or --light-elevation replaces the default key + back light pair.
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
+    light_azimuth: Option<f32>,
+    /// Elevation of the single light above the horizontal, degrees, -90..=90 (TAP: 45; the default when only
+    /// --light-azimuth is given).
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
+    light_elevation: Option<f32>,
+    /// Light seen through thin parts, with the thickness from the back light's shadow map (Listing 5.1):
+    /// shadow-map (the baked T(s) of eq. 5.12, the translucent-shadow-map path), green (Green's Beer-Lambert
+    /// T(s) = exp(-s sigma_t) with Jensen 2001's skin1 sigma_t', thesis 5.3) or off.
+    #[arg(long, value_enum, default_value = "shadow-map")]
+    transmittance: TransmittanceArg,
+    #[command(flatten)]
     common: crate::run::Common,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TransmittanceArg {
+    Off,
+    Green,
+    ShadowMap,
+}
+
+/// A scanned head's maps (shared by `run skin` and `run tap-grid`).
+#[derive(clap::Args)]
+pub struct MapArgs {
+    /// Albedo map (PNG or JPEG, sRGB, RGB or RGBA) read at the mesh's uv and applied after the diffusion
+    /// (post-scatter texturing, thesis §7.6), replacing the skin LUT's albedo. Default: the glTF material's
+    /// base-colour texture when --mesh has one.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) albedo: Option<PathBuf>,
+    /// Tangent-space normal map (PNG or JPEG, linear, RGB or RGBA, c = 0.5 + 0.5·n) in the mesh's MikkTSpace frame.
+    /// Default: the glTF material's normal texture when --mesh has one.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) normal_map: Option<PathBuf>,
+    /// Green channel of the normal map: opengl (+y up the texture: glTF's convention and the three.js scan's) or
+    /// directx (+y down the texture).
+    #[arg(long, value_enum, default_value = "opengl")]
+    normal_green: GreenArg,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum GreenArg {
+    Opengl,
+    Directx,
+}
+
+/// A map file of `flag` decoded with its own channel count (exit 2 naming the flag and the file).
+fn read_picture(flag: &str, path: &Path) -> anyhow::Result<rtbake::image_buf::ImageU8> {
+    let name = format!("{flag} {}", path.display());
+    let len = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?.len();
+    if len > MAX_MESH_FILE_BYTES {
+        return Err(usage_msg(format!("{name}: {len} bytes; accepted at most {MAX_MESH_FILE_BYTES}")));
+    }
+    let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+    io::picture::decode_u8(flag, &path.display().to_string(), &bytes).map_err(usage)
+}
+
+/// The surface maps of --albedo / --normal-map, or the glTF material's own textures where a flag is absent
+/// (exit 2 naming the flag or the mesh); None when there are none.
+pub fn surface_maps(a: &MapArgs, mesh: Option<&Path>) -> anyhow::Result<Option<SurfaceMaps>> {
+    use rtbake::runtime::skin::surface_maps::{ALBEDO_FLAG, NORMAL_MAP_FLAG};
+    let mut albedo = a.albedo.as_deref().map(|p| read_picture(ALBEDO_FLAG, p)).transpose()?;
+    let mut normal = a.normal_map.as_deref().map(|p| read_picture(NORMAL_MAP_FLAG, p)).transpose()?;
+    let gltf = mesh.filter(|p| {
+        matches!(p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(), Some("gltf" | "glb"))
+    });
+    if let (Some(path), true) = (gltf, albedo.is_none() || normal.is_none()) {
+        let name = format!("--mesh {}", path.display());
+        let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
+        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let images = rtbake::mesh::gltf::material_images(&name, &bytes, &|uri: &str| {
+            std::fs::read(dir.join(uri)).map_err(|e| format!("{uri}: {e}"))
+        })
+        .map_err(usage)?;
+        let decode = |flag: &str, img: &rtbake::mesh::gltf::EncodedImage| {
+            io::picture::decode_u8(flag, &format!("{name}: {}", img.origin), &img.bytes).map_err(usage)
+        };
+        if albedo.is_none() {
+            albedo = images.base_color.as_ref().map(|i| decode(ALBEDO_FLAG, i)).transpose()?;
+        }
+        if normal.is_none() {
+            normal = images.normal.as_ref().map(|i| decode(NORMAL_MAP_FLAG, i)).transpose()?;
+        }
+    }
+    if albedo.is_none() && normal.is_none() {
+        return Ok(None);
+    }
+    let green = match a.normal_green {
+        GreenArg::Opengl => GreenConvention::OpenGl,
+        GreenArg::Directx => GreenConvention::DirectX,
+    };
+    Ok(Some(SurfaceMaps::from_pictures(albedo.as_ref(), normal.as_ref(), green).map_err(usage)?))
 }
 
 /// A JSON argument given inline (starting with `{`) or as a file name (exit 2 naming `flag`).
@@ -173,7 +272,7 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
 
 /// Reads and validates `--mesh` (exit 2 naming the file and the defect), then puts it in metres (`units`) with
 /// its bounding-box centre at the origin unless `origin` is authored.
-fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Result<Mesh> {
+pub fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Result<Mesh> {
     let name = format!("--mesh {}", path.display());
     let meta = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
     if meta.len() > MAX_MESH_FILE_BYTES {
@@ -204,8 +303,8 @@ fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Re
 }
 
 /// The units of --mesh from --mesh-units / --mesh-mm-per-unit (default metres).
-fn mesh_units(a: &SkinArgs) -> anyhow::Result<MeshUnits> {
-    match (&a.mesh_units, a.mesh_mm_per_unit) {
+pub fn mesh_units_of(mesh_units: &Option<String>, mesh_mm_per_unit: Option<f32>) -> anyhow::Result<MeshUnits> {
+    match (mesh_units, mesh_mm_per_unit) {
         (Some(u), _) => MeshUnits::parse("--mesh-units", u).map_err(usage),
         (None, Some(v)) => {
             if !(v.is_finite() && v > 0.0) {
@@ -245,7 +344,7 @@ fn ts_settings(a: &SkinArgs) -> anyhow::Result<TsSettings> {
 }
 
 pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
-    let units = mesh_units(&a)?;
+    let units = mesh_units_of(&a.mesh_units, a.mesh_mm_per_unit)?;
     if a.mesh.is_none() && (a.mesh_units.is_some() || a.mesh_mm_per_unit.is_some()) {
         return Err(usage_msg("--mesh-units and --mesh-mm-per-unit apply to --mesh only".to_string()));
     }
@@ -274,7 +373,15 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         return Err(usage_msg("--ts-map-size and --ts-opt apply to --shader ts only".to_string()));
     }
     settings.validate().map_err(usage)?;
-    let inputs: Vec<&Path> = a.mesh.iter().map(|p| p.as_path()).collect();
+    let single_light = (a.light_azimuth.is_some() || a.light_elevation.is_some()).then(|| {
+        let az = a.light_azimuth.unwrap_or(rtbake::mesh::framing::TAP_LIGHT_AZIMUTHS_DEG[0]);
+        (az, a.light_elevation.unwrap_or(rtbake::mesh::framing::TAP_LIGHT_ELEVATION_DEG))
+    });
+    if let Some((az, el)) = single_light {
+        SceneLights::single(az, el, &settings.camera()).map_err(usage)?;
+    }
+    let inputs: Vec<&Path> =
+        a.mesh.iter().chain(&a.maps.albedo).chain(&a.maps.normal_map).map(|p| p.as_path()).collect();
     crate::run::check_output_of(&a.output, &inputs)?;
     ctx.check_budget(
         &format!("--width {} --height {}", a.width, a.height),
@@ -301,8 +408,17 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
     let (distance_m, named) = camera_distance(&a.distance, head_height_m)?;
     settings.distance_m = distance_m;
     settings.validate().map_err(usage)?;
-    let assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
-    let passes = passes(&a, &assets)?;
+    let mut assets = DemoAssets::load(&a.common.baked).map_err(usage)?;
+    assets.set_transmittance(match a.transmittance {
+        TransmittanceArg::Off => TransmittanceMode::Off,
+        TransmittanceArg::Green => TransmittanceMode::green_skin1(),
+        TransmittanceArg::ShadowMap => TransmittanceMode::ShadowMap,
+    });
+    if let Some((az, el)) = single_light {
+        assets.lights = SceneLights::single(az, el, &settings.camera()).map_err(usage)?;
+    }
+    let mut passes = passes(&a, &assets)?;
+    passes.surface_maps = surface_maps(&a.maps, a.mesh.as_deref())?;
     let gpu = crate::run::device(ctx, a.common.cpu)?;
     if let Some(g) = &gpu {
         // Every pass against the adapter's limits before any work (the CPU twins have none).
@@ -344,15 +460,33 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
                 "viewport": [out.width, out.height],
                 "head_height_mm": head_height_m * 1000.0,
             },
+            "light": match single_light {
+                Some((az, el)) => serde_json::json!({
+                    "kind": "single (TAP 2009)", "azimuth_deg": az, "elevation_deg": el,
+                    "direction_view": assets.lights.key_view,
+                }),
+                None => serde_json::json!({
+                    "kind": "key + back (default)", "key_view": assets.lights.key_view,
+                    "back_view": assets.lights.back_view,
+                }),
+            },
             "ss_full_stretch": matches!(a.shader, ShaderArg::SsFull).then(|| {
                 let p = settings.stretch.apply(assets.gaussian_params, settings.camera().fov_y_deg);
                 let v = p.for_viewport_height(out.height);
                 serde_json::json!({
                     "preset": format!("{:?}", a.stretch).to_lowercase(),
+                    "alpha_stated_for": {"fov_y_deg": rtbake::runtime::skin_render::ALPHA_FOV_DEG, "viewport_height": 720},
                     "alpha_at_720px": p.alpha, "alpha_at_viewport": v.alpha, "beta": p.beta,
                     "gamma": if p.gamma == f32::MAX { None } else { Some(p.gamma) },
                 })
             }),
+            "surface_maps": passes.surface_maps.as_ref().map(|m| serde_json::json!({
+                "albedo": m.albedo.as_ref().map(|t| [t.width, t.height]),
+                "normal_map": m.normal.as_ref().map(|t| [t.width, t.height]),
+                "tangents": "mikktspace",
+                "texturing": "post-scatter (thesis 7.6)",
+            })),
+            "transmittance": format!("{:?}", a.transmittance).to_lowercase(),
             "wall_ms": ms,
         }));
     }

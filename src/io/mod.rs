@@ -11,6 +11,7 @@ pub mod exr;
 pub mod file_set;
 pub mod frame_sequence;
 pub mod ktx2;
+pub mod picture;
 pub mod png;
 pub mod source;
 

@@ -323,3 +323,15 @@ pub fn wrinkled_normals_for<'g>(
         || Ok(wrinkles_cpu::wrinkled_normals(g, maps, weights)?),
     )
 }
+
+/// The scan's surface maps at the G-buffer's uv ([`crate::runtime::skin::surface_maps`]) on `gpu`.
+pub fn surface_pixels_for<'g>(
+    gpu: impl Into<Backend<'g>>,
+    g: &MeshGBuffer,
+    maps: &crate::runtime::skin::surface_maps::SurfaceMaps,
+) -> Result<crate::runtime::skin::surface_maps::SurfacedPixels, RuntimeError> {
+    gpu.into().run(
+        |d| crate::runtime::skin::surface_maps::surface_pixels(&d.device, &d.queue, g, maps),
+        || Ok(crate::runtime::skin::surface_maps_cpu::surface_pixels(g, maps)),
+    )
+}

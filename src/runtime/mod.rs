@@ -21,6 +21,7 @@ pub(crate) mod compute_chain;
 pub mod device;
 pub mod gpu;
 pub mod loader;
+pub mod resolve_order;
 pub mod sampler;
 pub mod skin;
 pub mod sss;

@@ -101,6 +101,23 @@ pub fn render_shapes(w: u32, h: u32, n: u32) -> Vec<u8> {
     out
 }
 
+/// The shapes scene with one sample per pixel at `offset` (pixel units from its top-left corner, each in 0..1):
+/// one sample image of an MSAA render (e.g. the standard 4× pattern), RGBA8 sRGB-encoded.
+pub fn render_shapes_at(w: u32, h: u32, offset: [f64; 2]) -> Vec<u8> {
+    let scene = shapes(w, h);
+    let mut out = vec![0u8; (w * h * 4) as usize];
+    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
+        for x in 0..w as usize {
+            let c = shade(&scene, x as f64 + offset[0], y as f64 + offset[1]);
+            for k in 0..3 {
+                row[x * 4 + k] = crate::runtime::sampler::unorm8(crate::runtime::sampler::linear_to_srgb(c[k] as f32));
+            }
+            row[x * 4 + 3] = 255;
+        }
+    });
+    out
+}
+
 /// The shapes scene with other colours: shape `i` gets `colours[i % colours.len()]`, the background `background`
 /// (linear RGB); `n` as in [`render_shapes`]. For scenes whose edges luma cannot see (equal-luma colours).
 pub fn render_shapes_recoloured(w: u32, h: u32, n: u32, colours: &[[f64; 3]], background: [f64; 3]) -> Vec<u8> {

@@ -29,6 +29,7 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
         depth: vec![50.0; n],
         skin: vec![false; n],
         specular: None,
+        albedo: None,
     };
     let hf = h as f32;
     let aspect = w as f32 / hf;

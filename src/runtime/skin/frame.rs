@@ -143,6 +143,9 @@ pub fn check_frame_fits(
             ));
         }
     }
+    if let Some(maps) = &passes.surface_maps {
+        maps.check_fits(storage)?;
+    }
     if let SkinShader::Ts(ts) = s.shader {
         // With --ts-opt depth, --ts-map-size is the largest map (T_max); every map is at most that.
         let b = texture_space::map_buffer_bytes(ts.map_size);

@@ -10,7 +10,7 @@ use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
 use crate::runtime::sampler;
 use crate::runtime::skin::inputs::SkinFrame;
-use crate::runtime::skin::lighting::{back_light_view, key_light_view, DemoAssets, Geometry, KEY_LIGHT_INTENSITY};
+use crate::runtime::skin::lighting::{key_light_view, DemoAssets, Geometry, KEY_LIGHT_INTENSITY};
 use crate::runtime::skin::mesh_raster::{self, MeshGBuffer};
 use crate::runtime::skin::mesh_raster_cpu;
 use crate::runtime::skin::passes::SkinPasses;
@@ -49,11 +49,12 @@ fn rasterise(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera, w: u32, h: u32) -> Res
     )
 }
 
-/// The light camera of the shadow map: 1.5 m from the heads towards the back light, looking at them.
-fn light_camera(cam: &Camera) -> Camera {
+/// The light camera of the shadow map: 1.5 m from the heads towards the back light (`back`, view space), looking at
+/// them.
+fn light_camera(cam: &Camera, back: [f32; 3]) -> Camera {
     // View → world for directions: the transpose of the view rotation.
     let view = cam.view();
-    let l = Vector3::from(back_light_view());
+    let l = Vector3::from(back);
     let rot = view.fixed_view::<3, 3>(0, 0).transpose();
     let dir = rot * l;
     let target = Vector3::from(cam.target);
@@ -79,9 +80,9 @@ pub(crate) struct ShadowMap {
 }
 
 impl ShadowMap {
-    /// `mesh` rasterised from the back light's camera of the frame seen by `cam`.
-    pub(crate) fn new(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera) -> Result<Self, RuntimeError> {
-        let light = light_camera(cam);
+    /// `mesh` rasterised from the camera of the back light `back` (view space) of the frame seen by `cam`.
+    pub(crate) fn new(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera, back: [f32; 3]) -> Result<Self, RuntimeError> {
+        let light = light_camera(cam, back);
         let map = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
         let light_view = light.view();
         Ok(Self { map, light_view, light_vp: light.projection(1.0) * light_view, mm_per_unit: mesh.mm_per_unit })
@@ -137,9 +138,13 @@ fn thickness_mm(g: &MeshGBuffer, cam: &Camera, shadow: &ShadowMap, mm_per_unit: 
 /// The Kelemen/Szirmay-Kalos specular of skin under the key light per covered pixel (view space: V points from
 /// the surface to the eye at the origin), scaled like the diffuse layer's key light.
 pub fn specular_layer(g: &MeshGBuffer, cam: &Camera) -> Vec<f32> {
+    specular_layer_lit(g, cam, key_light_view())
+}
+
+/// [`specular_layer`] under the key light `l` (view space, unit).
+pub fn specular_layer_lit(g: &MeshGBuffer, cam: &Camera, l: [f32; 3]) -> Vec<f32> {
     use crate::shading::kelemen::{specular, SKIN_F0, SKIN_RHO_S, SKIN_ROUGHNESS};
     let (w, h) = (g.width, g.height);
-    let l = key_light_view();
     (0..(w * h) as usize)
         .map(|i| {
             if !g.covered[i] {
@@ -166,16 +171,32 @@ pub(crate) fn geometry(
 ) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
     let (w, h, msaa) = (s.width, s.height, passes.msaa);
-    let mut g = gpu.run(
-        |d| mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, w, h, msaa),
-        || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
-    )?;
+    let mut g = match &passes.surface_maps {
+        // A normal map is baked in MikkTSpace: the mesh's frame, with vertices split where its corners disagree.
+        Some(_) => {
+            let (split, t) = crate::mesh::tangents::mikktspace_tangents(mesh);
+            gpu.run(
+                |d| mesh_raster::rasterise_with_tangents(&d.device, &d.queue, &split, &t, &cam, w, h, msaa),
+                || Ok(mesh_raster_cpu::rasterise_with_tangents(&split, &t, &cam, w, h, msaa)?),
+            )?
+        }
+        None => gpu.run(
+            |d| mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, w, h, msaa),
+            || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
+        )?,
+    };
+    let mut albedo = None;
+    if let Some(maps) = &passes.surface_maps {
+        let px = crate::runtime::chain::surface_pixels_for(gpu, &g, maps)?;
+        g.normal_view = px.normals;
+        albedo = px.albedo;
+    }
     if let Some(w) = &passes.wrinkles {
         g.normal_view = crate::runtime::chain::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
     }
-    let shadow = ShadowMap::new(gpu, mesh, &cam)?;
+    let shadow = ShadowMap::new(gpu, mesh, &cam, assets.lights.back_view)?;
     let thickness = thickness_mm(&g, &cam, &shadow, mesh.mm_per_unit);
-    let specular = specular_layer(&g, &cam);
+    let specular = specular_layer_lit(&g, &cam, assets.lights.key_view);
     let n = (s.width * s.height) as usize;
     let mut frame = SkinFrame {
         width: s.width,
@@ -208,7 +229,7 @@ pub(crate) fn geometry(
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
     let skin = g.covered.clone();
-    Ok((Geometry { frame, depth, skin, specular: Some(specular) }, g, shadow))
+    Ok((Geometry { frame, depth, skin, specular: Some(specular), albedo }, g, shadow))
 }
 
 /// MSAA: partly covered pixels of `frame` blend the shaded skin with the background by their `coverage`, in linear

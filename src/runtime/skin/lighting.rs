@@ -62,6 +62,44 @@ pub struct DemoAssets {
     /// the albedo multiplies it afterwards, so skin colour is not blurred; false (the demo): the pass blurs
     /// albedo · irradiance (pre-scatter texturing, as the screen-space passes of ch. 4 take a rendered image).
     pub post_scatter_albedo: bool,
+    /// The key light (Lambert, specular) and the light whose transmittance the back of the head lets through
+    /// (shadow-map thickness, eq. 5.13), view space; [`SceneLights::default`]: the demo's fixed pair.
+    pub lights: SceneLights,
+}
+
+/// Directions to the lights, view space, unit length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneLights {
+    /// To the key light: Lambert diffuse and the specular layer.
+    pub key_view: [f32; 3],
+    /// To the light seen through the head: the shadow map's thickness and E = max(0.3 − N·L, 0) of eq. 5.13.
+    pub back_view: [f32; 3],
+}
+
+impl Default for SceneLights {
+    /// The demo's fixed lights: a key light above left in front, a back light behind right.
+    fn default() -> Self {
+        SceneLights { key_view: key_light_view(), back_view: back_light_view() }
+    }
+}
+
+impl SceneLights {
+    /// TAP 2009 §6's single light (their stimuli: "a single light source") at azimuth ϕ and elevation θ around the
+    /// head ([`crate::mesh::framing::light_direction`]: 0° in front of the head, on the camera's side), seen by
+    /// `camera`: it is both the key light and the light transmitted through thin parts (thesis §5.3 uses the one
+    /// light for both). Out-of-range angles are refused naming `--light-azimuth` / `--light-elevation`.
+    pub fn single(
+        azimuth_deg: f32,
+        elevation_deg: f32,
+        camera: &crate::mesh::camera::Camera,
+    ) -> Result<Self, InvalidInput> {
+        let w =
+            crate::mesh::framing::light_direction(azimuth_deg, elevation_deg, "--light-azimuth", "--light-elevation")?;
+        let view = camera.view();
+        let r = view.fixed_view::<3, 3>(0, 0) * nalgebra::Vector3::from(w);
+        let v = normalise([r.x, r.y, r.z]);
+        Ok(SceneLights { key_view: v, back_view: v })
+    }
 }
 
 impl DemoAssets {
@@ -110,11 +148,53 @@ impl DemoAssets {
             importance_params: ImportanceSssParams::default(),
             bloom: None,
             post_scatter_albedo: false,
+            lights: SceneLights::default(),
         })
     }
 }
 
+/// Where the light seen through thin parts comes from (`run skin --transmittance`, thesis §5.3 and §5.6 compare
+/// these): every mode reads the thickness s from the back light's shadow map (Listing 5.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum TransmittanceMode {
+    /// The baked T(s) of the skin's sum of Gaussians (thesis eq. 5.12, the translucent-shadow-map path).
+    #[default]
+    ShadowMap,
+    /// Green's Beer–Lambert T(s) = exp(−s·σt) (GPU Gems ch. 16, thesis §5.3) through the same thickness.
+    Green(crate::transmittance::BeerLambert),
+    /// No transmitted light.
+    Off,
+}
+
+impl TransmittanceMode {
+    /// Green's law with Jensen et al. 2001's skin1: σt′ = σa + σs′ = (0.772, 1.05, 1.49) mm⁻¹.
+    pub fn green_skin1() -> Self {
+        let m = crate::diffusion::materials::find("skin1").expect("Jensen 2001 lists skin1");
+        let b = crate::transmittance::BeerLambert::from_reduced(
+            "--transmittance",
+            m.sigma_a_per_mm,
+            m.sigma_s_prime_per_mm,
+        )
+        .expect("skin1's coefficients are in range");
+        TransmittanceMode::Green(b)
+    }
+}
+
 impl DemoAssets {
+    /// Replaces the T(s) table the skin-inputs pass reads (same layout: s = s_max·i/(n−1)) by `mode`'s.
+    pub fn set_transmittance(&mut self, mode: TransmittanceMode) {
+        let n = self.luts.transmittance.len();
+        let s_max = self.luts.s_max_mm as f64;
+        match mode {
+            TransmittanceMode::ShadowMap => {}
+            TransmittanceMode::Off => self.luts.transmittance = vec![[0.0; 3]; n],
+            TransmittanceMode::Green(b) => {
+                self.luts.transmittance =
+                    (0..n).map(|i| b.at(s_max * i as f64 / (n.max(2) - 1) as f64).map(|t| t as f32)).collect();
+            }
+        }
+    }
+
     /// Sets the rig weights from a JSON object `{"target name": weight, …}` (`--rig-weights`): every name must
     /// be a target of the rig, weights finite, and their sum 1 ± 1e-3 (eq. 7.6 blends the targets); targets not
     /// named get 0.
@@ -165,6 +245,9 @@ pub(crate) struct Geometry {
     /// Specular radiance per pixel under the key light (white), added after the SSS pass so it is never blurred
     /// (TAP 2009 §4: diffuse and specular in separate render targets); None: no specular layer (the demo).
     pub(crate) specular: Option<Vec<f32>>,
+    /// Linear albedo per pixel from a scan's albedo map ([`crate::runtime::skin::surface_maps`]), replacing the skin
+    /// LUT's on skin pixels; None: the LUT's.
+    pub(crate) albedo: Option<Vec<[f32; 3]>>,
 }
 
 /// Radiance scale of the key light (the diffuse layer's E = KEY_LIGHT_INTENSITY · N·L + ambient).
@@ -205,13 +288,19 @@ pub(crate) fn lit_geometry(gpu: Backend<'_>, geo: Geometry, assets: &DemoAssets)
     let (w, h) = (geo.frame.width, geo.frame.height);
     let (luts, rig) = (&assets.luts, &assets.rig);
     let weights = &assets.rig_weights;
-    let (key, back) = (key_light_view(), back_light_view());
+    let (key, back) = (assets.lights.key_view, assets.lights.back_view);
     let (albedo, transmitted) = gpu.run(
         |g| SkinInputs::new(&g.device, &g.queue, w, h, luts, rig)?.run(&g.device, &g.queue, &geo.frame, weights, back),
         || Ok(crate::runtime::skin::inputs_cpu::skin_inputs(&geo.frame, luts, rig, weights, back)),
     )?;
-    // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let n = (w * h) as usize;
+    let mut albedo = albedo;
+    if let Some(map) = &geo.albedo {
+        for i in (0..n).filter(|&i| geo.skin[i]) {
+            albedo[4 * i..4 * i + 3].copy_from_slice(&map[i]);
+        }
+    }
+    // Diffuse irradiance · albedo (Lambert key light + ambient), alpha = SSS strength (1 on skin, 0 elsewhere).
     let mut diffuse = vec![0.0f32; 4 * n];
     for i in 0..n {
         if !geo.skin[i] {

@@ -106,6 +106,26 @@ pub fn rasterise_samples(
     height: u32,
     samples: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    rasterise_with_tangents(device, queue, mesh, &tangents, camera, width, height, samples)
+}
+
+/// [`rasterise_samples`] with the caller's per-vertex `tangents` (unit xyz, handedness w; one per vertex of
+/// `mesh`), e.g. MikkTSpace's for a normal-mapped scan ([`crate::mesh::tangents::mikktspace_tangents`]).
+#[allow(clippy::too_many_arguments)]
+pub fn rasterise_with_tangents(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mesh: &Mesh,
+    tangents: &[[f32; 4]],
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<MeshGBuffer, RuntimeError> {
+    if tangents.len() != mesh.positions.len() {
+        return Err(InvalidInput::new("tangents", "need one tangent per vertex of the mesh").into());
+    }
     check_samples(samples)?;
     if samples > 1 {
         use wgpu::TextureFormatFeatureFlags as Fl;
@@ -127,9 +147,8 @@ pub fn rasterise_samples(
         )
         .into());
     }
-    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
     let mut vertices = Vec::with_capacity(mesh.positions.len() * 12);
-    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(&tangents) {
+    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(tangents) {
         vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1], tg[0], tg[1], tg[2], tg[3]]);
     }
     let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

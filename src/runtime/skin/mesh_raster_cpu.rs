@@ -24,12 +24,11 @@ struct V {
 
 /// Every vertex of `mesh` seen by `camera` in a `width`×`height` frame, None behind half the near plane (its
 /// triangles are skipped).
-fn project(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> Vec<Option<V>> {
+fn project(mesh: &Mesh, tangents: &[[f32; 4]], camera: &Camera, width: u32, height: u32) -> Vec<Option<V>> {
     let u = camera_uniform(mesh, camera, width, height);
     let vp = Matrix4::from_column_slice(&u[..16]);
     let view = Matrix4::from_column_slice(&u[16..32]);
     let (wf, hf) = (width as f32, height as f32);
-    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
     (0..mesh.positions.len())
         .map(|i| {
             let p = mesh.positions[i];
@@ -142,16 +141,32 @@ pub fn rasterise_samples(
     height: u32,
     samples: u32,
 ) -> Result<MeshGBuffer, crate::error::InvalidInput> {
+    let tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    rasterise_with_tangents(mesh, &tangents, camera, width, height, samples)
+}
+
+/// [`rasterise_samples`] with the caller's per-vertex `tangents` (as `mesh_raster::rasterise_with_tangents`).
+pub fn rasterise_with_tangents(
+    mesh: &Mesh,
+    tangents: &[[f32; 4]],
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> Result<MeshGBuffer, crate::error::InvalidInput> {
     crate::runtime::skin::mesh_raster::check_samples(samples)?;
+    if tangents.len() != mesh.positions.len() {
+        return Err(crate::error::InvalidInput::new("tangents", "need one tangent per vertex of the mesh"));
+    }
     if samples == 1 {
-        return Ok(rasterise(mesh, camera, width, height));
+        return Ok(rasterise_one(mesh, tangents, camera, width, height));
     }
     let n = (width * height) as usize;
     let f16 = |v: f32| half::f16::from_f32(v).to_f32();
     // Per sample: depth, and the three targets' RGBA (zero where nothing covers the sample).
     let mut zbuf = vec![1.0f32; 4 * n];
     let mut targets = vec![[[0.0f32; 4]; 3]; 4 * n];
-    let verts = project(mesh, camera, width, height);
+    let verts = project(mesh, tangents, camera, width, height);
     for tri in Tri::front_faces(mesh, &verts, width, height) {
         for py in tri.y.clone() {
             for px in tri.x.clone() {
@@ -202,9 +217,13 @@ pub fn rasterise_samples(
 
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer (values rounded to f16 as the GPU stores them).
 pub fn rasterise(mesh: &Mesh, camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
+    rasterise_one(mesh, &crate::mesh::tangents::vertex_tangents(mesh), camera, width, height)
+}
+
+fn rasterise_one(mesh: &Mesh, tangents: &[[f32; 4]], camera: &Camera, width: u32, height: u32) -> MeshGBuffer {
     let mut g = MeshGBuffer::empty(width, height);
     let mut zbuf = vec![1.0f32; (width * height) as usize];
-    let verts = project(mesh, camera, width, height);
+    let verts = project(mesh, tangents, camera, width, height);
     let f16 = |v: f32| half::f16::from_f32(v).to_f32();
     for tri in Tri::front_faces(mesh, &verts, width, height) {
         for py in tri.y.clone() {

@@ -2,7 +2,7 @@
 //! CPU twin, and the frames built from them.
 //!
 //! Passes: [`mesh_raster`] (the G-buffer), [`inputs`] (albedo from the skin LUT, T(s)·E), [`mesh_inputs`] (the rig's
-//! eq. 7.6 at the mesh's uv), [`wrinkles`] (Listing 8.1), [`bloom`], [`texture_space`] (d'Eon et al.'s
+//! eq. 7.6 at the mesh's uv), [`wrinkles`] (Listing 8.1), [`surface_maps`] (a scan's albedo and normal map at the mesh's uv), [`bloom`], [`texture_space`] (d'Eon et al.'s
 //! texture-space diffusion, TAP's "TS").
 //! Frames: [`lighting`] (the shared lighting and compositing every frame goes through: skin inputs → diffuse +
 //! transmitted light → SSS → post-scatter albedo, specular, bloom → tone map), [`demo`] (the procedural spheres),
@@ -23,6 +23,9 @@ pub mod mesh_raster;
 pub mod mesh_raster_cpu;
 pub mod passes;
 pub mod settings;
+pub mod surface_maps;
+pub mod surface_maps_cpu;
+pub mod tap_grid;
 pub mod texture_space;
 pub mod texture_space_cpu;
 pub mod wrinkles;

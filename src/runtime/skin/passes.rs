@@ -26,6 +26,9 @@ pub struct SkinPasses {
     pub bloom: Option<BloomParams>,
     /// Samples per pixel of the G-buffer raster, 1 or 4 (MSAA, [`crate::runtime::skin::mesh_raster::rasterise_samples`]).
     pub msaa: u32,
+    /// A scanned head's albedo and tangent-space normal map at the mesh's uv
+    /// ([`crate::runtime::skin::surface_maps`]); None: the skin LUT's albedo and the mesh's normals.
+    pub surface_maps: Option<crate::runtime::skin::surface_maps::SurfaceMaps>,
 }
 
 impl Default for SkinPasses {
@@ -39,6 +42,6 @@ impl SkinPasses {
     /// Nothing around the SSS shader: neutral pose, no wrinkles, no bloom, one sample (what
     /// [`crate::runtime::skin::frame::render`] and the Table III benchmark `bench_skin_heads` measure).
     pub fn none() -> Self {
-        SkinPasses { rig_pose: None, wrinkles: None, bloom: None, msaa: 1 }
+        SkinPasses { rig_pose: None, wrinkles: None, bloom: None, msaa: 1, surface_maps: None }
     }
 }

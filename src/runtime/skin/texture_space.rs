@@ -38,11 +38,12 @@ use crate::runtime::skin::lighting::{composite, lit_geometry, DemoAssets, Geomet
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, HEAD_SPACING_M};
 pub use crate::runtime::skin::settings::{TsSettings, DEFAULT_MAP_SIZE, MAX_MAP_SIZE, MIN_MAP_SIZE};
+use crate::runtime::skin::surface_maps_cpu::{self, mapped_normal};
 use crate::runtime::skin::texture_space_cpu;
 use crate::runtime::RuntimeError;
 use crate::shading::texture_space::{
     depth_sized_map, frustum_planes_eye, inside_frustum, is_culled, nearest_corner_distance, normalised_weights,
-    rasterise_uv, UvMap,
+    rasterise_uv, rasterise_uv_attribute, UvMap,
 };
 use nalgebra::{Vector3, Vector4};
 use std::collections::HashMap;
@@ -175,6 +176,10 @@ pub fn render_with<'g>(
     let weights = normalised_weights(&assets.blurs.blend);
     let sigmas = &assets.blurs.incremental_sigma_mm;
     let (lo, hi) = mesh.bounds();
+    // A normal map perturbs each texel's normal in its MikkTSpace frame, as the G-buffer's pixels
+    // (`surface_maps`); the split mesh has the same triangles in the same order, so the same texels.
+    let normal_map = passes.surface_maps.as_ref().and_then(|m| m.normal.as_ref());
+    let split = normal_map.map(|_| crate::mesh::tangents::mikktspace_tangents(mesh));
     let mut pass = gpu.prepare(|g| TextureSpaceDiffusion::new(&g.device), || Ok(()))?;
     let mut diffuse = lit.diffuse.clone();
     let mut stats = TsStats { heads: Vec::new(), d_ref_m };
@@ -195,6 +200,7 @@ pub fn render_with<'g>(
             thickness_mm: vec![assets.luts.s_max_mm; n],
             normals: vec![[0.0, 0.0, 1.0]; n],
         };
+        let texel_tangents = split.as_ref().map(|(m, t)| rasterise_uv_attribute(m, t, size));
         let mut shaded = vec![false; n];
         #[allow(clippy::needless_range_loop)] // t indexes the UV map and the texel frame alike
         for t in 0..n {
@@ -224,6 +230,10 @@ pub fn render_with<'g>(
                 Some(r) => r.h0_at(u, v),
                 None => 0.006 * ((u * 400.0).sin() * (v * 300.0).cos()),
             };
+            let nw = match (normal_map, &texel_tangents) {
+                (Some(nm), Some(tt)) => mapped_normal(nw, tt[t], surface_maps_cpu::sample(nm, u, v)),
+                _ => nw,
+            };
             let nv = rot * Vector3::from(nw);
             frame.normals[t] = [nv.x, nv.y, nv.z];
             // The back light's transmittance joins the texel's light before the blurs (thesis §5.4), with the
@@ -234,7 +244,7 @@ pub fn render_with<'g>(
         if st.shaded_texels == 0 {
             continue;
         }
-        let texels = Geometry { frame, depth: vec![1.0; n], skin: shaded, specular: None };
+        let texels = Geometry { frame, depth: vec![1.0; n], skin: shaded, specular: None, albedo: None };
         let irr = lit_geometry(gpu, texels, &assets)?.diffuse;
         let irr: Vec<[f32; 4]> = irr.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let uvs: Vec<[f32; 2]> = pixels.iter().map(|&i| g.uv[i]).collect();

@@ -1,0 +1,174 @@
+//! The scanned head's surface maps in the G-buffer (thesis §7.6; the seeds' demos render the Lee Perry-Smith scan
+//! with an albedo and a tangent-space normal map): per covered pixel, at the mesh's texture coordinates,
+//!
+//! ```text
+//! albedo = bilinear(albedo map, uv)                                (linear RGB, decoded from sRGB on the host)
+//! n_ts   = normalize(bilinear(normal map, uv))                     (unit tangent-space normal, rtbake's frame)
+//! n      = normalize(n_ts.x·T + n_ts.y·B + n_ts.z·N),  B = w·(N × T)
+//! ```
+//!
+//! with (T, w) the MikkTSpace tangent and handedness interpolated by [`crate::runtime::skin::mesh_raster`] and left
+//! unnormalised, as MikkTSpace prescribes for the per-pixel frame (Mikkelsen 2008: the bitangent is rebuilt from the
+//! cross product and only the result is normalised). Maps are read bilinearly, clamp to edge, texel centres at
+//! (i + ½)/size (`bilinear_taps.wgsl`). The albedo is applied **after** the diffusion (post-scatter texturing,
+//! thesis §7.6: "lateral color bleeding due to subsurface scattering is already explicitly captured as part of the
+//! acquisition process, we use post-scattering texturing to avoid blurring the albedo twice"): it replaces the skin
+//! LUT's albedo in [`crate::runtime::skin::lighting`]; the mapped normal replaces the G-buffer's before any lighting
+//! (key light, transmittance's E, specular). Without a normal map the normal is the G-buffer's bit for bit.
+//!
+//! One compute dispatch over flat f32 buffers (`skin/surface_maps.wgsl`); CPU twin
+//! [`crate::runtime::skin::surface_maps_cpu`].
+
+use crate::error::InvalidInput;
+use crate::image_buf::ImageF32;
+use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::RuntimeError;
+
+/// The flag of the albedo map.
+pub const ALBEDO_FLAG: &str = "--albedo";
+/// The flag of the tangent-space normal map.
+pub const NORMAL_MAP_FLAG: &str = "--normal-map";
+
+/// One decoded map: `width`×`height` texels of (x, y, z, 0), row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceMap {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[f32; 4]>,
+}
+
+impl SurfaceMap {
+    /// From a 3-channel linear map (`crate::shading::material_maps`' output); `param` names the flag.
+    pub fn from_rgb(param: &str, img: &ImageF32) -> Result<Self, InvalidInput> {
+        if img.channels != 3 || img.data.len() != (img.width * img.height * 3) as usize || img.width == 0 {
+            return Err(InvalidInput::new(param, "needs a decoded 3-channel map of its stated size"));
+        }
+        let texels = img.data.chunks_exact(3).map(|c| [c[0], c[1], c[2], 0.0]).collect();
+        Ok(SurfaceMap { width: img.width, height: img.height, texels })
+    }
+
+    /// Bytes of the map as the GPU pass stores it (one vec4 of f32 per texel).
+    pub fn buffer_bytes(&self) -> u64 {
+        16 * self.width as u64 * self.height as u64
+    }
+}
+
+/// The scan's albedo (linear RGB) and tangent-space normal map (unit vectors, rtbake's DirectX frame); either may
+/// be absent.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceMaps {
+    pub albedo: Option<SurfaceMap>,
+    pub normal: Option<SurfaceMap>,
+}
+
+impl SurfaceMaps {
+    /// The maps from 8-bit pictures: `albedo` sRGB-encoded, `normal` a tangent-space normal map whose green channel
+    /// follows `green` — decoded and validated by [`crate::shading::material_maps`] (RGB or RGBA, edges in
+    /// range, a normal map's texels near unit length), refused naming [`ALBEDO_FLAG`] / [`NORMAL_MAP_FLAG`].
+    pub fn from_pictures(
+        albedo: Option<&crate::image_buf::ImageU8>,
+        normal: Option<&crate::image_buf::ImageU8>,
+        green: crate::facial::wrinkles::GreenConvention,
+    ) -> Result<Self, InvalidInput> {
+        use crate::shading::material_maps::{albedo_linear, normals_unit};
+        let albedo = match albedo {
+            Some(img) => Some(SurfaceMap::from_rgb(ALBEDO_FLAG, &albedo_linear(ALBEDO_FLAG, img)?)?),
+            None => None,
+        };
+        let normal = match normal {
+            Some(img) => Some(SurfaceMap::from_rgb(NORMAL_MAP_FLAG, &normals_unit(NORMAL_MAP_FLAG, img, green)?.0)?),
+            None => None,
+        };
+        Ok(SurfaceMaps { albedo, normal })
+    }
+
+    /// Checks both maps against a storage-binding limit of `storage` bytes (the GPU pass stores a vec4 of f32 per
+    /// texel), naming the flag and the limit.
+    pub fn check_fits(&self, storage: u64) -> Result<(), InvalidInput> {
+        for (flag, m) in [(ALBEDO_FLAG, &self.albedo), (NORMAL_MAP_FLAG, &self.normal)] {
+            let Some(m) = m else { continue };
+            if m.buffer_bytes() > storage {
+                return Err(InvalidInput::new(
+                    flag,
+                    format!(
+                        "{}x{} texels need a {}-byte storage buffer, over this GPU's limit of {storage} bytes \
+                         (max_storage_buffer_binding_size); use a smaller map, or --cpu",
+                        m.width,
+                        m.height,
+                        m.buffer_bytes()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the pass gives each pixel: the mapped view-space normal (the G-buffer's where not covered or with no
+/// normal map) and, with an albedo map, the linear albedo (zero where not covered).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfacedPixels {
+    pub normals: Vec<[f32; 3]>,
+    pub albedo: Option<Vec<[f32; 3]>>,
+}
+
+/// The largest per-pixel buffer [`surface_pixels`] allocates for a `width`×`height` G-buffer, bytes: the result, two
+/// vec4 of f32 per pixel (the maps are checked separately: [`SurfaceMap::buffer_bytes`]).
+pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
+    32 * width as u64 * height as u64
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    // frame width, height, albedo width, height
+    size: [f32; 4],
+    // normal map width, height, has albedo, has normal map
+    normal: [f32; 4],
+}
+
+/// The pass on the GPU (see the module doc).
+pub fn surface_pixels(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    g: &MeshGBuffer,
+    maps: &SurfaceMaps,
+) -> Result<SurfacedPixels, RuntimeError> {
+    let flat = SurfaceMap { width: 1, height: 1, texels: vec![[0.0, 0.0, 1.0, 0.0]] };
+    let a = maps.albedo.as_ref().unwrap_or(&flat);
+    let nm = maps.normal.as_ref().unwrap_or(&flat);
+    maps.check_fits(device.limits().max_storage_buffer_binding_size)?;
+    let params = Params {
+        size: [g.width as f32, g.height as f32, a.width as f32, a.height as f32],
+        normal: [
+            nm.width as f32,
+            nm.height as f32,
+            maps.albedo.is_some() as u8 as f32,
+            maps.normal.is_some() as u8 as f32,
+        ],
+    };
+    let uvc: Vec<f32> = g.uv.iter().zip(&g.covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
+    let nrm: Vec<f32> = g.normal_view.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    let out = compute_chain::run(
+        device,
+        queue,
+        "surface maps",
+        concat!(include_str!("bilinear_taps.wgsl"), include_str!("surface_maps.wgsl")),
+        bytemuck::bytes_of(&params),
+        &[
+            Buffer::Data(bytemuck::cast_slice(&uvc)),
+            Buffer::Data(bytemuck::cast_slice(&nrm)),
+            Buffer::Data(bytemuck::cast_slice(&g.tangent_view)),
+            Buffer::Data(bytemuck::cast_slice(&a.texels)),
+            Buffer::Data(bytemuck::cast_slice(&nm.texels)),
+            Buffer::Zeroed(largest_buffer_bytes(g.width, g.height)),
+        ],
+        &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
+        5,
+    )?;
+    let f: &[f32] = bytemuck::cast_slice(&out);
+    let normals = f.chunks_exact(8).map(|c| [c[0], c[1], c[2]]).collect();
+    let albedo = maps.albedo.as_ref().map(|_| f.chunks_exact(8).map(|c| [c[4], c[5], c[6]]).collect());
+    Ok(SurfacedPixels { normals, albedo })
+}

@@ -1,0 +1,83 @@
+// The scanned head's surface maps (runtime/skin/surface_maps.rs; thesis §7.6): per covered pixel, the albedo map
+// and the tangent-space normal map read bilinearly at the mesh's uv; the normal taken from the MikkTSpace frame
+// (T interpolated, B = w * N x T, the result normalised) to view space. CPU twin: runtime/skin/surface_maps_cpu.rs.
+
+struct Params {
+    // frame width, height, albedo width, height
+    size: vec4<f32>,
+    // normal map width, height, has albedo, has normal map
+    normal: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> p: Params;
+// u, v, covered, 0
+@group(0) @binding(1) var<storage, read_write> uvc: array<vec4<f32>>;
+// view normal (unit), 0
+@group(0) @binding(2) var<storage, read_write> nrm: array<vec4<f32>>;
+// view tangent (interpolated), handedness
+@group(0) @binding(3) var<storage, read_write> tng: array<vec4<f32>>;
+// linear albedo, 0
+@group(0) @binding(4) var<storage, read_write> albedo: array<vec4<f32>>;
+// unit tangent-space normal, 0
+@group(0) @binding(5) var<storage, read_write> nmap: array<vec4<f32>>;
+// per pixel: (normal, 0), (albedo, 0)
+@group(0) @binding(6) var<storage, read_write> outp: array<vec4<f32>>;
+
+// `Taps` and `taps` (bilinear texel indices and weights) come from bilinear_taps.wgsl, prepended.
+
+fn albedo_at(t: Taps) -> vec4<f32> {
+    let w = u32(p.size.z);
+    let a = albedo[t.i.z * w + t.i.x];
+    let b = albedo[t.i.z * w + t.i.y];
+    let c = albedo[t.i.w * w + t.i.x];
+    let d = albedo[t.i.w * w + t.i.y];
+    let top = a + (b - a) * t.f.x;
+    let bottom = c + (d - c) * t.f.x;
+    return top + (bottom - top) * t.f.y;
+}
+
+fn normal_at(t: Taps) -> vec4<f32> {
+    let w = u32(p.normal.x);
+    let a = nmap[t.i.z * w + t.i.x];
+    let b = nmap[t.i.z * w + t.i.y];
+    let c = nmap[t.i.w * w + t.i.x];
+    let d = nmap[t.i.w * w + t.i.y];
+    let top = a + (b - a) * t.f.x;
+    let bottom = c + (d - c) * t.f.x;
+    return top + (bottom - top) * t.f.y;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = u32(p.size.x);
+    if (id.x >= w || id.y >= u32(p.size.y)) {
+        return;
+    }
+    let i = id.y * w + id.x;
+    let c = uvc[i];
+    let n = nrm[i].xyz;
+    if (c.z < 0.5) {
+        outp[2u * i] = vec4<f32>(n, 0.0);
+        outp[2u * i + 1u] = vec4<f32>(0.0);
+        return;
+    }
+    var a = vec3<f32>(0.0);
+    if (p.normal.z > 0.5) {
+        a = albedo_at(taps(c.x, c.y, p.size.z, p.size.w)).xyz;
+    }
+    var out_n = n;
+    if (p.normal.w > 0.5) {
+        let s = normal_at(taps(c.x, c.y, p.normal.x, p.normal.y)).xyz;
+        let ls = sqrt(dot(s, s));
+        let t4 = tng[i];
+        let t = t4.xyz;
+        let b = t4.w * cross(n, t);
+        let v = s.x * t + s.y * b + s.z * n;
+        let lv = sqrt(dot(v, v));
+        if (ls > 1e-6 && lv > 1e-6) {
+            out_n = v / lv;
+        }
+    }
+    outp[2u * i] = vec4<f32>(out_n, 0.0);
+    outp[2u * i + 1u] = vec4<f32>(a, 0.0);
+}
