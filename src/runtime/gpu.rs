@@ -1,7 +1,115 @@
 //! Small wgpu helpers shared by the passes: explicit-format textures, uploads, read-backs, full-screen
 //! fragment pipelines and GPU timestamp collection. Nothing here creates a device.
+//!
+//! Shader modules, pipelines, bind-group layouts and samplers are created once per device and reused by every
+//! later frame ([`cached`]), as an engine builds its pipeline state objects at load time: a pass constructed per
+//! frame costs its textures and bind groups, never a shader compilation. [`pipelines_created_on_this_thread`]
+//! counts the pipelines actually compiled, so a test can assert that none is compiled after the first frame.
 
 use crate::runtime::RuntimeError;
+use std::any::Any;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{LazyLock, Mutex};
+
+type CacheKey = (wgpu::Device, &'static str, u64);
+type CacheMap = HashMap<CacheKey, Box<dyn Any + Send + Sync>>;
+
+/// The per-device objects built so far. A device stays alive while it has entries, so only the objects of the
+/// [`CACHED_DEVICES`] most recently seen devices are kept (a command has one; a test process makes many).
+static CACHE: LazyLock<Mutex<(CacheMap, Vec<wgpu::Device>)>> = LazyLock::new(|| Mutex::new((HashMap::new(), Vec::new())));
+/// Devices whose objects are kept.
+const CACHED_DEVICES: usize = 4;
+static CACHE_ENABLED: AtomicBool = AtomicBool::new(true);
+
+thread_local! {
+    static PIPELINES_CREATED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Turns the per-device object cache on (the default) or off. Off, every pass constructed recompiles its shader
+/// and pipelines as the runtime did before the cache existed: benchmarks measure the difference with it.
+pub fn set_object_cache_enabled(enabled: bool) {
+    CACHE_ENABLED.store(enabled, Ordering::Relaxed);
+}
+
+/// Render and compute pipelines compiled on the calling thread since it started (cache misses only).
+pub fn pipelines_created_on_this_thread() -> u64 {
+    PIPELINES_CREATED.with(|c| c.get())
+}
+
+/// Number of objects (modules, pipelines, layouts, samplers) cached for `device`.
+pub fn cached_objects(device: &wgpu::Device) -> usize {
+    CACHE.lock().unwrap_or_else(|e| e.into_inner()).0.keys().filter(|k| &k.0 == device).count()
+}
+
+/// A 64-bit hash of `key` (the cache's key within one `kind`).
+fn key_hash(key: &impl Hash) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    h.finish()
+}
+
+/// The object of `kind` and `key` for `device`: built by `make` the first time, a clone of it afterwards. The lock
+/// is not held while `make` runs (it may build other cached objects); two threads racing build it twice, one wins.
+pub fn cached<T: Clone + Send + Sync + 'static>(
+    device: &wgpu::Device,
+    kind: &'static str,
+    key: &impl Hash,
+    make: impl FnOnce() -> T,
+) -> T {
+    if !CACHE_ENABLED.load(Ordering::Relaxed) {
+        return make();
+    }
+    let k = (device.clone(), kind, key_hash(key));
+    if let Some(v) = CACHE.lock().unwrap_or_else(|e| e.into_inner()).0.get(&k).and_then(|b| b.downcast_ref::<T>()) {
+        return v.clone();
+    }
+    let v = make();
+    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    let (map, devices) = &mut *guard;
+    if !devices.contains(device) {
+        devices.push(device.clone());
+        if devices.len() > CACHED_DEVICES {
+            let old = devices.remove(0);
+            map.retain(|key, _| key.0 != old);
+        }
+    }
+    map.entry(k).or_insert_with(|| Box::new(v.clone()));
+    v
+}
+
+/// Compiles a render pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
+pub fn create_render_pipeline(device: &wgpu::Device, desc: &wgpu::RenderPipelineDescriptor<'_>) -> wgpu::RenderPipeline {
+    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
+    device.create_render_pipeline(desc)
+}
+
+/// Compiles a compute pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
+pub fn create_compute_pipeline(
+    device: &wgpu::Device,
+    desc: &wgpu::ComputePipelineDescriptor<'_>,
+) -> wgpu::ComputePipeline {
+    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
+    device.create_compute_pipeline(desc)
+}
+
+/// A compute pipeline of `module`'s `entry` with the layout derived from the shader, cached per device.
+pub fn compute_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, entry: &str) -> wgpu::ComputePipeline {
+    cached(device, "compute pipeline", &(module, entry), || {
+        create_compute_pipeline(
+            device,
+            &wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            },
+        )
+    })
+}
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
@@ -184,28 +292,30 @@ pub fn uniform_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu:
     buf
 }
 
-/// A WGSL module from source text.
+/// A WGSL module from source text, compiled once per device and source (the label of the first caller).
 pub fn shader(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
+    cached(device, "shader module", &source, || {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
     })
 }
 
 /// Nearest, clamp-to-edge sampler (the "PointSampler" of the MLAA listings).
 pub fn nearest_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    device.create_sampler(&wgpu::SamplerDescriptor {
+    cached(device, "sampler", &"nearest clamp", || device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("nearest clamp"),
         address_mode_u: wgpu::AddressMode::ClampToEdge,
         address_mode_v: wgpu::AddressMode::ClampToEdge,
         address_mode_w: wgpu::AddressMode::ClampToEdge,
         ..Default::default()
-    })
+    }))
 }
 
 /// Bilinear, clamp-to-edge sampler (the "LinearSampler" of SMAA).
 pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    device.create_sampler(&wgpu::SamplerDescriptor {
+    cached(device, "sampler", &"linear clamp", || device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("linear clamp"),
         address_mode_u: wgpu::AddressMode::ClampToEdge,
         address_mode_v: wgpu::AddressMode::ClampToEdge,
@@ -214,7 +324,7 @@ pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
         min_filter: wgpu::FilterMode::Linear,
         mipmap_filter: wgpu::MipmapFilterMode::Nearest,
         ..Default::default()
-    })
+    }))
 }
 
 /// A full-screen-triangle render pipeline: vertex entry `vs_fullscreen`, the given fragment entry, one colour
@@ -239,7 +349,19 @@ pub fn fullscreen_pipeline_with(
     fs_entry: &str,
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    cached(device, "fullscreen pipeline", &(module, fs_entry, targets), || {
+        fullscreen_pipeline_uncached(device, label, module, fs_entry, targets)
+    })
+}
+
+fn fullscreen_pipeline_uncached(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fs_entry: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    create_render_pipeline(device, &wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: None,
         vertex: wgpu::VertexState {

@@ -146,7 +146,8 @@ pub fn rasterise_samples(
         gpu::uniform_buffer(device, "mesh camera", bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)));
     let module = gpu::shader(device, "mesh_raster", include_str!("mesh_raster.wgsl"));
     let gformat = GBUFFER_FORMAT;
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let pipeline = gpu::cached(device, "mesh g-buffer pipeline", &(&module, samples), || {
+        gpu::create_render_pipeline(device, &wgpu::RenderPipelineDescriptor {
         label: Some("mesh g-buffer"),
         layout: None,
         vertex: wgpu::VertexState {
@@ -185,6 +186,7 @@ pub fn rasterise_samples(
         }),
         multiview_mask: None,
         cache: None,
+    })
     });
     let bind =
         gpu::bind_group(device, "mesh camera", &pipeline.get_bind_group_layout(0), &[(0, ubuf.as_entire_binding())]);

@@ -312,16 +312,7 @@ impl TextureSpaceDiffusion {
     pub fn new(device: &wgpu::Device) -> Result<Self, RuntimeError> {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "texture space", SHADER);
-        let pipe = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipe = |entry: &str| gpu::compute_pipeline(device, &module, entry);
         let (blur, gather) = (pipe("blur"), pipe("gather"));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RuntimeError::Gpu(format!("texture-space shader: {e}")));
