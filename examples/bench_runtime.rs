@@ -4,6 +4,12 @@
 //!
 //!     cargo run --release --example bench_runtime          # GPU passes, then the CPU reference SMAA
 //!     cargo run --release --example bench_runtime -- cpu   # the CPU reference SMAA only (no adapter needed)
+//!     cargo run --release --example bench_runtime -- 1920x1080 [gpu-only]   # one size; no CPU reference SMAA
+//!
+//! Each pass is printed beside its bytes-moved bound: the bytes it must read and write (its input and output
+//! images at their formats, each texel once; the look-up tables are left out) divided by the adapter's copy
+//! bandwidth, measured first in the same run with buffer-to-buffer copies (read + write bytes per second), and
+//! the ratio time / bound.
 //!
 //! GPU passes are timed with timestamp queries when the adapter supports them, else by wall time of
 //! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
@@ -71,16 +77,94 @@ fn time_passes(g: &rtbake::runtime::device::Gpu, slots: u32, encode: &Encode<'_>
 fn main() {
     let dir = baked_dir();
     let luts = loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"));
-    if std::env::args().nth(1).as_deref() != Some("cpu") {
-        gpu_passes(&dir, &luts);
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let sizes: Vec<(u32, u32)> = args
+        .iter()
+        .filter_map(|a| a.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?))))
+        .collect();
+    let sizes = if sizes.is_empty() { vec![(1280u32, 720u32), (1920, 1080)] } else { sizes };
+    if args.first().map(String::as_str) != Some("cpu") {
+        gpu_passes(&dir, &luts, &sizes);
     }
-    cpu_smaa(&luts);
+    if !args.iter().any(|a| a == "gpu-only") {
+        cpu_smaa(&luts);
+    }
 }
 
-fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures) {
+/// The adapter's copy bandwidth in bytes (read + written) per second: the median of RUNS submissions of four
+/// copies between two buffers of up to 256 MiB, by timestamps around the copies where the adapter has them
+/// (empty compute passes either side), else by wall time of submit + wait.
+fn copy_bandwidth(g: &rtbake::runtime::device::Gpu) -> f64 {
+    let limits = g.device.limits();
+    let size = (256u64 << 20).min(limits.max_buffer_size / 2) / 16 * 16;
+    let mk = |label| {
+        g.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let (a, b) = (mk("copy a"), mk("copy b"));
+    let copies = 4u64;
+    let timer = g.timestamps.then(|| GpuTimer::new(&g.device, 2));
+    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
+    for run in 0..RUNS + 1 {
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
+            if let Some(t) = &timer {
+                let tw = wgpu::ComputePassTimestampWrites {
+                    query_set: &t.query_set,
+                    beginning_of_pass_write_index: Some(2 * slot),
+                    end_of_pass_write_index: Some(2 * slot + 1),
+                };
+                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
+            }
+        };
+        mark(&mut enc, 0);
+        for k in 0..copies {
+            let (src, dst) = if k % 2 == 0 { (&a, &b) } else { (&b, &a) };
+            enc.copy_buffer_to_buffer(src, 0, dst, 0, size);
+        }
+        mark(&mut enc, 1);
+        if let Some(t) = &timer {
+            t.resolve(&mut enc);
+        }
+        let t0 = Instant::now();
+        g.queue.submit([enc.finish()]);
+        g.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if run == 0 {
+            continue;
+        }
+        wall_ms.push(ms);
+        if let Some(t) = &timer {
+            // Slot 0 ends before the copies, slot 1 begins after them.
+            let bytes = rtbake::runtime::gpu::map_read(&g.device, &t.readback_buffer()).unwrap();
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+            gpu_ms.push(ticks[2].wrapping_sub(ticks[1]) as f64 * g.queue.get_timestamp_period() as f64 * 1e-6);
+        }
+    }
+    let moved = (2 * copies * size) as f64;
+    let (ms, how) = if gpu_ms.is_empty() || median(gpu_ms.clone()) <= 0.0 {
+        (median(wall_ms), "wall time")
+    } else {
+        (median(gpu_ms), "timestamps")
+    };
+    let bw = moved / (ms * 1e-3);
+    println!(
+        "copy bandwidth: {:.1} GB/s (read + write; {copies} copies of {} MiB, median of {RUNS}, {how}: {ms:.3} ms)",
+        bw * 1e-9,
+        size >> 20
+    );
+    bw
+}
+
+fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures, sizes: &[(u32, u32)]) {
     let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
     println!("adapter: {}", g.describe());
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
+    let bw = copy_bandwidth(&g);
     let n = 33;
     let map = MlaaAreaMap::new(n, loader::load_mlaa_area(dir, n).unwrap_or_else(|e| panic!("{e}"))).unwrap();
     let kernel = loader::load_separable_kernel(dir, rtbake::baked_layout::path::SEPARABLE_KERNEL_DEFAULT)
@@ -88,26 +172,39 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures)
     let fit =
         loader::load_gaussians(dir, rtbake::baked_layout::path::GAUSSIANS_DEFAULT).unwrap_or_else(|e| panic!("{e}"));
     println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
-    for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
+    for &(w, h) in sizes {
+        let px = w as u64 * h as u64;
         let img = render_shapes(w, h, 1);
         let smaa = Smaa::new(&g.device, &g.queue, w, h, luts).unwrap();
         smaa.upload(&g.queue, &img).unwrap();
         let (pp, wall) = time_passes(&g, 3, &|e, t| smaa.encode(e, t));
         print_line(&format!("SMAA 1x {w}x{h}"), &pp, wall, "thesis 1.02 ms @1080p GTX 470");
+        // Edges: colour RGBA8 in, edges RG8 out; weights: edges in, weights RGBA8 out; blend: colour + weights in,
+        // RGBA8 out.
+        let aa_bytes = [6 * px, 6 * px, 12 * px];
+        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
         let mlaa = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
         mlaa.upload(&g.queue, &img).unwrap();
         let (pp, wall) = time_passes(&g, 3, &|e, t| mlaa.encode(e, t));
         print_line(&format!("MLAA N={n} {w}x{h}"), &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
+        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
         // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
         let (color, depth) = sss_frame(w, h);
         let sss = SeparableSss::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
         sss.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, 2, &|e, t| sss.encode(e, t));
         print_sum(&format!("separable SSS 17 taps {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
+        // Each pass: RGBA16F colour and R32F depth in, RGBA16F out.
+        print_bounds(&["horizontal", "vertical"], &pp, wall, &[20 * px, 20 * px], bw);
         let gs = GaussianSss::new(&g.device, w, h, &fit.blurs, &fit.params).unwrap();
         gs.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, gs.passes(), &|e, t| gs.encode(e, t));
         print_sum(&format!("sum-of-Gaussians SSS (deon6) {w}x{h}"), &pp, wall, "thesis 3.07 ms @1080p GTX 580");
+        // Horizontal: RGBA16F source, R32F depth and RGBA16F matte in, RGBA16F out; vertical: the same in, RGBA16F
+        // out and the blended RGBA16F sum read and written.
+        let names: Vec<String> = (0..gs.passes()).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
+        let bytes: Vec<u64> = (0..gs.passes()).map(|i| if i % 2 == 0 { 28 * px } else { 44 * px }).collect();
+        print_bounds(&names.iter().map(String::as_str).collect::<Vec<_>>(), &pp, wall, &bytes, bw);
     }
 }
 
@@ -194,6 +291,30 @@ fn sss_frame(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
         }
     }
     (color, depth)
+}
+
+/// Per pass: GPU time, bytes read + written, the bytes-moved bound at `bw` bytes/s and time / bound (the whole
+/// chain by wall time when there are no timestamps).
+fn print_bounds(names: &[&str], per_pass: &[f64], wall: f64, bytes: &[u64], bw: f64) {
+    let bound_ms = |b: u64| b as f64 / bw * 1e3;
+    if per_pass.is_empty() {
+        let total: u64 = bytes.iter().sum();
+        println!(
+            "    all passes: wall {wall:.3} ms, {:.1} MB moved, bound {:.4} ms, time/bound {:.1}",
+            total as f64 * 1e-6,
+            bound_ms(total),
+            wall / bound_ms(total)
+        );
+        return;
+    }
+    for ((name, ms), b) in names.iter().zip(per_pass).zip(bytes) {
+        println!(
+            "    {name:<10} {ms:.4} ms, {:.1} MB moved, bound {:.4} ms, time/bound {:.1}",
+            *b as f64 * 1e-6,
+            bound_ms(*b),
+            ms / bound_ms(*b)
+        );
+    }
 }
 
 fn print_sum(name: &str, per_pass: &[f64], wall: f64, anchor: &str) {

@@ -454,6 +454,12 @@ impl GpuTimer {
         enc.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, 16 * self.slots as u64);
     }
 
+    /// The buffer the raw timestamps land in after [`GpuTimer::resolve`] (`2 × slots` u64 ticks), for callers that
+    /// time between passes rather than across one.
+    pub fn readback_buffer(&self) -> wgpu::Buffer {
+        self.readback.clone()
+    }
+
     /// Durations of each slot in milliseconds (after the submission that resolved them).
     pub fn read_ms(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f64>, RuntimeError> {
         let bytes = map_read(device, &self.readback)?;
