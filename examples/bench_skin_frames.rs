@@ -1,6 +1,7 @@
 //! Frames shaped like an engine's: `run skin`'s frame (default passes: bloom on) per shader, first frame and
-//! steady state (median of frames 2..=N), with the per-device object cache off — every frame compiles its shader
-//! modules and pipelines, as the runtime did before the cache — and on, in one run on one adapter, and the ratio.
+//! steady state (median of frames 2..=N), with the runtime's per-frame caches off — every frame compiles its shader
+//! modules and pipelines and rasterises the texture-space UV maps on the host, as the runtime did before the
+//! caches — and on, in one run on one adapter, and the ratio.
 //!
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES]   # defaults 1280 720 5
 //!

@@ -5,6 +5,9 @@
 //! later frame ([`cached`]), as an engine builds its pipeline state objects at load time: a pass constructed per
 //! frame costs its textures and bind groups, never a shader compilation. [`pipelines_created_on_this_thread`]
 //! counts the pipelines actually compiled, so a test can assert that none is compiled after the first frame.
+//! The cache keys on the device's id, distinct among the devices of one wgpu instance: the runtime's devices come
+//! from the one instance of [`crate::runtime::device`]; a caller mixing devices of several instances turns the
+//! cache off ([`set_object_cache_enabled`]).
 
 use crate::runtime::RuntimeError;
 use std::any::Any;
@@ -17,10 +20,11 @@ type CacheKey = (wgpu::Device, &'static str, u64);
 type CacheMap = HashMap<CacheKey, Box<dyn Any + Send + Sync>>;
 
 /// The per-device objects built so far. A device stays alive while it has entries, so only the objects of the
-/// [`CACHED_DEVICES`] most recently seen devices are kept (a command has one; a test process makes many).
-static CACHE: LazyLock<Mutex<(CacheMap, Vec<wgpu::Device>)>> = LazyLock::new(|| Mutex::new((HashMap::new(), Vec::new())));
-/// Devices whose objects are kept.
-const CACHED_DEVICES: usize = 4;
+/// [`CACHED_DEVICES`] most recently used devices are kept (a command has one; a test process makes many).
+static CACHE: LazyLock<Mutex<(CacheMap, Vec<wgpu::Device>)>> =
+    LazyLock::new(|| Mutex::new((HashMap::new(), Vec::new())));
+/// Devices whose objects are kept: the most recently used ones.
+const CACHED_DEVICES: usize = 16;
 static CACHE_ENABLED: AtomicBool = AtomicBool::new(true);
 
 thread_local! {
@@ -31,6 +35,11 @@ thread_local! {
 /// and pipelines as the runtime did before the cache existed: benchmarks measure the difference with it.
 pub fn set_object_cache_enabled(enabled: bool) {
     CACHE_ENABLED.store(enabled, Ordering::Relaxed);
+}
+
+/// Whether the per-device object cache is on (the runtime's other per-frame caches follow the same switch).
+pub fn object_cache_enabled() -> bool {
+    CACHE_ENABLED.load(Ordering::Relaxed)
 }
 
 /// Render and compute pipelines compiled on the calling thread since it started (cache misses only).
@@ -62,8 +71,20 @@ pub fn cached<T: Clone + Send + Sync + 'static>(
         return make();
     }
     let k = (device.clone(), kind, key_hash(key));
-    if let Some(v) = CACHE.lock().unwrap_or_else(|e| e.into_inner()).0.get(&k).and_then(|b| b.downcast_ref::<T>()) {
-        return v.clone();
+    {
+        let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        let (map, devices) = &mut *guard;
+        if let Some(v) = map.get(&k).and_then(|b| b.downcast_ref::<T>()) {
+            let v = v.clone();
+            // Most recently used last.
+            if devices.last() != Some(device) {
+                if let Some(i) = devices.iter().position(|d| d == device) {
+                    let d = devices.remove(i);
+                    devices.push(d);
+                }
+            }
+            return v;
+        }
     }
     let v = make();
     let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
@@ -80,7 +101,10 @@ pub fn cached<T: Clone + Send + Sync + 'static>(
 }
 
 /// Compiles a render pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
-pub fn create_render_pipeline(device: &wgpu::Device, desc: &wgpu::RenderPipelineDescriptor<'_>) -> wgpu::RenderPipeline {
+pub fn create_render_pipeline(
+    device: &wgpu::Device,
+    desc: &wgpu::RenderPipelineDescriptor<'_>,
+) -> wgpu::RenderPipeline {
     PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
     device.create_render_pipeline(desc)
 }
@@ -304,27 +328,31 @@ pub fn shader(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderM
 
 /// Nearest, clamp-to-edge sampler (the "PointSampler" of the MLAA listings).
 pub fn nearest_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"nearest clamp", || device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("nearest clamp"),
-        address_mode_u: wgpu::AddressMode::ClampToEdge,
-        address_mode_v: wgpu::AddressMode::ClampToEdge,
-        address_mode_w: wgpu::AddressMode::ClampToEdge,
-        ..Default::default()
-    }))
+    cached(device, "sampler", &"nearest clamp", || {
+        device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("nearest clamp"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        })
+    })
 }
 
 /// Bilinear, clamp-to-edge sampler (the "LinearSampler" of SMAA).
 pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"linear clamp", || device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("linear clamp"),
-        address_mode_u: wgpu::AddressMode::ClampToEdge,
-        address_mode_v: wgpu::AddressMode::ClampToEdge,
-        address_mode_w: wgpu::AddressMode::ClampToEdge,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Nearest,
-        ..Default::default()
-    }))
+    cached(device, "sampler", &"linear clamp", || {
+        device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("linear clamp"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
+        })
+    })
 }
 
 /// A full-screen-triangle render pipeline: vertex entry `vs_fullscreen`, the given fragment entry, one colour
@@ -361,27 +389,30 @@ fn fullscreen_pipeline_uncached(
     fs_entry: &str,
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
-    create_render_pipeline(device, &wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: None,
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
+    create_render_pipeline(
+        device,
+        &wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs_entry),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
         },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs_entry),
-            compilation_options: Default::default(),
-            targets,
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    )
 }
 
 /// Records one full-screen draw into `target` (cleared to zero first), with optional timestamps.

@@ -15,7 +15,8 @@ fn no_pipeline_is_compiled_after_the_first_frame_of_each_shader() {
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let head = default_head();
     let ts = TsSettings { map_size: 128, ..Default::default() };
-    let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered, SkinShader::Ts(ts)];
+    let shaders =
+        [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered, SkinShader::Ts(ts)];
     // Bloom on: the compute chain (bloom) runs in every frame too.
     let passes = SkinPasses::default();
     for shader in shaders {
@@ -33,7 +34,9 @@ fn no_pipeline_is_compiled_after_the_first_frame_of_each_shader() {
         let compiled_first = pipelines_created_on_this_thread() - before;
         let second = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
         let compiled_second = pipelines_created_on_this_thread() - before - compiled_first;
-        eprintln!("{shader:?}: {compiled_first} pipelines compiled by the first frame, {compiled_second} by the second");
+        eprintln!(
+            "{shader:?}: {compiled_first} pipelines compiled by the first frame, {compiled_second} by the second"
+        );
         assert_eq!(compiled_second, 0, "{shader:?}: the second frame compiled {compiled_second} pipelines");
         if shader == SkinShader::None {
             // A fresh device: the first frame compiles the G-buffer, skin-input, lighting and bloom pipelines.
