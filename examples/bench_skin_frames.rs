@@ -3,7 +3,7 @@
 //! modules and pipelines and rasterises the texture-space UV maps on the host, as the runtime did before the
 //! caches — and on, in one run on one adapter, and the ratio.
 //!
-//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES]   # defaults 1280 720 5
+//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 5
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures. Each frame includes
 //! what `run skin` does per frame today (uploads, host read-backs between the stages, the final read-back). Tables
@@ -27,6 +27,7 @@ fn main() {
     let args: Vec<u32> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (width, height) = (args.first().copied().unwrap_or(1280), args.get(1).copied().unwrap_or(720));
     let frames = args.get(2).copied().unwrap_or(5).max(3) as usize;
+    let bloom = !std::env::args().any(|a| a == "no-bloom");
     let dir = std::env::var_os("RTBAKE_BAKED_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"));
@@ -35,8 +36,9 @@ fn main() {
     println!("adapter: {}", g.describe());
     let head = default_head();
     println!(
-        "run skin frame, default passes (bloom on), the default head ({} triangles), {width}x{height}; frame 1 and \
+        "run skin frame, {} the default head ({} triangles), {width}x{height}; frame 1 and \
          the median of frames 2..={frames} (wall ms, host read-backs included); pipelines compiled per frame",
+        if bloom { "default passes (bloom on)," } else { "no bloom," },
         head.triangle_count()
     );
     println!(
@@ -59,7 +61,7 @@ fn main() {
             melanin: 0.02,
             stretch: Default::default(),
         };
-        let passes = SkinPasses::default();
+        let passes = if bloom { SkinPasses::default() } else { SkinPasses::none() };
         let run = |cached: bool| {
             set_object_cache_enabled(cached);
             let mut times = Vec::new();

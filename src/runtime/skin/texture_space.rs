@@ -52,7 +52,9 @@ use wgpu::util::DeviceExt;
 
 /// UV maps kept across frames, keyed by the mesh's content and the map size (the mesh's rasterisation at its
 /// texture coordinates does not change with the camera, the lights or the pose): the last [`UV_MAPS_KEPT`].
-static UV_MAPS: LazyLock<Mutex<Vec<((u64, u32), Arc<UvMap>)>>> = LazyLock::new(|| Mutex::new(Vec::new()));
+static UV_MAPS: LazyLock<Mutex<Vec<KeptUvMap>>> = LazyLock::new(|| Mutex::new(Vec::new()));
+/// (mesh hash, map size) and the map.
+type KeptUvMap = ((u64, u32), Arc<UvMap>);
 /// UV maps kept (a depth-sized frame of several heads uses a few sizes of one mesh).
 const UV_MAPS_KEPT: usize = 8;
 
