@@ -92,73 +92,11 @@ fn main() {
     }
 }
 
-/// The adapter's copy bandwidth in bytes (read + written) per second: the median of RUNS submissions of four
-/// copies between two buffers of up to 256 MiB, by timestamps around the copies where the adapter has them
-/// (empty compute passes either side), else by wall time of submit + wait.
+/// The adapter's copy bandwidth (read + write bytes per second), printed.
 fn copy_bandwidth(g: &rtbake::runtime::device::Gpu) -> f64 {
-    let limits = g.device.limits();
-    let size = (256u64 << 20).min(limits.max_buffer_size / 2) / 16 * 16;
-    let mk = |label| {
-        g.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    };
-    let (a, b) = (mk("copy a"), mk("copy b"));
-    let copies = 4u64;
-    let timer = g.timestamps.then(|| GpuTimer::new(&g.device, 2));
-    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
-    for run in 0..RUNS + 1 {
-        let mut enc = g.device.create_command_encoder(&Default::default());
-        let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
-            if let Some(t) = &timer {
-                let tw = wgpu::ComputePassTimestampWrites {
-                    query_set: &t.query_set,
-                    beginning_of_pass_write_index: Some(2 * slot),
-                    end_of_pass_write_index: Some(2 * slot + 1),
-                };
-                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
-            }
-        };
-        mark(&mut enc, 0);
-        for k in 0..copies {
-            let (src, dst) = if k % 2 == 0 { (&a, &b) } else { (&b, &a) };
-            enc.copy_buffer_to_buffer(src, 0, dst, 0, size);
-        }
-        mark(&mut enc, 1);
-        if let Some(t) = &timer {
-            t.resolve(&mut enc);
-        }
-        let t0 = Instant::now();
-        g.queue.submit([enc.finish()]);
-        g.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        if run == 0 {
-            continue;
-        }
-        wall_ms.push(ms);
-        if let Some(t) = &timer {
-            // Slot 0 ends before the copies, slot 1 begins after them.
-            let bytes = rtbake::runtime::gpu::map_read(&g.device, &t.readback_buffer()).unwrap();
-            let ticks: &[u64] = bytemuck::cast_slice(&bytes);
-            gpu_ms.push(ticks[2].wrapping_sub(ticks[1]) as f64 * g.queue.get_timestamp_period() as f64 * 1e-6);
-        }
-    }
-    let moved = (2 * copies * size) as f64;
-    let (ms, how) = if gpu_ms.is_empty() || median(gpu_ms.clone()) <= 0.0 {
-        (median(wall_ms), "wall time")
-    } else {
-        (median(gpu_ms), "timestamps")
-    };
-    let bw = moved / (ms * 1e-3);
-    println!(
-        "copy bandwidth: {:.1} GB/s (read + write; {copies} copies of {} MiB, median of {RUNS}, {how}: {ms:.3} ms)",
-        bw * 1e-9,
-        size >> 20
-    );
-    bw
+    let c = rtbake::runtime::gpu::copy_bandwidth(&g.device, &g.queue, g.timestamps, RUNS);
+    println!("{}", c.describe());
+    c.bytes_per_s
 }
 
 fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures, sizes: &[(u32, u32)]) {

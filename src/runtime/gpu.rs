@@ -485,12 +485,6 @@ impl GpuTimer {
         enc.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, 16 * self.slots as u64);
     }
 
-    /// The buffer the raw timestamps land in after [`GpuTimer::resolve`] (`2 × slots` u64 ticks), for callers that
-    /// time between passes rather than across one.
-    pub fn readback_buffer(&self) -> wgpu::Buffer {
-        self.readback.clone()
-    }
-
     /// Durations of each slot in milliseconds (after the submission that resolved them).
     pub fn read_ms(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f64>, RuntimeError> {
         let bytes = map_read(device, &self.readback)?;
@@ -499,5 +493,107 @@ impl GpuTimer {
         Ok((0..self.slots as usize)
             .map(|i| ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * period_ns * 1e-6)
             .collect())
+    }
+}
+
+/// A measured copy bandwidth: what [`copy_bandwidth`] timed.
+#[derive(Clone, Debug)]
+pub struct CopyBandwidth {
+    /// Bytes read plus bytes written per second.
+    pub bytes_per_s: f64,
+    /// Median time of one submission's copies, ms.
+    pub ms: f64,
+    /// Copies per submission and bytes per copy.
+    pub copies: u64,
+    pub bytes_per_copy: u64,
+    /// Medians of how many submissions, and whether timed by timestamps (else wall time of submit + wait).
+    pub runs: usize,
+    pub by_timestamps: bool,
+}
+
+impl CopyBandwidth {
+    /// One line: the bandwidth and how it was measured.
+    pub fn describe(&self) -> String {
+        format!(
+            "copy bandwidth: {:.1} GB/s (read + write; {} copies of {} MiB, median of {}, {}: {:.3} ms)",
+            self.bytes_per_s * 1e-9,
+            self.copies,
+            self.bytes_per_copy >> 20,
+            self.runs,
+            if self.by_timestamps { "timestamps" } else { "wall time" },
+            self.ms
+        )
+    }
+}
+
+/// The adapter's buffer-to-buffer copy bandwidth, the figure a pass's bytes-moved bound divides by: the median of
+/// `runs` submissions (after one warm-up) of four copies between two buffers of up to 256 MiB, timed by
+/// timestamps around the copies (empty compute passes either side) when `timestamps` (the device has
+/// `TIMESTAMP_QUERY`), else by wall time of submit + wait.
+pub fn copy_bandwidth(device: &wgpu::Device, queue: &wgpu::Queue, timestamps: bool, runs: usize) -> CopyBandwidth {
+    let size = (256u64 << 20).min(device.limits().max_buffer_size / 2) / 16 * 16;
+    let mk = |label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let (a, b) = (mk("copy a"), mk("copy b"));
+    let copies = 4u64;
+    let timer = timestamps.then(|| GpuTimer::new(device, 2));
+    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
+    for run in 0..runs.max(1) + 1 {
+        let mut enc = device.create_command_encoder(&Default::default());
+        let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
+            if let Some(t) = &timer {
+                let tw = wgpu::ComputePassTimestampWrites {
+                    query_set: &t.query_set,
+                    beginning_of_pass_write_index: Some(2 * slot),
+                    end_of_pass_write_index: Some(2 * slot + 1),
+                };
+                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
+            }
+        };
+        mark(&mut enc, 0);
+        for k in 0..copies {
+            let (src, dst) = if k % 2 == 0 { (&a, &b) } else { (&b, &a) };
+            enc.copy_buffer_to_buffer(src, 0, dst, 0, size);
+        }
+        mark(&mut enc, 1);
+        if let Some(t) = &timer {
+            t.resolve(&mut enc);
+        }
+        let t0 = std::time::Instant::now();
+        queue.submit([enc.finish()]);
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if run == 0 {
+            continue;
+        }
+        wall_ms.push(ms);
+        if let Some(t) = &timer {
+            // Slot 0 ends before the copies, slot 1 begins after them.
+            if let Ok(bytes) = map_read(device, &t.readback) {
+                let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+                gpu_ms.push(ticks[2].wrapping_sub(ticks[1]) as f64 * queue.get_timestamp_period() as f64 * 1e-6);
+            }
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let n = wall_ms.len();
+    let by_gpu = !gpu_ms.is_empty() && median(gpu_ms.clone()) > 0.0;
+    let ms = if by_gpu { median(gpu_ms) } else { median(wall_ms) };
+    CopyBandwidth {
+        bytes_per_s: (2 * copies * size) as f64 / (ms * 1e-3),
+        ms,
+        copies,
+        bytes_per_copy: size,
+        runs: n,
+        by_timestamps: by_gpu,
     }
 }

@@ -46,3 +46,15 @@ fn no_pipeline_is_compiled_after_the_first_frame_of_each_shader() {
     }
     assert!(cached_objects(&g.device) >= 10, "{} objects cached", cached_objects(&g.device));
 }
+
+/// The bandwidth the benchmarks divide bytes by: measured by four 2×size copies, positive, finite and above what
+/// any adapter moves (a software adapter copies at gigabytes per second); timestamps only when the device has them.
+#[test]
+fn the_copy_bandwidth_the_bounds_divide_by_is_measured() {
+    let g = gpu();
+    let c = rtbake::runtime::gpu::copy_bandwidth(&g.device, &g.queue, g.timestamps, 3);
+    assert!(c.bytes_per_s.is_finite() && c.bytes_per_s > 1e8, "{c:?}");
+    assert_eq!((c.copies, c.runs), (4, 3));
+    assert!(!c.by_timestamps || g.timestamps);
+    assert!(c.describe().contains("GB/s"), "{}", c.describe());
+}
