@@ -4,6 +4,12 @@
 //!
 //!     cargo run --release --example bench_runtime          # GPU passes, then the CPU reference SMAA
 //!     cargo run --release --example bench_runtime -- cpu   # the CPU reference SMAA only (no adapter needed)
+//!     cargo run --release --example bench_runtime -- 1920x1080 [gpu-only]   # one size; no CPU reference SMAA
+//!
+//! Each pass is printed beside its bytes-moved bound: the bytes it must read and write (its input and output
+//! images at their formats, each texel once; the look-up tables are left out) divided by the adapter's copy
+//! bandwidth, measured first in the same run with buffer-to-buffer copies (read + write bytes per second), and
+//! the ratio time / bound.
 //!
 //! GPU passes are timed with timestamp queries when the adapter supports them, else by wall time of
 //! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
@@ -21,6 +27,7 @@ use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
 use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
 use rtbake::runtime::smaa::{Smaa, SubsampleIndices};
+use rtbake::runtime::sss::separable_tiled::SeparableSssTiled;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -71,16 +78,32 @@ fn time_passes(g: &rtbake::runtime::device::Gpu, slots: u32, encode: &Encode<'_>
 fn main() {
     let dir = baked_dir();
     let luts = loader::load_smaa_textures(&dir).unwrap_or_else(|e| panic!("{e}"));
-    if std::env::args().nth(1).as_deref() != Some("cpu") {
-        gpu_passes(&dir, &luts);
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let sizes: Vec<(u32, u32)> = args
+        .iter()
+        .filter_map(|a| a.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?))))
+        .collect();
+    let sizes = if sizes.is_empty() { vec![(1280u32, 720u32), (1920, 1080)] } else { sizes };
+    if args.first().map(String::as_str) != Some("cpu") {
+        gpu_passes(&dir, &luts, &sizes);
     }
-    cpu_smaa(&luts);
+    if !args.iter().any(|a| a == "gpu-only") {
+        cpu_smaa(&luts);
+    }
 }
 
-fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures) {
+/// The adapter's copy bandwidth (read + write bytes per second), printed.
+fn copy_bandwidth(g: &rtbake::runtime::device::Gpu) -> f64 {
+    let c = rtbake::runtime::gpu::copy_bandwidth(&g.device, &g.queue, g.timestamps, RUNS);
+    println!("{}", c.describe());
+    c.bytes_per_s
+}
+
+fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures, sizes: &[(u32, u32)]) {
     let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
     println!("adapter: {}", g.describe());
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
+    let bw = copy_bandwidth(&g);
     let n = 33;
     let map = MlaaAreaMap::new(n, loader::load_mlaa_area(dir, n).unwrap_or_else(|e| panic!("{e}"))).unwrap();
     let kernel = loader::load_separable_kernel(dir, rtbake::baked_layout::path::SEPARABLE_KERNEL_DEFAULT)
@@ -88,26 +111,45 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures)
     let fit =
         loader::load_gaussians(dir, rtbake::baked_layout::path::GAUSSIANS_DEFAULT).unwrap_or_else(|e| panic!("{e}"));
     println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
-    for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
+    for &(w, h) in sizes {
+        let px = w as u64 * h as u64;
         let img = render_shapes(w, h, 1);
         let smaa = Smaa::new(&g.device, &g.queue, w, h, luts).unwrap();
         smaa.upload(&g.queue, &img).unwrap();
         let (pp, wall) = time_passes(&g, 3, &|e, t| smaa.encode(e, t));
         print_line(&format!("SMAA 1x {w}x{h}"), &pp, wall, "thesis 1.02 ms @1080p GTX 470");
+        // Edges: colour RGBA8 in, edges RG8 out; weights: edges in, weights RGBA8 out; blend: colour + weights in,
+        // RGBA8 out.
+        let aa_bytes = [6 * px, 6 * px, 12 * px];
+        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
         let mlaa = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
         mlaa.upload(&g.queue, &img).unwrap();
         let (pp, wall) = time_passes(&g, 3, &|e, t| mlaa.encode(e, t));
         print_line(&format!("MLAA N={n} {w}x{h}"), &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
+        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
         // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
         let (color, depth) = sss_frame(w, h);
         let sss = SeparableSss::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
         sss.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, 2, &|e, t| sss.encode(e, t));
-        print_sum(&format!("separable SSS 17 taps {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
+        print_sum(&format!("separable SSS 17 taps, fragment {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
+        // Each pass: RGBA16F colour and R32F depth in, RGBA16F out.
+        print_bounds(&["horizontal", "vertical"], &pp, wall, &[20 * px, 20 * px], bw);
+        let tiled = SeparableSssTiled::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
+        tiled.upload(&g.queue, &color, &depth).unwrap();
+        let (pp, wall) = time_passes(&g, 2, &|e, t| tiled.encode(e, t));
+        print_sum(&format!("separable SSS 17 taps, compute line tiles {w}x{h}"), &pp, wall, "goal 0.2 ms @1080p");
+        print_bounds(&["horizontal", "vertical"], &pp, wall, &[20 * px, 20 * px], bw);
         let gs = GaussianSss::new(&g.device, w, h, &fit.blurs, &fit.params).unwrap();
         gs.upload(&g.queue, &color, &depth).unwrap();
         let (pp, wall) = time_passes(&g, gs.passes(), &|e, t| gs.encode(e, t));
         print_sum(&format!("sum-of-Gaussians SSS (deon6) {w}x{h}"), &pp, wall, "thesis 3.07 ms @1080p GTX 580");
+        // Horizontal: RGBA16F source, R32F depth and RGBA16F matte in, RGBA16F out; vertical: the same in, RGBA16F
+        // out and the blended RGBA16F sum read and written.
+        let names: Vec<String> =
+            (0..gs.passes()).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
+        let bytes: Vec<u64> = (0..gs.passes()).map(|i| if i % 2 == 0 { 28 * px } else { 44 * px }).collect();
+        print_bounds(&names.iter().map(String::as_str).collect::<Vec<_>>(), &pp, wall, &bytes, bw);
     }
 }
 
@@ -194,6 +236,37 @@ fn sss_frame(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
         }
     }
     (color, depth)
+}
+
+/// Per pass: GPU time, bytes read + written, the bytes-moved bound at `bw` bytes/s and time / bound (the whole
+/// chain by wall time when there are no timestamps).
+fn print_bounds(names: &[&str], per_pass: &[f64], wall: f64, bytes: &[u64], bw: f64) {
+    let bound_ms = |b: u64| b as f64 / bw * 1e3;
+    if per_pass.is_empty() {
+        let total: u64 = bytes.iter().sum();
+        println!(
+            "    all passes: wall {wall:.3} ms, {:.1} MB moved, bound {:.4} ms, time/bound {:.1}",
+            total as f64 * 1e-6,
+            bound_ms(total),
+            wall / bound_ms(total)
+        );
+        return;
+    }
+    let total: u64 = bytes.iter().sum();
+    println!(
+        "    all passes by wall time (submit + wait): {wall:.3} ms, {:.1} MB, time/bound {:.1} (a software adapter's \
+         compute timestamps are not to be trusted)",
+        total as f64 * 1e-6,
+        wall / bound_ms(total)
+    );
+    for ((name, ms), b) in names.iter().zip(per_pass).zip(bytes) {
+        println!(
+            "    {name:<10} {ms:.4} ms, {:.1} MB moved, bound {:.4} ms, time/bound {:.1}",
+            *b as f64 * 1e-6,
+            bound_ms(*b),
+            ms / bound_ms(*b)
+        );
+    }
 }
 
 fn print_sum(name: &str, per_pass: &[f64], wall: f64, anchor: &str) {

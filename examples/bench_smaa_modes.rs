@@ -104,6 +104,8 @@ fn main() {
         }
     );
     println!("timestamps: {}", if g.timestamps { "yes (per-pass GPU time)" } else { "no (wall time only)" });
+    let bw = rtbake::runtime::gpu::copy_bandwidth(&g.device, &g.queue, g.timestamps, RUNS);
+    println!("{}", bw.describe());
     println!("medians of {RUNS} runs (min–max); scene: rtbake::runtime::moving_scene, frame 1");
     let luts = loader::load_smaa_textures(&baked_dir()).unwrap_or_else(|e| panic!("{e}"));
     for (w, h) in [(1280u32, 720u32), (1920, 1080)] {
@@ -130,6 +132,21 @@ fn main() {
                 wall.0,
                 wall.1,
                 wall.2
+            );
+            // Bytes per pixel: per sample edges 4 + 2, weights 2 + 4, blend 4 + 4 + 4 (RGBA8 colour, RG8 edges, RGBA8
+            // weights and result); two samples averaged 4 + 4 + 4; the temporal resolve reads the frame, the
+            // previous frame (RGBA8) and the velocity (RG32F) and writes RGBA8.
+            let per_px = 24 * mode.samples_per_frame() as u64
+                + if mode.samples_per_frame() == 2 { 12 } else { 0 }
+                + if mode.is_temporal() { 20 } else { 0 };
+            let bytes = per_px * w as u64 * h as u64;
+            let bound_ms = bytes as f64 / bw.bytes_per_s * 1e3;
+            let t = if sum.0.is_finite() { sum.0 } else { wall.0 };
+            println!(
+                "    {:.1} MB moved, bytes-moved bound {bound_ms:.4} ms, time/bound {:.1} ({})",
+                bytes as f64 * 1e-6,
+                t / bound_ms,
+                if sum.0.is_finite() { "GPU time" } else { "wall time" }
             );
         }
     }

@@ -22,6 +22,7 @@ use crate::runtime::skin::{bloom_cpu, mesh_inputs_cpu, wrinkles_cpu};
 use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSss, GaussianSssParams};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
 use crate::runtime::sss::separable::{SeparableSss, SssKernel, SssParams};
+use crate::runtime::sss::separable_tiled::SeparableSssTiled;
 use crate::runtime::sss::{gaussian_cpu, importance_cpu, separable_cpu};
 use crate::runtime::transport::mc_gpu::TransportGpu;
 use crate::runtime::RuntimeError;
@@ -203,7 +204,20 @@ pub fn subsurface<'g>(
     let gpu = gpu.into();
     match method {
         Subsurface::Separable { kernel, params } => gpu.run(
-            |g| SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear),
+            // The compute pass over workgroup-memory line tiles on GPUs; the fragment pass on software adapters,
+            // where workgroup barriers are emulated and the tiles are slower (same arithmetic, same twin).
+            |g| {
+                if g.is_software() {
+                    SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear)
+                } else {
+                    SeparableSssTiled::new(&g.device, w, h, kernel, params)?.run(
+                        &g.device,
+                        &g.queue,
+                        rgba,
+                        depth_linear,
+                    )
+                }
+            },
             || Ok(separable_cpu::separable_sss(rgba, depth_linear, w, h, kernel, params)),
         ),
         Subsurface::Gaussians { blurs, params } => {

@@ -1,7 +1,8 @@
 //! A small compute-shader runner for the per-pixel skin passes of `run skin` (the rig at the mesh's uv, the
 //! wrinkle pass, bloom): one WGSL module, one uniform block at binding 0 and flat `f32` storage buffers at bindings
 //! 1..=N (all `var<storage, read_write>`, so every entry point shares one explicit layout), run as a chain of
-//! entry points in one submission, one buffer read back. Flat buffers with the filtering done in shader
+//! entry points in one submission, one buffer read back. The module, layout and pipelines are built once per device
+//! and chain ([`gpu::cached`]); each run creates only its buffers and bind group. Flat buffers with the filtering done in shader
 //! arithmetic keep the passes free of texture formats and filter precision (the CPU twins do the same f32 sums).
 
 use crate::error::InvalidInput;
@@ -57,49 +58,10 @@ pub(crate) fn run(
         return Err(RuntimeError::Gpu(format!("{what}: more storage buffers than the adapter binds")));
     }
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = gpu::shader(device, what, source);
-    let mut entries = vec![wgpu::BindGroupLayoutEntry {
-        binding: 0,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }];
-    for i in 0..buffers.len() {
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: i as u32 + 1,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: false },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        });
-    }
-    let bgl =
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(what), entries: &entries });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(what),
-        bind_group_layouts: &[Some(&bgl)],
-        immediate_size: 0,
+    let entry_names: Vec<&str> = stages.iter().map(|s| s.entry).collect();
+    let (bgl, pipelines) = gpu::cached(device, "compute chain", &(source, &entry_names, buffers.len()), || {
+        chain_pipelines(device, what, source, buffers.len(), &entry_names)
     });
-    let pipelines: Vec<wgpu::ComputePipeline> = stages
-        .iter()
-        .map(|s| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(s.entry),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(s.entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })
-        .collect();
     let mut padded = uniform.to_vec();
     padded.resize(uniform.len().div_ceil(16).max(1) * 16, 0);
     let ubo = gpu::uniform_buffer(device, what, &padded);
@@ -151,4 +113,61 @@ pub(crate) fn run(
     let mut out = gpu::map_read(device, &readback)?;
     out.truncate(sizes[read] as usize);
     Ok(out)
+}
+
+/// The chain's layout (uniform at 0, `buffers` read-write storage buffers at 1..=N) and one pipeline per entry.
+fn chain_pipelines(
+    device: &wgpu::Device,
+    what: &str,
+    source: &str,
+    buffers: usize,
+    entries_named: &[&str],
+) -> (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>) {
+    let module = gpu::shader(device, what, source);
+    let mut entries = vec![wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }];
+    for i in 0..buffers {
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: i as u32 + 1,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        });
+    }
+    let bgl =
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(what), entries: &entries });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(what),
+        bind_group_layouts: &[Some(&bgl)],
+        immediate_size: 0,
+    });
+    let pipelines = entries_named
+        .iter()
+        .map(|entry| {
+            gpu::create_compute_pipeline(
+                device,
+                &wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&layout),
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                },
+            )
+        })
+        .collect();
+    (bgl, pipelines)
 }

@@ -58,15 +58,21 @@ pub fn create_headless(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
     pollster::block_on(create_headless_async(opts))
 }
 
-async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
+/// The process's one wgpu instance and its backends. Devices of one instance have distinct ids while alive, which
+/// the per-device object cache of [`crate::runtime::gpu::cached`] keys on (ids of two instances may coincide).
+static INSTANCE: std::sync::LazyLock<(wgpu::Instance, wgpu::Backends)> = std::sync::LazyLock::new(|| {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
     let backends = desc.backends;
-    let instance = wgpu::Instance::new(desc);
+    (wgpu::Instance::new(desc), backends)
+});
+
+async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
+    let (instance, backends) = &*INSTANCE;
     let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
         Ok(want) if !want.is_empty() => {
             let want_lc = want.to_lowercase();
-            let adapters = instance.enumerate_adapters(backends).await;
+            let adapters = instance.enumerate_adapters(*backends).await;
             let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
             adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&want_lc)).ok_or_else(|| {
                 RuntimeError::NoAdapter(format!(

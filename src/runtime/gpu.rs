@@ -1,7 +1,139 @@
 //! Small wgpu helpers shared by the passes: explicit-format textures, uploads, read-backs, full-screen
 //! fragment pipelines and GPU timestamp collection. Nothing here creates a device.
+//!
+//! Shader modules, pipelines, bind-group layouts and samplers are created once per device and reused by every
+//! later frame ([`cached`]), as an engine builds its pipeline state objects at load time: a pass constructed per
+//! frame costs its textures and bind groups, never a shader compilation. [`pipelines_created_on_this_thread`]
+//! counts the pipelines actually compiled, so a test can assert that none is compiled after the first frame.
+//! The cache keys on the device's id, distinct among the devices of one wgpu instance: the runtime's devices come
+//! from the one instance of [`crate::runtime::device`]; a caller mixing devices of several instances turns the
+//! cache off ([`set_object_cache_enabled`]).
 
 use crate::runtime::RuntimeError;
+use std::any::Any;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{LazyLock, Mutex};
+
+type CacheKey = (wgpu::Device, &'static str, u64);
+type CacheMap = HashMap<CacheKey, Box<dyn Any + Send + Sync>>;
+
+/// The per-device objects built so far. A device stays alive while it has entries, so only the objects of the
+/// [`CACHED_DEVICES`] most recently used devices are kept (a command has one; a test process makes many).
+static CACHE: LazyLock<Mutex<(CacheMap, Vec<wgpu::Device>)>> =
+    LazyLock::new(|| Mutex::new((HashMap::new(), Vec::new())));
+/// Devices whose objects are kept: the most recently used ones.
+const CACHED_DEVICES: usize = 16;
+static CACHE_ENABLED: AtomicBool = AtomicBool::new(true);
+
+thread_local! {
+    static PIPELINES_CREATED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Turns the per-device object cache on (the default) or off. Off, every pass constructed recompiles its shader
+/// and pipelines as the runtime did before the cache existed: benchmarks measure the difference with it.
+pub fn set_object_cache_enabled(enabled: bool) {
+    CACHE_ENABLED.store(enabled, Ordering::Relaxed);
+}
+
+/// Whether the per-device object cache is on (the runtime's other per-frame caches follow the same switch).
+pub fn object_cache_enabled() -> bool {
+    CACHE_ENABLED.load(Ordering::Relaxed)
+}
+
+/// Render and compute pipelines compiled on the calling thread since it started (cache misses only).
+pub fn pipelines_created_on_this_thread() -> u64 {
+    PIPELINES_CREATED.with(|c| c.get())
+}
+
+/// Number of objects (modules, pipelines, layouts, samplers) cached for `device`.
+pub fn cached_objects(device: &wgpu::Device) -> usize {
+    CACHE.lock().unwrap_or_else(|e| e.into_inner()).0.keys().filter(|k| &k.0 == device).count()
+}
+
+/// A 64-bit hash of `key` (the cache's key within one `kind`).
+fn key_hash(key: &impl Hash) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    key.hash(&mut h);
+    h.finish()
+}
+
+/// The object of `kind` and `key` for `device`: built by `make` the first time, a clone of it afterwards. The lock
+/// is not held while `make` runs (it may build other cached objects); two threads racing build it twice, one wins.
+pub fn cached<T: Clone + Send + Sync + 'static>(
+    device: &wgpu::Device,
+    kind: &'static str,
+    key: &impl Hash,
+    make: impl FnOnce() -> T,
+) -> T {
+    if !CACHE_ENABLED.load(Ordering::Relaxed) {
+        return make();
+    }
+    let k = (device.clone(), kind, key_hash(key));
+    {
+        let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        let (map, devices) = &mut *guard;
+        if let Some(v) = map.get(&k).and_then(|b| b.downcast_ref::<T>()) {
+            let v = v.clone();
+            // Most recently used last.
+            if devices.last() != Some(device) {
+                if let Some(i) = devices.iter().position(|d| d == device) {
+                    let d = devices.remove(i);
+                    devices.push(d);
+                }
+            }
+            return v;
+        }
+    }
+    let v = make();
+    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    let (map, devices) = &mut *guard;
+    if !devices.contains(device) {
+        devices.push(device.clone());
+        if devices.len() > CACHED_DEVICES {
+            let old = devices.remove(0);
+            map.retain(|key, _| key.0 != old);
+        }
+    }
+    map.entry(k).or_insert_with(|| Box::new(v.clone()));
+    v
+}
+
+/// Compiles a render pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
+pub fn create_render_pipeline(
+    device: &wgpu::Device,
+    desc: &wgpu::RenderPipelineDescriptor<'_>,
+) -> wgpu::RenderPipeline {
+    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
+    device.create_render_pipeline(desc)
+}
+
+/// Compiles a compute pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
+pub fn create_compute_pipeline(
+    device: &wgpu::Device,
+    desc: &wgpu::ComputePipelineDescriptor<'_>,
+) -> wgpu::ComputePipeline {
+    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
+    device.create_compute_pipeline(desc)
+}
+
+/// A compute pipeline of `module`'s `entry` with the layout derived from the shader, cached per device.
+pub fn compute_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, entry: &str) -> wgpu::ComputePipeline {
+    cached(device, "compute pipeline", &(module, entry), || {
+        create_compute_pipeline(
+            device,
+            &wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            },
+        )
+    })
+}
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
@@ -184,36 +316,42 @@ pub fn uniform_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu:
     buf
 }
 
-/// A WGSL module from source text.
+/// A WGSL module from source text, compiled once per device and source (the label of the first caller).
 pub fn shader(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
+    cached(device, "shader module", &source, || {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
     })
 }
 
 /// Nearest, clamp-to-edge sampler (the "PointSampler" of the MLAA listings).
 pub fn nearest_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("nearest clamp"),
-        address_mode_u: wgpu::AddressMode::ClampToEdge,
-        address_mode_v: wgpu::AddressMode::ClampToEdge,
-        address_mode_w: wgpu::AddressMode::ClampToEdge,
-        ..Default::default()
+    cached(device, "sampler", &"nearest clamp", || {
+        device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("nearest clamp"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            ..Default::default()
+        })
     })
 }
 
 /// Bilinear, clamp-to-edge sampler (the "LinearSampler" of SMAA).
 pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("linear clamp"),
-        address_mode_u: wgpu::AddressMode::ClampToEdge,
-        address_mode_v: wgpu::AddressMode::ClampToEdge,
-        address_mode_w: wgpu::AddressMode::ClampToEdge,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Nearest,
-        ..Default::default()
+    cached(device, "sampler", &"linear clamp", || {
+        device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("linear clamp"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+            ..Default::default()
+        })
     })
 }
 
@@ -239,27 +377,42 @@ pub fn fullscreen_pipeline_with(
     fs_entry: &str,
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: None,
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs_entry),
-            compilation_options: Default::default(),
-            targets,
-        }),
-        multiview_mask: None,
-        cache: None,
+    cached(device, "fullscreen pipeline", &(module, fs_entry, targets), || {
+        fullscreen_pipeline_uncached(device, label, module, fs_entry, targets)
     })
+}
+
+fn fullscreen_pipeline_uncached(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    fs_entry: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    create_render_pipeline(
+        device,
+        &wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs_entry),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        },
+    )
 }
 
 /// Records one full-screen draw into `target` (cleared to zero first), with optional timestamps.
@@ -340,5 +493,107 @@ impl GpuTimer {
         Ok((0..self.slots as usize)
             .map(|i| ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * period_ns * 1e-6)
             .collect())
+    }
+}
+
+/// A measured copy bandwidth: what [`copy_bandwidth`] timed.
+#[derive(Clone, Debug)]
+pub struct CopyBandwidth {
+    /// Bytes read plus bytes written per second.
+    pub bytes_per_s: f64,
+    /// Median time of one submission's copies, ms.
+    pub ms: f64,
+    /// Copies per submission and bytes per copy.
+    pub copies: u64,
+    pub bytes_per_copy: u64,
+    /// Medians of how many submissions, and whether timed by timestamps (else wall time of submit + wait).
+    pub runs: usize,
+    pub by_timestamps: bool,
+}
+
+impl CopyBandwidth {
+    /// One line: the bandwidth and how it was measured.
+    pub fn describe(&self) -> String {
+        format!(
+            "copy bandwidth: {:.1} GB/s (read + write; {} copies of {} MiB, median of {}, {}: {:.3} ms)",
+            self.bytes_per_s * 1e-9,
+            self.copies,
+            self.bytes_per_copy >> 20,
+            self.runs,
+            if self.by_timestamps { "timestamps" } else { "wall time" },
+            self.ms
+        )
+    }
+}
+
+/// The adapter's buffer-to-buffer copy bandwidth, the figure a pass's bytes-moved bound divides by: the median of
+/// `runs` submissions (after one warm-up) of four copies between two buffers of up to 256 MiB, timed by
+/// timestamps around the copies (empty compute passes either side) when `timestamps` (the device has
+/// `TIMESTAMP_QUERY`), else by wall time of submit + wait.
+pub fn copy_bandwidth(device: &wgpu::Device, queue: &wgpu::Queue, timestamps: bool, runs: usize) -> CopyBandwidth {
+    let size = (256u64 << 20).min(device.limits().max_buffer_size / 2) / 16 * 16;
+    let mk = |label| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let (a, b) = (mk("copy a"), mk("copy b"));
+    let copies = 4u64;
+    let timer = timestamps.then(|| GpuTimer::new(device, 2));
+    let (mut gpu_ms, mut wall_ms) = (Vec::new(), Vec::new());
+    for run in 0..runs.max(1) + 1 {
+        let mut enc = device.create_command_encoder(&Default::default());
+        let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
+            if let Some(t) = &timer {
+                let tw = wgpu::ComputePassTimestampWrites {
+                    query_set: &t.query_set,
+                    beginning_of_pass_write_index: Some(2 * slot),
+                    end_of_pass_write_index: Some(2 * slot + 1),
+                };
+                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
+            }
+        };
+        mark(&mut enc, 0);
+        for k in 0..copies {
+            let (src, dst) = if k % 2 == 0 { (&a, &b) } else { (&b, &a) };
+            enc.copy_buffer_to_buffer(src, 0, dst, 0, size);
+        }
+        mark(&mut enc, 1);
+        if let Some(t) = &timer {
+            t.resolve(&mut enc);
+        }
+        let t0 = std::time::Instant::now();
+        queue.submit([enc.finish()]);
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if run == 0 {
+            continue;
+        }
+        wall_ms.push(ms);
+        if let Some(t) = &timer {
+            // Slot 0 ends before the copies, slot 1 begins after them.
+            if let Ok(bytes) = map_read(device, &t.readback) {
+                let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+                gpu_ms.push(ticks[2].wrapping_sub(ticks[1]) as f64 * queue.get_timestamp_period() as f64 * 1e-6);
+            }
+        }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let n = wall_ms.len();
+    let by_gpu = !gpu_ms.is_empty() && median(gpu_ms.clone()) > 0.0;
+    let ms = if by_gpu { median(gpu_ms) } else { median(wall_ms) };
+    CopyBandwidth {
+        bytes_per_s: (2 * copies * size) as f64 / (ms * 1e-3),
+        ms,
+        copies,
+        bytes_per_copy: size,
+        runs: n,
+        by_timestamps: by_gpu,
     }
 }

@@ -4,7 +4,7 @@
 //!
 //! Per head of the row (each head has its own maps, as the thesis' multi-head scenes):
 //! 1. **Irradiance map**: the head's mesh rasterised at its texture coordinates into a `T`×`T` map (host side,
-//!    [`crate::shading::texture_space::rasterise_uv`]); each texel is lit exactly as the screen-space shaders'
+//!    [`crate::shading::texture_space::rasterise_uv`], once per mesh and map size: [`uv_map_of`]); each texel is lit exactly as the screen-space shaders'
 //!    pixels are — albedo from the skin LUT at the texel's H0 and melanin, Lambert key light + ambient on the
 //!    texel's view-space normal, plus the back light's T(s)·E with the shadow map's thickness at the texel's
 //!    surface point (stored with the reflected light and blurred with it, thesis §5.4; [`crate::runtime::skin::lighting`]'s
@@ -47,7 +47,51 @@ use crate::shading::texture_space::{
 };
 use nalgebra::{Vector3, Vector4};
 use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, LazyLock, Mutex};
 use wgpu::util::DeviceExt;
+
+/// UV maps kept across frames, keyed by the mesh's content and the map size (the mesh's rasterisation at its
+/// texture coordinates does not change with the camera, the lights or the pose): the last [`UV_MAPS_KEPT`].
+static UV_MAPS: LazyLock<Mutex<Vec<KeptUvMap>>> = LazyLock::new(|| Mutex::new(Vec::new()));
+/// (mesh hash, map size) and the map.
+type KeptUvMap = ((u64, u32), Arc<UvMap>);
+/// UV maps kept (a depth-sized frame of several heads uses a few sizes of one mesh).
+const UV_MAPS_KEPT: usize = 8;
+
+/// A 64-bit hash of everything [`rasterise_uv`] reads of `mesh`.
+fn mesh_key(mesh: &Mesh) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let bits =
+        |v: &[f32], h: &mut std::collections::hash_map::DefaultHasher| v.iter().for_each(|x| x.to_bits().hash(h));
+    mesh.positions.iter().for_each(|p| bits(p, &mut h));
+    mesh.normals.iter().for_each(|n| bits(n, &mut h));
+    mesh.uvs.iter().for_each(|t| bits(t, &mut h));
+    mesh.indices.hash(&mut h);
+    mesh.mm_per_unit.to_bits().hash(&mut h);
+    h.finish()
+}
+
+/// `mesh` rasterised at its texture coordinates into a `size`² map, once per mesh and size (every time while
+/// [`gpu::object_cache_enabled`] is off).
+pub fn uv_map_of(mesh: &Mesh, size: u32) -> Arc<UvMap> {
+    if !gpu::object_cache_enabled() {
+        return Arc::new(rasterise_uv(mesh, size));
+    }
+    let key = (mesh_key(mesh), size);
+    if let Some((_, m)) = UV_MAPS.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
+        return m.clone();
+    }
+    let map = Arc::new(rasterise_uv(mesh, size));
+    let mut kept = UV_MAPS.lock().unwrap_or_else(|e| e.into_inner());
+    if !kept.iter().any(|(k, _)| *k == key) {
+        if kept.len() == UV_MAPS_KEPT {
+            kept.remove(0);
+        }
+        kept.push((key, map.clone()));
+    }
+    map
+}
 
 /// Bytes of each of the three irradiance-map buffers (chain, temporary, weighted sum) of a `size`² map on the GPU:
 /// one RGBA f32 per texel, the largest buffer of the texture-space pass apart from the per-pixel gather.
@@ -170,8 +214,8 @@ pub fn render_with<'g>(
         pixels_of[k].push(i);
     }
     let planes = frustum_planes_eye(&cam.projection(w as f32 / h as f32));
-    let mut maps: HashMap<u32, UvMap> = HashMap::new();
-    let base = maps.entry(ts.map_size).or_insert_with(|| rasterise_uv(mesh, ts.map_size));
+    let mut maps: HashMap<u32, Arc<UvMap>> = HashMap::new();
+    let base = maps.entry(ts.map_size).or_insert_with(|| uv_map_of(mesh, ts.map_size));
     let d_ref_m = d_ref_m(base, h, cam.fov_y_deg);
     let weights = normalised_weights(&assets.blurs.blend);
     let sigmas = &assets.blurs.incremental_sigma_mm;
@@ -188,7 +232,7 @@ pub fn render_with<'g>(
         let (lo_k, hi_k) = ([lo[0] + dx, lo[1], lo[2]], [hi[0] + dx, hi[1], hi[2]]);
         let distance_m = nearest_corner_distance(cam.eye, lo_k, hi_k) * mmu / 1000.0;
         let size = if ts.depth_sized { depth_sized_map(ts.map_size, d_ref_m, distance_m) } else { ts.map_size };
-        let uv = maps.entry(size).or_insert_with(|| rasterise_uv(mesh, size));
+        let uv = maps.entry(size).or_insert_with(|| uv_map_of(mesh, size));
         let mut st = TsHeadStats { map_size: size, distance_m, pixels: pixels.len() as u64, ..Default::default() };
         // The texels as a frame for the lighting of the screen-space shaders.
         let n = (size * size) as usize;
@@ -322,16 +366,7 @@ impl TextureSpaceDiffusion {
     pub fn new(device: &wgpu::Device) -> Result<Self, RuntimeError> {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "texture space", SHADER);
-        let pipe = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipe = |entry: &str| gpu::compute_pipeline(device, &module, entry);
         let (blur, gather) = (pipe("blur"), pipe("gather"));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RuntimeError::Gpu(format!("texture-space shader: {e}")));

@@ -63,11 +63,30 @@ impl SssParams {
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Params {
+pub(crate) struct Params {
     rt: [f32; 4],
     cfg: [f32; 4],
     dir: [f32; 4],
     taps: [[f32; 4]; MAX_TAPS],
+}
+
+impl Params {
+    /// The uniform block of one pass in direction `dir` (shared with the compute variant).
+    pub(crate) fn new(width: u32, height: u32, kernel: &SssKernel, params: &SssParams, dir: [f32; 2]) -> Self {
+        let mut taps = [[0.0f32; 4]; MAX_TAPS];
+        taps[..kernel.taps.len()].copy_from_slice(&kernel.taps);
+        Params {
+            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+            cfg: [
+                params.sss_width,
+                params.dist_to_window(),
+                if params.follow_surface { 1.0 } else { 0.0 },
+                kernel.taps.len() as f32,
+            ],
+            dir: [dir[0], dir[1], 0.0, 0.0],
+            taps,
+        }
+    }
 }
 
 const SHADER: &str = include_str!("separable.wgsl");
@@ -101,19 +120,7 @@ impl SeparableSss {
         let module = gpu::shader(device, "separable_sss.wgsl", SHADER);
         let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", F::Rgba16Float);
         let lin = gpu::linear_clamp_sampler(device);
-        let mut taps = [[0.0f32; 4]; MAX_TAPS];
-        taps[..kernel.taps.len()].copy_from_slice(&kernel.taps);
-        let mk = |dir: [f32; 2]| Params {
-            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
-            cfg: [
-                params.sss_width,
-                params.dist_to_window(),
-                if params.follow_surface { 1.0 } else { 0.0 },
-                kernel.taps.len() as f32,
-            ],
-            dir: [dir[0], dir[1], 0.0, 0.0],
-            taps,
-        };
+        let mk = |dir: [f32; 2]| Params::new(width, height, kernel, params, dir);
         let ubo_h = gpu::uniform_buffer(device, "sss h", bytemuck::bytes_of(&mk([1.0, 0.0])));
         let ubo_v = gpu::uniform_buffer(device, "sss v", bytemuck::bytes_of(&mk([0.0, 1.0])));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
