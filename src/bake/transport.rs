@@ -385,7 +385,13 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
         per unit flux entering the surface; skins spectral (D65, CIE 1931 2 degree, linear sRGB); dipole: Jensen et \
         al. 2001; layered multipole: Donner & Jensen 2005; directional adding: Kubelka 1954"});
     let mut files = Vec::new();
-    files.push(text_file(path::TRANSPORT_REPORT_CSV, report_csv(&rows), FileKind::Csv, FileFormat::Csv, CSV_CONVENTION));
+    files.push(text_file(
+        path::TRANSPORT_REPORT_CSV,
+        report_csv(&rows),
+        FileKind::Csv,
+        FileFormat::Csv,
+        CSV_CONVENTION,
+    ));
     files.push(json_file(
         &format!("{}/report.json", path::TRANSPORT_DIR),
         &json!({"provenance": provenance, "rows": report_json(&rows)}),
