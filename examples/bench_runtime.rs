@@ -254,8 +254,8 @@ fn print_bounds(names: &[&str], per_pass: &[f64], wall: f64, bytes: &[u64], bw: 
     }
     let total: u64 = bytes.iter().sum();
     println!(
-        "    all passes by wall time (submit + wait): {wall:.3} ms, {:.1} MB, time/bound {:.1} (a software adapter's \
-         compute timestamps are not to be trusted)",
+        "    all passes by wall time (submit + wait): {wall:.3} ms, {:.1} MB, time/bound {:.1} (a check on the \
+         per-pass timestamps below, which a software adapter's compute passes do not report faithfully)",
         total as f64 * 1e-6,
         wall / bound_ms(total)
     );
