@@ -20,7 +20,7 @@
 //! per unit flux entering the surface (Monte Carlo ÷ (1 − Rsp), [`crate::transport::profile`]).
 //!
 //! Files in `transport/`:
-//! - `report.csv` / `report.json`: one row per case, g, channel and model (see [`CSV_CONVENTION`]);
+//! - `report.csv` / `report.json`: one row per case, g, channel and model (see `CSV_CONVENTION`);
 //! - `summary.md`: per family, model and g, the range of total-R differences and the median and largest r·R(r)
 //!   error over cases and channels (the README's accuracy table);
 //! - `accuracy.svg`: total-R difference and r·R(r) error against the Monte Carlo total R, one line per model and g;

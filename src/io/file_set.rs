@@ -180,7 +180,7 @@ fn still_names(_path: &Path, _file: &fs::File) -> bool {
 impl Drop for DirLock {
     /// Releases the lock. The last holder removes the lock file while it still holds it exclusively (a shared
     /// holder first tries to become the only one), so no `.NAME.rtbake-lock` stays beside a directory after the
-    /// command, a read-only `verify` included; a process waiting on the removed file notices ([`still_names`]) and
+    /// command, a read-only `verify` included; a process waiting on the removed file notices (`still_names`) and
     /// takes a fresh one.
     fn drop(&mut self) {
         let Some((file, path)) = self.file.take() else { return };
