@@ -135,14 +135,13 @@ pub fn compute_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, entr
     })
 }
 
-/// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
-/// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
-pub fn texture(
+/// A 2D non-sRGB texture with one mip level and `usage` (the one descriptor the helpers below share).
+fn texture_with_usage(
     device: &wgpu::Device,
     label: &str,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
     format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
     debug_assert!(!format.is_srgb(), "runtime textures are never sRGB");
     device.create_texture(&wgpu::TextureDescriptor {
@@ -152,12 +151,23 @@ pub fn texture(
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::COPY_DST
-            | wgpu::TextureUsages::COPY_SRC,
+        usage,
         view_formats: &[],
     })
+}
+
+/// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
+/// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
+pub fn texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    use wgpu::TextureUsages as U;
+    let usage = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT | U::COPY_DST | U::COPY_SRC;
+    texture_with_usage(device, label, (width, height), format, usage)
 }
 
 /// A sampled, upload-only 2D texture (no render attachment): for inputs such as the `R32Float` linear depth,
@@ -169,17 +179,21 @@ pub fn data_texture(
     height: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    debug_assert!(!format.is_srgb(), "runtime textures are never sRGB");
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    })
+    use wgpu::TextureUsages as U;
+    texture_with_usage(device, label, (width, height), format, U::TEXTURE_BINDING | U::COPY_DST)
+}
+
+/// A 2D texture a compute pass writes (storage) and later passes sample or copy, one mip level.
+pub fn storage_texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    use wgpu::TextureUsages as U;
+    let usage = U::TEXTURE_BINDING | U::STORAGE_BINDING | U::COPY_SRC | U::COPY_DST;
+    texture_with_usage(device, label, (width, height), format, usage)
 }
 
 /// Bytes per texel of the formats the runtime uses.

@@ -26,22 +26,6 @@ pub struct SeparableSssTiled {
     dispatch: [[u32; 3]; 2],
 }
 
-fn storage_texture(device: &wgpu::Device, label: &str, width: u32, height: u32) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba16Float,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    })
-}
-
 impl SeparableSssTiled {
     pub fn new(
         device: &wgpu::Device,
@@ -55,8 +39,8 @@ impl SeparableSssTiled {
         params.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "sss colour", width, height, F::Rgba16Float);
-        let tmp = storage_texture(device, "sss horizontal", width, height);
-        let output = storage_texture(device, "sss output", width, height);
+        let tmp = gpu::storage_texture(device, "sss horizontal", width, height, F::Rgba16Float);
+        let output = gpu::storage_texture(device, "sss output", width, height, F::Rgba16Float);
         let depth = gpu::data_texture(device, "sss depth", width, height, F::R32Float);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "separable_tiled.wgsl", SHADER);
