@@ -6,7 +6,7 @@ use rtbake::manifest::{BakedFile, FileMeta};
 use rtbake::mesh::framing::head_height_units;
 use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
-use rtbake::runtime::skin::tap_grid::{render_grid, TapGridSettings};
+use rtbake::runtime::skin::tap_grid::{display_name, render_grid, TapGridSettings};
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{self, StretchPreset};
 use rtbake::runtime::texture_space::DEFAULT_MAP_SIZE;
@@ -44,6 +44,10 @@ pub struct TapGridArgs {
     /// Frame height in pixels.
     #[arg(long, default_value_t = 360, value_name = "PIXELS")]
     height: u32,
+    /// Also render separable SSS (thesis ch. 6; not one of TAP's stimuli) under every condition: a fifth row of
+    /// frames and differences and a fifth column of the RMSE table.
+    #[arg(long)]
+    separable: bool,
     #[command(flatten)]
     common: crate::run::Common,
 }
@@ -66,6 +70,7 @@ pub fn run(ctx: &Ctx, a: TapGridArgs) -> anyhow::Result<()> {
         stretch,
         ts_map_size: a.ts_map_size,
         melanin: a.melanin,
+        separable: a.separable,
     };
     settings.validate().map_err(usage)?;
     let inputs: Vec<&Path> =
@@ -136,17 +141,16 @@ pub fn run(ctx: &Ctx, a: TapGridArgs) -> anyhow::Result<()> {
         .collect();
     crate::cli::write_set(ctx, "--out", &a.out, &files, &inputs)?;
     let secs = t.elapsed().as_secs_f64();
+    let means: Vec<String> =
+        settings.shaders()[1..].iter().map(|sh| format!("{} {:.4}", display_name(sh), grid.mean_rmse(sh))).collect();
     ctx.info(format!(
-        "tap-grid: {} frames + {} sweep frames at {}x{} in {secs:.1} s -> {}; mean RMSE vs TS: SS Full {:.4}, SS \
-         Jittered {:.4}, No SSS {:.4}",
+        "tap-grid: {} frames + {} sweep frames at {}x{} in {secs:.1} s -> {}; mean RMSE vs TS: {}",
         grid.frames.len(),
         grid.sweep.len(),
         a.width,
         a.height,
         a.out.display(),
-        grid.mean_rmse("ss-full"),
-        grid.mean_rmse("ss-jittered"),
-        grid.mean_rmse("no-sss"),
+        means.join(", "),
     ));
     if ctx.json {
         ctx.emit_json(&grid.rmse_json(describe));

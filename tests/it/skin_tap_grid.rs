@@ -177,6 +177,51 @@ fn tap_grid_writes_frames_differences_rmse_and_sheets_for_the_procedural_head() 
     }
 }
 
+/// `--separable` adds the fifth shader of `run skin` under every condition: its frames, its differences against
+/// TS and its rows of the RMSE table (recomputed from the frames); it blurs, so it is nearer TS than No SSS on average
+/// and differs from both.
+#[test]
+fn tap_grid_with_separable_adds_a_fifth_row_recomputable_from_its_frames() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("grid5");
+    let o = rtbake(&[
+        "--json",
+        "run",
+        "tap-grid",
+        "--cpu",
+        "--separable",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--ts-map-size",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let count = |d: &str| std::fs::read_dir(out.join(d)).unwrap().count();
+    assert_eq!((count("frames"), count("differences"), count("fig4")), (60, 48, 6));
+    let csv = std::fs::read_to_string(out.join("rmse.csv")).unwrap();
+    let sep: Vec<&str> = csv.lines().filter(|r| r.starts_with("separable,")).collect();
+    assert_eq!(sep.len(), 12, "{csv}");
+    for row in &sep {
+        let f: Vec<&str> = row.split(',').collect();
+        let stem = |sh: &str| format!("{sh}_{}_az{:03}.png", f[1], f[2].parse::<i32>().unwrap());
+        let a = read_rgba(&out.join("frames").join(stem("separable")));
+        let ts = read_rgba(&out.join("frames").join(stem("ts")));
+        let none = read_rgba(&out.join("frames").join(stem("no-sss")));
+        let got: f64 = f[4].parse().unwrap();
+        assert!((got - rmse(&a, &ts)).abs() < 1e-6, "{row}");
+        assert!(rmse(&a, &none) > 0.0, "{row}: separable equals No SSS");
+    }
+    let mean = |sh: &str| v["mean_rmse"][sh].as_f64().unwrap();
+    assert!(mean("separable") > 0.0 && mean("separable") < mean("no-sss"), "{}", v["mean_rmse"]);
+    let sheet = read_rgba(&out.join("contact_sheet.png"));
+    assert!(sheet.height() > 9 * 54, "5 frame rows + 4 difference rows: {}", sheet.height());
+}
+
 #[test]
 fn tap_grid_bad_input_exits_2_and_writes_nothing() {
     let t = tempfile::tempdir().unwrap();

@@ -23,6 +23,21 @@ use crate::runtime::RuntimeError;
 
 /// TAP's shaders, in the order of its Table II and Fig. 8 (TS first: the reference).
 pub const GRID_SHADERS: [&str; 4] = ["ts", "ss-full", "ss-jittered", "no-sss"];
+/// The shader the grid adds on request ([`TapGridSettings::separable`]): separable SSS (thesis ch. 6), which came
+/// after TAP 2009 and is not one of its stimuli.
+pub const SEPARABLE_SHADER: &str = "separable";
+
+/// The name TAP (and the thesis, for separable) print for a grid shader: "TS", "SS Full", "SS Jittered", "No SSS",
+/// "Separable".
+pub fn display_name(shader: &str) -> &'static str {
+    match shader {
+        "ts" => "TS",
+        "ss-full" => "SS Full",
+        "ss-jittered" => "SS Jittered",
+        "no-sss" => "No SSS",
+        _ => "Separable",
+    }
+}
 /// TAP Fig. 4's sweep: (α, β) as printed, for the thesis' 20° field of view (scaled to the camera's as
 /// [`StretchPreset::apply`] does).
 pub const FIG4_SWEEP: [(f32, f32); 6] =
@@ -42,15 +57,28 @@ pub struct TapGridSettings {
     /// TS's irradiance map edge, texels.
     pub ts_map_size: u32,
     pub melanin: f32,
+    /// Also render [`SEPARABLE_SHADER`] under every condition (after TAP's four), so the frames, differences and
+    /// RMSE table compare all five of `run skin`'s shaders against TS.
+    pub separable: bool,
 }
 
 impl TapGridSettings {
-    /// The frame settings of `shader` (one of [`GRID_SHADERS`]) at `distance`.
+    /// The shaders rendered under every condition: [`GRID_SHADERS`] (TS first), then [`SEPARABLE_SHADER`] when asked.
+    pub fn shaders(&self) -> Vec<&'static str> {
+        let mut v = GRID_SHADERS.to_vec();
+        if self.separable {
+            v.push(SEPARABLE_SHADER);
+        }
+        v
+    }
+
+    /// The frame settings of `shader` (one of [`TapGridSettings::shaders`]) at `distance`.
     pub fn frame(&self, shader: &str, distance: TapDistance) -> SkinRenderSettings {
         let shader = match shader {
             "ts" => SkinShader::Ts(TsSettings { map_size: self.ts_map_size, ..Default::default() }),
             "ss-full" => SkinShader::SsFull,
             "ss-jittered" => SkinShader::SsJittered,
+            SEPARABLE_SHADER => SkinShader::Separable,
             _ => SkinShader::None,
         };
         SkinRenderSettings {
@@ -67,18 +95,18 @@ impl TapGridSettings {
     /// Every frame's settings validated before any work (sizes, distances, map size).
     pub fn validate(&self) -> Result<(), InvalidInput> {
         for d in TapDistance::ALL {
-            for sh in GRID_SHADERS {
+            for sh in self.shaders() {
                 self.frame(sh, d).validate()?;
             }
         }
         TsSettings { map_size: self.ts_map_size, ..Default::default() }.validate()
     }
 
-    /// Every frame of the grid and the sweep, for budget checks: 48 + 6 + the sweep's TS reference.
+    /// Every frame of the grid and the sweep, for budget checks: 48 (60 with separable) + the 6 of the sweep.
     pub fn frames(&self) -> Vec<SkinRenderSettings> {
         let mut v = Vec::new();
         for d in TapDistance::ALL {
-            for sh in GRID_SHADERS {
+            for sh in self.shaders() {
                 v.extend(std::iter::repeat_n(self.frame(sh, d), TAP_LIGHT_AZIMUTHS_DEG.len()));
             }
         }
@@ -154,7 +182,7 @@ pub fn render_grid<'g>(
     for d in TapDistance::ALL {
         for az in TAP_LIGHT_AZIMUTHS_DEG {
             let mut ts: Option<Image<u8>> = None;
-            for sh in GRID_SHADERS {
+            for sh in s.shaders() {
                 let img = render(&s.frame(sh, d), az, assets)?;
                 let rmse = ts.as_ref().map_or(0.0, |t| rmse_rgb(&img, t));
                 if ts.is_none() {
@@ -220,10 +248,10 @@ impl TapGrid {
         out
     }
 
-    /// Mean RMSE against TS of `shader` over the 12 conditions.
+    /// Mean RMSE against TS of `shader` over the 12 conditions (NaN when the grid has no such shader).
     pub fn mean_rmse(&self, shader: &str) -> f64 {
         let v: Vec<f64> = self.frames.iter().filter(|f| f.shader == shader).map(|f| f.rmse).collect();
-        v.iter().sum::<f64>() / v.len().max(1) as f64
+        v.iter().sum::<f64>() / v.len() as f64
     }
 
     /// The RMSE table as JSON (per condition, per shader mean, the sweep) with the frame size and camera.
@@ -238,7 +266,7 @@ impl TapGrid {
                 .collect::<std::collections::BTreeMap<_, _>>(),
             "ts_map_size": s.ts_map_size,
             "ss_full_stretch": format!("{:?}", s.stretch).to_lowercase(),
-            "mean_rmse": GRID_SHADERS[1..].iter().map(|sh| (*sh, self.mean_rmse(sh)))
+            "mean_rmse": s.shaders()[1..].iter().map(|sh| (*sh, self.mean_rmse(sh)))
                 .collect::<std::collections::BTreeMap<_, _>>(),
             "conditions": self.frames.iter().filter(|f| f.shader != "ts").map(|f| serde_json::json!({
                 "shader": f.shader, "distance": f.distance.name(), "azimuth_deg": f.azimuth_deg, "rmse": f.rmse,
@@ -279,12 +307,13 @@ impl TapGrid {
         let conditions: Vec<(TapDistance, f32)> =
             TapDistance::ALL.iter().flat_map(|&d| TAP_LIGHT_AZIMUTHS_DEG.map(|a| (d, a))).collect();
         let columns: Vec<String> = conditions.iter().map(|(d, a)| format!("{} {}°", d.name(), *a as i32)).collect();
-        let mut rows: Vec<String> = GRID_SHADERS.iter().map(|s| s.to_uppercase()).collect();
+        let shaders = self.settings.shaders();
+        let mut rows: Vec<String> = shaders.iter().map(|s| s.to_uppercase()).collect();
         let mut cells: Vec<Option<&Image<u8>>> = Vec::new();
-        for sh in GRID_SHADERS {
+        for &sh in &shaders {
             cells.extend(conditions.iter().map(|&(d, a)| self.frame(sh, d, a).map(|f| &f.image)));
         }
-        for sh in &GRID_SHADERS[1..] {
+        for sh in &shaders[1..] {
             rows.push(format!("{} - TS x{}", sh.to_uppercase(), DIFFERENCE_SCALE));
             cells.extend(
                 conditions
@@ -293,13 +322,10 @@ impl TapGrid {
             );
         }
         let (w, h) = (self.settings.width, self.settings.height);
-        let title = format!(
-            "TAP 2009 stimulus grid, {w}x{h}, light elevation 45 deg; mean RMSE vs TS: SS Full {:.4}, SS Jittered \
-             {:.4}, No SSS {:.4}",
-            self.mean_rmse("ss-full"),
-            self.mean_rmse("ss-jittered"),
-            self.mean_rmse("no-sss")
-        );
+        let means: Vec<String> =
+            shaders[1..].iter().map(|sh| format!("{} {:.4}", display_name(sh), self.mean_rmse(sh))).collect();
+        let title =
+            format!("TAP 2009 stimulus grid, {w}x{h}, light elevation 45 deg; mean RMSE vs TS: {}", means.join(", "));
         let sheet = contact_sheet(&title, &rows, &columns, &cells, w, h);
         files.push(("contact_sheet.png".into(), crate::io::png::encode_u8(&sheet)?));
         let sweep_rows = vec!["beta = 800".to_string(), "alpha = 11".to_string()];
