@@ -15,6 +15,7 @@ use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{LazyLock, Mutex};
+use wgpu::TextureUsages as U;
 
 type CacheKey = (wgpu::Device, &'static str, u64);
 type CacheMap = HashMap<CacheKey, Box<dyn Any + Send + Sync>>;
@@ -156,6 +157,13 @@ fn texture_with_usage(
     })
 }
 
+/// The usages of [`texture`]: sampled, render target, copy source and destination.
+const TARGET_USAGE: U = U::TEXTURE_BINDING.union(U::RENDER_ATTACHMENT).union(U::COPY_DST).union(U::COPY_SRC);
+/// The usages of [`data_texture`]: sampled and uploaded to, nothing else.
+const DATA_USAGE: U = U::TEXTURE_BINDING.union(U::COPY_DST);
+/// The usages of [`storage_texture`]: written by a compute pass, then sampled or copied.
+const STORAGE_USAGE: U = U::TEXTURE_BINDING.union(U::STORAGE_BINDING).union(U::COPY_SRC).union(U::COPY_DST);
+
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
 pub fn texture(
@@ -165,35 +173,24 @@ pub fn texture(
     height: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    let usage = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT | U::COPY_DST | U::COPY_SRC;
-    texture_with_usage(device, label, (width, height), format, usage)
+    texture_with_usage(device, label, (width, height), format, TARGET_USAGE)
 }
 
 /// A sampled, upload-only 2D texture (no render attachment): for inputs such as the `R32Float` linear depth,
 /// which not every backend can render to.
-pub fn data_texture(
-    device: &wgpu::Device,
-    label: &str,
-    width: u32,
-    height: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    texture_with_usage(device, label, (width, height), format, U::TEXTURE_BINDING | U::COPY_DST)
+pub fn data_texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), format, DATA_USAGE)
 }
 
 /// A 2D texture a compute pass writes (storage) and later passes sample or copy, one mip level.
 pub fn storage_texture(
     device: &wgpu::Device,
     label: &str,
-    width: u32,
-    height: u32,
+    w: u32,
+    h: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    let usage = U::TEXTURE_BINDING | U::STORAGE_BINDING | U::COPY_SRC | U::COPY_DST;
-    texture_with_usage(device, label, (width, height), format, usage)
+    texture_with_usage(device, label, (w, h), format, STORAGE_USAGE)
 }
 
 /// Bytes per texel of the formats the runtime uses.
@@ -342,27 +339,24 @@ pub fn shader(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderM
 
 /// Nearest, clamp-to-edge sampler (the "PointSampler" of the MLAA listings).
 pub fn nearest_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"nearest clamp", || {
-        device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("nearest clamp"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            address_mode_w: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        })
-    })
+    clamp_sampler(device, "nearest clamp", wgpu::FilterMode::Nearest)
 }
 
 /// Bilinear, clamp-to-edge sampler (the "LinearSampler" of SMAA).
 pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"linear clamp", || {
+    clamp_sampler(device, "linear clamp", wgpu::FilterMode::Linear)
+}
+
+/// A clamp-to-edge sampler filtering with `filter` (mipmaps: nearest), created once per device.
+fn clamp_sampler(device: &wgpu::Device, label: &'static str, filter: wgpu::FilterMode) -> wgpu::Sampler {
+    cached(device, "sampler", &label, || {
         device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("linear clamp"),
+            label: Some(label),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             address_mode_w: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
+            mag_filter: filter,
+            min_filter: filter,
             mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         })
@@ -438,11 +432,7 @@ pub fn draw_fullscreen(
     target: &wgpu::TextureView,
     timer: Option<(&GpuTimer, u32)>,
 ) {
-    let timestamp_writes = timer.map(|(t, i)| wgpu::RenderPassTimestampWrites {
-        query_set: &t.query_set,
-        beginning_of_pass_write_index: Some(2 * i),
-        end_of_pass_write_index: Some(2 * i + 1),
-    });
+    let timestamp_writes = timer.map(|(t, i)| t.render_pass_writes(i));
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -491,6 +481,23 @@ impl GpuTimer {
             mapped_at_creation: false,
         });
         Self { query_set, resolve, readback, slots }
+    }
+
+    /// The query set and the begin/end query indices of the pass timed in `slot` (2·slot and 2·slot + 1).
+    fn slot_queries(&self, slot: u32) -> (&wgpu::QuerySet, Option<u32>, Option<u32>) {
+        (&self.query_set, Some(2 * slot), Some(2 * slot + 1))
+    }
+
+    /// The timestamps of a render pass timed in `slot`.
+    pub fn render_pass_writes(&self, slot: u32) -> wgpu::RenderPassTimestampWrites<'_> {
+        let (query_set, beginning_of_pass_write_index, end_of_pass_write_index) = self.slot_queries(slot);
+        wgpu::RenderPassTimestampWrites { query_set, beginning_of_pass_write_index, end_of_pass_write_index }
+    }
+
+    /// The timestamps of a compute pass timed in `slot`.
+    pub fn compute_pass_writes(&self, slot: u32) -> wgpu::ComputePassTimestampWrites<'_> {
+        let (query_set, beginning_of_pass_write_index, end_of_pass_write_index) = self.slot_queries(slot);
+        wgpu::ComputePassTimestampWrites { query_set, beginning_of_pass_write_index, end_of_pass_write_index }
     }
 
     /// Records the resolve; call after the timed passes, before `finish`.
@@ -562,12 +569,8 @@ pub fn copy_bandwidth(device: &wgpu::Device, queue: &wgpu::Queue, timestamps: bo
         let mut enc = device.create_command_encoder(&Default::default());
         let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
             if let Some(t) = &timer {
-                let tw = wgpu::ComputePassTimestampWrites {
-                    query_set: &t.query_set,
-                    beginning_of_pass_write_index: Some(2 * slot),
-                    end_of_pass_write_index: Some(2 * slot + 1),
-                };
-                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
+                let timestamp_writes = Some(t.compute_pass_writes(slot));
+                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes }));
             }
         };
         mark(&mut enc, 0);

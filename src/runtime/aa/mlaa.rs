@@ -66,7 +66,12 @@ struct Params {
     cfg: [f32; 4],
 }
 
-const SHADER: &str = include_str!("mlaa.wgsl");
+const SHADER: &str = concat!(
+    include_str!("../fullscreen.wgsl"),
+    include_str!("srgb.wgsl"),
+    include_str!("morphological.wgsl"),
+    include_str!("mlaa.wgsl")
+);
 
 /// MLAA for one frame size and area map. Create once, run per frame.
 pub struct Mlaa(ThreePass);

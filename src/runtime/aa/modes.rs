@@ -249,7 +249,7 @@ struct Params {
     resolve: [f32; 4],
 }
 
-const SHADER: &str = include_str!("modes.wgsl");
+const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("srgb.wgsl"), include_str!("modes.wgsl"));
 
 /// The SMAA passes of one frame slot and, for two samples, their S2x average.
 struct Slot {

@@ -104,7 +104,12 @@ struct Params {
     subsample: [f32; 4],
 }
 
-const SHADER: &str = include_str!("smaa.wgsl");
+const SHADER: &str = concat!(
+    include_str!("../fullscreen.wgsl"),
+    include_str!("srgb.wgsl"),
+    include_str!("morphological.wgsl"),
+    include_str!("smaa.wgsl")
+);
 
 /// Number of timed passes [`ThreePass::encode`] records (edges, weights, blending).
 pub const SMAA_PASSES: u32 = 3;

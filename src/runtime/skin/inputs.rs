@@ -107,7 +107,7 @@ struct Params {
     weights: [[f32; 4]; 2],
 }
 
-const SHADER: &str = include_str!("inputs.wgsl");
+const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("inputs.wgsl"));
 
 fn f16_bytes(v: impl Iterator<Item = f32>) -> Vec<u8> {
     let h: Vec<half::f16> = v.map(half::f16::from_f32).collect();

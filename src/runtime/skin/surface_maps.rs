@@ -154,7 +154,12 @@ pub fn surface_pixels(
         device,
         queue,
         "surface maps",
-        concat!(include_str!("bilinear_taps.wgsl"), include_str!("surface_maps.wgsl")),
+        concat!(
+            include_str!("pixel_frame.wgsl"),
+            include_str!("view_frame.wgsl"),
+            include_str!("bilinear_taps.wgsl"),
+            include_str!("surface_maps.wgsl")
+        ),
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),

@@ -167,7 +167,12 @@ pub fn wrinkled_normals(
         device,
         queue,
         "wrinkle pass",
-        concat!(include_str!("bilinear_taps.wgsl"), include_str!("wrinkles.wgsl")),
+        concat!(
+            include_str!("pixel_frame.wgsl"),
+            include_str!("view_frame.wgsl"),
+            include_str!("bilinear_taps.wgsl"),
+            include_str!("wrinkles.wgsl")
+        ),
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),
