@@ -136,6 +136,13 @@ pub fn compute_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, entr
     })
 }
 
+/// Checks a `width`×`height` frame before any work: a valid image size ([`crate::error::check_size`]) that the
+/// device can hold at `bytes_per_texel` ([`crate::runtime::device::check_image_fits`]).
+pub fn check_frame(device: &wgpu::Device, width: u32, height: u32, bytes_per_texel: u32) -> Result<(), RuntimeError> {
+    crate::error::check_size("image", width as u64, height as u64)?;
+    crate::runtime::device::check_image_fits(device, width, height, bytes_per_texel)
+}
+
 /// A 2D non-sRGB texture with one mip level and `usage` (the one descriptor the helpers below share).
 fn texture_with_usage(
     device: &wgpu::Device,
@@ -166,14 +173,8 @@ const STORAGE_USAGE: U = U::TEXTURE_BINDING.union(U::STORAGE_BINDING).union(U::C
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
-pub fn texture(
-    device: &wgpu::Device,
-    label: &str,
-    width: u32,
-    height: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    texture_with_usage(device, label, (width, height), format, TARGET_USAGE)
+pub fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), format, TARGET_USAGE)
 }
 
 /// A sampled, upload-only 2D texture (no render attachment): for inputs such as the `R32Float` linear depth,
@@ -183,14 +184,8 @@ pub fn data_texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: 
 }
 
 /// A 2D texture a compute pass writes (storage) and later passes sample or copy, one mip level.
-pub fn storage_texture(
-    device: &wgpu::Device,
-    label: &str,
-    w: u32,
-    h: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    texture_with_usage(device, label, (w, h), format, STORAGE_USAGE)
+pub fn storage_texture(device: &wgpu::Device, label: &str, w: u32, h: u32, fmt: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), fmt, STORAGE_USAGE)
 }
 
 /// Bytes per texel of the formats the runtime uses.

@@ -103,8 +103,7 @@ impl Mlaa {
         map: &MlaaAreaMap,
         options: &MlaaOptions,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 4)?;
+        gpu::check_frame(device, width, height, 4)?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "mlaa colour", width, height, F::Rgba8Unorm);
         let edges = gpu::texture(device, "mlaa edges", width, height, F::Rg8Unorm);

@@ -159,8 +159,7 @@ impl Smaa {
         options: &SmaaOptions,
     ) -> Result<Self, RuntimeError> {
         let subsample = options.subsample;
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 4)?;
+        gpu::check_frame(device, width, height, 4)?;
         subsample.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "smaa colour", width, height, F::Rgba8Unorm);

@@ -159,8 +159,7 @@ impl SkinInputs {
         luts: &SkinLuts,
         rig: &RigScaleBiasMaps,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 16)?;
+        gpu::check_frame(device, width, height, 16)?;
         luts.validate()?;
         rig.validate()?;
         use wgpu::TextureFormat as F;

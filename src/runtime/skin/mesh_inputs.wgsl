@@ -10,13 +10,12 @@ struct Params {
     weights: array<vec4<f32>, 2>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
 // (scale, bias) per texel, target-major, rows top first
 @group(0) @binding(2) var<storage, read_write> rig: array<vec2<f32>>;
 @group(0) @binding(3) var<storage, read_write> h0: array<f32>;
 @group(0) @binding(4) var<storage, read_write> hb: array<f32>;
 
-// Prepended by the host module: `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl); `Taps`, `taps`,
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl); `Taps`, `taps`,
 // `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn rig_at(k: u32, t: Taps) -> vec2<f32> {
@@ -27,8 +26,7 @@ fn rig_at(k: u32, t: Taps) -> vec2<f32> {
 }
 
 fn h0_at(t: Taps) -> f32 {
-    let w = u32(p.cfg.x);
-    let q = tap_index(t, 0u, w);
+    let q = tap_index(t, 0u, u32(p.cfg.x));
     return bilerp1(t, h0[q.x], h0[q.y], h0[q.z], h0[q.w]);
 }
 

@@ -1,7 +1,9 @@
 // The frame the texture-space compute passes run over (mesh_inputs.wgsl, surface_maps.wgsl, wrinkles.wgsl;
 // prepended to each by its Rust module): one invocation per pixel of the rasterised mesh, workgroups of 8 × 8, and
-// per pixel the mesh's (u, v) and coverage (`mesh_raster`). The including shader declares `p` with `size.xy` = the
-// frame's width and height.
+// per pixel the mesh's (u, v) and coverage (`mesh_raster`). The including shader declares the type of its uniform
+// block, `Params`, whose `size.xy` is the frame's width and height.
+
+@group(0) @binding(0) var<uniform> p: Params;
 
 // u, v, covered (0 or 1), 0 per pixel, rows top first
 @group(0) @binding(1) var<storage, read_write> uvc: array<vec4<f32>>;

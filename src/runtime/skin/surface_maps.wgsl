@@ -9,7 +9,6 @@ struct Params {
     normal: vec4<f32>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
 // linear albedo, 0
 @group(0) @binding(4) var<storage, read_write> albedo: array<vec4<f32>>;
 // unit tangent-space normal, 0
@@ -17,19 +16,17 @@ struct Params {
 // per pixel: (normal, 0), (albedo, 0)
 @group(0) @binding(6) var<storage, read_write> outp: array<vec4<f32>>;
 
-// Prepended by the host module: `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
 // (view_frame.wgsl); `Taps`, `taps`,
 // `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn albedo_at(t: Taps) -> vec4<f32> {
-    let w = u32(p.size.z);
-    let q = tap_index(t, 0u, w);
+    let q = tap_index(t, 0u, u32(p.size.z));
     return bilerp4(t, albedo[q.x], albedo[q.y], albedo[q.z], albedo[q.w]);
 }
 
 fn normal_at(t: Taps) -> vec4<f32> {
-    let w = u32(p.normal.x);
-    let q = tap_index(t, 0u, w);
+    let q = tap_index(t, 0u, u32(p.normal.x));
     return bilerp4(t, nmap[q.x], nmap[q.y], nmap[q.z], nmap[q.w]);
 }
 

@@ -11,20 +11,18 @@ struct Params {
     weights: array<vec4<f32>, 2>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
 // decoded PD slopes (-1 + 2 * texel)
 @group(0) @binding(4) var<storage, read_write> pd: array<vec2<f32>>;
 // decoded masks: map 0 then map 1, each mask width x height
 @group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
 
-// Prepended by the host module: `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
 // (view_frame.wgsl); `Taps`, `taps`,
 // `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn pd_at(t: Taps) -> vec2<f32> {
-    let w = u32(p.size.z);
-    let q = tap_index(t, 0u, w);
+    let q = tap_index(t, 0u, u32(p.size.z));
     return bilerp2(t, pd[q.x], pd[q.y], pd[q.z], pd[q.w]);
 }
 

@@ -7,6 +7,7 @@
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
 
+mod blur_cpu;
 pub mod gaussian;
 pub mod gaussian_cpu;
 pub mod importance;
@@ -43,9 +44,7 @@ pub(crate) struct SssInputs {
 impl SssInputs {
     /// Checks the frame size and that a frame of 8 bytes per texel fits the device: before any other check or work.
     pub(crate) fn check_size(device: &wgpu::Device, width: u32, height: u32) -> Result<(), RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
-        Ok(())
+        gpu::check_frame(device, width, height, 8)
     }
 
     /// Creates the two textures, labelled `"{label} colour"` and `"{label} depth"`.
@@ -54,6 +53,18 @@ impl SssInputs {
         let color = gpu::texture(device, &format!("{label} colour"), width, height, F::Rgba16Float);
         let depth = gpu::data_texture(device, &format!("{label} depth"), width, height, F::R32Float);
         Self { color, depth }
+    }
+
+    /// The intermediate (`"{label} horizontal"`) and output (`"{label} output"`) `Rgba16Float` textures of a
+    /// two-pass blur, made by `make` (a render target or a storage texture).
+    pub(crate) fn targets(
+        device: &wgpu::Device,
+        label: &str,
+        (width, height): (u32, u32),
+        make: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture,
+    ) -> [wgpu::Texture; 2] {
+        let mk = |name| make(device, &format!("{label} {name}"), width, height, wgpu::TextureFormat::Rgba16Float);
+        [mk("horizontal"), mk("output")]
     }
 
     /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.

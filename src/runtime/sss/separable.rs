@@ -88,17 +88,19 @@ impl Params {
         }
     }
 
-    /// The uniform buffers of the horizontal and the vertical pass.
+    /// Checks the frame size and the parameters (in that order, before any work), then creates the uniform buffers
+    /// of the horizontal and the vertical pass: the common start of both forms of the pass.
     pub(crate) fn buffers(
         device: &wgpu::Device,
         (width, height): (u32, u32),
         kernel: &SssKernel,
         params: &SssParams,
-    ) -> [wgpu::Buffer; 2] {
-        let mk = |label, dir| {
-            gpu::uniform_buffer(device, label, bytemuck::bytes_of(&Self::new(width, height, kernel, params, dir)))
-        };
-        [mk("sss h", [1.0, 0.0]), mk("sss v", [0.0, 1.0])]
+    ) -> Result<[wgpu::Buffer; 2], RuntimeError> {
+        SssInputs::check_size(device, width, height)?;
+        params.validate()?;
+        let block = |dir| Self::new(width, height, kernel, params, dir);
+        let mk = |label, dir| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
+        Ok([mk("sss h", [1.0, 0.0]), mk("sss v", [0.0, 1.0])])
     }
 }
 
@@ -127,15 +129,11 @@ impl SeparableSss {
         kernel: &SssKernel,
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
-        SssInputs::check_size(device, width, height)?;
-        params.validate()?;
-        use wgpu::TextureFormat as F;
+        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
         let inputs = SssInputs::new(device, "sss", width, height);
-        let tmp = gpu::texture(device, "sss horizontal", width, height, F::Rgba16Float);
-        let output = gpu::texture(device, "sss output", width, height, F::Rgba16Float);
+        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::texture);
         let module = gpu::shader(device, "separable_sss.wgsl", SHADER);
-        let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", F::Rgba16Float);
-        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params);
+        let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", wgpu::TextureFormat::Rgba16Float);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (cv, tv) = (view(&inputs.color), view(&tmp));
         let layout = pipe.get_bind_group_layout(0);

@@ -34,16 +34,12 @@ impl SeparableSssTiled {
         kernel: &SssKernel,
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
-        SssInputs::check_size(device, width, height)?;
-        params.validate()?;
-        use wgpu::TextureFormat as F;
+        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
         let inputs = SssInputs::new(device, "sss", width, height);
-        let tmp = gpu::storage_texture(device, "sss horizontal", width, height, F::Rgba16Float);
-        let output = gpu::storage_texture(device, "sss output", width, height, F::Rgba16Float);
+        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::storage_texture);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "separable_tiled.wgsl", SHADER);
         let pipe = gpu::compute_pipeline(device, &module, "blur");
-        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (cv, tv, dv, ov) = (view(&inputs.color), view(&tmp), view(&inputs.depth), view(&output));
         let layout = pipe.get_bind_group_layout(0);
