@@ -102,21 +102,22 @@ pub fn cached<T: Clone + Send + Sync + 'static>(
 }
 
 /// Compiles a render pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
-pub fn create_render_pipeline(
-    device: &wgpu::Device,
-    desc: &wgpu::RenderPipelineDescriptor<'_>,
-) -> wgpu::RenderPipeline {
-    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
-    device.create_render_pipeline(desc)
+pub fn create_render_pipeline(device: &wgpu::Device, d: &wgpu::RenderPipelineDescriptor<'_>) -> wgpu::RenderPipeline {
+    counted(|| device.create_render_pipeline(d))
 }
 
 /// Compiles a compute pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
 pub fn create_compute_pipeline(
     device: &wgpu::Device,
-    desc: &wgpu::ComputePipelineDescriptor<'_>,
+    d: &wgpu::ComputePipelineDescriptor<'_>,
 ) -> wgpu::ComputePipeline {
+    counted(|| device.create_compute_pipeline(d))
+}
+
+/// Runs a pipeline compilation, counting it.
+fn counted<T>(compile: impl FnOnce() -> T) -> T {
     PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
-    device.create_compute_pipeline(desc)
+    compile()
 }
 
 /// A compute pipeline of `module`'s `entry` with the layout derived from the shader, cached per device.

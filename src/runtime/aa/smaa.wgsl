@@ -14,7 +14,8 @@
 //   would otherwise mix neighbouring search texels;
 // - edge detection returns 0 instead of discarding (the edges target is cleared to 0 first anyway).
 //
-// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA and the sRGB transfer functions
+// Prepended by the host module: the preset constants THRESHOLD … AREATEX_SUBTEX_ROWS and AREATEX_SIZE (written
+// from `smaa::preset`), vs_fullscreen (../fullscreen.wgsl), LUMA and the sRGB transfer functions
 // (srgb.wgsl), luma_at, edges_at, color_lin and blend_at (morphological.wgsl).
 
 struct Params {
@@ -32,15 +33,6 @@ struct Params {
 @group(0) @binding(5) var blend_tex: texture_2d<f32>;
 @group(0) @binding(6) var lin: sampler;
 
-const THRESHOLD: f32 = 0.1;
-const LOCAL_CONTRAST_ADAPTATION: f32 = 2.0;
-const MAX_SEARCH_STEPS: f32 = 16.0;
-const MAX_SEARCH_STEPS_DIAG: f32 = 8.0;
-const CORNER_ROUNDING_NORM: f32 = 0.25;
-const AREATEX_MAX_DISTANCE: f32 = 16.0;
-const AREATEX_MAX_DISTANCE_DIAG: f32 = 20.0;
-const AREATEX_SIZE: vec2<f32> = vec2<f32>(160.0, 560.0);
-const AREATEX_SUBTEX_ROWS: f32 = 80.0;
 // ---------------------------------------------------------------------------------------------------------
 // Pass 1: luma edge detection with local contrast adaptation. R = edge on the left, G = edge on top.
 
