@@ -98,9 +98,10 @@ pub trait SssBlur {
     fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>);
 }
 
-/// A screen-space SSS pass for one frame size: its input frame (irradiance and linear depth), its output (`Rgba16Float`) and the
-/// blur `B` that reads the one and writes the other ([`separable::SeparableSss`], [`gaussian::GaussianSss`],
-/// [`importance::ImportanceSss`], [`separable_tiled::SeparableSssTiled`]). Created by each blur's `new`.
+/// A screen-space SSS pass for one frame size: its input frame (irradiance and linear depth), its output
+/// (`Rgba16Float`) and the blur `B` that reads the one and writes the other ([`separable::SeparableSss`],
+/// [`gaussian::GaussianSss`], [`importance::ImportanceSss`], [`separable_tiled::SeparableSssTiled`]). Created by
+/// each blur's `new`.
 pub struct SssPass<B> {
     inputs: SssInputs,
     output: wgpu::Texture,
