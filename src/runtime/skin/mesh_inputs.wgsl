@@ -15,8 +15,8 @@ struct Params {
 @group(0) @binding(3) var<storage, read_write> h0: array<f32>;
 @group(0) @binding(4) var<storage, read_write> hb: array<f32>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl); `Taps`, `taps`,
-// `tap_index` and `bilerp*` (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
+// (pixel_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn rig_at(k: u32, t: Taps) -> vec2<f32> {
     let w = u32(p.size.z);

@@ -16,9 +16,9 @@ struct Params {
 // per pixel: (normal, 0), (albedo, 0)
 @group(0) @binding(6) var<storage, read_write> outp: array<vec4<f32>>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
-// (view_frame.wgsl); `Taps`, `taps`,
-// `tap_index` and `bilerp*` (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
+// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
+// (bilinear_taps.wgsl).
 
 fn albedo_at(t: Taps) -> vec4<f32> {
     let q = tap_index(t, 0u, u32(p.size.z));

@@ -17,9 +17,9 @@ struct Params {
 @group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel` (pixel_frame.wgsl), `nrm` and `tng`
-// (view_frame.wgsl); `Taps`, `taps`,
-// `tap_index` and `bilerp*` (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
+// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
+// (bilinear_taps.wgsl).
 
 fn pd_at(t: Taps) -> vec2<f32> {
     let q = tap_index(t, 0u, u32(p.size.z));

@@ -6,7 +6,8 @@
 // alpha (0: not skin, the pixel passes through). Follow-surface: s = saturate(|Δdepth|·mm_per_world_unit/cutoff_mm),
 // sample = mix(sample, centre, s). Colour rgba16float filtered by the sampler; depth r32float loaded four times.
 //
-// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl); depth_tex, lin, depth_load and depth_at (frame.wgsl).
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl); depth_tex, lin, depth_load and depth_at
+// (frame.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
