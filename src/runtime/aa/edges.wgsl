@@ -1,8 +1,8 @@
 // Edge detectors of SMAA and MLAA other than plain luma, and the matte/stencil composite.
 // Thesis ch. 9 (§9.3, Listing 9.1: depth edges, threshold) and ch. 10 (§10.4.1: colour edges, local contrast
 // adaptation eq. 10.1); predicated thresholding as documented in SMAA.hlsl (SMAA_PREDICATION_*). Written for rtbake
-// from those descriptions; the CPU mirror is `runtime/cpu/smaa_edges.rs` (keep every arithmetic step in sync).
-// The host module is `runtime/smaa_edges.rs`.
+// from those descriptions; the CPU mirror is `runtime/aa/edges_cpu.rs` (keep every arithmetic step in sync).
+// The host module is `runtime/aa/edges.rs`.
 //
 // Outputs as the passes' own `fs_edges`: R = edge on the left boundary, G = edge on the top boundary, 0 or 1.
 // Pixel positions are integer texel coordinates, loads clamp to the edge.

@@ -1,7 +1,7 @@
 // Jimenez's MLAA (Jimenez, Masia, Echevarria, Navarro, Gutierrez, "Practical Morphological Antialiasing",
 // GPU Pro 2, 2011; thesis ch. 9, Listings 9.1–9.5): luma edge detection, blending weights from distance searches
 // (bilinear fetches of two edgels at a time) and a point-sampled precomputed area map of maximum distance N,
-// 4-neighbourhood blending. Written for rtbake from the listings; CPU twin: `runtime/cpu/mlaa.rs`.
+// 4-neighbourhood blending. Written for rtbake from the listings; CPU twin: `runtime/aa/mlaa_cpu.rs`.
 //
 // Positions are in pixel units (pixel centre = x + 0.5), converted at the fetch. Blending happens in linear light
 // (the colour texture is Rgba8Unorm holding sRGB-encoded values; the shader decodes and re-encodes).

@@ -6,7 +6,7 @@
 //   with ‖v‖ in normalised screen units carried in the alpha channel as a = sqrt(5 ‖v‖) (so that SMAA, which blends
 //   alpha like colour, propagates velocity to the antialiased pixels, as the thesis prescribes); or the plain 50/50
 //   blend without reprojection.
-// Written for rtbake from the thesis' equations; the CPU twin is `runtime/cpu/smaa_modes.rs` (keep in sync).
+// Written for rtbake from the thesis' equations; the CPU twin is `runtime/aa/modes_cpu.rs` (keep in sync).
 // Colour textures are Rgba8Unorm holding sRGB-encoded values; the velocity texture is Rg32Float (px/frame).
 //
 // Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), srgb_to_linear and linear_to_srgb (srgb.wgsl).

@@ -1,6 +1,6 @@
 // SMAA 1x: luma edge detection, blending-weight calculation, neighbourhood blending.
 // Jimenez, Echevarria, Sousa, Gutierrez, "SMAA: Enhanced Subpixel Morphological Antialiasing", Eurographics 2012;
-// thesis ch. 10. Written for rtbake from the algorithm description; the CPU mirror is `runtime/cpu/smaa.rs`, and
+// thesis ch. 10. Written for rtbake from the algorithm description; the CPU mirror is `runtime/aa/smaa_cpu.rs`, and
 // every arithmetic step here has its twin there (keep them in sync).
 //
 // Conventions: all positions are in PIXEL units of the frame (pixel (x, y) has its centre at (x + 0.5, y + 0.5),

@@ -3,7 +3,7 @@
 //   albedo      = skinLUT(u = cbrt(Cm/0.5), v = cbrt(H/0.32))                   (eq. 7.7, normalised, node-inclusive)
 //   transmitted = T(s) · E,  E = max(0.3 + dot(−N, L), 0)                       (eq. 5.12/5.13; T node-inclusive on [0, s_max])
 // Node-inclusive lookup of t ∈ [0, 1] in an n-texel axis: texel coordinate t·(n−1) + 0.5.
-// CPU twin: `runtime/cpu/skin_inputs.rs`.
+// CPU twin: `runtime/skin/inputs_cpu.rs`.
 //
 // Prepended by the host module: vs_fullscreen (../fullscreen.wgsl).
 

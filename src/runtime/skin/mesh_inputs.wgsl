@@ -1,6 +1,6 @@
-// The rig's eq. 7.6 at the mesh's texture coordinates (runtime/mesh_skin_inputs.rs): per covered pixel
+// The rig's eq. 7.6 at the mesh's texture coordinates (runtime/skin/mesh_inputs.rs): per covered pixel
 // H = g * (sum_i w_i * bias_i(uv) + H0(uv) * sum_i w_i * scale_i(uv)), every map read bilinearly (texel centres at
-// (i + 0.5) / size, clamp to edge) in f32 arithmetic. CPU twin: runtime/cpu/mesh_skin_inputs.rs.
+// (i + 0.5) / size, clamp to edge) in f32 arithmetic. CPU twin: runtime/skin/mesh_inputs_cpu.rs.
 
 struct Params {
     // frame width, height, rig width, rig height

@@ -1,8 +1,8 @@
-// Texture-space diffusion (runtime/texture_space.rs; d'Eon et al. 2007, thesis ch. 3): the chained u/v Gaussian
+// Texture-space diffusion (runtime/skin/texture_space.rs; d'Eon et al. 2007, thesis ch. 3): the chained u/v Gaussian
 // blurs of the irradiance map in texture space, each tap step sigma / stretch texels, accumulated into the weighted
 // sum of blurs, and the final gather at each visible pixel's uv. Maps are premultiplied RGBA f32 in storage buffers
 // (alpha = 1 on shaded texels, 0 on uncovered, culled or clipped ones); bilinear filtering is done here by hand so the
-// CPU twin (runtime/cpu/texture_space.rs) reproduces it. Texels with alpha 0 are not blurred (Listing 3.3) and
+// CPU twin (runtime/skin/texture_space_cpu.rs) reproduces it. Texels with alpha 0 are not blurred (Listing 3.3) and
 // contribute nothing to their neighbours (normalised convolution).
 
 struct BlurParams {

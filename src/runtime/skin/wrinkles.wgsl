@@ -1,7 +1,7 @@
-// The wrinkle pass (runtime/wrinkle_pass.rs; thesis ch. 8, Listing 8.1): per covered pixel, the partial-derivative
+// The wrinkle pass (runtime/skin/wrinkles.rs; thesis ch. 8, Listing 8.1): per covered pixel, the partial-derivative
 // wrinkle map and the two zone-mask maps read bilinearly at the mesh's uv, xy = base.xy + sum_z mask_z * weight_z *
 // wrinkle.xy (base: flat, the meshes carry no base normal map), n_ts = normalize(xy, 1), then n_ts taken from the
-// mesh's tangent frame (T, B = w * N x T, N) to view space. CPU twin: runtime/cpu/wrinkle_pass.rs.
+// mesh's tangent frame (T, B = w * N x T, N) to view space. CPU twin: runtime/skin/wrinkles_cpu.rs.
 
 struct Params {
     // frame width, height, PD map width, height

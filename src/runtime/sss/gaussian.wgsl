@@ -1,7 +1,7 @@
 // Screen-space sum-of-Gaussians subsurface scattering (Jimenez, Sundstedt, Gutierrez, "Screen-Space Perceptual
 // Rendering of Human Skin", ACM TAP 2009; thesis ch. 4, Listing 4.1). One Gaussian = a horizontal pass (RT1 →
 // RT2) and a vertical pass (RT2 → RT1 and, blended with the constant w′ᵢ of eq. 4.8–4.9, into RTF).
-// CPU twin: `runtime/cpu/gaussian_sss.rs`.
+// CPU twin: `runtime/sss/gaussian_cpu.rs`.
 //
 // Stretch (eq. 4.1–4.4): s = α / (d + β·min(|∂d|, γ)) · a(x, y), a = alpha of the diffuse image (local SSS level;
 // 0 = not skin, the matte). ∂d is the fine screen-space derivative of the quad (ddx/ddy) written out with loads so

@@ -1,6 +1,6 @@
 // Importance-sampled screen-space subsurface scattering: one pass over an N-sample disk kernel drawn from the
 // profile's radial CDF (the sampling of Unity HDRP's diffusion profiles; Golubev, SIGGRAPH 2018 course "Advances in
-// Real-Time Rendering"). CPU twin: `runtime/cpu/importance_sss.rs`; algorithm in `runtime/importance_sss.rs`.
+// Real-Time Rendering"). CPU twin: `runtime/sss/importance_cpu.rs`; algorithm in `runtime/sss/importance.rs`.
 //
 // offset (pixels) = (x, y)mm · strength · (H/2)·(1/tan(0.5·FOVy)) / (depth · mm_per_world_unit), strength = colour
 // alpha (0: not skin, the pixel passes through). Follow-surface: s = saturate(|Δdepth|·mm_per_world_unit/cutoff_mm),

@@ -1,6 +1,6 @@
 // Separable subsurface scattering (Jimenez, Zsolnai, Jarabo, Freude, Auzinger, Wu, von der Pahlen, Wimmer,
 // Gutierrez, "Separable Subsurface Scattering", Computer Graphics Forum 2015; thesis ch. 6), one 1-D pass.
-// Run twice: dir = (1, 0) then (0, 1). CPU twin: `runtime/cpu/separable_sss.rs`.
+// Run twice: dir = (1, 0) then (0, 1). CPU twin: `runtime/sss/separable_cpu.rs`.
 //
 // step (uv) = sssWidth · (1/tan(0.5·FOVy)) / depth · dir · strength / 3, strength = colour alpha (0: not skin,
 // the pixel passes through unchanged — the matte). Follow-surface: s = saturate(300 · (1/tan(0.5·FOVy)) ·
