@@ -382,20 +382,7 @@ pub fn fullscreen_pipeline_with(
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
     cached(device, "fullscreen pipeline", &(module, fs_entry, targets), || {
-        fullscreen_pipeline_uncached(device, label, module, fs_entry, targets)
-    })
-}
-
-fn fullscreen_pipeline_uncached(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    fs_entry: &str,
-    targets: &[Option<wgpu::ColorTargetState>],
-) -> wgpu::RenderPipeline {
-    create_render_pipeline(
-        device,
-        &wgpu::RenderPipelineDescriptor {
+        let descriptor = wgpu::RenderPipelineDescriptor {
             label: Some(label),
             layout: None,
             vertex: wgpu::VertexState {
@@ -415,8 +402,9 @@ fn fullscreen_pipeline_uncached(
             }),
             multiview_mask: None,
             cache: None,
-        },
-    )
+        };
+        create_render_pipeline(device, &descriptor)
+    })
 }
 
 /// Records one full-screen draw into `target` (cleared to zero first), with optional timestamps.
