@@ -6,6 +6,11 @@
 //! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel.
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
+//!
+//! Shared by the four: [`SssPass`] (the input frame, the output and upload / encode / run; each module's `new`
+//! builds its blur), the camera scale [`dist_to_window`], the blur bind group and frame checks of `SssInputs`, the
+//! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches) and `separable_params.wgsl` (the uniform block
+//! of both separable forms), and `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
 
 mod blur_cpu;
 pub mod gaussian;
