@@ -33,6 +33,16 @@ pub enum MapsCommand {
     Synthetic(SyntheticArgs),
 }
 
+/// `--out DIR` and `--zstd LEVEL`: where a map command writes its file set, and how its KTX2 files are compressed.
+#[derive(clap::Args)]
+struct MapSetOutput {
+    /// Output directory.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    #[command(flatten)]
+    zstd: crate::cli::ZstdArg,
+}
+
 #[derive(clap::Args)]
 pub struct HemoglobinArgs {
     /// Neutral hemoglobin map Hn: EXR (f16/f32), 16-bit PNG, or 8-bit PNG with --value-range; single-channel, or
@@ -64,11 +74,8 @@ pub struct HemoglobinArgs {
     /// read as they are.
     #[arg(long, value_name = "R|G|B|A|Y|luminance")]
     channel: Option<String>,
-    /// Output directory.
-    #[arg(long, value_name = "DIR")]
-    out: PathBuf,
     #[command(flatten)]
-    zstd: crate::cli::ZstdArg,
+    output: MapSetOutput,
 }
 
 #[derive(clap::Args)]
@@ -119,11 +126,8 @@ pub struct WrinklesArgs {
     /// Stored wrinkle map size (thesis: 256), area-downsampled, clamped per axis to the input; 1..=16384.
     #[arg(long, default_value_t = 256, value_name = "TEXELS")]
     size: u32,
-    /// Output directory.
-    #[arg(long, value_name = "DIR")]
-    out: PathBuf,
     #[command(flatten)]
-    zstd: crate::cli::ZstdArg,
+    output: MapSetOutput,
 }
 
 #[derive(clap::Args)]
@@ -135,11 +139,8 @@ pub struct WrinkleMasksArgs {
     /// Stored mask size (thesis: 64), area-downsampled, clamped per axis to the input; 1..=16384.
     #[arg(long, default_value_t = 64, value_name = "TEXELS")]
     size: u32,
-    /// Output directory.
-    #[arg(long, value_name = "DIR")]
-    out: PathBuf,
     #[command(flatten)]
-    zstd: crate::cli::ZstdArg,
+    output: MapSetOutput,
 }
 
 #[derive(clap::Args)]
@@ -204,7 +205,7 @@ fn write_files(
 }
 
 fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
-    a.zstd.level()?;
+    a.output.zstd.level()?;
     let range = match &a.value_range {
         None => None,
         Some(s) => {
@@ -289,12 +290,12 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     )?;
     let mut input_paths: Vec<&Path> = vec![a.neutral.as_path()];
     input_paths.extend(pairs.iter().map(|(_, p)| p.as_path()));
-    let files = write_files(ctx, "--out", &a.out, files, &input_paths, &a.zstd)?;
+    let files = write_files(ctx, "--out", &a.output.out, files, &input_paths, &a.output.zstd)?;
     let pct = 100.0 * rig.sigma_floored_texels as f64 / (w as f64 * h as f64);
     ctx.info(format!(
         "wrote {} files to {} (rig {}x{}); sigma_neutral floored at {} in {} texels ({pct:.3} %)",
         files.len(),
-        a.out.display(),
+        a.output.out.display(),
         rig.rig_width,
         rig.rig_height,
         a.sigma_floor,
@@ -302,7 +303,7 @@ fn run_hemoglobin(a: HemoglobinArgs, ctx: &Ctx) -> Result<()> {
     ));
     if ctx.json {
         ctx.emit_json(&json!({
-            "rig": a.out.join("rig.json").display().to_string(),
+            "rig": a.output.out.join("rig.json").display().to_string(),
             "full_size": desc.full_size,
             "rig_size": desc.rig_size,
             "sigma_floored_texels": rig.sigma_floored_texels,
@@ -409,7 +410,7 @@ fn run_rig_eval(a: RigEvalArgs, ctx: &Ctx) -> Result<()> {
 }
 
 fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
-    a.zstd.level()?;
+    a.output.zstd.level()?;
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
     let green =
         if a.green == "opengl" { wrinkles::GreenConvention::OpenGl } else { wrinkles::GreenConvention::DirectX };
@@ -440,7 +441,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
     let WrinkleOutput { files, report, summary } = wrinkle_maps::wrinkle_files(&normal, base.as_ref(), &conversion)?;
     ctx.info(summary);
     let inputs_read: Vec<&Path> = std::iter::once(a.normal.as_path()).chain(a.base.as_deref()).collect();
-    write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
+    write_files(ctx, "--out", &a.output.out, files, &inputs_read, &a.output.zstd)?;
     if ctx.json {
         ctx.emit_json(&report);
     }
@@ -448,7 +449,7 @@ fn run_wrinkles(a: WrinklesArgs, ctx: &Ctx) -> Result<()> {
 }
 
 fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
-    a.zstd.level()?;
+    a.output.zstd.level()?;
     rtbake::error::check_range("--size", a.size, 1, rtbake::error::MAX_TEXTURE_EDGE, "texels")?;
     let mut masks: [Option<Vec<f64>>; 8] = Default::default();
     let mut dims: Option<(u32, u32, String)> = None;
@@ -491,7 +492,7 @@ fn run_masks(a: WrinkleMasksArgs, ctx: &Ctx) -> Result<()> {
         .flat_map(|z| z.split(','))
         .filter_map(|z| z.split_once('=').map(|(_, f)| Path::new(f)))
         .collect();
-    write_files(ctx, "--out", &a.out, files, &inputs_read, &a.zstd)?;
+    write_files(ctx, "--out", &a.output.out, files, &inputs_read, &a.output.zstd)?;
     ctx.info(format!("packed {given} zone masks into 2 RGBA8 textures {}x{}", packed[0], packed[1]));
     if ctx.json {
         ctx.emit_json(&report);

@@ -48,16 +48,21 @@ pub fn transport_panels(result: &McResult, diffusion: Option<(&[[f64; 3]], &str)
                 });
             }
         }
-        LinePlot {
-            title: format!("{title}: {}", if weighted { "r R(r)" } else { "R(r), log y" }),
-            x_label: "r (mm)".into(),
-            y_label: if weighted { "r R(r) (1/mm)".into() } else { "R(r) (1/mm^2)".into() },
-            log_x: false,
-            log_y: !weighted,
-            series,
-        }
+        profile_panel(title, weighted, series)
     };
     [panel(true), panel(false)]
+}
+
+/// One panel of radial profiles: r·R(r) on linear axes when `weighted`, else R(r) on a log y axis.
+fn profile_panel(title: &str, weighted: bool, series: Vec<Curve>) -> LinePlot {
+    LinePlot {
+        title: format!("{title}: {}", if weighted { "r R(r)" } else { "R(r), log y" }),
+        x_label: "r (mm)".into(),
+        y_label: if weighted { "r R(r) (1/mm)".into() } else { "R(r) (1/mm^2)".into() },
+        log_x: false,
+        log_y: !weighted,
+        series,
+    }
 }
 
 /// The same two panels for a reference already on bins ([`crate::transport::compare::BinnedReference`]: a Monte
@@ -103,14 +108,7 @@ pub fn reference_panels(
                 });
             }
         }
-        LinePlot {
-            title: format!("{title}: {}", if weighted { "r R(r)" } else { "R(r), log y" }),
-            x_label: "r (mm)".into(),
-            y_label: if weighted { "r R(r) (1/mm)".into() } else { "R(r) (1/mm^2)".into() },
-            log_x: false,
-            log_y: !weighted,
-            series,
-        }
+        profile_panel(title, weighted, series)
     };
     [panel(true), panel(false)]
 }

@@ -15,6 +15,7 @@ use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{LazyLock, Mutex};
+use wgpu::TextureUsages as U;
 
 type CacheKey = (wgpu::Device, &'static str, u64);
 type CacheMap = HashMap<CacheKey, Box<dyn Any + Send + Sync>>;
@@ -101,21 +102,22 @@ pub fn cached<T: Clone + Send + Sync + 'static>(
 }
 
 /// Compiles a render pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
-pub fn create_render_pipeline(
-    device: &wgpu::Device,
-    desc: &wgpu::RenderPipelineDescriptor<'_>,
-) -> wgpu::RenderPipeline {
-    PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
-    device.create_render_pipeline(desc)
+pub fn create_render_pipeline(device: &wgpu::Device, d: &wgpu::RenderPipelineDescriptor<'_>) -> wgpu::RenderPipeline {
+    counted(|| device.create_render_pipeline(d))
 }
 
 /// Compiles a compute pipeline, counted in [`pipelines_created_on_this_thread`] (wrap it in [`cached`]).
 pub fn create_compute_pipeline(
     device: &wgpu::Device,
-    desc: &wgpu::ComputePipelineDescriptor<'_>,
+    d: &wgpu::ComputePipelineDescriptor<'_>,
 ) -> wgpu::ComputePipeline {
+    counted(|| device.create_compute_pipeline(d))
+}
+
+/// Runs a pipeline compilation, counting it.
+fn counted<T>(compile: impl FnOnce() -> T) -> T {
     PIPELINES_CREATED.with(|c| c.set(c.get() + 1));
-    device.create_compute_pipeline(desc)
+    compile()
 }
 
 /// A compute pipeline of `module`'s `entry` with the layout derived from the shader, cached per device.
@@ -133,6 +135,13 @@ pub fn compute_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, entr
             },
         )
     })
+}
+
+/// Checks a `width`×`height` frame before any work: a valid image size ([`crate::error::check_size`]) that the
+/// device can hold at `bytes_per_texel` ([`crate::runtime::device::check_image_fits`]).
+pub fn check_frame(device: &wgpu::Device, width: u32, height: u32, bytes_per_texel: u32) -> Result<(), RuntimeError> {
+    crate::error::check_size("image", width as u64, height as u64)?;
+    crate::runtime::device::check_image_fits(device, width, height, bytes_per_texel)
 }
 
 /// A 2D non-sRGB texture with one mip level and `usage` (the one descriptor the helpers below share).
@@ -156,44 +165,28 @@ fn texture_with_usage(
     })
 }
 
+/// The usages of [`texture`]: sampled, render target, copy source and destination.
+const TARGET_USAGE: U = U::TEXTURE_BINDING.union(U::RENDER_ATTACHMENT).union(U::COPY_DST).union(U::COPY_SRC);
+/// The usages of [`data_texture`]: sampled and uploaded to, nothing else.
+const DATA_USAGE: U = U::TEXTURE_BINDING.union(U::COPY_DST);
+/// The usages of [`storage_texture`]: written by a compute pass, then sampled or copied.
+const STORAGE_USAGE: U = U::TEXTURE_BINDING.union(U::STORAGE_BINDING).union(U::COPY_SRC).union(U::COPY_DST);
+
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).
-pub fn texture(
-    device: &wgpu::Device,
-    label: &str,
-    width: u32,
-    height: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    let usage = U::TEXTURE_BINDING | U::RENDER_ATTACHMENT | U::COPY_DST | U::COPY_SRC;
-    texture_with_usage(device, label, (width, height), format, usage)
+pub fn texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), format, TARGET_USAGE)
 }
 
 /// A sampled, upload-only 2D texture (no render attachment): for inputs such as the `R32Float` linear depth,
 /// which not every backend can render to.
-pub fn data_texture(
-    device: &wgpu::Device,
-    label: &str,
-    width: u32,
-    height: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    texture_with_usage(device, label, (width, height), format, U::TEXTURE_BINDING | U::COPY_DST)
+pub fn data_texture(device: &wgpu::Device, label: &str, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), format, DATA_USAGE)
 }
 
 /// A 2D texture a compute pass writes (storage) and later passes sample or copy, one mip level.
-pub fn storage_texture(
-    device: &wgpu::Device,
-    label: &str,
-    width: u32,
-    height: u32,
-    format: wgpu::TextureFormat,
-) -> wgpu::Texture {
-    use wgpu::TextureUsages as U;
-    let usage = U::TEXTURE_BINDING | U::STORAGE_BINDING | U::COPY_SRC | U::COPY_DST;
-    texture_with_usage(device, label, (width, height), format, usage)
+pub fn storage_texture(device: &wgpu::Device, label: &str, w: u32, h: u32, fmt: wgpu::TextureFormat) -> wgpu::Texture {
+    texture_with_usage(device, label, (w, h), fmt, STORAGE_USAGE)
 }
 
 /// Bytes per texel of the formats the runtime uses.
@@ -342,27 +335,24 @@ pub fn shader(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderM
 
 /// Nearest, clamp-to-edge sampler (the "PointSampler" of the MLAA listings).
 pub fn nearest_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"nearest clamp", || {
-        device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("nearest clamp"),
-            address_mode_u: wgpu::AddressMode::ClampToEdge,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            address_mode_w: wgpu::AddressMode::ClampToEdge,
-            ..Default::default()
-        })
-    })
+    clamp_sampler(device, "nearest clamp", wgpu::FilterMode::Nearest)
 }
 
 /// Bilinear, clamp-to-edge sampler (the "LinearSampler" of SMAA).
 pub fn linear_clamp_sampler(device: &wgpu::Device) -> wgpu::Sampler {
-    cached(device, "sampler", &"linear clamp", || {
+    clamp_sampler(device, "linear clamp", wgpu::FilterMode::Linear)
+}
+
+/// A clamp-to-edge sampler filtering with `filter` (mipmaps: nearest), created once per device.
+fn clamp_sampler(device: &wgpu::Device, label: &'static str, filter: wgpu::FilterMode) -> wgpu::Sampler {
+    cached(device, "sampler", &label, || {
         device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("linear clamp"),
+            label: Some(label),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             address_mode_w: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
+            mag_filter: filter,
+            min_filter: filter,
             mipmap_filter: wgpu::MipmapFilterMode::Nearest,
             ..Default::default()
         })
@@ -392,20 +382,7 @@ pub fn fullscreen_pipeline_with(
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
     cached(device, "fullscreen pipeline", &(module, fs_entry, targets), || {
-        fullscreen_pipeline_uncached(device, label, module, fs_entry, targets)
-    })
-}
-
-fn fullscreen_pipeline_uncached(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    fs_entry: &str,
-    targets: &[Option<wgpu::ColorTargetState>],
-) -> wgpu::RenderPipeline {
-    create_render_pipeline(
-        device,
-        &wgpu::RenderPipelineDescriptor {
+        let descriptor = wgpu::RenderPipelineDescriptor {
             label: Some(label),
             layout: None,
             vertex: wgpu::VertexState {
@@ -425,8 +402,9 @@ fn fullscreen_pipeline_uncached(
             }),
             multiview_mask: None,
             cache: None,
-        },
-    )
+        };
+        create_render_pipeline(device, &descriptor)
+    })
 }
 
 /// Records one full-screen draw into `target` (cleared to zero first), with optional timestamps.
@@ -438,11 +416,7 @@ pub fn draw_fullscreen(
     target: &wgpu::TextureView,
     timer: Option<(&GpuTimer, u32)>,
 ) {
-    let timestamp_writes = timer.map(|(t, i)| wgpu::RenderPassTimestampWrites {
-        query_set: &t.query_set,
-        beginning_of_pass_write_index: Some(2 * i),
-        end_of_pass_write_index: Some(2 * i + 1),
-    });
+    let timestamp_writes = timer.map(|(t, i)| t.render_pass_writes(i));
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -491,6 +465,23 @@ impl GpuTimer {
             mapped_at_creation: false,
         });
         Self { query_set, resolve, readback, slots }
+    }
+
+    /// The query set and the begin/end query indices of the pass timed in `slot` (2·slot and 2·slot + 1).
+    fn slot_queries(&self, slot: u32) -> (&wgpu::QuerySet, Option<u32>, Option<u32>) {
+        (&self.query_set, Some(2 * slot), Some(2 * slot + 1))
+    }
+
+    /// The timestamps of a render pass timed in `slot`.
+    pub fn render_pass_writes(&self, slot: u32) -> wgpu::RenderPassTimestampWrites<'_> {
+        let (query_set, beginning_of_pass_write_index, end_of_pass_write_index) = self.slot_queries(slot);
+        wgpu::RenderPassTimestampWrites { query_set, beginning_of_pass_write_index, end_of_pass_write_index }
+    }
+
+    /// The timestamps of a compute pass timed in `slot`.
+    pub fn compute_pass_writes(&self, slot: u32) -> wgpu::ComputePassTimestampWrites<'_> {
+        let (query_set, beginning_of_pass_write_index, end_of_pass_write_index) = self.slot_queries(slot);
+        wgpu::ComputePassTimestampWrites { query_set, beginning_of_pass_write_index, end_of_pass_write_index }
     }
 
     /// Records the resolve; call after the timed passes, before `finish`.
@@ -562,12 +553,8 @@ pub fn copy_bandwidth(device: &wgpu::Device, queue: &wgpu::Queue, timestamps: bo
         let mut enc = device.create_command_encoder(&Default::default());
         let mark = |enc: &mut wgpu::CommandEncoder, slot: u32| {
             if let Some(t) = &timer {
-                let tw = wgpu::ComputePassTimestampWrites {
-                    query_set: &t.query_set,
-                    beginning_of_pass_write_index: Some(2 * slot),
-                    end_of_pass_write_index: Some(2 * slot + 1),
-                };
-                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: Some(tw) }));
+                let timestamp_writes = Some(t.compute_pass_writes(slot));
+                drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes }));
             }
         };
         mark(&mut enc, 0);

@@ -142,36 +142,46 @@ pub fn rasterise_uv(mesh: &Mesh, size: u32) -> UvMap {
         let uv = [mesh.uvs[a], mesh.uvs[b], mesh.uvs[c]];
         let Some(st) = triangle_stretch(p, uv) else { continue };
         let stretch = st.map(|s| s * mesh.mm_per_unit / t);
-        let q = uv.map(|u| [u[0] * t, u[1] * t]);
-        let area = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-        let x0 = q.iter().map(|v| v[0]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-        let x1 = (q.iter().map(|v| v[0]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
-        let y0 = q.iter().map(|v| v[1]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-        let y1 = (q.iter().map(|v| v[1]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
-        let edge = |p: [f32; 2], r: [f32; 2], x: f32, y: f32| (r[0] - p[0]) * (y - p[1]) - (x - p[0]) * (r[1] - p[1]);
         let na = [mesh.normals[a], mesh.normals[b], mesh.normals[c]];
-        for py in y0..y1 {
-            for px in x0..x1 {
-                let i = (py * size + px) as usize;
-                if m.covered[i] {
-                    continue;
-                }
-                let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
-                let w = [edge(q[1], q[2], x, y) / area, edge(q[2], q[0], x, y) / area, edge(q[0], q[1], x, y) / area];
-                if w.iter().any(|&v| v < 0.0) {
-                    continue;
-                }
-                let lerp3 = |v: [[f32; 3]; 3]| [0, 1, 2].map(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]);
-                let nn = lerp3(na);
-                let l = (nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]).sqrt();
-                m.covered[i] = true;
-                m.position[i] = lerp3(p);
-                m.normal[i] = nn.map(|v| v / l);
-                m.stretch_mm_per_texel[i] = stretch;
-            }
-        }
+        for_each_new_texel(uv, size, &mut m.covered, |i, w| {
+            let lerp3 = |v: [[f32; 3]; 3]| [0, 1, 2].map(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]);
+            let nn = lerp3(na);
+            let l = (nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]).sqrt();
+            m.position[i] = lerp3(p);
+            m.normal[i] = nn.map(|v| v / l);
+            m.stretch_mm_per_texel[i] = stretch;
+        });
     }
     m
+}
+
+/// Calls `texel(i, w)` for every texel `i` of a `size`×`size` map whose centre lies in the triangle of texture
+/// coordinates `uv` (barycentric weights `w`, none negative) and is not yet `covered`, marking it covered first: the
+/// texel walk [`rasterise_uv`] and [`rasterise_uv_attribute`] share.
+fn for_each_new_texel(uv: [[f32; 2]; 3], size: u32, covered: &mut [bool], mut texel: impl FnMut(usize, [f32; 3])) {
+    let t = size as f32;
+    let q = uv.map(|u| [u[0] * t, u[1] * t]);
+    let area = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+    let x0 = q.iter().map(|v| v[0]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
+    let x1 = (q.iter().map(|v| v[0]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
+    let y0 = q.iter().map(|v| v[1]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
+    let y1 = (q.iter().map(|v| v[1]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
+    let edge = |p: [f32; 2], r: [f32; 2], x: f32, y: f32| (r[0] - p[0]) * (y - p[1]) - (x - p[0]) * (r[1] - p[1]);
+    for py in y0..y1 {
+        for px in x0..x1 {
+            let i = (py * size + px) as usize;
+            if covered[i] {
+                continue;
+            }
+            let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
+            let w = [edge(q[1], q[2], x, y) / area, edge(q[2], q[0], x, y) / area, edge(q[0], q[1], x, y) / area];
+            if w.iter().any(|&v| v < 0.0) {
+                continue;
+            }
+            covered[i] = true;
+            texel(i, w);
+        }
+    }
 }
 
 /// A per-vertex attribute of `mesh` (e.g. its tangents) interpolated over a `size`×`size` map at its texture
@@ -181,7 +191,6 @@ pub fn rasterise_uv_attribute(mesh: &Mesh, attribute: &[[f32; 4]], size: u32) ->
     let n = (size * size) as usize;
     let mut out = vec![[0.0f32; 4]; n];
     let mut covered = vec![false; n];
-    let t = size as f32;
     for tri in mesh.indices.chunks_exact(3) {
         let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
         let p = [mesh.positions[a], mesh.positions[b], mesh.positions[c]];
@@ -189,29 +198,10 @@ pub fn rasterise_uv_attribute(mesh: &Mesh, attribute: &[[f32; 4]], size: u32) ->
         if triangle_stretch(p, uv).is_none() {
             continue;
         }
-        let q = uv.map(|u| [u[0] * t, u[1] * t]);
-        let area = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
-        let x0 = q.iter().map(|v| v[0]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-        let x1 = (q.iter().map(|v| v[0]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
-        let y0 = q.iter().map(|v| v[1]).fold(f32::INFINITY, f32::min).floor().max(0.0) as u32;
-        let y1 = (q.iter().map(|v| v[1]).fold(f32::NEG_INFINITY, f32::max).ceil() as i64).clamp(0, size as i64) as u32;
-        let edge = |p: [f32; 2], r: [f32; 2], x: f32, y: f32| (r[0] - p[0]) * (y - p[1]) - (x - p[0]) * (r[1] - p[1]);
         let va = [attribute[a], attribute[b], attribute[c]];
-        for py in y0..y1 {
-            for px in x0..x1 {
-                let i = (py * size + px) as usize;
-                if covered[i] {
-                    continue;
-                }
-                let (x, y) = (px as f32 + 0.5, py as f32 + 0.5);
-                let w = [edge(q[1], q[2], x, y) / area, edge(q[2], q[0], x, y) / area, edge(q[0], q[1], x, y) / area];
-                if w.iter().any(|&v| v < 0.0) {
-                    continue;
-                }
-                covered[i] = true;
-                out[i] = [0, 1, 2, 3].map(|k| w[0] * va[0][k] + w[1] * va[1][k] + w[2] * va[2][k]);
-            }
-        }
+        for_each_new_texel(uv, size, &mut covered, |i, w| {
+            out[i] = [0, 1, 2, 3].map(|k| w[0] * va[0][k] + w[1] * va[1][k] + w[2] * va[2][k]);
+        });
     }
     out
 }

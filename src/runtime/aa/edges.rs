@@ -185,7 +185,7 @@ struct Params {
     pred: [f32; 4],
 }
 
-const SHADER: &str = include_str!("edges.wgsl");
+const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("srgb.wgsl"), include_str!("edges.wgsl"));
 
 /// The GPU side of this module for one pass: the depth and mask textures, the edge pipeline replacing the pass's
 /// luma detector (unless plain luma) and the mask composite (when masked).

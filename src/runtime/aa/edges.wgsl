@@ -1,11 +1,13 @@
 // Edge detectors of SMAA and MLAA other than plain luma, and the matte/stencil composite.
 // Thesis ch. 9 (§9.3, Listing 9.1: depth edges, threshold) and ch. 10 (§10.4.1: colour edges, local contrast
 // adaptation eq. 10.1); predicated thresholding as documented in SMAA.hlsl (SMAA_PREDICATION_*). Written for rtbake
-// from those descriptions; the CPU mirror is `runtime/cpu/smaa_edges.rs` (keep every arithmetic step in sync).
-// The host module is `runtime/smaa_edges.rs`.
+// from those descriptions; the CPU mirror is `runtime/aa/edges_cpu.rs` (keep every arithmetic step in sync).
+// The host module is `runtime/aa/edges.rs`.
 //
 // Outputs as the passes' own `fs_edges`: R = edge on the left boundary, G = edge on the top boundary, 0 or 1.
 // Pixel positions are integer texel coordinates, loads clamp to the edge.
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -21,15 +23,6 @@ struct Params {
 @group(0) @binding(2) var depth_tex: texture_2d<f32>;
 @group(0) @binding(3) var aa_tex: texture_2d<f32>;
 @group(0) @binding(4) var mask_tex: texture_2d<f32>;
-
-const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
 
 fn clamp_px(p: vec2<i32>) -> vec2<i32> {
     return clamp(p, vec2<i32>(0, 0), vec2<i32>(P.rt.zw) - vec2<i32>(1, 1));

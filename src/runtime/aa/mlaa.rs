@@ -66,7 +66,12 @@ struct Params {
     cfg: [f32; 4],
 }
 
-const SHADER: &str = include_str!("mlaa.wgsl");
+const SHADER: &str = concat!(
+    include_str!("../fullscreen.wgsl"),
+    include_str!("srgb.wgsl"),
+    include_str!("morphological.wgsl"),
+    include_str!("mlaa.wgsl")
+);
 
 /// MLAA for one frame size and area map. Create once, run per frame.
 pub struct Mlaa(ThreePass);
@@ -98,8 +103,7 @@ impl Mlaa {
         map: &MlaaAreaMap,
         options: &MlaaOptions,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 4)?;
+        gpu::check_frame(device, width, height, 4)?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "mlaa colour", width, height, F::Rgba8Unorm);
         let edges = gpu::texture(device, "mlaa edges", width, height, F::Rg8Unorm);

@@ -1,10 +1,13 @@
 // Jimenez's MLAA (Jimenez, Masia, Echevarria, Navarro, Gutierrez, "Practical Morphological Antialiasing",
 // GPU Pro 2, 2011; thesis ch. 9, Listings 9.1–9.5): luma edge detection, blending weights from distance searches
 // (bilinear fetches of two edgels at a time) and a point-sampled precomputed area map of maximum distance N,
-// 4-neighbourhood blending. Written for rtbake from the listings; CPU twin: `runtime/cpu/mlaa.rs`.
+// 4-neighbourhood blending. Written for rtbake from the listings; CPU twin: `runtime/aa/mlaa_cpu.rs`.
 //
 // Positions are in pixel units (pixel centre = x + 0.5), converted at the fetch. Blending happens in linear light
 // (the colour texture is Rgba8Unorm holding sRGB-encoded values; the shader decodes and re-encodes).
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA and the sRGB transfer functions
+// (srgb.wgsl), luma_at, edges_at, color_lin and blend_at (morphological.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -21,20 +24,6 @@ struct Params {
 @group(0) @binding(6) var lin: sampler;
 @group(0) @binding(7) var pnt: sampler;
 
-const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
-fn luma_at(p: vec2<i32>) -> f32 {
-    let size = vec2<i32>(P.rt.zw);
-    return dot(textureLoad(color_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0).rgb, LUMA);
-}
-
 // Listing 9.1 (luminance variant): R = edge on the left, G = edge on top.
 @fragment
 fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
@@ -43,10 +32,6 @@ fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let delta = abs(vec2<f32>(l - luma_at(p + vec2<i32>(-1, 0)), l - luma_at(p + vec2<i32>(0, -1))));
     let edges = step(vec2<f32>(P.cfg.z), delta);
     return vec4<f32>(edges, 0.0, 0.0);
-}
-
-fn edges_at(p: vec2<f32>) -> vec2<f32> {
-    return textureSampleLevel(edges_tex, lin, p * P.rt.xy, 0.0).rg;
 }
 
 // Listing 9.3 and its three siblings: distance to the end of the line, two edgels per fetch.
@@ -129,25 +114,6 @@ fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         weights.w = a.y;
     }
     return weights;
-}
-
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
-fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
-    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
-}
-
-fn color_lin(p: vec2<i32>) -> vec4<f32> {
-    let size = vec2<i32>(P.rt.zw);
-    let c = textureLoad(color_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0);
-    return vec4<f32>(srgb_to_linear(c.rgb), c.a);
-}
-
-fn blend_at(p: vec2<i32>) -> vec4<f32> {
-    let size = vec2<i32>(P.rt.zw);
-    return textureLoad(blend_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0);
 }
 
 // Listing 9.5: a = (own north, bottom pixel's g, own west, right pixel's a); each neighbour is blended in by the

@@ -249,7 +249,7 @@ struct Params {
     resolve: [f32; 4],
 }
 
-const SHADER: &str = include_str!("modes.wgsl");
+const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("srgb.wgsl"), include_str!("modes.wgsl"));
 
 /// The SMAA passes of one frame slot and, for two samples, their S2x average.
 struct Slot {
@@ -292,8 +292,7 @@ impl SmaaModes {
         mode: SmaaMode,
         resolve: TemporalResolve,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
+        gpu::check_frame(device, width, height, 8)?;
         resolve.validate()?;
         use wgpu::TextureFormat as F;
         let module = gpu::shader(device, "smaa_temporal.wgsl", SHADER);

@@ -6,8 +6,10 @@
 //   with ‖v‖ in normalised screen units carried in the alpha channel as a = sqrt(5 ‖v‖) (so that SMAA, which blends
 //   alpha like colour, propagates velocity to the antialiased pixels, as the thesis prescribes); or the plain 50/50
 //   blend without reprojection.
-// Written for rtbake from the thesis' equations; the CPU twin is `runtime/cpu/smaa_modes.rs` (keep in sync).
+// Written for rtbake from the thesis' equations; the CPU twin is `runtime/aa/modes_cpu.rs` (keep in sync).
 // Colour textures are Rgba8Unorm holding sRGB-encoded values; the velocity texture is Rg32Float (px/frame).
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), srgb_to_linear and linear_to_srgb (srgb.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -21,21 +23,6 @@ struct Params {
 @group(0) @binding(1) var a_tex: texture_2d<f32>;
 @group(0) @binding(2) var b_tex: texture_2d<f32>;
 @group(0) @binding(3) var velocity_tex: texture_2d<f32>;
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
-fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
-    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
-}
 
 fn lin(c: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(srgb_to_linear(c.rgb), c.a);

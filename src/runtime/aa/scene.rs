@@ -76,24 +76,22 @@ fn shade(scene: &[(Shape, [f64; 3])], x: f64, y: f64) -> [f64; 3] {
 /// one sample at the pixel centre; n > 1: regular grid, averaged in linear light).
 pub fn render_shapes(w: u32, h: u32, n: u32) -> Vec<u8> {
     let scene = shapes(w, h);
+    encode_rows(w, h, |x, y| {
+        let acc = grid_sum(x, y, n, |sx, sy| shade(&scene, sx, sy));
+        let inv = 1.0 / (n * n) as f64;
+        acc.map(|a| a * inv)
+    })
+}
+
+/// RGBA8 (sRGB-encoded, alpha 255) of the linear colour `pixel(x, y)` of every pixel, rows in parallel.
+fn encode_rows(w: u32, h: u32, pixel: impl Fn(usize, usize) -> [f64; 3] + Sync) -> Vec<u8> {
+    use crate::runtime::sampler::{linear_to_srgb, unorm8};
     let mut out = vec![0u8; (w * h * 4) as usize];
     out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
         for x in 0..w as usize {
-            let mut acc = [0.0f64; 3];
-            for j in 0..n {
-                for i in 0..n {
-                    let sx = x as f64 + (i as f64 + 0.5) / n as f64;
-                    let sy = y as f64 + (j as f64 + 0.5) / n as f64;
-                    let c = shade(&scene, sx, sy);
-                    for k in 0..3 {
-                        acc[k] += c[k];
-                    }
-                }
-            }
-            let inv = 1.0 / (n * n) as f64;
+            let c = pixel(x, y);
             for k in 0..3 {
-                row[x * 4 + k] =
-                    crate::runtime::sampler::unorm8(crate::runtime::sampler::linear_to_srgb((acc[k] * inv) as f32));
+                row[x * 4 + k] = unorm8(linear_to_srgb(c[k] as f32));
             }
             row[x * 4 + 3] = 255;
         }
@@ -101,21 +99,27 @@ pub fn render_shapes(w: u32, h: u32, n: u32) -> Vec<u8> {
     out
 }
 
+/// The sum of `shade(sx, sy)` over the regular `n × n` grid of sample positions of pixel (x, y).
+fn grid_sum(x: usize, y: usize, n: u32, shade: impl Fn(f64, f64) -> [f64; 3]) -> [f64; 3] {
+    let mut acc = [0.0f64; 3];
+    for j in 0..n {
+        for i in 0..n {
+            let sx = x as f64 + (i as f64 + 0.5) / n as f64;
+            let sy = y as f64 + (j as f64 + 0.5) / n as f64;
+            let c = shade(sx, sy);
+            for k in 0..3 {
+                acc[k] += c[k];
+            }
+        }
+    }
+    acc
+}
+
 /// The shapes scene with one sample per pixel at `offset` (pixel units from its top-left corner, each in 0..1):
 /// one sample image of an MSAA render (e.g. the standard 4× pattern), RGBA8 sRGB-encoded.
 pub fn render_shapes_at(w: u32, h: u32, offset: [f64; 2]) -> Vec<u8> {
     let scene = shapes(w, h);
-    let mut out = vec![0u8; (w * h * 4) as usize];
-    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
-        for x in 0..w as usize {
-            let c = shade(&scene, x as f64 + offset[0], y as f64 + offset[1]);
-            for k in 0..3 {
-                row[x * 4 + k] = crate::runtime::sampler::unorm8(crate::runtime::sampler::linear_to_srgb(c[k] as f32));
-            }
-            row[x * 4 + 3] = 255;
-        }
-    });
-    out
+    encode_rows(w, h, |x, y| shade(&scene, x as f64 + offset[0], y as f64 + offset[1]))
 }
 
 /// The shapes scene with other colours: shape `i` gets `colours[i % colours.len()]`, the background `background`
@@ -124,33 +128,18 @@ pub fn render_shapes_recoloured(w: u32, h: u32, n: u32, colours: &[[f64; 3]], ba
     assert!(!colours.is_empty(), "at least one colour");
     let scene: Vec<_> =
         shapes(w, h).into_iter().enumerate().map(|(i, (s, _))| (s, colours[i % colours.len()])).collect();
-    let mut out = vec![0u8; (w * h * 4) as usize];
-    out.par_chunks_mut((w * 4) as usize).enumerate().for_each(|(y, row)| {
-        for x in 0..w as usize {
-            let mut acc = [0.0f64; 3];
-            for j in 0..n {
-                for i in 0..n {
-                    let (sx, sy) = (x as f64 + (i as f64 + 0.5) / n as f64, y as f64 + (j as f64 + 0.5) / n as f64);
-                    let mut c = background;
-                    for (shape, col) in &scene {
-                        if shape.contains(sx, sy) {
-                            c = *col;
-                        }
-                    }
-                    for k in 0..3 {
-                        acc[k] += c[k];
-                    }
+    encode_rows(w, h, |x, y| {
+        let acc = grid_sum(x, y, n, |sx, sy| {
+            let mut c = background;
+            for (shape, col) in &scene {
+                if shape.contains(sx, sy) {
+                    c = *col;
                 }
             }
-            for k in 0..3 {
-                row[x * 4 + k] = crate::runtime::sampler::unorm8(crate::runtime::sampler::linear_to_srgb(
-                    (acc[k] / (n * n) as f64) as f32,
-                ));
-            }
-            row[x * 4 + 3] = 255;
-        }
-    });
-    out
+            c
+        });
+        acc.map(|a| a / (n * n) as f64)
+    })
 }
 
 /// Linear depth of the shapes scene at each pixel centre (what an aliased depth buffer holds): shape `i` (drawn

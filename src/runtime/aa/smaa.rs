@@ -104,7 +104,49 @@ struct Params {
     subsample: [f32; 4],
 }
 
-const SHADER: &str = include_str!("smaa.wgsl");
+/// SMAA's preset HIGH (SMAA.hlsl, `SMAA_PRESET_HIGH`) and the area texture's layout: the constants the shader and
+/// the CPU twin ([`super::smaa_cpu`]) share. The shader receives them as WGSL constants written ahead of its source
+/// ([`shader_source`]), so each value is stated once.
+pub(crate) mod preset {
+    pub const THRESHOLD: f32 = 0.1;
+    pub const LOCAL_CONTRAST_ADAPTATION: f32 = 2.0;
+    pub const MAX_SEARCH_STEPS: f32 = 16.0;
+    pub const MAX_SEARCH_STEPS_DIAG: f32 = 8.0;
+    /// Corner rounding 25 %.
+    pub const CORNER_ROUNDING_NORM: f32 = 0.25;
+    pub const AREATEX_MAX_DISTANCE: f32 = 16.0;
+    pub const AREATEX_MAX_DISTANCE_DIAG: f32 = 20.0;
+    /// Rows of one subsample slice of the area texture.
+    pub const AREATEX_SUBTEX_ROWS: f32 = 80.0;
+}
+
+/// The SMAA shader: the [`preset`] constants as WGSL, then the full-screen triangle, the shared AA fetches and
+/// `smaa.wgsl`.
+fn shader_source() -> &'static str {
+    use preset::*;
+    static SOURCE: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+        let scalars = [
+            ("THRESHOLD", THRESHOLD),
+            ("LOCAL_CONTRAST_ADAPTATION", LOCAL_CONTRAST_ADAPTATION),
+            ("MAX_SEARCH_STEPS", MAX_SEARCH_STEPS),
+            ("MAX_SEARCH_STEPS_DIAG", MAX_SEARCH_STEPS_DIAG),
+            ("CORNER_ROUNDING_NORM", CORNER_ROUNDING_NORM),
+            ("AREATEX_MAX_DISTANCE", AREATEX_MAX_DISTANCE),
+            ("AREATEX_MAX_DISTANCE_DIAG", AREATEX_MAX_DISTANCE_DIAG),
+            ("AREATEX_SUBTEX_ROWS", AREATEX_SUBTEX_ROWS),
+        ];
+        let mut s: String = scalars.iter().map(|(name, v)| format!("const {name}: f32 = {v:?};\n")).collect();
+        let (w, h) = (AREA_TEX_SIZE.0 as f32, AREA_TEX_SIZE.1 as f32);
+        s += &format!("const AREATEX_SIZE: vec2<f32> = vec2<f32>({w:?}, {h:?});\n");
+        s + concat!(
+            include_str!("../fullscreen.wgsl"),
+            include_str!("srgb.wgsl"),
+            include_str!("morphological.wgsl"),
+            include_str!("smaa.wgsl")
+        )
+    });
+    &SOURCE
+}
 
 /// Number of timed passes [`ThreePass::encode`] records (edges, weights, blending).
 pub const SMAA_PASSES: u32 = 3;
@@ -154,8 +196,7 @@ impl Smaa {
         options: &SmaaOptions,
     ) -> Result<Self, RuntimeError> {
         let subsample = options.subsample;
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 4)?;
+        gpu::check_frame(device, width, height, 4)?;
         subsample.validate()?;
         use wgpu::TextureFormat as F;
         let color = gpu::texture(device, "smaa colour", width, height, F::Rgba8Unorm);
@@ -171,7 +212,7 @@ impl Smaa {
             subsample: subsample.as_f32(),
         };
         let ubo = gpu::uniform_buffer(device, "smaa params", bytemuck::bytes_of(&params));
-        let module = gpu::shader(device, "smaa.wgsl", SHADER);
+        let module = gpu::shader(device, "smaa.wgsl", shader_source());
         let pipe_edges = gpu::fullscreen_pipeline(device, "smaa edges", &module, "fs_edges", F::Rg8Unorm);
         let pipe_weights = gpu::fullscreen_pipeline(device, "smaa weights", &module, "fs_weights", F::Rgba8Unorm);
         let pipe_blend = gpu::fullscreen_pipeline(device, "smaa blend", &module, "fs_blend", F::Rgba8Unorm);

@@ -1,6 +1,6 @@
 // SMAA 1x: luma edge detection, blending-weight calculation, neighbourhood blending.
 // Jimenez, Echevarria, Sousa, Gutierrez, "SMAA: Enhanced Subpixel Morphological Antialiasing", Eurographics 2012;
-// thesis ch. 10. Written for rtbake from the algorithm description; the CPU mirror is `runtime/cpu/smaa.rs`, and
+// thesis ch. 10. Written for rtbake from the algorithm description; the CPU mirror is `runtime/aa/smaa_cpu.rs`, and
 // every arithmetic step here has its twin there (keep them in sync).
 //
 // Conventions: all positions are in PIXEL units of the frame (pixel (x, y) has its centre at (x + 0.5, y + 0.5),
@@ -13,6 +13,10 @@
 //   instead of a bilinear fetch at that texel's centre: adapters whose filtering returns 8-bit results (lavapipe)
 //   would otherwise mix neighbouring search texels;
 // - edge detection returns 0 instead of discarding (the edges target is cleared to 0 first anyway).
+//
+// Prepended by the host module: the preset constants THRESHOLD … AREATEX_SUBTEX_ROWS and AREATEX_SIZE (written
+// from `smaa::preset`), vs_fullscreen (../fullscreen.wgsl), LUMA and the sRGB transfer functions
+// (srgb.wgsl), luma_at, edges_at, color_lin and blend_at (morphological.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -29,32 +33,8 @@ struct Params {
 @group(0) @binding(5) var blend_tex: texture_2d<f32>;
 @group(0) @binding(6) var lin: sampler;
 
-const THRESHOLD: f32 = 0.1;
-const LOCAL_CONTRAST_ADAPTATION: f32 = 2.0;
-const MAX_SEARCH_STEPS: f32 = 16.0;
-const MAX_SEARCH_STEPS_DIAG: f32 = 8.0;
-const CORNER_ROUNDING_NORM: f32 = 0.25;
-const AREATEX_MAX_DISTANCE: f32 = 16.0;
-const AREATEX_MAX_DISTANCE_DIAG: f32 = 20.0;
-const AREATEX_SIZE: vec2<f32> = vec2<f32>(160.0, 560.0);
-const AREATEX_SUBTEX_ROWS: f32 = 80.0;
-const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
 // ---------------------------------------------------------------------------------------------------------
 // Pass 1: luma edge detection with local contrast adaptation. R = edge on the left, G = edge on top.
-
-fn luma_at(p: vec2<i32>) -> f32 {
-    let size = vec2<i32>(P.rt.zw);
-    let q = clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1));
-    return dot(textureLoad(color_tex, q, 0).rgb, LUMA);
-}
 
 @fragment
 fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
@@ -81,11 +61,6 @@ fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
 
 // ---------------------------------------------------------------------------------------------------------
 // Pass 2: blending-weight calculation.
-
-// Bilinear fetch of the edges texture at a position in pixel units.
-fn edges_at(p: vec2<f32>) -> vec2<f32> {
-    return textureSampleLevel(edges_tex, lin, p * P.rt.xy, 0.0).rg;
-}
 
 // Bilinear fetch of the area texture at a position in area-texture texels.
 fn area_at(t: vec2<f32>) -> vec2<f32> {
@@ -307,25 +282,6 @@ fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
 // ---------------------------------------------------------------------------------------------------------
 // Pass 3: neighbourhood blending, in linear light (the colour image holds sRGB-encoded values; the texture is
 // Rgba8Unorm, so the shader decodes and re-encodes itself).
-
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
-fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
-    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
-}
-
-fn color_lin(p: vec2<i32>) -> vec4<f32> {
-    let size = vec2<i32>(P.rt.zw);
-    let c = textureLoad(color_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0);
-    return vec4<f32>(srgb_to_linear(c.rgb), c.a);
-}
-
-fn blend_at(p: vec2<i32>) -> vec4<f32> {
-    let size = vec2<i32>(P.rt.zw);
-    return textureLoad(blend_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0);
-}
 
 @fragment
 fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

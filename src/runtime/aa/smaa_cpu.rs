@@ -9,20 +9,13 @@
 
 use crate::error::InvalidInput;
 use crate::runtime::aa::edges::{AaInputs, SMAA_LOCAL_CONTRAST_ADAPTATION};
+use crate::runtime::aa::smaa::preset::*;
 use crate::runtime::aa::smaa::{SmaaOptions, SmaaTextures, SubsampleIndices, AREA_TEX_SIZE, SEARCH_TEX_SIZE};
 use crate::runtime::sampler::{
     linear_to_srgb, srgb_to_linear, unorm8, wgsl_round as round, FilterPrecision, Tex8, UNORM8_F32,
 };
 use rayon::prelude::*;
 
-const THRESHOLD: f32 = 0.1;
-const LOCAL_CONTRAST_ADAPTATION: f32 = 2.0;
-const MAX_SEARCH_STEPS: f32 = 16.0;
-const MAX_SEARCH_STEPS_DIAG: f32 = 8.0;
-const CORNER_ROUNDING_NORM: f32 = 0.25;
-const AREATEX_MAX_DISTANCE: f32 = 16.0;
-const AREATEX_MAX_DISTANCE_DIAG: f32 = 20.0;
-const AREATEX_SUBTEX_ROWS: f32 = 80.0;
 const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
 /// Intermediate and final images of one SMAA run.
@@ -230,9 +223,16 @@ impl Ctx<'_> {
         ([c[2], c[3]], e)
     }
 
-    fn area_diag(&self, dist: [f32; 2], e: [f32; 2], offset: f32) -> [f32; 2] {
-        let tx = AREATEX_MAX_DISTANCE_DIAG * e[0] + dist[0] + 0.5 + 80.0;
-        let ty = AREATEX_MAX_DISTANCE_DIAG * e[1] + dist[1] + 0.5 + AREATEX_SUBTEX_ROWS * offset;
+    /// The area of a diagonal line of lengths `d[0]`, `d[1]` with crossing edges `e`, an end's crossing dropped where
+    /// its search stopped on one (`d[2]`, `d[3]` ≥ 0.9).
+    fn area_diag(&self, d: [f32; 4], mut e: [f32; 2], offset: f32) -> [f32; 2] {
+        for k in 0..2 {
+            if d[2 + k] >= 0.9 {
+                e[k] = 0.0;
+            }
+        }
+        let tx = AREATEX_MAX_DISTANCE_DIAG * e[0] + d[0] + 0.5 + 80.0;
+        let ty = AREATEX_MAX_DISTANCE_DIAG * e[1] + d[1] + 0.5 + AREATEX_SUBTEX_ROWS * offset;
         self.area_at(tx, ty)
     }
 
@@ -251,14 +251,8 @@ impl Ctx<'_> {
             let c0 = decode_diag(self.edges_at(px - d[0] + 0.25 - 1.0, py + d[0]));
             let c1 = decode_diag(self.edges_at(px + d[1] + 1.0, py - d[1] - 0.25));
             let c = [c0[1], c0[0], c1[1], c1[0]];
-            let mut cc = [2.0 * c[0] + c[1], 2.0 * c[2] + c[3]];
-            if d[2] >= 0.9 {
-                cc[0] = 0.0;
-            }
-            if d[3] >= 0.9 {
-                cc[1] = 0.0;
-            }
-            let a = self.area_diag([d[0], d[1]], cc, self.subsample[2]);
+            let cc = [2.0 * c[0] + c[1], 2.0 * c[2] + c[3]];
+            let a = self.area_diag(d, cc, self.subsample[2]);
             weights = [weights[0] + a[0], weights[1] + a[1]];
         }
         let (r2, _) = self.search_diag(px, py, [-1.0, -1.0], true);
@@ -279,14 +273,8 @@ impl Ctx<'_> {
             let cy = self.edges_at(q0x, q0y - 1.0)[0];
             let c1 = self.edges_at(q1x + 1.0, q1y);
             let (cz, cw) = (c1[1], c1[0]);
-            let mut cc = [2.0 * cx + cy, 2.0 * cz + cw];
-            if d[2] >= 0.9 {
-                cc[0] = 0.0;
-            }
-            if d[3] >= 0.9 {
-                cc[1] = 0.0;
-            }
-            let a = self.area_diag([d[0], d[1]], cc, self.subsample[3]);
+            let cc = [2.0 * cx + cy, 2.0 * cz + cw];
+            let a = self.area_diag(d, cc, self.subsample[3]);
             weights = [weights[0] + a[1], weights[1] + a[0]];
         }
         weights

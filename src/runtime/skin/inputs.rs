@@ -107,7 +107,7 @@ struct Params {
     weights: [[f32; 4]; 2],
 }
 
-const SHADER: &str = include_str!("inputs.wgsl");
+const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("inputs.wgsl"));
 
 fn f16_bytes(v: impl Iterator<Item = f32>) -> Vec<u8> {
     let h: Vec<half::f16> = v.map(half::f16::from_f32).collect();
@@ -159,8 +159,7 @@ impl SkinInputs {
         luts: &SkinLuts,
         rig: &RigScaleBiasMaps,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 16)?;
+        gpu::check_frame(device, width, height, 16)?;
         luts.validate()?;
         rig.validate()?;
         use wgpu::TextureFormat as F;

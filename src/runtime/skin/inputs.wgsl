@@ -3,7 +3,9 @@
 //   albedo      = skinLUT(u = cbrt(Cm/0.5), v = cbrt(H/0.32))                   (eq. 7.7, normalised, node-inclusive)
 //   transmitted = T(s) · E,  E = max(0.3 + dot(−N, L), 0)                       (eq. 5.12/5.13; T node-inclusive on [0, s_max])
 // Node-inclusive lookup of t ∈ [0, 1] in an n-texel axis: texel coordinate t·(n−1) + 0.5.
-// CPU twin: `runtime/cpu/skin_inputs.rs`.
+// CPU twin: `runtime/skin/inputs_cpu.rs`.
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -33,13 +35,6 @@ struct Out {
     @location(0) albedo: vec4<f32>,
     // rgb: T(s)·E, a: E
     @location(1) transmitted: vec4<f32>,
-}
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
 }
 
 fn node(t: f32, n: f32) -> f32 {

@@ -170,7 +170,7 @@ pub fn hemoglobin_at_uv(
         device,
         queue,
         "mesh skin inputs",
-        concat!(include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl")),
+        concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl")),
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),

@@ -1,7 +1,7 @@
-// The mesh G-buffer pass (runtime/mesh_raster.rs): rasterises a triangle mesh with a depth buffer and writes, per
+// The mesh G-buffer pass (runtime/skin/mesh_raster.rs): rasterises a triangle mesh with a depth buffer and writes, per
 // pixel, the view-space unit normal and the linear view depth in mm (target 0), the texture coordinates with a
 // coverage flag (target 1) and the view-space tangent with its handedness (target 2, mesh/tangents.rs). Its CPU
-// twin is runtime/cpu/mesh_raster.rs.
+// twin is runtime/skin/mesh_raster_cpu.rs.
 
 struct Camera {
     view_proj: mat4x4<f32>,

@@ -21,8 +21,9 @@
 
 use crate::error::InvalidInput;
 use crate::image_buf::ImageF32;
-use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::compute_chain::Buffer;
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::skin::view_frame;
 use crate::runtime::RuntimeError;
 
 /// The flag of the albedo map.
@@ -148,24 +149,15 @@ pub fn surface_pixels(
             maps.normal.is_some() as u8 as f32,
         ],
     };
-    let uvc: Vec<f32> = g.uv.iter().zip(&g.covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
-    let nrm: Vec<f32> = g.normal_view.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
-    let out = compute_chain::run(
+    let out = view_frame::run(
         device,
         queue,
         "surface maps",
-        concat!(include_str!("bilinear_taps.wgsl"), include_str!("surface_maps.wgsl")),
+        include_str!("surface_maps.wgsl"),
         bytemuck::bytes_of(&params),
-        &[
-            Buffer::Data(bytemuck::cast_slice(&uvc)),
-            Buffer::Data(bytemuck::cast_slice(&nrm)),
-            Buffer::Data(bytemuck::cast_slice(&g.tangent_view)),
-            Buffer::Data(bytemuck::cast_slice(&a.texels)),
-            Buffer::Data(bytemuck::cast_slice(&nm.texels)),
-            Buffer::Zeroed(largest_buffer_bytes(g.width, g.height)),
-        ],
-        &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
-        5,
+        g,
+        [Buffer::Data(bytemuck::cast_slice(&a.texels)), Buffer::Data(bytemuck::cast_slice(&nm.texels))],
+        largest_buffer_bytes(g.width, g.height),
     )?;
     let f: &[f32] = bytemuck::cast_slice(&out);
     let normals = f.chunks_exact(8).map(|c| [c[0], c[1], c[2]]).collect();

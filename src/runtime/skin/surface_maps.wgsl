@@ -9,13 +9,6 @@ struct Params {
     normal: vec4<f32>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
-// u, v, covered, 0
-@group(0) @binding(1) var<storage, read_write> uvc: array<vec4<f32>>;
-// view normal (unit), 0
-@group(0) @binding(2) var<storage, read_write> nrm: array<vec4<f32>>;
-// view tangent (interpolated), handedness
-@group(0) @binding(3) var<storage, read_write> tng: array<vec4<f32>>;
 // linear albedo, 0
 @group(0) @binding(4) var<storage, read_write> albedo: array<vec4<f32>>;
 // unit tangent-space normal, 0
@@ -23,37 +16,26 @@ struct Params {
 // per pixel: (normal, 0), (albedo, 0)
 @group(0) @binding(6) var<storage, read_write> outp: array<vec4<f32>>;
 
-// `Taps` and `taps` (bilinear texel indices and weights) come from bilinear_taps.wgsl, prepended.
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
+// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
+// (bilinear_taps.wgsl).
 
 fn albedo_at(t: Taps) -> vec4<f32> {
-    let w = u32(p.size.z);
-    let a = albedo[t.i.z * w + t.i.x];
-    let b = albedo[t.i.z * w + t.i.y];
-    let c = albedo[t.i.w * w + t.i.x];
-    let d = albedo[t.i.w * w + t.i.y];
-    let top = a + (b - a) * t.f.x;
-    let bottom = c + (d - c) * t.f.x;
-    return top + (bottom - top) * t.f.y;
+    let q = tap_index(t, 0u, u32(p.size.z));
+    return bilerp4(t, albedo[q.x], albedo[q.y], albedo[q.z], albedo[q.w]);
 }
 
 fn normal_at(t: Taps) -> vec4<f32> {
-    let w = u32(p.normal.x);
-    let a = nmap[t.i.z * w + t.i.x];
-    let b = nmap[t.i.z * w + t.i.y];
-    let c = nmap[t.i.w * w + t.i.x];
-    let d = nmap[t.i.w * w + t.i.y];
-    let top = a + (b - a) * t.f.x;
-    let bottom = c + (d - c) * t.f.x;
-    return top + (bottom - top) * t.f.y;
+    let q = tap_index(t, 0u, u32(p.normal.x));
+    return bilerp4(t, nmap[q.x], nmap[q.y], nmap[q.z], nmap[q.w]);
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = u32(p.size.x);
-    if (id.x >= w || id.y >= u32(p.size.y)) {
+    if (outside_frame(id)) {
         return;
     }
-    let i = id.y * w + id.x;
+    let i = frame_pixel(id);
     let c = uvc[i];
     let n = nrm[i].xyz;
     if (c.z < 0.5) {

@@ -1,8 +1,8 @@
-// Texture-space diffusion (runtime/texture_space.rs; d'Eon et al. 2007, thesis ch. 3): the chained u/v Gaussian
+// Texture-space diffusion (runtime/skin/texture_space.rs; d'Eon et al. 2007, thesis ch. 3): the chained u/v Gaussian
 // blurs of the irradiance map in texture space, each tap step sigma / stretch texels, accumulated into the weighted
 // sum of blurs, and the final gather at each visible pixel's uv. Maps are premultiplied RGBA f32 in storage buffers
 // (alpha = 1 on shaded texels, 0 on uncovered, culled or clipped ones); bilinear filtering is done here by hand so the
-// CPU twin (runtime/cpu/texture_space.rs) reproduces it. Texels with alpha 0 are not blurred (Listing 3.3) and
+// CPU twin (runtime/skin/texture_space_cpu.rs) reproduces it. Texels with alpha 0 are not blurred (Listing 3.3) and
 // contribute nothing to their neighbours (normalised convolution).
 
 struct BlurParams {
@@ -34,19 +34,33 @@ fn load_src(x: i32, y: i32) -> vec4<f32> {
     return src[u32(cy * n + cx)];
 }
 
-// Bilinear sample at texel-space position (px, py) (texel centres at +0.5), clamp to edge.
-fn bilinear_src(px: f32, py: f32) -> vec4<f32> {
+// A bilinear sample at texel-space position (px, py) (texel centres at +0.5): the top-left texel and the weights.
+struct Bilinear {
+    i: vec2<i32>,
+    f: vec2<f32>,
+}
+
+fn bilinear(px: f32, py: f32) -> Bilinear {
     let x = px - 0.5;
     let y = py - 0.5;
     let x0 = floor(x);
     let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let ix = i32(x0);
-    let iy = i32(y0);
-    let top = load_src(ix, iy) * (1.0 - fx) + load_src(ix + 1, iy) * fx;
-    let bottom = load_src(ix, iy + 1) * (1.0 - fx) + load_src(ix + 1, iy + 1) * fx;
-    return top * (1.0 - fy) + bottom * fy;
+    return Bilinear(vec2<i32>(i32(x0), i32(y0)), vec2<f32>(x - x0, y - y0));
+}
+
+// The blend of the sample's four texels (a: top left, b: top right, c: bottom left, d: bottom right).
+fn bilinear_blend(t: Bilinear, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>, d: vec4<f32>) -> vec4<f32> {
+    let top = a * (1.0 - t.f.x) + b * t.f.x;
+    let bottom = c * (1.0 - t.f.x) + d * t.f.x;
+    return top * (1.0 - t.f.y) + bottom * t.f.y;
+}
+
+// Bilinear sample of the source at texel-space position (px, py), clamp to edge.
+fn bilinear_src(px: f32, py: f32) -> vec4<f32> {
+    let t = bilinear(px, py);
+    let x = t.i.x;
+    let y = t.i.y;
+    return bilinear_blend(t, load_src(x, y), load_src(x + 1, y), load_src(x, y + 1), load_src(x + 1, y + 1));
 }
 
 @compute @workgroup_size(8, 8)
@@ -111,17 +125,10 @@ fn gather(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let uv = uvs[j];
-    let x = uv.x * f32(gp.size) - 0.5;
-    let y = uv.y * f32(gp.size) - 0.5;
-    let x0 = floor(x);
-    let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let ix = i32(x0);
-    let iy = i32(y0);
-    let top = load_sum(ix, iy) * (1.0 - fx) + load_sum(ix + 1, iy) * fx;
-    let bottom = load_sum(ix, iy + 1) * (1.0 - fx) + load_sum(ix + 1, iy + 1) * fx;
-    let s = top * (1.0 - fy) + bottom * fy;
+    let t = bilinear(uv.x * f32(gp.size), uv.y * f32(gp.size));
+    let x = t.i.x;
+    let y = t.i.y;
+    let s = bilinear_blend(t, load_sum(x, y), load_sum(x + 1, y), load_sum(x, y + 1), load_sum(x + 1, y + 1));
     var out = vec4<f32>(0.0);
     if (s.a > 0.0) {
         out = vec4<f32>(s.rgb / s.a, 1.0);

@@ -23,9 +23,10 @@ use crate::baked_layout::path;
 use crate::error::InvalidInput;
 use crate::facial::wrinkles::{zone_weights, TABLE_8_1};
 use crate::io::PixelFormat;
-use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::compute_chain::Buffer;
 use crate::runtime::loader::{BakedDir, LutError, LutSpec};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::skin::view_frame;
 use crate::runtime::RuntimeError;
 use std::path::Path;
 
@@ -160,25 +161,16 @@ pub fn wrinkled_normals(
         mask: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
         weights: [[weights[0], weights[1], weights[2], weights[3]], [weights[4], weights[5], weights[6], weights[7]]],
     };
-    let uvc: Vec<f32> = g.uv.iter().zip(&g.covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
-    let nrm: Vec<f32> = g.normal_view.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
     let masks: Vec<f32> = maps.masks.iter().flatten().flatten().copied().collect();
-    let out = compute_chain::run(
+    let out = view_frame::run(
         device,
         queue,
         "wrinkle pass",
-        concat!(include_str!("bilinear_taps.wgsl"), include_str!("wrinkles.wgsl")),
+        include_str!("wrinkles.wgsl"),
         bytemuck::bytes_of(&params),
-        &[
-            Buffer::Data(bytemuck::cast_slice(&uvc)),
-            Buffer::Data(bytemuck::cast_slice(&nrm)),
-            Buffer::Data(bytemuck::cast_slice(&g.tangent_view)),
-            Buffer::Data(bytemuck::cast_slice(&maps.pd)),
-            Buffer::Data(bytemuck::cast_slice(&masks)),
-            Buffer::Zeroed(largest_buffer_bytes(g.width, g.height)),
-        ],
-        &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
-        5,
+        g,
+        [Buffer::Data(bytemuck::cast_slice(&maps.pd)), Buffer::Data(bytemuck::cast_slice(&masks))],
+        largest_buffer_bytes(g.width, g.height),
     )?;
     let f: &[f32] = bytemuck::cast_slice(&out);
     Ok(f.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())

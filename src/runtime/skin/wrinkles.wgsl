@@ -1,7 +1,7 @@
-// The wrinkle pass (runtime/wrinkle_pass.rs; thesis ch. 8, Listing 8.1): per covered pixel, the partial-derivative
+// The wrinkle pass (runtime/skin/wrinkles.rs; thesis ch. 8, Listing 8.1): per covered pixel, the partial-derivative
 // wrinkle map and the two zone-mask maps read bilinearly at the mesh's uv, xy = base.xy + sum_z mask_z * weight_z *
 // wrinkle.xy (base: flat, the meshes carry no base normal map), n_ts = normalize(xy, 1), then n_ts taken from the
-// mesh's tangent frame (T, B = w * N x T, N) to view space. CPU twin: runtime/cpu/wrinkle_pass.rs.
+// mesh's tangent frame (T, B = w * N x T, N) to view space. CPU twin: runtime/skin/wrinkles_cpu.rs.
 
 struct Params {
     // frame width, height, PD map width, height
@@ -11,51 +11,34 @@ struct Params {
     weights: array<vec4<f32>, 2>,
 };
 
-@group(0) @binding(0) var<uniform> p: Params;
-// u, v, covered, 0
-@group(0) @binding(1) var<storage, read_write> uvc: array<vec4<f32>>;
-// view normal (unit), 0
-@group(0) @binding(2) var<storage, read_write> nrm: array<vec4<f32>>;
-// view tangent (interpolated), handedness
-@group(0) @binding(3) var<storage, read_write> tng: array<vec4<f32>>;
 // decoded PD slopes (-1 + 2 * texel)
 @group(0) @binding(4) var<storage, read_write> pd: array<vec2<f32>>;
 // decoded masks: map 0 then map 1, each mask width x height
 @group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
 
-// `Taps` and `taps` (bilinear texel indices and weights) come from bilinear_taps.wgsl, prepended.
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
+// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
+// (bilinear_taps.wgsl).
 
 fn pd_at(t: Taps) -> vec2<f32> {
-    let w = u32(p.size.z);
-    let a = pd[t.i.z * w + t.i.x];
-    let b = pd[t.i.z * w + t.i.y];
-    let c = pd[t.i.w * w + t.i.x];
-    let d = pd[t.i.w * w + t.i.y];
-    let top = a + (b - a) * t.f.x;
-    let bottom = c + (d - c) * t.f.x;
-    return top + (bottom - top) * t.f.y;
+    let q = tap_index(t, 0u, u32(p.size.z));
+    return bilerp2(t, pd[q.x], pd[q.y], pd[q.z], pd[q.w]);
 }
 
 fn mask_at(k: u32, t: Taps) -> vec4<f32> {
     let w = u32(p.mask.x);
     let base = k * w * u32(p.mask.y);
-    let a = masks[base + t.i.z * w + t.i.x];
-    let b = masks[base + t.i.z * w + t.i.y];
-    let c = masks[base + t.i.w * w + t.i.x];
-    let d = masks[base + t.i.w * w + t.i.y];
-    let top = a + (b - a) * t.f.x;
-    let bottom = c + (d - c) * t.f.x;
-    return top + (bottom - top) * t.f.y;
+    let q = tap_index(t, base, w);
+    return bilerp4(t, masks[q.x], masks[q.y], masks[q.z], masks[q.w]);
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = u32(p.size.x);
-    if (id.x >= w || id.y >= u32(p.size.y)) {
+    if (outside_frame(id)) {
         return;
     }
-    let i = id.y * w + id.x;
+    let i = frame_pixel(id);
     let c = uvc[i];
     let n = nrm[i].xyz;
     if (c.z < 0.5) {

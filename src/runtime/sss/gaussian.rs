@@ -11,6 +11,7 @@
 use crate::diffusion::sum_of_gaussians::SumOfGaussians;
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
 /// The blurs derived from a sum-of-Gaussians fit.
@@ -96,14 +97,17 @@ struct Params {
     blur: [f32; 4],
 }
 
-const SHADER: &str = include_str!("gaussian.wgsl");
+const SHADER: &str =
+    concat!(include_str!("../fullscreen.wgsl"), include_str!("frame.wgsl"), include_str!("gaussian.wgsl"));
 
 /// Screen-space sum-of-Gaussians SSS for one frame size and fit.
-pub struct GaussianSss {
+pub type GaussianSss = SssPass<GaussianChain>;
+
+/// The passes of [`GaussianSss`]: per Gaussian after the first, a horizontal and a blended vertical pass.
+pub struct GaussianChain {
     width: u32,
     height: u32,
     input: wgpu::Texture,
-    depth: wgpu::Texture,
     rt1: wgpu::Texture,
     rtf: wgpu::Texture,
     rt1_view: wgpu::TextureView,
@@ -123,15 +127,13 @@ impl GaussianSss {
         blurs: &GaussianBlurs,
         params: &GaussianSssParams,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
+        SssInputs::check_size(device, width, height)?;
         params.validate()?;
         use wgpu::TextureFormat as F;
-        let input = gpu::texture(device, "gsss input", width, height, F::Rgba16Float);
+        let inputs = SssInputs::new(device, "gsss", width, height);
         let rt1 = gpu::texture(device, "gsss rt1", width, height, F::Rgba16Float);
         let rt2 = gpu::texture(device, "gsss rt2", width, height, F::Rgba16Float);
         let rtf = gpu::texture(device, "gsss rtf", width, height, F::Rgba16Float);
-        let depth = gpu::data_texture(device, "gsss depth", width, height, F::R32Float);
         let module = gpu::shader(device, "gaussian_sss.wgsl", SHADER);
         let pipe_h = gpu::fullscreen_pipeline(device, "gsss horizontal", &module, "fs_horizontal", F::Rgba16Float);
         let blend = wgpu::BlendState {
@@ -155,11 +157,9 @@ impl GaussianSss {
             }),
         ];
         let pipe_v = gpu::fullscreen_pipeline_with(device, "gsss vertical", &module, "fs_vertical", &targets);
-        let lin = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (iv, dv, rt1_view, rt2_view, rtf_view) = (view(&input), view(&depth), view(&rt1), view(&rt2), view(&rtf));
+        let (iv, rt1_view, rt2_view, rtf_view) = (view(&inputs.color), view(&rt1), view(&rt2), view(&rtf));
         let (lh, lv) = (pipe_h.get_bind_group_layout(0), pipe_v.get_bind_group_layout(0));
-        use wgpu::BindingResource as R;
         let mut steps = Vec::new();
         for i in 1..blurs.sigma_mm.len() {
             let mk = |dir: [f32; 2]| Params {
@@ -169,56 +169,36 @@ impl GaussianSss {
             };
             let uh = gpu::uniform_buffer(device, "gsss h", bytemuck::bytes_of(&mk([1.0, 0.0])));
             let uv = gpu::uniform_buffer(device, "gsss v", bytemuck::bytes_of(&mk([0.0, 1.0])));
-            let gh = gpu::bind_group(
-                device,
-                "gsss h",
-                &lh,
-                &[
-                    (0, uh.as_entire_binding()),
-                    (1, R::TextureView(&rt1_view)),
-                    (2, R::TextureView(&dv)),
-                    (3, R::TextureView(&iv)),
-                    (6, R::Sampler(&lin)),
-                ],
-            );
-            let gv = gpu::bind_group(
-                device,
-                "gsss v",
-                &lv,
-                &[
-                    (0, uv.as_entire_binding()),
-                    (1, R::TextureView(&rt2_view)),
-                    (2, R::TextureView(&dv)),
-                    (3, R::TextureView(&iv)),
-                    (6, R::Sampler(&lin)),
-                ],
-            );
+            let gh = inputs.blur_group(device, "gsss h", &lh, (&uh, &rt1_view), &[(3, &iv)]);
+            let gv = inputs.blur_group(device, "gsss v", &lv, (&uv, &rt2_view), &[(3, &iv)]);
             steps.push((gh, gv, blurs.blend[i]));
         }
-        Ok(Self { width, height, input, depth, rt1, rtf, rt1_view, rt2_view, rtf_view, pipe_h, pipe_v, steps })
-    }
-
-    /// The diffuse input (`Rgba16Float`, linear, alpha = SSS level); other passes may render into it.
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.input
-    }
-    /// The final target RTF (`Rgba16Float`).
-    pub fn output(&self) -> &wgpu::Texture {
-        &self.rtf
+        let input = inputs.color.clone();
+        let chain = GaussianChain {
+            width,
+            height,
+            input,
+            rt1,
+            rtf: rtf.clone(),
+            rt1_view,
+            rt2_view,
+            rtf_view,
+            pipe_h,
+            pipe_v,
+            steps,
+        };
+        Ok(SssPass { inputs, output: rtf, blur: chain })
     }
 
     /// Number of passes [`Self::encode`] records (two per Gaussian after the first).
     pub fn passes(&self) -> u32 {
-        2 * self.steps.len() as u32
+        2 * self.blur.steps.len() as u32
     }
+}
 
-    /// Uploads `color` (RGBA f32, linear, alpha = SSS level) and `depth` (linear), both top row first.
-    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        gpu::upload_sss_frame(queue, (&self.input, &self.depth), color, depth)
-    }
-
+impl SssBlur for GaussianChain {
     /// Records the whole chain; pass k (0-based, H and V alternating) uses timer slot `first + k`.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let full = wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 };
         let whole = |t| wgpu::TexelCopyTextureInfo {
             texture: t,
@@ -231,30 +211,15 @@ impl GaussianSss {
         for (k, (gh, gv, w)) in self.steps.iter().enumerate() {
             let slot = |j: u32| timer.map(|(t, first)| (t, first + 2 * k as u32 + j));
             gpu::draw_fullscreen(enc, "gsss horizontal", &self.pipe_h, gh, &self.rt2_view, slot(0));
-            let ts = slot(1).map(|(t, i)| wgpu::RenderPassTimestampWrites {
-                query_set: &t.query_set,
-                beginning_of_pass_write_index: Some(2 * i),
-                end_of_pass_write_index: Some(2 * i + 1),
-            });
             let load = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
+            let attachment = |view| {
+                Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops: load })
+            };
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("gsss vertical"),
-                color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &self.rt1_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: load,
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &self.rtf_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: load,
-                    }),
-                ],
+                color_attachments: &[attachment(&self.rt1_view), attachment(&self.rtf_view)],
                 depth_stencil_attachment: None,
-                timestamp_writes: ts,
+                timestamp_writes: slot(1).map(|(t, i)| t.render_pass_writes(i)),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -263,22 +228,5 @@ impl GaussianSss {
             pass.set_blend_constant(wgpu::Color { r: w[0] as f64, g: w[1] as f64, b: w[2] as f64, a: 1.0 });
             pass.draw(0..3, 0..1);
         }
-    }
-
-    /// Uploads, runs and reads back RTF as RGBA f32.
-    pub fn run(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        color: &[f32],
-        depth: &[f32],
-    ) -> Result<Vec<f32>, RuntimeError> {
-        self.upload(queue, color, depth)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gsss") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        let bytes = gpu::read_texture(device, queue, &self.rtf)?;
-        let half: &[half::f16] = bytemuck::cast_slice(&bytes);
-        Ok(half.iter().map(|v| v.to_f32()).collect())
     }
 }

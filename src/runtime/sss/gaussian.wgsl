@@ -1,13 +1,15 @@
 // Screen-space sum-of-Gaussians subsurface scattering (Jimenez, Sundstedt, Gutierrez, "Screen-Space Perceptual
 // Rendering of Human Skin", ACM TAP 2009; thesis ch. 4, Listing 4.1). One Gaussian = a horizontal pass (RT1 →
 // RT2) and a vertical pass (RT2 → RT1 and, blended with the constant w′ᵢ of eq. 4.8–4.9, into RTF).
-// CPU twin: `runtime/cpu/gaussian_sss.rs`.
+// CPU twin: `runtime/sss/gaussian_cpu.rs`.
 //
 // Stretch (eq. 4.1–4.4): s = α / (d + β·min(|∂d|, γ)) · a(x, y), a = alpha of the diffuse image (local SSS level;
 // 0 = not skin, the matte). ∂d is the fine screen-space derivative of the quad (ddx/ddy) written out with loads so
 // that it is deterministic. Depth LOD (eq. 4.6): the Gaussian is skipped where d ≥ lod·sqrt(vᵢ)·α (lod = 2 is the
 // exact half-pixel rule; the thesis ships 0.5). A skipped pixel is left untouched by the vertical pass (the
 // thesis uses the depth test); the horizontal pass copies it so RT2 never holds stale texels.
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl); depth_tex, lin, depth_load (frame.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -20,25 +22,11 @@ struct Params {
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var src_tex: texture_2d<f32>;
-@group(0) @binding(2) var depth_tex: texture_2d<f32>;
 @group(0) @binding(3) var matte_tex: texture_2d<f32>;
-@group(0) @binding(6) var lin: sampler;
 
 struct VOut {
     @location(0) rt1: vec4<f32>,
     @location(1) rtf: vec4<f32>,
-}
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
-fn depth_load(p: vec2<i32>) -> f32 {
-    let size = vec2<i32>(P.rt.zw);
-    return textureLoad(depth_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0).r;
 }
 
 // Fine derivative along `dir` within the 2×2 quad, like ddx_fine / ddy_fine.

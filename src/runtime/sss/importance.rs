@@ -19,8 +19,9 @@
 //! **Samples** live in the uniform block (≤ [`MAX_SAMPLES`] = 1024, 32 KiB): per sample (x mm, y mm, r mm, 0) and
 //! the normalised (w_r, w_g, w_b, 0).
 
-use crate::error::{check_positive, check_range, InvalidInput};
+use crate::error::{check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 use crate::sss_sampling::ImportanceKernel;
 
@@ -91,12 +92,11 @@ impl Default for ImportanceSssParams {
 impl ImportanceSssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
         check_positive("--mm-per-world-unit", self.mm_per_world_unit as f64, "mm")?;
-        check_range("--fovy", self.fovy_deg, 1.0, 179.0, "degrees")?;
-        Ok(())
+        super::check_fovy(self.fovy_deg)
     }
-    /// 1/tan(0.5·FOVy): distance to the projection window.
+    /// 1/tan(0.5·FOVy): distance to the projection window ([`super::dist_to_window`]).
     pub fn dist_to_window(&self) -> f32 {
-        1.0 / (0.5 * self.fovy_deg.to_radians()).tan()
+        super::dist_to_window(self.fovy_deg)
     }
 }
 
@@ -108,13 +108,14 @@ struct Params {
     samples: [[f32; 4]; 2 * MAX_SAMPLES],
 }
 
-const SHADER: &str = include_str!("importance.wgsl");
+const SHADER: &str =
+    concat!(include_str!("../fullscreen.wgsl"), include_str!("frame.wgsl"), include_str!("importance.wgsl"));
 
 /// Importance-sampled SSS for one frame size and kernel.
-pub struct ImportanceSss {
-    color: wgpu::Texture,
-    depth: wgpu::Texture,
-    output: wgpu::Texture,
+pub type ImportanceSss = SssPass<ImportanceBlur>;
+
+/// The one fragment pass of [`ImportanceSss`].
+pub struct ImportanceBlur {
     pipe: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     target: wgpu::TextureView,
@@ -128,17 +129,14 @@ impl ImportanceSss {
         samples: &ImportanceSamples,
         params: &ImportanceSssParams,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
+        SssInputs::check_size(device, width, height)?;
         params.validate()?;
         samples.validate()?;
         use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, "isss colour", width, height, F::Rgba16Float);
+        let inputs = SssInputs::new(device, "isss", width, height);
         let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
-        let depth = gpu::data_texture(device, "isss depth", width, height, F::R32Float);
         let module = gpu::shader(device, "importance_sss.wgsl", SHADER);
         let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
-        let lin = gpu::linear_clamp_sampler(device);
         let mut p: Params = bytemuck::Zeroable::zeroed();
         let n = samples.offsets_mm.len();
         for i in 0..n {
@@ -153,53 +151,16 @@ impl ImportanceSss {
             n as f32,
         ];
         let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
-        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, dv) = (view(&color), view(&depth));
-        let layout = pipe.get_bind_group_layout(0);
-        use wgpu::BindingResource as R;
-        let group = gpu::bind_group(
-            device,
-            "isss",
-            &layout,
-            &[(0, ubo.as_entire_binding()), (1, R::TextureView(&cv)), (2, R::TextureView(&dv)), (6, R::Sampler(&lin))],
-        );
-        let target = view(&output);
-        Ok(Self { color, depth, output, pipe, group, target })
+        let cv = inputs.color.create_view(&Default::default());
+        let group = inputs.blur_group(device, "isss", &pipe.get_bind_group_layout(0), (&ubo, &cv), &[]);
+        let target = output.create_view(&Default::default());
+        Ok(SssPass { inputs, output, blur: ImportanceBlur { pipe, group, target } })
     }
+}
 
-    /// The irradiance input (`Rgba16Float`, linear, alpha = strength).
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.color
-    }
-    /// The blurred result (`Rgba16Float`).
-    pub fn output(&self) -> &wgpu::Texture {
-        &self.output
-    }
-
-    /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.
-    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        gpu::upload_sss_frame(queue, (&self.color, &self.depth), color, depth)
-    }
-
+impl SssBlur for ImportanceBlur {
     /// Records the pass.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         gpu::draw_fullscreen(enc, "isss", &self.pipe, &self.group, &self.target, timer);
-    }
-
-    /// Uploads, runs the pass and reads back RGBA f32.
-    pub fn run(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        color: &[f32],
-        depth: &[f32],
-    ) -> Result<Vec<f32>, RuntimeError> {
-        self.upload(queue, color, depth)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("isss") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        let bytes = gpu::read_texture(device, queue, &self.output)?;
-        let half: &[half::f16] = bytemuck::cast_slice(&bytes);
-        Ok(half.iter().map(|v| v.to_f32()).collect())
     }
 }

@@ -1,10 +1,13 @@
 // Importance-sampled screen-space subsurface scattering: one pass over an N-sample disk kernel drawn from the
 // profile's radial CDF (the sampling of Unity HDRP's diffusion profiles; Golubev, SIGGRAPH 2018 course "Advances in
-// Real-Time Rendering"). CPU twin: `runtime/cpu/importance_sss.rs`; algorithm in `runtime/importance_sss.rs`.
+// Real-Time Rendering"). CPU twin: `runtime/sss/importance_cpu.rs`; algorithm in `runtime/sss/importance.rs`.
 //
 // offset (pixels) = (x, y)mm · strength · (H/2)·(1/tan(0.5·FOVy)) / (depth · mm_per_world_unit), strength = colour
 // alpha (0: not skin, the pixel passes through). Follow-surface: s = saturate(|Δdepth|·mm_per_world_unit/cutoff_mm),
 // sample = mix(sample, centre, s). Colour rgba16float filtered by the sampler; depth r32float loaded four times.
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl); depth_tex, lin, depth_load and depth_at
+// (frame.wgsl).
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -18,31 +21,6 @@ struct Params {
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var color_tex: texture_2d<f32>;
-@group(0) @binding(2) var depth_tex: texture_2d<f32>;
-@group(0) @binding(6) var lin: sampler;
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
-fn depth_load(p: vec2<i32>) -> f32 {
-    let size = vec2<i32>(P.rt.zw);
-    return textureLoad(depth_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0).r;
-}
-
-// Bilinear, clamp-to-edge fetch of the depth at normalised coordinates.
-fn depth_at(uv: vec2<f32>) -> f32 {
-    let x = uv * P.rt.zw - vec2<f32>(0.5, 0.5);
-    let x0 = floor(x);
-    let f = x - x0;
-    let p = vec2<i32>(x0);
-    let top = mix(depth_load(p), depth_load(p + vec2<i32>(1, 0)), f.x);
-    let bottom = mix(depth_load(p + vec2<i32>(0, 1)), depth_load(p + vec2<i32>(1, 1)), f.x);
-    return mix(top, bottom, f.y);
-}
 
 @fragment
 fn fs_blur(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

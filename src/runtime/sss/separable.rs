@@ -4,8 +4,9 @@
 //! (rgb weight, a offset; centre first) and the published shader's conventions (sssWidth, FOVy,
 //! follow-surface). Resources created once in [`SeparableSss::new`]; CPU twin [`crate::runtime::sss::separable_cpu`].
 
-use crate::error::{check_positive, check_range, InvalidInput};
+use crate::error::{check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
+use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
 /// Largest kernel the shader's uniform block holds.
@@ -52,12 +53,11 @@ impl Default for SssParams {
 impl SssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
         check_positive("--sss-width", self.sss_width as f64, "world units")?;
-        check_range("--fovy", self.fovy_deg, 1.0, 179.0, "degrees")?;
-        Ok(())
+        super::check_fovy(self.fovy_deg)
     }
-    /// 1/tan(0.5·FOVy): distance to the projection window.
+    /// 1/tan(0.5·FOVy): distance to the projection window ([`super::dist_to_window`]).
     pub fn dist_to_window(&self) -> f32 {
-        1.0 / (0.5 * self.fovy_deg.to_radians()).tan()
+        super::dist_to_window(self.fovy_deg)
     }
 }
 
@@ -87,15 +87,35 @@ impl Params {
             taps,
         }
     }
+
+    /// Checks the frame size and the parameters (in that order, before any work), then creates the uniform buffers
+    /// of the horizontal and the vertical pass: the common start of both forms of the pass.
+    pub(crate) fn buffers(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+        kernel: &SssKernel,
+        params: &SssParams,
+    ) -> Result<[wgpu::Buffer; 2], RuntimeError> {
+        SssInputs::check_size(device, width, height)?;
+        params.validate()?;
+        let block = |dir| Self::new(width, height, kernel, params, dir);
+        let mk = |label, dir| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
+        Ok([mk("sss h", [1.0, 0.0]), mk("sss v", [0.0, 1.0])])
+    }
 }
 
-const SHADER: &str = include_str!("separable.wgsl");
+const SHADER: &str = concat!(
+    include_str!("separable_params.wgsl"),
+    include_str!("../fullscreen.wgsl"),
+    include_str!("frame.wgsl"),
+    include_str!("separable.wgsl")
+);
 
 /// Separable SSS for one frame size and kernel.
-pub struct SeparableSss {
-    color: wgpu::Texture,
-    depth: wgpu::Texture,
-    output: wgpu::Texture,
+pub type SeparableSss = SssPass<SeparableBlur>;
+
+/// The two fragment passes of [`SeparableSss`].
+pub struct SeparableBlur {
     pipe: wgpu::RenderPipeline,
     groups: [wgpu::BindGroup; 2],
     targets: [wgpu::TextureView; 2],
@@ -109,88 +129,29 @@ impl SeparableSss {
         kernel: &SssKernel,
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
-        params.validate()?;
-        use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, "sss colour", width, height, F::Rgba16Float);
-        let tmp = gpu::texture(device, "sss horizontal", width, height, F::Rgba16Float);
-        let output = gpu::texture(device, "sss output", width, height, F::Rgba16Float);
-        let depth = gpu::data_texture(device, "sss depth", width, height, F::R32Float);
+        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
+        let inputs = SssInputs::new(device, "sss", width, height);
+        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::texture);
         let module = gpu::shader(device, "separable_sss.wgsl", SHADER);
-        let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", F::Rgba16Float);
-        let lin = gpu::linear_clamp_sampler(device);
-        let mk = |dir: [f32; 2]| Params::new(width, height, kernel, params, dir);
-        let ubo_h = gpu::uniform_buffer(device, "sss h", bytemuck::bytes_of(&mk([1.0, 0.0])));
-        let ubo_v = gpu::uniform_buffer(device, "sss v", bytemuck::bytes_of(&mk([0.0, 1.0])));
+        let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", wgpu::TextureFormat::Rgba16Float);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, tv, dv) = (view(&color), view(&tmp), view(&depth));
+        let (cv, tv) = (view(&inputs.color), view(&tmp));
         let layout = pipe.get_bind_group_layout(0);
-        use wgpu::BindingResource as R;
         let groups = [
-            gpu::bind_group(
-                device,
-                "sss h",
-                &layout,
-                &[
-                    (0, ubo_h.as_entire_binding()),
-                    (1, R::TextureView(&cv)),
-                    (2, R::TextureView(&dv)),
-                    (6, R::Sampler(&lin)),
-                ],
-            ),
-            gpu::bind_group(
-                device,
-                "sss v",
-                &layout,
-                &[
-                    (0, ubo_v.as_entire_binding()),
-                    (1, R::TextureView(&tv)),
-                    (2, R::TextureView(&dv)),
-                    (6, R::Sampler(&lin)),
-                ],
-            ),
+            inputs.blur_group(device, "sss h", &layout, (&ubo_h, &cv), &[]),
+            inputs.blur_group(device, "sss v", &layout, (&ubo_v, &tv), &[]),
         ];
         let targets = [tv, view(&output)];
-        Ok(Self { color, depth, output, pipe, groups, targets })
+        Ok(SssPass { inputs, output, blur: SeparableBlur { pipe, groups, targets } })
     }
+}
 
-    /// The irradiance input (`Rgba16Float`, linear, alpha = strength); other passes may render into it.
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.color
-    }
-    /// The blurred result (`Rgba16Float`).
-    pub fn output(&self) -> &wgpu::Texture {
-        &self.output
-    }
-
-    /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.
-    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        gpu::upload_sss_frame(queue, (&self.color, &self.depth), color, depth)
-    }
-
+impl SssBlur for SeparableBlur {
     /// Records the horizontal and vertical passes.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         for k in 0..2 {
             let slot = timer.map(|(t, first)| (t, first + k as u32));
             gpu::draw_fullscreen(enc, "sss", &self.pipe, &self.groups[k], &self.targets[k], slot);
         }
-    }
-
-    /// Uploads, runs both passes and reads back RGBA f32.
-    pub fn run(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        color: &[f32],
-        depth: &[f32],
-    ) -> Result<Vec<f32>, RuntimeError> {
-        self.upload(queue, color, depth)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        let bytes = gpu::read_texture(device, queue, &self.output)?;
-        let half: &[half::f16] = bytemuck::cast_slice(&bytes);
-        Ok(half.iter().map(|v| v.to_f32()).collect())
     }
 }

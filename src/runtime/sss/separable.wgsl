@@ -1,50 +1,15 @@
 // Separable subsurface scattering (Jimenez, Zsolnai, Jarabo, Freude, Auzinger, Wu, von der Pahlen, Wimmer,
 // Gutierrez, "Separable Subsurface Scattering", Computer Graphics Forum 2015; thesis ch. 6), one 1-D pass.
-// Run twice: dir = (1, 0) then (0, 1). CPU twin: `runtime/cpu/separable_sss.rs`.
+// Run twice: dir = (1, 0) then (0, 1). CPU twin: `runtime/sss/separable_cpu.rs`.
 //
 // step (uv) = sssWidth · (1/tan(0.5·FOVy)) / depth · dir · strength / 3, strength = colour alpha (0: not skin,
 // the pixel passes through unchanged — the matte). Follow-surface: s = saturate(300 · (1/tan(0.5·FOVy)) ·
 // sssWidth · |Δdepth|), tap = lerp(tap, centre, s). Kernel: N taps (rgb weight, a offset), centre first.
 // Colour: rgba16float, linear, filtered by the sampler; depth: r32float (not filterable without
 // FLOAT32_FILTERABLE), so its bilinear fetch is written out with four loads.
-
-struct Params {
-    // (1/width, 1/height, width, height)
-    rt: vec4<f32>,
-    // x: sssWidth, y: 1/tan(0.5·FOVy), z: follow surface (0/1), w: number of taps
-    cfg: vec4<f32>,
-    // xy: direction
-    dir: vec4<f32>,
-    taps: array<vec4<f32>, 64>,
-}
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var color_tex: texture_2d<f32>;
-@group(0) @binding(2) var depth_tex: texture_2d<f32>;
-@group(0) @binding(6) var lin: sampler;
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((i << 1u) & 2u);
-    let y = f32(i & 2u);
-    return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
-}
-
-fn depth_load(p: vec2<i32>) -> f32 {
-    let size = vec2<i32>(P.rt.zw);
-    return textureLoad(depth_tex, clamp(p, vec2<i32>(0, 0), size - vec2<i32>(1, 1)), 0).r;
-}
-
-// Bilinear, clamp-to-edge fetch of the depth at normalised coordinates.
-fn depth_at(uv: vec2<f32>) -> f32 {
-    let x = uv * P.rt.zw - vec2<f32>(0.5, 0.5);
-    let x0 = floor(x);
-    let f = x - x0;
-    let p = vec2<i32>(x0);
-    let top = mix(depth_load(p), depth_load(p + vec2<i32>(1, 0)), f.x);
-    let bottom = mix(depth_load(p + vec2<i32>(0, 1)), depth_load(p + vec2<i32>(1, 1)), f.x);
-    return mix(top, bottom, f.y);
-}
+//
+// Prepended by the host module: Params, P and color_tex (separable_params.wgsl), vs_fullscreen
+// (../fullscreen.wgsl); depth_tex, lin, depth_load and depth_at (frame.wgsl).
 
 @fragment
 fn fs_blur(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

@@ -7,20 +7,20 @@
 //! line, so its bilinear fetch is a lerp of two neighbours), so a pass moves each texel in and out once. Taps beyond
 //! the apron read the textures. The result is written through a storage texture (`Rgba16Float`).
 
-use crate::error::InvalidInput;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::separable::{Params, SssKernel, SssParams};
+use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
-const SHADER: &str = include_str!("separable_tiled.wgsl");
+const SHADER: &str = concat!(include_str!("separable_params.wgsl"), include_str!("separable_tiled.wgsl"));
 /// Texels a workgroup blurs along its line (the shader's `SEGMENT`).
 const SEGMENT: u32 = 128;
 
 /// Separable SSS (compute, workgroup-memory tiles) for one frame size and kernel.
-pub struct SeparableSssTiled {
-    color: wgpu::Texture,
-    depth: wgpu::Texture,
-    output: wgpu::Texture,
+pub type SeparableSssTiled = SssPass<TiledBlur>;
+
+/// The two compute passes of [`SeparableSssTiled`].
+pub struct TiledBlur {
     pipe: wgpu::ComputePipeline,
     groups: [wgpu::BindGroup; 2],
     dispatch: [[u32; 3]; 2],
@@ -34,74 +34,39 @@ impl SeparableSssTiled {
         kernel: &SssKernel,
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
-        crate::error::check_size("image", width as u64, height as u64)?;
-        crate::runtime::device::check_image_fits(device, width, height, 8)?;
-        params.validate()?;
-        use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, "sss colour", width, height, F::Rgba16Float);
-        let tmp = gpu::storage_texture(device, "sss horizontal", width, height, F::Rgba16Float);
-        let output = gpu::storage_texture(device, "sss output", width, height, F::Rgba16Float);
-        let depth = gpu::data_texture(device, "sss depth", width, height, F::R32Float);
+        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
+        let inputs = SssInputs::new(device, "sss", width, height);
+        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::storage_texture);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "separable_tiled.wgsl", SHADER);
         let pipe = gpu::compute_pipeline(device, &module, "blur");
-        let ubo_h = gpu::uniform_buffer(
-            device,
-            "sss h",
-            bytemuck::bytes_of(&Params::new(width, height, kernel, params, [1.0, 0.0])),
-        );
-        let ubo_v = gpu::uniform_buffer(
-            device,
-            "sss v",
-            bytemuck::bytes_of(&Params::new(width, height, kernel, params, [0.0, 1.0])),
-        );
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, tv, dv, ov) = (view(&color), view(&tmp), view(&depth), view(&output));
+        let (cv, tv, dv, ov) = (view(&inputs.color), view(&tmp), view(&inputs.depth), view(&output));
         let layout = pipe.get_bind_group_layout(0);
         use wgpu::BindingResource as R;
         let group = |label, ubo: &wgpu::Buffer, src: &wgpu::TextureView, dst: &wgpu::TextureView| {
-            gpu::bind_group(
-                device,
-                label,
-                &layout,
-                &[
-                    (0, ubo.as_entire_binding()),
-                    (1, R::TextureView(src)),
-                    (2, R::TextureView(&dv)),
-                    (3, R::TextureView(dst)),
-                ],
-            )
+            let entries = [
+                (0, ubo.as_entire_binding()),
+                (1, R::TextureView(src)),
+                (2, R::TextureView(&dv)),
+                (3, R::TextureView(dst)),
+            ];
+            gpu::bind_group(device, label, &layout, &entries)
         };
         let groups = [group("sss h", &ubo_h, &cv, &tv), group("sss v", &ubo_v, &tv, &ov)];
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RuntimeError::Gpu(format!("separable SSS (compute): {e}")));
         }
         let dispatch = [[width.div_ceil(SEGMENT), height, 1], [height.div_ceil(SEGMENT), width, 1]];
-        Ok(Self { color, depth, output, pipe, groups, dispatch })
+        Ok(SssPass { inputs, output, blur: TiledBlur { pipe, groups, dispatch } })
     }
+}
 
-    /// The irradiance input (`Rgba16Float`, linear, alpha = strength); other passes may render into it.
-    pub fn input(&self) -> &wgpu::Texture {
-        &self.color
-    }
-    /// The blurred result (`Rgba16Float`).
-    pub fn output(&self) -> &wgpu::Texture {
-        &self.output
-    }
-
-    /// Uploads a frame: `color` RGBA f32 (linear; alpha = strength), `depth` linear depth, both top row first.
-    pub fn upload(&self, queue: &wgpu::Queue, color: &[f32], depth: &[f32]) -> Result<(), InvalidInput> {
-        gpu::upload_sss_frame(queue, (&self.color, &self.depth), color, depth)
-    }
-
+impl SssBlur for TiledBlur {
     /// Records the horizontal and vertical passes (timestamps in slots `first` and `first + 1`).
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         for k in 0..2 {
-            let timestamp_writes = timer.map(|(t, first)| wgpu::ComputePassTimestampWrites {
-                query_set: &t.query_set,
-                beginning_of_pass_write_index: Some(2 * (first + k as u32)),
-                end_of_pass_write_index: Some(2 * (first + k as u32) + 1),
-            });
+            let timestamp_writes = timer.map(|(t, first)| t.compute_pass_writes(first + k as u32));
             let mut pass =
                 enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sss"), timestamp_writes });
             pass.set_pipeline(&self.pipe);
@@ -109,20 +74,5 @@ impl SeparableSssTiled {
             let [x, y, z] = self.dispatch[k];
             pass.dispatch_workgroups(x, y, z);
         }
-    }
-
-    /// Uploads, runs both passes and reads back RGBA f32.
-    pub fn run(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        color: &[f32],
-        depth: &[f32],
-    ) -> Result<Vec<f32>, RuntimeError> {
-        self.upload(queue, color, depth)?;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss") });
-        self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        gpu::read_texture_f16(device, queue, &self.output)
     }
 }

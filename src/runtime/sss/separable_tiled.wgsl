@@ -6,19 +6,9 @@
 //
 // Along the pass's axis a tap lands at a texel centre's row or column exactly, so its bilinear fetch is the 1-D
 // lerp of two neighbours (clamp to edge), written out in f32 for colour and depth alike.
+//
+// Prepended by the host module: Params, P and color_tex (separable_params.wgsl).
 
-struct Params {
-    // (1/width, 1/height, width, height)
-    rt: vec4<f32>,
-    // x: sssWidth, y: 1/tan(0.5·FOVy), z: follow surface (0/1), w: number of taps
-    cfg: vec4<f32>,
-    // xy: direction
-    dir: vec4<f32>,
-    taps: array<vec4<f32>, 64>,
-}
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var color_tex: texture_2d<f32>;
 @group(0) @binding(2) var depth_tex: texture_2d<f32>;
 @group(0) @binding(3) var out_tex: texture_storage_2d<rgba16float, write>;
 

@@ -1,0 +1,42 @@
+//! The G-buffer as the view-frame compute passes read it ([`super::surface_maps`], [`super::wrinkles`]): a pass's
+//! shader is `pixel_frame.wgsl`, `view_frame.wgsl` and `bilinear_taps.wgsl` ahead of its own WGSL (entry `main`,
+//! 8 × 8 workgroups over the frame); bindings 1–3 are the G-buffer's (u, v, covered, 0), (view normal, 0) and view
+//! tangent per pixel, bindings 4 and 5 the pass's own maps, binding 6 its output.
+
+use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::skin::mesh_raster::MeshGBuffer;
+use crate::runtime::RuntimeError;
+
+/// The WGSL every view-frame pass starts with.
+const PRELUDES: &str =
+    concat!(include_str!("pixel_frame.wgsl"), include_str!("view_frame.wgsl"), include_str!("bilinear_taps.wgsl"));
+
+/// Runs the view-frame pass `what` (`pass_wgsl`) over `g` with the uniform block `params` and the pass's two `maps`,
+/// and reads back its output buffer of `out_bytes` (zeroed first).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    what: &str,
+    pass_wgsl: &str,
+    params: &[u8],
+    g: &MeshGBuffer,
+    [map_a, map_b]: [Buffer<'_>; 2],
+    out_bytes: u64,
+) -> Result<Vec<u8>, RuntimeError> {
+    let uvc: Vec<f32> = g.uv.iter().zip(&g.covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
+    let nrm: Vec<f32> = g.normal_view.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    let frame = [uvc.as_slice(), nrm.as_slice(), bytemuck::cast_slice(&g.tangent_view)]
+        .map(|d| Buffer::Data(bytemuck::cast_slice(d)));
+    let [uvc, nrm, tng] = frame;
+    compute_chain::run(
+        device,
+        queue,
+        what,
+        &[PRELUDES, pass_wgsl].concat(),
+        params,
+        &[uvc, nrm, tng, map_a, map_b, Buffer::Zeroed(out_bytes)],
+        &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
+        5,
+    )
+}
