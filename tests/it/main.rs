@@ -90,3 +90,4 @@ mod transmittance_table;
 mod transport_cli;
 mod transport_gpu;
 mod transport_physics;
+mod mcml_spectral_skin;
