@@ -3,8 +3,8 @@
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::manifest::{FileFormat, FileKind};
 use crate::skin_color::lut::{bake_lut_with_progress, IndexForm, LutLayout};
-use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::monte_carlo::McColorParams;
+use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
 use serde_json::Value;
 use std::fmt::Write;
@@ -27,24 +27,26 @@ pub const SAMPLE_HEMOGLOBIN: [f64; 6] = [0.0, 0.01, 0.04, 0.1, 0.2, 0.32];
 pub const SPECTRUM_POINTS: [(f64, f64); 5] = [(0.0, 0.0), (0.5, 0.0), (0.0, 0.32), (0.5, 0.32), (0.07, 0.04)];
 
 pub fn assets() -> Vec<Asset> {
-    vec![Asset {
-        name: SKIN_COLOR_LUT,
-        summary: "skin colour LUT: melanin x hemoglobin -> linear sRGB albedo (spectral two-layer model, eq. 7.7)",
-        default_params: || serde_json::to_value(SkinColorParams::default()).expect("params serialise"),
-        bake: |v| {
-            let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
-            skin_color_lut_files(&p)
+    vec![
+        Asset {
+            name: SKIN_COLOR_LUT,
+            summary: "skin colour LUT: melanin x hemoglobin -> linear sRGB albedo (spectral two-layer model, eq. 7.7)",
+            default_params: || serde_json::to_value(SkinColorParams::default()).expect("params serialise"),
+            bake: |v| {
+                let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
+                skin_color_lut_files(&p)
+            },
         },
-    },
-    Asset {
-        name: SKIN_COLOR_MC_DIFFERENCE,
-        summary: "published skin colour LUT vs Monte Carlo transport: CIELAB dE*ab map (coarse MC grid, bilinear)",
-        default_params: || serde_json::to_value(McColorParams::default()).expect("params serialise"),
-        bake: |v| {
-            let p: McColorParams = parse_params(SKIN_COLOR_MC_DIFFERENCE, v)?;
-            skin_color_mc_difference_files(&p)
+        Asset {
+            name: SKIN_COLOR_MC_DIFFERENCE,
+            summary: "published skin colour LUT vs Monte Carlo transport: CIELAB dE*ab map (coarse MC grid, bilinear)",
+            default_params: || serde_json::to_value(McColorParams::default()).expect("params serialise"),
+            bake: |v| {
+                let p: McColorParams = parse_params(SKIN_COLOR_MC_DIFFERENCE, v)?;
+                skin_color_mc_difference_files(&p)
+            },
         },
-    }]
+    ]
 }
 
 /// Asset name of the published-LUT-versus-Monte-Carlo difference map.
@@ -53,17 +55,25 @@ pub const SKIN_COLOR_MC_DIFFERENCE: &str = "skin-color-mc-difference";
 /// Every file of the difference asset: the published table (multipole, thesis defaults) against the Monte Carlo
 /// grid of `p` ([`crate::skin_color::monte_carlo`]).
 pub fn skin_color_mc_difference_files(p: &McColorParams) -> Result<Vec<BakedFile>, BakeError> {
+    skin_color_mc_difference_files_for(&SkinColorParams::default(), p)
+}
+
+/// [`skin_color_mc_difference_files`] for the table of `published` (its physiology, adding, spectral step, …;
+/// the Monte Carlo runs the same physiology) — `rtbake skin-color --model mc`.
+pub fn skin_color_mc_difference_files_for(
+    published: &SkinColorParams,
+    p: &McColorParams,
+) -> Result<Vec<BakedFile>, BakeError> {
     use crate::baked_layout::path::{SKIN_MC_DIFFERENCE_CSV, SKIN_MC_DIFFERENCE_PNG, SKIN_MC_NODES};
     use crate::skin_color::monte_carlo::{difference_map, McColorGrid};
-    let published = SkinColorParams::default();
     let model = published.model().map_err(invalid)?;
     let grid = McColorGrid::simulate(p, &published.physiology())?;
     let map = difference_map(&model, &grid)?;
     let n = p.map_size;
-    let (worst_i, worst) = map
-        .iter()
-        .enumerate()
-        .fold((0, 0.0f64), |(bi, b), (i, t)| if t.delta_e_ab > b { (i, t.delta_e_ab) } else { (bi, b) });
+    let (worst_i, worst) =
+        map.iter()
+            .enumerate()
+            .fold((0, 0.0f64), |(bi, b), (i, t)| if t.delta_e_ab > b { (i, t.delta_e_ab) } else { (bi, b) });
     // Colour ramp black -> red -> yellow -> white over 0..scale, scale = max dE rounded up to a multiple of 5.
     let scale = ((worst / 5.0).ceil() * 5.0).max(5.0);
     let mut px = crate::image_buf::Image::from_vec(n, n, 3, vec![0u8; (3 * n * n) as usize]);
@@ -71,8 +81,8 @@ pub fn skin_color_mc_difference_files(p: &McColorParams) -> Result<Vec<BakedFile
         let (i, j) = (k as u32 % n, k as u32 / n);
         // Row 0 of the map is Chd = 0, drawn at the top like the LUT preview.
         let c = crate::plot::sheet::difference_colour((t.delta_e_ab / scale) as f32);
-        for ch in 0..3 {
-            px.set(i, j, ch as u32, c[ch]);
+        for (ch, v) in c.into_iter().enumerate() {
+            px.set(i, j, ch as u32, v);
         }
     }
     let layout = LutLayout { width: n, height: n, index_form: IndexForm::NormalizedCbrt };

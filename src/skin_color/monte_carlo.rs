@@ -39,7 +39,7 @@ pub const MAX_NODES: u32 = 17;
 pub struct McColorParams {
     /// Henyey–Greenstein anisotropy, open interval (−1, 1) (0.8, the profiles' tissue-like default).
     pub g: f64,
-    /// Photons per wavelength and node, ≥ 1.
+    /// Photons per wavelength at the lightest nodes (Cm = 0), ≥ 1; see [`Self::photons_at`].
     pub photons: u64,
     /// Seed of the first node; node k (row-major, Chd slowest) uses `seed + k`.
     pub seed: u64,
@@ -52,9 +52,9 @@ pub struct McColorParams {
 }
 
 impl Default for McColorParams {
-    /// The baked map: 4 × 4 nodes, 40 nm, 200 photons per wavelength and node, g = 0.8.
+    /// The baked map: 4 × 4 nodes, 40 nm, 120 photons per wavelength at Cm = 0 (up to 1920 at Cm = 0.5), g = 0.8.
     fn default() -> Self {
-        Self { g: 0.8, photons: 200, seed: 1, mc_nodes: 4, mc_step_nm: 40, map_size: 32 }
+        Self { g: 0.8, photons: 120, seed: 1, mc_nodes: 4, mc_step_nm: 40, map_size: 32 }
     }
 }
 
@@ -78,10 +78,22 @@ impl McColorParams {
         (MELANIN_FRACTION_MAX * t(i), DERMAL_HEMOGLOBIN_FRACTION_MAX * t(j))
     }
 
-    fn source(&self, physiology: &SkinPhysiology, k: u32) -> Result<crate::diffusion::source::ProfileSource, InvalidInput> {
+    /// Photons per wavelength at melanin node `i`: `photons · (1 + 3u)²` with u = i/(nodes − 1), so the darker
+    /// nodes (less light returns, but their photons are absorbed sooner and cost less) reach a relative standard
+    /// error closer to the light ones' (16 × at Cm = 0.5).
+    pub fn photons_at(&self, i: u32) -> u64 {
+        let u = i as f64 / (self.mc_nodes - 1) as f64;
+        (self.photons as f64 * (1.0 + 3.0 * u).powi(2)).round() as u64
+    }
+
+    fn source(
+        &self,
+        physiology: &SkinPhysiology,
+        k: u32,
+    ) -> Result<crate::diffusion::source::ProfileSource, InvalidInput> {
         let (i, j) = (k % self.mc_nodes, k / self.mc_nodes);
         let (cm, chd) = self.node(i, j);
-        let transport = TransportModel::monte_carlo(self.g, self.photons, self.seed.wrapping_add(k as u64))?;
+        let transport = TransportModel::monte_carlo(self.g, self.photons_at(i), self.seed.wrapping_add(k as u64))?;
         let projection = SkinProjection::Spectral { illuminant: Illuminant::D65, step_nm: self.mc_step_nm };
         let (src, _) = physiological_skin_source(
             physiology,
@@ -149,6 +161,24 @@ impl McColorGrid {
         })
     }
 
+    /// The per-channel ratio transport / `published` at the nodes, as a grid (its standard errors relative).
+    /// The colour falls steeply between the coarse nodes (a factor 6 between adjacent melanin nodes); the ratio
+    /// varies slowly, so the ratio is what is interpolated.
+    pub fn ratio_to(&self, published: &TwoLayerSkinModel) -> Result<Self, InvalidInput> {
+        let mut ratios = self.clone();
+        for (k, (r, se)) in ratios.linear_rgb.iter_mut().zip(ratios.linear_rgb_se.iter_mut()).enumerate() {
+            let (i, j) = (k as u32 % self.params.mc_nodes, k as u32 / self.params.mc_nodes);
+            let (cm, chd) = self.params.node(i, j);
+            let p = published
+                .evaluate(cm, chd, false)
+                .map_err(|super::two_layer::SkinColorError::Invalid(e)| e)?
+                .linear_rgb;
+            *r = [0, 1, 2].map(|c| r[c] / p[c]);
+            *se = [0, 1, 2].map(|c| se[c] / p[c]);
+        }
+        Ok(ratios)
+    }
+
     /// The colour at (Cm, Chd) in Table 7.1's ranges.
     pub fn colour_at(&self, cm: f64, chd: f64) -> [f64; 3] {
         self.interpolate((cm / MELANIN_FRACTION_MAX).cbrt(), (chd / DERMAL_HEMOGLOBIN_FRACTION_MAX).cbrt())
@@ -172,21 +202,16 @@ pub struct DifferenceTexel {
 /// bilinear interpolation (in u, v) of the per-channel ratio transport / published at the nodes.
 pub fn difference_map(published: &TwoLayerSkinModel, grid: &McColorGrid) -> Result<Vec<DifferenceTexel>, InvalidInput> {
     let n = grid.params.map_size;
-    // The colour falls steeply between the coarse nodes (a factor 6 between adjacent melanin nodes); the ratio of
-    // the transport to the published colour varies slowly, so the ratio is what is interpolated.
-    let mut ratios = grid.clone();
-    for (k, r) in ratios.linear_rgb.iter_mut().enumerate() {
-        let (i, j) = (k as u32 % grid.params.mc_nodes, k as u32 / grid.params.mc_nodes);
-        let (cm, chd) = grid.params.node(i, j);
-        let p = published.evaluate(cm, chd, false).map_err(|super::two_layer::SkinColorError::Invalid(e)| e)?.linear_rgb;
-        *r = [0, 1, 2].map(|c| r[c] / p[c]);
-    }
+    let ratios = grid.ratio_to(published)?;
     let mut out = Vec::with_capacity((n * n) as usize);
     for j in 0..n {
         for i in 0..n {
             let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
             let (cm, chd) = (MELANIN_FRACTION_MAX * u.powi(3), DERMAL_HEMOGLOBIN_FRACTION_MAX * v.powi(3));
-            let p = published.evaluate(cm, chd, false).map_err(|super::two_layer::SkinColorError::Invalid(e)| e)?.linear_rgb;
+            let p = published
+                .evaluate(cm, chd, false)
+                .map_err(|super::two_layer::SkinColorError::Invalid(e)| e)?
+                .linear_rgb;
             let ratio = ratios.interpolate(u, v);
             let m = [0, 1, 2].map(|c| p[c] * ratio[c]);
             let (yp, ym) = (xyz_of_linear_srgb(p)[1], xyz_of_linear_srgb(m)[1]);
@@ -272,7 +297,8 @@ mod tests {
             }
         }
         let mid = grid.interpolate(0.25, 0.25);
-        let expect = [0, 1, 2].map(|c| (linear_rgb[0][c] + linear_rgb[1][c] + linear_rgb[3][c] + linear_rgb[4][c]) / 4.0);
+        let expect =
+            [0, 1, 2].map(|c| (linear_rgb[0][c] + linear_rgb[1][c] + linear_rgb[3][c] + linear_rgb[4][c]) / 4.0);
         assert!((0..3).all(|c| (mid[c] - expect[c]).abs() < 1e-12), "{mid:?} {expect:?}");
     }
 
