@@ -121,6 +121,12 @@ pub mod path {
     pub const SKIN_SAMPLES: &str = "skin/skin_color_samples.csv";
     /// Reflectance spectra R(λ) at the corner points (CSV).
     pub const SKIN_SPECTRA: &str = "skin/skin_color_spectra.csv";
+    /// Published skin-colour LUT against Monte Carlo transport: CIELAB ΔE*ab map for people (sRGB PNG).
+    pub const SKIN_MC_DIFFERENCE_PNG: &str = "skin/skin_color_mc_difference.png";
+    /// The same map as numbers, one row per texel (CSV).
+    pub const SKIN_MC_DIFFERENCE_CSV: &str = "skin/skin_color_mc_difference.csv";
+    /// The Monte Carlo grid nodes with their standard errors (CSV).
+    pub const SKIN_MC_NODES: &str = "skin/skin_color_mc_nodes.csv";
 
     /// Folder of the example hemoglobin rig.
     pub const RIG_EXAMPLE_DIR: &str = "facial/hemoglobin/example";

@@ -7,6 +7,7 @@ use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
 use rtbake::diffusion::FdrForm;
 use rtbake::error::InvalidInput;
 use rtbake::skin_color::lut::{IndexForm, LutEvaluation};
+use rtbake::skin_color::monte_carlo::McColorParams;
 use rtbake::skin_color::two_layer::{SkinColorError, ThinLayer};
 use rtbake::skin_color::SkinColorParams;
 use rtbake::spectral::colorimetry::Illuminant;
@@ -31,6 +32,70 @@ pub struct SkinColorArgs {
     pub model: Box<ModelFlags>,
     #[command(flatten)]
     pub zstd: crate::cli::ZstdArg,
+    /// Transport model: multipole (the published table: multipole slabs + adding) or mc (Monte Carlo transport on
+    /// a coarse (Cm, Chd) grid, the ratio to the published colour interpolated bilinearly; with --out writes the
+    /// difference map of the bake's skin-color-mc-difference asset instead of the table) [default: multipole].
+    #[arg(long = "model", value_enum)]
+    pub transport: Option<SkinModelArg>,
+    #[command(flatten)]
+    pub mc: Box<McFlags>,
+}
+
+#[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
+pub enum SkinModelArg {
+    Multipole,
+    Mc,
+}
+
+/// Monte Carlo flags of `--model mc`; each is the JSON field of `McColorParams` in kebab case.
+#[derive(clap::Args)]
+pub struct McFlags {
+    /// Henyey-Greenstein anisotropy for --model mc, in the open interval (-1, 1); sigma_s = sigma_s' / (1 - g)
+    /// [default: 0.8].
+    #[arg(long, allow_negative_numbers = true)]
+    pub g: Option<f64>,
+    /// Photons per wavelength at the Cm = 0 grid nodes for --model mc, >= 1; darker nodes get up to 16 times as
+    /// many, (1 + 3u)^2 with u = cbrt(Cm/0.5) [default: 120].
+    #[arg(long)]
+    pub photons: Option<u64>,
+    /// Seed of the first grid node for --model mc (node k uses SEED + k) [default: 1].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Grid nodes per axis for --model mc, 2..=17, uniform in the table's cube-root axes [default: 4].
+    #[arg(long)]
+    pub mc_nodes: Option<u32>,
+    /// Wavelength step of the Monte Carlo, nm; must divide 400 [default: 40].
+    #[arg(long)]
+    pub mc_step_nm: Option<u32>,
+    /// Edge of the difference map for --model mc --out, 8..=256 texels [default: 32].
+    #[arg(long)]
+    pub map_size: Option<u32>,
+}
+
+impl McFlags {
+    fn given(&self) -> Option<&'static str> {
+        [
+            (self.g.is_some(), "--g"),
+            (self.photons.is_some(), "--photons"),
+            (self.seed.is_some(), "--seed"),
+            (self.mc_nodes.is_some(), "--mc-nodes"),
+            (self.mc_step_nm.is_some(), "--mc-step-nm"),
+            (self.map_size.is_some(), "--map-size"),
+        ]
+        .into_iter()
+        .find_map(|(given, flag)| given.then_some(flag))
+    }
+
+    fn params(&self) -> McColorParams {
+        let mut p = McColorParams::default();
+        p.g = self.g.unwrap_or(p.g);
+        p.photons = self.photons.unwrap_or(p.photons);
+        p.seed = self.seed.unwrap_or(p.seed);
+        p.mc_nodes = self.mc_nodes.unwrap_or(p.mc_nodes);
+        p.mc_step_nm = self.mc_step_nm.unwrap_or(p.mc_step_nm);
+        p.map_size = self.map_size.unwrap_or(p.map_size);
+        p
+    }
 }
 
 /// Every model/table parameter; each flag is the JSON field of `SkinColorParams` in kebab case.
@@ -221,6 +286,12 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
     if point.is_none() && a.out.is_none() {
         return Err(usage_msg("give a point (--melanin CM --hemoglobin CHD) and/or --out DIR to bake the table"));
     }
+    if a.transport == Some(SkinModelArg::Mc) {
+        return run_mc(&a, ctx, &p, point);
+    }
+    if let Some(flag) = a.mc.given() {
+        return Err(usage_msg(format!("{flag} needs --model mc (it is a Monte Carlo setting)")));
+    }
     if a.spectrum && point.is_none() {
         return Err(usage_msg("--spectrum needs a point (--melanin CM --hemoglobin CHD)"));
     }
@@ -313,6 +384,92 @@ pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {
         }
     } else if ctx.json {
         ctx.emit_json(&serde_json::json!({ "written": written }));
+    }
+    Ok(())
+}
+
+/// `--model mc`: the Monte Carlo grid of the same skin, validated and budgeted before any photon; the point's
+/// colour (published colour times the interpolated node ratio) beside the published one, and/or the difference
+/// map's files in `--out`.
+fn run_mc(a: &SkinColorArgs, ctx: &Ctx, p: &SkinColorParams, point: Option<(f64, f64)>) -> anyhow::Result<()> {
+    use rtbake::skin_color::monte_carlo::{delta_e_ab, McColorGrid};
+    if a.spectrum {
+        return Err(usage_msg("--spectrum is not available with --model mc (the grid holds colours, not spectra)"));
+    }
+    if p.allow_unphysiological {
+        return Err(usage_msg("--allow-unphysiological is not available with --model mc (the grid spans Table 7.1)"));
+    }
+    a.zstd.level()?;
+    let mc = a.mc.params();
+    mc.validate().map_err(|e| flag_error(SkinColorError::Invalid(e)))?;
+    let model = p.model().map_err(flag_error)?;
+    let sample = match point {
+        Some((cm, chd)) => Some(model.evaluate(cm, chd, false).map_err(flag_error)?),
+        None => None,
+    };
+    let physiology = p.physiology();
+    let estimate = mc
+        .time_estimate_seconds(&physiology, rayon::current_num_threads())
+        .map_err(|e| flag_error(SkinColorError::Invalid(e)))?;
+    ctx.check_time(
+        &format!(
+            "--model mc --photons {} --mc-nodes {} --mc-step-nm {} --g {}",
+            mc.photons, mc.mc_nodes, mc.mc_step_nm, mc.g
+        ),
+        estimate,
+    )?;
+    let grid = McColorGrid::simulate(&mc, &physiology).map_err(|e| flag_error(SkinColorError::Invalid(e)))?;
+    let mut written = Vec::new();
+    if let Some(dir) = &a.out {
+        let mut files = rtbake::bake::skin::skin_color_mc_difference_files_for(p, &mc).map_err(|e| match e {
+            rtbake::bake::BakeError::Invalid(i) => flag_error(SkinColorError::Invalid(i)),
+            other => anyhow::Error::new(other),
+        })?;
+        a.zstd.apply(&mut files)?;
+        for f in &mut files {
+            f.path = f.path.strip_prefix("skin/").map(str::to_string).unwrap_or(f.path.clone());
+        }
+        prepare_out_dir("--out", dir)?;
+        written = crate::cli::write_set(ctx, "--out", dir, &files, &[])?
+            .iter()
+            .map(|p| p.strip_prefix(dir).unwrap_or(p).to_string_lossy().into_owned())
+            .collect();
+        ctx.info(format!("wrote {} files of the Monte Carlo difference map to {}", written.len(), dir.display()));
+    }
+    let mut v = serde_json::json!({
+        "model": "mc",
+        "g": mc.g,
+        "photons": mc.photons,
+        "seed": mc.seed,
+        "mc_nodes": mc.mc_nodes,
+        "mc_step_nm": mc.mc_step_nm,
+        "nodes_linear_rgb_se_max": grid.linear_rgb_se.iter().flatten().fold(0.0f64, |m, &x| m.max(x)),
+    });
+    if let Some(s) = &sample {
+        // The point's Monte Carlo colour: the published colour times the bilinear ratio at the nodes, as in the map.
+        let ratio = grid
+            .ratio_to(&model)
+            .map_err(|e| flag_error(SkinColorError::Invalid(e)))?
+            .colour_at(s.melanin, s.hemoglobin);
+        let m = [0, 1, 2].map(|c| s.linear_rgb[c] * ratio[c]);
+        let de = delta_e_ab(s.linear_rgb, m);
+        v["melanin"] = serde_json::json!(s.melanin);
+        v["hemoglobin"] = serde_json::json!(s.hemoglobin);
+        v["linear_rgb"] = serde_json::json!(m);
+        v["published_linear_rgb"] = serde_json::json!(s.linear_rgb);
+        v["delta_e_ab"] = serde_json::json!(de);
+        if !ctx.json {
+            println!(
+                "Cm {} Chd {}: Monte Carlo (g {}) linear sRGB {:.6} {:.6} {:.6}; published {:.6} {:.6} {:.6}; dE*ab {de:.2}",
+                s.melanin, s.hemoglobin, mc.g, m[0], m[1], m[2], s.linear_rgb[0], s.linear_rgb[1], s.linear_rgb[2]
+            );
+        }
+    }
+    if a.out.is_some() {
+        v["written"] = serde_json::json!(written);
+    }
+    if ctx.json {
+        ctx.emit_json(&v);
     }
     Ok(())
 }

@@ -3,6 +3,7 @@
 use super::{json_file, parse_params, text_file, Asset, BakeError, BakedFile};
 use crate::manifest::{FileFormat, FileKind};
 use crate::skin_color::lut::{bake_lut_with_progress, IndexForm, LutLayout};
+use crate::skin_color::monte_carlo::McColorParams;
 use crate::skin_color::two_layer::{SkinColorError, TwoLayerSkinModel};
 use crate::skin_color::SkinColorParams;
 use serde_json::Value;
@@ -26,15 +27,133 @@ pub const SAMPLE_HEMOGLOBIN: [f64; 6] = [0.0, 0.01, 0.04, 0.1, 0.2, 0.32];
 pub const SPECTRUM_POINTS: [(f64, f64); 5] = [(0.0, 0.0), (0.5, 0.0), (0.0, 0.32), (0.5, 0.32), (0.07, 0.04)];
 
 pub fn assets() -> Vec<Asset> {
-    vec![Asset {
-        name: SKIN_COLOR_LUT,
-        summary: "skin colour LUT: melanin x hemoglobin -> linear sRGB albedo (spectral two-layer model, eq. 7.7)",
-        default_params: || serde_json::to_value(SkinColorParams::default()).expect("params serialise"),
-        bake: |v| {
-            let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
-            skin_color_lut_files(&p)
+    vec![
+        Asset {
+            name: SKIN_COLOR_LUT,
+            summary: "skin colour LUT: melanin x hemoglobin -> linear sRGB albedo (spectral two-layer model, eq. 7.7)",
+            default_params: || serde_json::to_value(SkinColorParams::default()).expect("params serialise"),
+            bake: |v| {
+                let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
+                skin_color_lut_files(&p)
+            },
         },
-    }]
+        Asset {
+            name: SKIN_COLOR_MC_DIFFERENCE,
+            summary: "published skin colour LUT vs Monte Carlo transport: CIELAB dE*ab map (coarse MC grid, bilinear)",
+            default_params: || serde_json::to_value(McColorParams::default()).expect("params serialise"),
+            bake: |v| {
+                let p: McColorParams = parse_params(SKIN_COLOR_MC_DIFFERENCE, v)?;
+                skin_color_mc_difference_files(&p)
+            },
+        },
+    ]
+}
+
+/// Asset name of the published-LUT-versus-Monte-Carlo difference map.
+pub const SKIN_COLOR_MC_DIFFERENCE: &str = "skin-color-mc-difference";
+
+/// Every file of the difference asset: the published table (multipole, thesis defaults) against the Monte Carlo
+/// grid of `p` ([`crate::skin_color::monte_carlo`]).
+pub fn skin_color_mc_difference_files(p: &McColorParams) -> Result<Vec<BakedFile>, BakeError> {
+    skin_color_mc_difference_files_for(&SkinColorParams::default(), p)
+}
+
+/// [`skin_color_mc_difference_files`] for the table of `published` (its physiology, adding, spectral step, …;
+/// the Monte Carlo runs the same physiology) — `rtbake skin-color --model mc`.
+pub fn skin_color_mc_difference_files_for(
+    published: &SkinColorParams,
+    p: &McColorParams,
+) -> Result<Vec<BakedFile>, BakeError> {
+    use crate::baked_layout::path::{SKIN_MC_DIFFERENCE_CSV, SKIN_MC_DIFFERENCE_PNG, SKIN_MC_NODES};
+    use crate::skin_color::monte_carlo::{difference_map, McColorGrid};
+    let model = published.model().map_err(invalid)?;
+    let grid = McColorGrid::simulate(p, &published.physiology())?;
+    let map = difference_map(&model, &grid)?;
+    let n = p.map_size;
+    let (worst_i, worst) =
+        map.iter()
+            .enumerate()
+            .fold((0, 0.0f64), |(bi, b), (i, t)| if t.delta_e_ab > b { (i, t.delta_e_ab) } else { (bi, b) });
+    // Colour ramp black -> red -> yellow -> white over 0..scale, scale = max dE rounded up to a multiple of 5.
+    let scale = ((worst / 5.0).ceil() * 5.0).max(5.0);
+    let mut px = crate::image_buf::Image::from_vec(n, n, 3, vec![0u8; (3 * n * n) as usize]);
+    for (k, t) in map.iter().enumerate() {
+        let (i, j) = (k as u32 % n, k as u32 / n);
+        // Row 0 of the map is Chd = 0, drawn at the top like the LUT preview.
+        let c = crate::plot::sheet::difference_colour((t.delta_e_ab / scale) as f32);
+        for (ch, v) in c.into_iter().enumerate() {
+            px.set(i, j, ch as u32, v);
+        }
+    }
+    let layout = LutLayout { width: n, height: n, index_form: IndexForm::NormalizedCbrt };
+    let mut axes = lut_axes(&layout);
+    axes.title = format!(
+        "published skin LUT vs Monte Carlo (g {}): CIELAB dE*ab, black 0 > red > yellow > white {scale}; max {worst:.1}",
+        p.g
+    );
+    let img = crate::plot::preview::labelled_preview(&px, &axes);
+    let conv = format!(
+        "plot for people: CIELAB dE*ab (D65 white) between the published skin-colour LUT (multipole + symmetric          adding, 1 nm) and Monte Carlo transport (g {}, {} photons per wavelength and node, {} nm, {}x{} nodes          uniform in u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), ratio MC/published interpolated bilinearly), {n}x{n} texel centres; Cm along x, Chd down y",
+        p.g, p.photons, p.mc_step_nm, p.mc_nodes, p.mc_nodes
+    );
+    let mut meta = crate::manifest::FileMeta::text(FileKind::Plot, FileFormat::Png, &conv);
+    (meta.width, meta.height, meta.channels) = (img.width, img.height, img.channels);
+    meta.sample_type = crate::manifest::SampleType::U8;
+    meta.color_space = crate::manifest::ColorSpace::Srgb;
+    let png = BakedFile {
+        path: SKIN_MC_DIFFERENCE_PNG.into(),
+        bytes: crate::io::png::encode_u8_as(&img, crate::io::png::PngColor::Srgb)?,
+        meta,
+    };
+    let mut csv = String::from(
+        "melanin_cm,hemoglobin_chd,published_r,published_g,published_b,mc_r,mc_g,mc_b,delta_e_ab,relative_luminance\n",
+    );
+    for t in &map {
+        let [pr, pg, pb] = t.published_linear_rgb;
+        let [mr, mg, mb] = t.monte_carlo_linear_rgb;
+        writeln!(
+            csv,
+            "{:.8},{:.8},{pr:.8},{pg:.8},{pb:.8},{mr:.8},{mg:.8},{mb:.8},{:.6},{:.6}",
+            t.melanin, t.hemoglobin, t.delta_e_ab, t.relative_luminance
+        )
+        .expect("string write");
+    }
+    let mut nodes = String::from("melanin_cm,hemoglobin_chd,mc_r,mc_g,mc_b,se_r,se_g,se_b,seed\n");
+    for (k, (c, se)) in grid.linear_rgb.iter().zip(&grid.linear_rgb_se).enumerate() {
+        let (i, j) = (k as u32 % p.mc_nodes, k as u32 / p.mc_nodes);
+        let (cm, chd) = p.node(i, j);
+        writeln!(
+            nodes,
+            "{cm:.8},{chd:.8},{:.8},{:.8},{:.8},{:.8},{:.8},{:.8},{}",
+            c[0],
+            c[1],
+            c[2],
+            se[0],
+            se[1],
+            se[2],
+            p.seed.wrapping_add(k as u64)
+        )
+        .expect("string write");
+    }
+    let w = &map[worst_i];
+    let csv_conv = format!(
+        "one row per texel centre of the {n}x{n} map (Chd slowest): linear sRGB of the published LUT and of the \
+         Monte Carlo grid (published times the bilinear node ratio), CIELAB dE*ab and (Y_mc - Y_published)/Y_published; largest dE*ab {worst:.2} at \
+         Cm {:.4}, Chd {:.4}",
+        w.melanin, w.hemoglobin
+    );
+    Ok(vec![
+        png,
+        text_file(SKIN_MC_DIFFERENCE_CSV, csv, FileKind::Csv, FileFormat::Csv, &csv_conv),
+        text_file(
+            SKIN_MC_NODES,
+            nodes,
+            FileKind::Csv,
+            FileFormat::Csv,
+            "Monte Carlo nodes: total diffuse reflectance (per entering flux) projected to linear sRGB with the LUT's \
+             colour weights, its standard error per channel, and the node's seed",
+        ),
+    ])
 }
 
 fn invalid(e: SkinColorError) -> BakeError {

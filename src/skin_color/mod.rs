@@ -13,6 +13,7 @@
 
 pub mod epidermis_table;
 pub mod lut;
+pub mod monte_carlo;
 pub mod two_layer;
 
 use crate::diffusion::FdrForm;
