@@ -76,8 +76,10 @@ pub const COS_TAYLOR: [f64; 9] = [
 /// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Medium {
+    /// Depth of the layer's top and bottom faces, mm (the bottom may be infinite).
     pub z_top_mm: f64,
     pub z_bottom_mm: f64,
+    /// σt = σa + σs, mm⁻¹ (0: a clear layer).
     pub sigma_t_per_mm: f64,
     /// 1/σt, mm (unused in a clear layer).
     pub inv_sigma_t_mm: f64,
@@ -87,6 +89,7 @@ pub struct Medium {
     /// 1 − g², 1 − g, 2g, 1 + g², 1/(2g) of cos θ = (1 + g² − ((1 − g²)/(1 − g + 2gξ))²)/(2g) (MCML eq. 3.28).
     pub isotropic: bool,
     pub hg: [f64; 5],
+    /// Refractive index of the layer.
     pub eta: f64,
 }
 
@@ -102,6 +105,7 @@ pub struct Channel<'a> {
     pub start_weight: f64,
     /// The channel's Philox counter word.
     pub index: u32,
+    /// The Philox key (photon k of the channel draws block e at counter (k, index, e)).
     pub seed: u64,
 }
 
