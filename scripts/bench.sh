@@ -45,3 +45,8 @@ row "skin LUT 256x256 at 1 nm (FLOP bound)" "$skin" "$(bound 952.5 "$gflops")" 2
 row "hemoglobin rig 4096x4096, 9 maps, r = 32 (FP)" "$rig" "$(bound 79375 "$gflops")" 2 "$(path rig)"
 row "CPU SMAA 1x 1080p (memory bound)" "$smaa" "$(bound 44.85 "$gbps")" 3 "no explicit SIMD path"
 row "CPU SMAA 1x 1080p, reused buffers (memory)" "$smaa_reused" "$(bound 44.85 "$gbps")" 3 "no explicit SIMD path"
+
+# The lane kernel per instruction-set path against MCML 1.2.2, CPU seconds on one core (MCML_BIN / MCML_BIN2 name
+# MCML binaries; without them the script says MCML is absent and prints rtbake's figures only).
+echo "== bench_mcml (scripts/bench_mcml.sh)"
+bash scripts/bench_mcml.sh | tee "$OUT/bench_mcml.txt"

@@ -13,9 +13,11 @@
 //! The multipole does not depend on g (it sees σs′ only); the Monte Carlo does.
 //!
 //! **Photons and seeds.** Skins: `skin_photons` per wavelength and channel, so a skin's channel sums
-//! (780 − 380)/`step_nm` + 1 wavelengths' photons (41 × 800 = 3.3·10⁴ by default, standard errors from 4 batches per wavelength group, pooled over the 14 groups; fewer than 10⁵ photons and batches of at least a few hundred photons, so that 32-lane chunks are not dominated by their longest history, keep the default bake near a minute) and its total R carries the
-//! standard error printed beside it; materials: `photons` per channel (g = 0 only: the high-albedo materials
-//! scatter thousands of times per photon). Every case and g has its own seed, derived from `seed` and the case's
+//! (780 − 380)/`step_nm` + 1 wavelengths' photons (41 × 2500 = 1.03·10⁵ by default; standard errors from 4 batches
+//! per wavelength group, pooled over the 14 groups) and its total R carries the
+//! standard error printed beside it; materials: `photons` per channel (10⁵ by default; g = 0 only: the high-albedo
+//! materials scatter thousands of times per photon). The whole report takes ~25 CPU-s in the README's dev build
+//! (the lane kernel is built at opt-level 3 there too, `crates/rtbake-lanes`). Every case and g has its own seed, derived from `seed` and the case's
 //! name by FNV-1a ([`case_seed`]); a wavelength group j adds j·2³² as `--model mc` does. Both models are normalised
 //! per unit flux entering the surface (Monte Carlo ÷ (1 − Rsp), [`crate::transport::profile`]).
 //!
@@ -98,8 +100,8 @@ struct ReportParams {
 
 fn default_params() -> ReportParams {
     ReportParams {
-        photons: 2000,
-        skin_photons: 800,
+        photons: 100_000,
+        skin_photons: 2500,
         seed: 1,
         batches: 4,
         bin_mm: 0.1,
@@ -553,10 +555,13 @@ fn summary_markdown(rows: &[Row], p: &ReportParams) -> String {
     }
     s.push_str(&format!(
         "\nMonte Carlo: {} photons per channel (materials, g = 0); skins {} photons per wavelength and channel, \
-         {} nm steps; every case its own seed. Skins: {} two-layer skins and {} dermis-only slab(s).\n",
+         {} nm steps ({} wavelengths: {} photons per channel); every case its own seed. Skins: {} two-layer skins \
+         and {} dermis-only slab(s).\n",
         p.photons,
         p.skin_photons,
         p.step_nm,
+        400 / p.step_nm + 1,
+        u64::from(400 / p.step_nm + 1) * p.skin_photons,
         p.skin.len() + p.grid.melanin_fraction.len() * p.grid.hemoglobin_fraction.len(),
         p.dermis_only.len()
     ));

@@ -57,9 +57,9 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Weight below which Russian roulette is played (MCML's default, §3.6).
-pub const ROULETTE_THRESHOLD: f64 = 1e-4;
+pub const ROULETTE_THRESHOLD: f64 = rtbake_lanes::ROULETTE_THRESHOLD;
 /// A packet survives roulette with chance 1/m and weight ×m, m = 10 (MCML §3.6).
-pub const ROULETTE_CHANCE: f64 = 10.0;
+pub const ROULETTE_CHANCE: f64 = rtbake_lanes::ROULETTE_CHANCE;
 /// Most photons per channel accepted (refused before any work).
 pub const MAX_PHOTONS: u64 = 10_000_000_000;
 /// Most radial bins accepted.
@@ -161,11 +161,12 @@ impl McSettings {
     }
 }
 
-/// How much slower the engine runs in a build with debug assertions (the dev profile the README's `cargo run`
-/// uses: opt-level 1, where the lane engine's SIMD helpers are not inlined) than in the release build the rates
-/// below were measured with: a high-albedo slab (`transport --material marble --photons 100000`) took 24.6 CPU-s
-/// with the dev build against 1.46 with the release build on the project's 2-core machine (2026-11-26), 17×.
-pub const BUILD_SLOWDOWN: f64 = if cfg!(debug_assertions) { 20.0 } else { 1.0 };
+/// How much slower the engine runs in the dev build (the README's `cargo run`) than in the release build the rates
+/// below were measured with: 1. The lane kernel is the `rtbake-lanes` workspace crate, which the dev profile builds
+/// at opt-level 3 (`[profile.dev.package.rtbake-lanes]`); a high-albedo slab (`transport --material marble
+/// --photons 100000`) took 1.46 CPU-s with the dev build, as with the release build, on the project's 2-core
+/// machine (2026-11-26; 24.6 CPU-s, 17×, when the kernel was built at the dev profile's opt-level 1).
+pub const BUILD_SLOWDOWN: f64 = 1.0;
 
 /// Interactions per thread and second assumed by [`McSettings::time_estimate_for_stack`] (AVX2 / AVX-512F paths):
 /// a third of the rate measured on the project's 2-core machine with the release build (`examples/bench_transport`
@@ -258,44 +259,8 @@ pub struct McResult {
 
 /// Raw weight sums of a chunk or batch of one channel (photon weights, not yet divided by the photon count or the
 /// annulus area). The CPU path fills them per chunk; the GPU path (`runtime::transport_gpu`) reads them back per
-/// batch; both hand them to [`assemble`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tally {
-    /// Weight leaving through the top face per radial bin.
-    pub r: Vec<f64>,
-    /// Weight leaving through the bottom face per radial bin.
-    pub t: Vec<f64>,
-    /// Weight leaving through the top face (all radii).
-    pub rd: f64,
-    /// Weight leaving through the bottom face (all radii).
-    pub td: f64,
-    /// Weight absorbed per layer.
-    pub absorbed: Vec<f64>,
-    /// Interactions traced.
-    pub interactions: u64,
-}
-
-impl Tally {
-    /// Zero tallies for `bins` radial bins and `layers` layers.
-    pub fn new(bins: usize, layers: usize) -> Self {
-        Self { r: vec![0.0; bins], t: vec![0.0; bins], rd: 0.0, td: 0.0, absorbed: vec![0.0; layers], interactions: 0 }
-    }
-    /// Adds `o` bin by bin.
-    pub fn add(&mut self, o: &Tally) {
-        for (a, b) in self.r.iter_mut().zip(&o.r) {
-            *a += b;
-        }
-        for (a, b) in self.t.iter_mut().zip(&o.t) {
-            *a += b;
-        }
-        self.rd += o.rd;
-        self.td += o.td;
-        for (a, b) in self.absorbed.iter_mut().zip(&o.absorbed) {
-            *a += b;
-        }
-        self.interactions += o.interactions;
-    }
-}
+/// batch; both hand them to [`assemble`]. (Defined by the lane kernel's crate, which fills it.)
+pub use rtbake_lanes::Tally;
 
 /// Per-layer constants of one channel, with what the photon loop would otherwise divide by precomputed.
 #[derive(Clone, Copy, Debug)]

@@ -8,10 +8,7 @@
 //! fixed by its index alone, so no generator state is shared between threads and results do not depend on how
 //! photons are scheduled.
 
-pub(super) const M0: u32 = 0xD251_1F53;
-pub(super) const M1: u32 = 0xCD9E_8D57;
-pub(super) const W0: u32 = 0x9E37_79B9;
-pub(super) const W1: u32 = 0xBB67_AE85;
+pub(super) use rtbake_lanes::{M0, M1, W0, W1};
 
 /// Philox4x32-10 of `counter` under `key`.
 pub fn philox4x32_10(counter: [u32; 4], key: [u32; 2]) -> [u32; 4] {

@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Photons per CPU second of rtbake's lane kernel on each instruction-set path against the original MCML 1.2.2
+# (Wang, Jacques & Zheng 1995) on the same problems, one core each.
+#
+#   MCML_BIN=/path/to/mcml [MCML_BIN2=/path/to/other-mcml] [RUNS=3] bash scripts/bench_mcml.sh
+#
+# rtbake side: `crates/rtbake-lanes/examples/lane_paths` (the kernel `rtbake transport` runs, one thread, chunks of
+# 4096 photons), built with `cargo build --release -p rtbake-lanes --example lane_paths`; each path is forced with
+# RTBAKE_LANE_PATH=portable|avx2|avx512 (paths the CPU lacks are skipped) and must print the same checksum.
+# MCML side: the .mci input written here (one run, same optical properties, same photon count). Both are timed
+# with /usr/bin/time (user + system CPU seconds of the process, so the load of a shared machine does not count);
+# RUNS runs each, alternated, medians and the ratio rtbake photons/s over MCML photons/s printed. Without MCML_BIN
+# (or if it is not executable) the MCML side is left out and the script says so.
+#
+# Problems (mm, mm^-1; sigma_s = sigma_s'/(1 - g), sigma_s' kept), at g = 0 and g = 0.8:
+#   skin:   two layers at one wavelength, air above: epidermis 0.25 mm, eta 1.4, mu_a 1.5, mu_s' 5.0;
+#           dermis semi-infinite, eta 1.4, mu_a 0.3, mu_s' 2.0;
+#   jensen: a Jensen-like semi-infinite material, air above, eta 1.3, mu_a 0.1, mu_s' 1.0 (reduced albedo 0.91).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+RUNS=${RUNS:-3}
+PHOTONS=${PHOTONS:-300000}
+TARGET=${CARGO_TARGET_DIR:-target}
+cargo build --release --locked -p rtbake-lanes --example lane_paths >&2
+LANE="$TARGET/release/examples/lane_paths"
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+
+MCMLS=()
+for b in "${MCML_BIN:-}" "${MCML_BIN2:-}"; do
+  if [ -n "$b" ] && [ -x "$b" ]; then MCMLS+=("$b"); fi
+done
+if [ ${#MCMLS[@]} -eq 0 ]; then
+  echo "MCML ABSENT: MCML_BIN is unset or not executable; only rtbake's figures are printed (no ratios)."
+  echo "  Build MCML 1.2.2 (github.com/lhvwang/MCML, V1/mcR5unix/mcmlcode: gcc -O3 -o mcml *.c -lm) and set MCML_BIN."
+fi
+
+median() { sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
+cpu() { # command... -> user+sys seconds
+  /usr/bin/time -f "%U %S" -o "$WORK/t" "$@" >"$WORK/out" 2>&1
+  awk '{print $1 + $2}' "$WORK/t"
+}
+
+# mci LAYERS_LINES NLAYERS N ETA_ABOVE ETA_BELOW -> writes $WORK/in.mci (MCML: cm, cm^-1)
+write_mci() {
+  { echo "1.0"; echo "1"; echo "out.mco A"; echo "$3"; echo "0.01 0.01"; echo "10 100 1"
+    echo "$2"; echo "$4"; printf '%b' "$1"; echo "$5"; } > "$WORK/in.mci"
+}
+
+for g in 0 0.8; do
+  s=$(awk -v g="$g" 'BEGIN {print 1 / (1 - g)}')
+  # rtbake layers (mm): thickness,eta,mu_a,mu_s,g; MCML layers (cm): n mua mus g d
+  skin_r=("0.25,1.4,1.5,$(awk -v s="$s" 'BEGIN{print 5.0*s}'),$g" "inf,1.4,0.3,$(awk -v s="$s" 'BEGIN{print 2.0*s}'),$g")
+  skin_m="1.4 15 $(awk -v s="$s" 'BEGIN{print 50*s}') $g 0.025\n1.4 3 $(awk -v s="$s" 'BEGIN{print 20*s}') $g 1E+8\n"
+  jen_r=("inf,1.3,0.1,$(awk -v s="$s" 'BEGIN{print 1.0*s}'),$g")
+  jen_m="1.3 1 $(awk -v s="$s" 'BEGIN{print 10*s}') $g 1E+8\n"
+  for case in skin jensen; do
+    if [ "$case" = skin ]; then layers=("${skin_r[@]}"); mci="$skin_m"; nl=2; eb=1.4; else layers=("${jen_r[@]}"); mci="$jen_m"; nl=1; eb=1.3; fi
+    write_mci "$mci" "$nl" "$PHOTONS" 1.0 "$eb"
+    declare -A t=()
+    sums=""
+    rd=""
+    for ((r = 0; r < RUNS; r++)); do
+      for path in avx512 avx2 portable; do
+        out=$(RTBAKE_LANE_PATH=$path "$LANE" 1 1.0 "$eb" "${layers[@]}")
+        [[ "$out" == *"path Portable"* && $path != portable ]] && continue   # not supported: detect fell back
+        [[ "$out" == *"path Avx2"* && $path == avx512 ]] && continue
+        t[$path]+="$(RTBAKE_LANE_PATH=$path cpu "$LANE" "$PHOTONS" 1.0 "$eb" "${layers[@]}") "
+        sums+="$(awk '{print $NF}' "$WORK/out") "
+        rd=$(grep -o 'Rd [0-9.]*' "$WORK/out" || true)
+      done
+      for i in "${!MCMLS[@]}"; do
+        t[mcml$i]+="$(cd "$WORK" && cpu "${MCMLS[$i]}" in.mci) "
+      done
+    done
+    nsum=$(echo $sums | tr ' ' '\n' | sort -u | wc -l)
+    echo "== $case, g $g, $PHOTONS photons, $RUNS runs, rtbake $rd, checksums equal across paths and runs: $([ "$nsum" = 1 ] && echo yes || echo NO)"
+    for i in "${!MCMLS[@]}"; do
+      [ -f "$WORK/out.mco" ] && echo "   MCML ${MCMLS[$i]}: Rd $(grep -m1 'Diffuse reflectance' "$WORK/out.mco" | awk '{print $1}')"
+    done
+    for key in avx512 avx2 portable $(for i in "${!MCMLS[@]}"; do echo mcml$i; done); do
+      [ -n "${t[$key]:-}" ] || continue
+      m=$(echo ${t[$key]} | tr ' ' '\n' | median)
+      rate=$(awk -v n="$PHOTONS" -v m="$m" 'BEGIN {printf "%.3f", n / m / 1e6}')
+      name=$key; [[ $key == mcml* ]] && name="MCML ${MCMLS[${key#mcml}]}"
+      line=$(printf '   %-28s median %6.3f CPU-s (runs: %s) %s M photons/s' "$name" "$m" "$(echo ${t[$key]})" "$rate")
+      if [[ $key != mcml* ]]; then
+        for i in "${!MCMLS[@]}"; do
+          mm=$(echo ${t[mcml$i]} | tr ' ' '\n' | median)
+          line+=$(awk -v a="$m" -v b="$mm" -v n="$(basename "${MCMLS[$i]}")" 'BEGIN {printf "; %.2fx %s", b / a, n}')
+        done
+      fi
+      echo "$line"
+    done
+    unset t
+  done
+done
