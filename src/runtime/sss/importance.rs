@@ -90,8 +90,8 @@ impl Default for ImportanceSssParams {
 
 impl ImportanceSssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--mm-per-world-unit", self.mm_per_world_unit as f64, "mm")?;
-        check_range("--fovy", self.fovy_deg, 1.0, 179.0, "degrees")?;
+        check_positive("mm_per_world_unit", self.mm_per_world_unit as f64, "mm")?;
+        check_range("fovy_deg", self.fovy_deg, 1.0, 179.0, "degrees")?;
         Ok(())
     }
     /// 1/tan(0.5·FOVy): distance to the projection window.

@@ -51,8 +51,8 @@ impl Default for SssParams {
 
 impl SssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--sss-width", self.sss_width as f64, "world units")?;
-        check_range("--fovy", self.fovy_deg, 1.0, 179.0, "degrees")?;
+        check_positive("sss_width", self.sss_width as f64, "world units")?;
+        check_range("fovy_deg", self.fovy_deg, 1.0, 179.0, "degrees")?;
         Ok(())
     }
     /// 1/tan(0.5·FOVy): distance to the projection window.
