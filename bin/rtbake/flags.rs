@@ -51,11 +51,9 @@ const FIELD_FLAGS: &[(&str, &str)] = &[
     ("alpha", "--alpha"),
     ("beta", "--beta"),
     ("gamma", "--gamma"),
-    ("lod_factor", "--lod-factor"),
     // antialiasing
     ("mode", "--mode"),
     ("k", "--k"),
-    ("subsample", "--subsample"),
     ("edges", "--edges"),
     ("predication", "--predication"),
     ("predication_threshold", "--predication-threshold"),
@@ -101,7 +99,6 @@ const FIELD_FLAGS: &[(&str, &str)] = &[
     // transmittance tables
     ("s_mm", "--s"),
     ("s_max_mm", "--s-max"),
-    ("sigma_t", "--sigma-t"),
     // separable kernels and their fit
     ("range", "--range"),
     ("exponent", "--exponent"),
@@ -242,6 +239,54 @@ mod tests {
         assert_eq!(flag_of("layers[0].sigma_a"), None);
         let set: std::collections::BTreeSet<_> = fields().collect();
         assert_eq!(set.len(), FIELD_FLAGS.len(), "a field listed twice");
+    }
+
+    /// Every row's flag is a flag of some `rtbake` command (no stale row).
+    #[test]
+    fn every_row_is_a_flag_of_the_cli() {
+        fn all(cmd: &clap::Command, out: &mut Vec<String>) {
+            long_flags(cmd, out);
+            cmd.get_subcommands().for_each(|s| all(s, out));
+        }
+        let mut flags = Vec::new();
+        all(&crate::command(), &mut flags);
+        let stale: Vec<_> = FIELD_FLAGS.iter().filter(|(_, flag)| !flags.iter().any(|f| f == flag)).collect();
+        assert!(stale.is_empty(), "rows whose flag is no flag of rtbake: {stale:?}");
+    }
+
+    /// The settings the `run`, `aa`, `kernel`, `fit separable`, `transmittance` and `maps` commands hand the library
+    /// refuse bad values naming fields the table maps, so the CLI names the flag.
+    #[test]
+    fn the_commands_settings_name_fields_with_flags() {
+        use rtbake::runtime::sss::{
+            gaussian::GaussianSssParams, importance::ImportanceSssParams, separable::SssParams,
+        };
+        use rtbake::separable::kernel::KernelSpec;
+        let bad_params = [
+            SssParams { sss_width: -1.0, ..Default::default() }.validate(),
+            SssParams { fovy_deg: 0.0, ..Default::default() }.validate(),
+            ImportanceSssParams { mm_per_world_unit: 0.0, ..Default::default() }.validate(),
+            GaussianSssParams { alpha: f32::NAN, ..Default::default() }.validate(),
+            rtbake::runtime::skin::settings::TsSettings { map_size: 1, ..Default::default() }.validate(),
+            rtbake::aa::smaa_area::SmaaAreaParams { ortho_max_distance: 0, ..Default::default() }
+                .validate()
+                .map(|_| ()),
+            rtbake::aa::mlaa_area::validate(rtbake::aa::mlaa_area::MlaaVersion::V1_4, 0).map(|_| ()),
+            KernelSpec { exponent: f64::NAN, ..KernelSpec::new(17, rtbake::separable::PUBLISHED) }.validate(),
+            rtbake::separable::fit::ObjectiveSpec { grid_nodes: 4, ..Default::default() }.validate(),
+            rtbake::transmittance::TableSettings { s_max_mm: -1.0, ..Default::default() }.validate(),
+            rtbake::facial::hemoglobin_rig::check_settings(
+                &rtbake::facial::hemoglobin_rig::RigSettings { sigma_floor: 0.0, ..Default::default() },
+                64,
+                64,
+            ),
+            "8x".parse::<rtbake::runtime::aa::modes::SmaaMode>().map(|_| ()),
+        ];
+        for r in bad_params {
+            let e = r.expect_err("a bad value is refused");
+            assert!(!e.param.starts_with('-'), "the library names a field, not a flag: {e}");
+            assert!(render(&e).param.starts_with("--"), "{}: no row in the table", e.param);
+        }
     }
 
     /// Parameters and marked fields become flags; pairs, indices and values after the field are kept; unmarked
