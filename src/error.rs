@@ -1,8 +1,8 @@
 //! Input validation shared by every user-facing path.
 //!
 //! Library modules define one `thiserror` enum per operation; the checks here produce the common
-//! [`InvalidInput`] they wrap, named after the CLI flag / JSON field so a user can fix the call
-//! ("--radius must be in 1..=512 texels, got 0").
+//! [`InvalidInput`] they wrap, named after the parameter's field (struct field / JSON key) so a user can fix the
+//! call ("radius_texels must be in 1..=512 texels, got 0"); the CLI prints each field as its flag.
 
 use std::fmt::Display;
 
@@ -10,7 +10,9 @@ use std::fmt::Display;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{param} {message}")]
 pub struct InvalidInput {
-    /// Flag or field name as the user wrote it, e.g. `--max-distance` or `layers[1].thickness_mm`.
+    /// The field, e.g. `max_distance`, `layers[1].thickness_mm`, a pair `width/height` or a field and the value
+    /// it concerns (`target cheek`). A message names another setting as its field between backticks
+    /// (`` `cpu` ``); the CLI turns both into flags (`bin/rtbake/flags.rs`).
     pub param: String,
     /// What is wrong and what is accepted.
     pub message: String,

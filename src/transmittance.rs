@@ -60,7 +60,7 @@ pub const MAX_S_MAX_MM: f64 = 1e4;
 /// Errors of the transmittance functions.
 #[derive(Debug, thiserror::Error)]
 pub enum TransmittanceError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
 }
 
@@ -188,11 +188,11 @@ impl TransmittanceModel {
 /// Validates distances (finite, ≥ 0, `--s`).
 pub fn check_distances(s_mm: &[f64]) -> Result<(), InvalidInput> {
     if s_mm.is_empty() {
-        return Err(InvalidInput::new("--s", "needs at least one distance in mm"));
+        return Err(InvalidInput::new("s_mm", "needs at least one distance in mm"));
     }
     for &s in s_mm {
         if !(s.is_finite() && s >= 0.0) {
-            return Err(InvalidInput::new("--s", format!("distances must be finite numbers >= 0 mm, got {s}")));
+            return Err(InvalidInput::new("s_mm", format!("distances must be finite numbers >= 0 mm, got {s}")));
         }
     }
     Ok(())
@@ -225,12 +225,12 @@ impl Default for TableSettings {
 
 impl TableSettings {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_range("--samples", self.samples, 2, MAX_SAMPLES, "texels")?;
-        check_range("--height", self.height, 1, MAX_SAMPLES, "texels")?;
-        check_positive("--s-max", self.s_max_mm, "mm")?;
+        check_range("samples", self.samples, 2, MAX_SAMPLES, "texels")?;
+        check_range("height", self.height, 1, MAX_SAMPLES, "texels")?;
+        check_positive("s_max_mm", self.s_max_mm, "mm")?;
         if self.s_max_mm > MAX_S_MAX_MM {
             return Err(InvalidInput::new(
-                "--s-max",
+                "s_max_mm",
                 format!("must be in (0, {MAX_S_MAX_MM}] mm, got {}", self.s_max_mm),
             ));
         }
@@ -338,7 +338,7 @@ mod tests {
         assert_eq!((table.width, table.height, table.channels), (5, 2, 3));
         assert_eq!(table.data[3..6], skin.at(1.0).map(|v| v as f32));
         assert_eq!(table.row(0), table.row(1));
-        assert_eq!(BeerLambert::new("--sigma-t", [1.0, -1.0, 1.0]).unwrap_err().param, "--sigma-t");
-        assert!(BeerLambert::new("--sigma-t", [1.0, f64::NAN, 1.0]).is_err());
+        assert_eq!(BeerLambert::new("sigma_t", [1.0, -1.0, 1.0]).unwrap_err().param, "sigma_t");
+        assert!(BeerLambert::new("sigma_t", [1.0, f64::NAN, 1.0]).is_err());
     }
 }

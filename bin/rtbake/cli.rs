@@ -184,11 +184,14 @@ pub fn is_usage(e: &anyhow::Error) -> bool {
 /// `--json`, also prints one object `{"error": …, "param": …, "exit_code": …}` on stdout, so scripts parse every
 /// outcome with one parser (`param` is the flag/field of a validation error, else null).
 pub fn exit_with(e: &anyhow::Error, json: bool) -> ! {
-    let mut msg = format!("error: {e}");
-    let mut last = e.to_string();
+    // The library names fields; every line is printed with the flags of this command (`flags::render`).
+    let invalid: Vec<&rtbake::error::InvalidInput> = e.chain().filter_map(invalid_input).collect();
+    let render = |s: String| crate::flags::render_line(&s, &invalid);
+    let mut msg = format!("error: {}", render(e.to_string()));
+    let mut last = render(e.to_string());
     let mut chain = vec![last.clone()];
     for cause in e.chain().skip(1) {
-        let c = cause.to_string();
+        let c = render(cause.to_string());
         if !last.contains(&c) {
             msg.push_str(&format!("\n  caused by: {c}"));
             chain.push(c.clone());
@@ -207,18 +210,20 @@ pub fn exit_with(e: &anyhow::Error, json: bool) -> ! {
     // A command that already printed its JSON result (e.g. `verify`'s report listing the failures) keeps stdout to
     // that one object.
     if json && !JSON_EMITTED.load(std::sync::atomic::Ordering::SeqCst) {
-        let invalid = e.chain().find_map(|c| {
-            c.downcast_ref::<rtbake::error::InvalidInput>()
-                .or_else(|| c.downcast_ref::<Usage>().and_then(|u| u.0.downcast_ref::<rtbake::error::InvalidInput>()))
-        });
         // Without a typed validation error, a message that starts with a flag (`--out …: exists`) names it.
-        let param = invalid.map(|i| i.param.clone()).or_else(|| {
+        let param = invalid.first().map(|i| crate::flags::render_param(&i.param)).or_else(|| {
             let first = chain[0].split([' ', ':', '=']).next().unwrap_or("");
             (first.starts_with("--") && first.len() > 2).then(|| first.to_string())
         });
         emit_json_error(&chain.join(": "), param.as_deref(), code);
     }
     std::process::exit(code);
+}
+
+/// The validation error `c` is, or a `Usage` marker wraps.
+fn invalid_input<'a>(c: &'a (dyn std::error::Error + 'static)) -> Option<&'a rtbake::error::InvalidInput> {
+    c.downcast_ref::<rtbake::error::InvalidInput>()
+        .or_else(|| c.downcast_ref::<Usage>().and_then(|u| u.0.downcast_ref::<rtbake::error::InvalidInput>()))
 }
 
 /// Set once a command has printed its JSON result.

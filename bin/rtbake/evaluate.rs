@@ -178,7 +178,7 @@ fn separable_params(text: &str) -> anyhow::Result<SeparableParams> {
         n => return Err(usage_msg(format!("--separable: expected S,F or Sr,Sg,Sb,Fr,Fg,Fb, got {n} numbers"))),
     };
     rtbake::separable::kernel::validate_params(&p)
-        .map_err(|e| usage(anyhow::anyhow!("--separable: {} {}", e.param, e.message)))?;
+        .map_err(|e| usage(anyhow::anyhow!("--separable: {}", crate::flags::render(&e))))?;
     Ok(p)
 }
 

@@ -156,6 +156,7 @@ fn main() {
     };
     let cmd = command();
     let argv = cli::join_negative_values(argv, &cmd);
+    flags::set_command(&cmd, &argv);
     let parsed = match cmd.clone().try_get_matches_from(argv.clone()).and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         // clap prints help/version to stdout with exit 0, usage errors to stderr with exit 2.

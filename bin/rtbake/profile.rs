@@ -116,8 +116,6 @@ fn flag_error(e: InvalidInput, layers_file: Option<&PathBuf>) -> anyhow::Error {
         ["--material", "--profile-preset", "--thickness-mm", "--radii", "--r-min-mm", "--r-max-mm", "--count"];
     let param = match (e.param.as_str(), crate::flags::flag_of(&e.param)) {
         (p, Some(f)) if PROFILE_FLAGS.contains(&f) && !p.contains('[') => f.to_string(),
-        // The overlay fit's count, which `fit_overlay_plot` names by its own flag.
-        ("--count", _) => "--overlay-fit".to_string(),
         (p, _) if p.starts_with("layers") || p.starts_with("eta_") => match layers_file {
             Some(f) => format!("--layers {}: {p}", f.display()),
             None => p.to_string(),
@@ -232,7 +230,11 @@ pub fn run(args: ProfileArgs, ctx: &Ctx) -> anyhow::Result<()> {
     let fit_settings =
         args.overlay_fit.map(|count| FitSettings { count, shared_variances: true, normalize: false, starts: 8 });
     if let Some(s) = &fit_settings {
-        s.validate().map_err(|e| flag_error(e, None))?;
+        s.validate().map_err(|e| match e.param.as_str() {
+            // The overlay fit's count is set by its own flag here.
+            "count" => usage(InvalidInput::new("--overlay-fit", e.message)),
+            _ => flag_error(e, None),
+        })?;
     }
 
     if layered {

@@ -189,22 +189,22 @@ pub enum GreenArg {
 }
 
 /// A map file of `flag` decoded with its own channel count (exit 2 naming the flag and the file).
-fn read_picture(flag: &str, path: &Path) -> anyhow::Result<rtbake::image_buf::ImageU8> {
-    let name = format!("{flag} {}", path.display());
+fn read_picture(param: &str, path: &Path) -> anyhow::Result<rtbake::image_buf::ImageU8> {
+    let name = format!("{} {}", crate::flags::render_param(param), path.display());
     let len = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?.len();
     if len > MAX_MESH_FILE_BYTES {
         return Err(usage_msg(format!("{name}: {len} bytes; accepted at most {MAX_MESH_FILE_BYTES}")));
     }
     let bytes = std::fs::read(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
-    io::picture::decode_u8(flag, &path.display().to_string(), &bytes).map_err(usage)
+    io::picture::decode_u8(param, &path.display().to_string(), &bytes).map_err(usage)
 }
 
 /// The surface maps of --albedo / --normal-map, or the glTF material's own textures where a flag is absent
 /// (exit 2 naming the flag or the mesh); None when there are none.
 pub fn surface_maps(a: &MapArgs, mesh: Option<&Path>) -> anyhow::Result<Option<SurfaceMaps>> {
-    use rtbake::runtime::skin::surface_maps::{ALBEDO_FLAG, NORMAL_MAP_FLAG};
-    let mut albedo = a.albedo.as_deref().map(|p| read_picture(ALBEDO_FLAG, p)).transpose()?;
-    let mut normal = a.normal_map.as_deref().map(|p| read_picture(NORMAL_MAP_FLAG, p)).transpose()?;
+    use rtbake::runtime::skin::surface_maps::{ALBEDO_PARAM, NORMAL_MAP_PARAM};
+    let mut albedo = a.albedo.as_deref().map(|p| read_picture(ALBEDO_PARAM, p)).transpose()?;
+    let mut normal = a.normal_map.as_deref().map(|p| read_picture(NORMAL_MAP_PARAM, p)).transpose()?;
     let gltf = mesh.filter(|p| {
         matches!(p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(), Some("gltf" | "glb"))
     });
@@ -216,14 +216,14 @@ pub fn surface_maps(a: &MapArgs, mesh: Option<&Path>) -> anyhow::Result<Option<S
             std::fs::read(dir.join(uri)).map_err(|e| format!("{uri}: {e}"))
         })
         .map_err(usage)?;
-        let decode = |flag: &str, img: &rtbake::mesh::gltf::EncodedImage| {
-            io::picture::decode_u8(flag, &format!("{name}: {}", img.origin), &img.bytes).map_err(usage)
+        let decode = |param: &str, img: &rtbake::mesh::gltf::EncodedImage| {
+            io::picture::decode_u8(param, &format!("{name}: {}", img.origin), &img.bytes).map_err(usage)
         };
         if albedo.is_none() {
-            albedo = images.base_color.as_ref().map(|i| decode(ALBEDO_FLAG, i)).transpose()?;
+            albedo = images.base_color.as_ref().map(|i| decode(ALBEDO_PARAM, i)).transpose()?;
         }
         if normal.is_none() {
-            normal = images.normal.as_ref().map(|i| decode(NORMAL_MAP_FLAG, i)).transpose()?;
+            normal = images.normal.as_ref().map(|i| decode(NORMAL_MAP_PARAM, i)).transpose()?;
         }
     }
     if albedo.is_none() && normal.is_none() {

@@ -67,14 +67,14 @@ pub const MAX_CELL: u32 = 1024;
 /// Errors of [`mlaa_area_map`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MlaaAreaError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
 }
 
 /// Checks the cell size `n` for `version` (CLI `--max-distance`) and returns the texture edge `5n`.
 pub fn validate(version: MlaaVersion, n: u32) -> Result<u32, InvalidInput> {
     let (lo, hi, odd) = version.accepted();
-    let flag = "--max-distance";
+    let flag = "max_distance";
     let kind = if odd { "an odd" } else { "an" };
     if n < lo || n > hi || (odd && n.is_multiple_of(2)) {
         return Err(InvalidInput::new(
@@ -297,7 +297,7 @@ mod tests {
 
     #[test]
     fn validation_names_flag_and_parity() {
-        assert!(validate(MlaaVersion::V1_4, 0).unwrap_err().to_string().contains("--max-distance"));
+        assert!(validate(MlaaVersion::V1_4, 0).unwrap_err().to_string().contains("max_distance"));
         assert!(validate(MlaaVersion::V1_4, 16).unwrap_err().to_string().contains("odd"));
         assert!(validate(MlaaVersion::V1_3, 16).is_ok());
         assert!(validate(MlaaVersion::V2, 1_000_000).is_err());

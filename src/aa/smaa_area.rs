@@ -70,7 +70,7 @@ impl Default for SmaaAreaParams {
 /// Errors of [`smaa_area_texture`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SmaaAreaError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
 }
 
@@ -97,16 +97,16 @@ impl SmaaAreaParams {
     /// Checks every field (names as the CLI flags) and returns the texture size, before anything is allocated.
     pub fn validate(&self) -> Result<(u32, u32), InvalidInput> {
         let (lo, hi) = MAX_DISTANCE_RANGE;
-        check_range("--ortho-max-distance", self.ortho_max_distance, lo, hi, "texels per cell")?;
-        check_range("--diag-max-distance", self.diag_max_distance, lo, hi, "texels per cell")?;
-        check_count("--ortho-offsets", self.ortho_offsets.len())?;
-        check_count("--diag-offsets", self.diag_offsets.len())?;
+        check_range("ortho_max_distance", self.ortho_max_distance, lo, hi, "texels per cell")?;
+        check_range("diag_max_distance", self.diag_max_distance, lo, hi, "texels per cell")?;
+        check_count("ortho_offsets", self.ortho_offsets.len())?;
+        check_count("diag_offsets", self.diag_offsets.len())?;
         for (k, &o) in self.ortho_offsets.iter().enumerate() {
-            check_offset(&format!("--ortho-offsets[{k}]"), o)?;
+            check_offset(&format!("ortho_offsets[{k}]"), o)?;
         }
         for (k, o) in self.diag_offsets.iter().enumerate() {
-            check_offset(&format!("--diag-offsets[{k}].x"), o[0])?;
-            check_offset(&format!("--diag-offsets[{k}].y"), o[1])?;
+            check_offset(&format!("diag_offsets[{k}].x"), o[0])?;
+            check_offset(&format!("diag_offsets[{k}].y"), o[1])?;
         }
         let (w, h) = self.size();
         check_size("SMAA area texture", w, h)
@@ -196,11 +196,11 @@ mod tests {
             f(&mut p);
             p.validate().unwrap_err()
         };
-        assert_eq!(bad(&|p| p.ortho_max_distance = 0).param, "--ortho-max-distance");
-        assert_eq!(bad(&|p| p.diag_max_distance = 1_000_000).param, "--diag-max-distance");
-        assert_eq!(bad(&|p| p.ortho_offsets = vec![]).param, "--ortho-offsets");
-        assert_eq!(bad(&|p| p.ortho_offsets[3] = f64::NAN).param, "--ortho-offsets[3]");
-        assert_eq!(bad(&|p| p.diag_offsets[1][1] = 0.5).param, "--diag-offsets[1].y");
+        assert_eq!(bad(&|p| p.ortho_max_distance = 0).param, "ortho_max_distance");
+        assert_eq!(bad(&|p| p.diag_max_distance = 1_000_000).param, "diag_max_distance");
+        assert_eq!(bad(&|p| p.ortho_offsets = vec![]).param, "ortho_offsets");
+        assert_eq!(bad(&|p| p.ortho_offsets[3] = f64::NAN).param, "ortho_offsets[3]");
+        assert_eq!(bad(&|p| p.diag_offsets[1][1] = 0.5).param, "diag_offsets[1].y");
         let e = bad(&|p| p.ortho_offsets = vec![0.0; 17]);
         assert!(e.message.contains("1..=16"), "{e}");
     }

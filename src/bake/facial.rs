@@ -446,11 +446,11 @@ pub fn pd_wrinkle_files(
     size: u32,
 ) -> Result<(Vec<BakedFile>, Value, Option<Value>), BakeError> {
     let (w, h) = (normal.width, normal.height);
-    let pd = wrinkles::normals_to_pd("--normal", normal, green, cone)?;
+    let pd = wrinkles::normals_to_pd("normal", normal, green, cone)?;
     let mut files = Vec::new();
     let (values, range_clamped, base_report) = match base {
         Some(b) => {
-            let bpd = wrinkles::normals_to_pd("--base", b, green, cone)?;
+            let bpd = wrinkles::normals_to_pd("base", b, green, cone)?;
             files.extend(unorm8_texture_files(
                 &format!("{prefix}base_pd"),
                 &wrinkles::pd_to_rg8(w, h, &bpd.pd),

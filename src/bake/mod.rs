@@ -16,7 +16,7 @@ pub use crate::manifest::{BakedFile, ColorSpace, FileFormat, FileKind, FileMeta,
 /// Errors while baking an asset.
 #[derive(Debug, thiserror::Error)]
 pub enum BakeError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] crate::error::InvalidInput),
     #[error(transparent)]
     Io(#[from] io::IoError),

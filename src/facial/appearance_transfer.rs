@@ -78,7 +78,7 @@ mod tests {
         let settings = RigSettings { radius_texels: 8, rig_size: SIZE, ..RigSettings::default() };
         let (na, joy_a, nb) = (map(1, None), map(1, Some("joy")), map(7, None));
         let rig_a = build_rig(&na, SIZE, SIZE, &[("joy".into(), &joy_a)], &settings).unwrap();
-        let rig_b = transfer_rig(&rig_a, &nb, "--neutral").unwrap();
+        let rig_b = transfer_rig(&rig_a, &nb, "neutral").unwrap();
         assert_eq!(rig_b.maps.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(), vec!["neutral", "joy"]);
         let neutral_b = evaluate(&rig_b, &[1.0, 0.0], 1.0);
         let worst = neutral_b.iter().zip(&nb).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
@@ -124,11 +124,11 @@ mod tests {
         let settings = RigSettings { radius_texels: 4, rig_size: 16, ..RigSettings::default() };
         let na = map(1, None);
         let rig = build_rig(&na, SIZE, SIZE, &[], &settings).unwrap();
-        let e = transfer_rig(&rig, &na[..100], "--neutral").unwrap_err();
-        assert_eq!(e.param, "--neutral");
+        let e = transfer_rig(&rig, &na[..100], "neutral").unwrap_err();
+        assert_eq!(e.param, "neutral");
         assert!(e.message.contains("must be 128x128"), "{e}");
         let mut bad = na.clone();
         bad[5] = f32::NAN;
-        assert!(transfer_rig(&rig, &bad, "--neutral").unwrap_err().message.contains("texel 5"));
+        assert!(transfer_rig(&rig, &bad, "neutral").unwrap_err().message.contains("texel 5"));
     }
 }

@@ -639,8 +639,8 @@ mod tests {
         assert!(disk_stats(&data, 10, 8, 0, Border::Clip).is_err());
         assert!(disk_stats(&data, 10, 8, 4, Border::Clip).is_err());
         assert!(disk_stats(&data, 10, 8, 3, Border::Clip).is_ok());
-        let e = check_radius("--radius", 9, 10, 8).unwrap_err();
-        assert!(e.to_string().contains("--radius must be in 1..=3"), "{e}");
+        let e = check_radius("radius_texels", 9, 10, 8).unwrap_err();
+        assert!(e.to_string().contains("radius_texels must be in 1..=3"), "{e}");
     }
 
     #[test]

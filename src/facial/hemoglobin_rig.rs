@@ -87,7 +87,7 @@ pub fn check_target_name(param: &str, name: &str) -> Result<(), InvalidInput> {
         ));
     }
     if name == NEUTRAL {
-        return Err(InvalidInput::new(param, "target name 'neutral' is reserved for the neutral map (--neutral)"));
+        return Err(InvalidInput::new(param, "target name 'neutral' is reserved for the neutral map (`neutral`)"));
     }
     Ok(())
 }
@@ -99,14 +99,14 @@ pub fn rig_dims(width: u32, height: u32, rig_size: u32) -> (u32, u32) {
 
 /// Validates the settings against the map size.
 pub fn check_settings(settings: &RigSettings, width: u32, height: u32) -> Result<(), InvalidInput> {
-    disk_stats::check_radius("--radius", settings.radius_texels, width, height)?;
+    disk_stats::check_radius("radius_texels", settings.radius_texels, width, height)?;
     if !(settings.sigma_floor.is_finite() && settings.sigma_floor > 0.0) {
         return Err(InvalidInput::new(
-            "--sigma-floor",
+            "sigma_floor",
             format!("must be a finite number > 0 (concentration units), got {}", settings.sigma_floor),
         ));
     }
-    crate::error::check_range("--rig-size", settings.rig_size, 1, crate::error::MAX_TEXTURE_EDGE, "texels")?;
+    crate::error::check_range("rig_size", settings.rig_size, 1, crate::error::MAX_TEXTURE_EDGE, "texels")?;
     Ok(())
 }
 
@@ -133,15 +133,15 @@ pub fn build_rig_with_progress(
     check_settings(settings, width, height)?;
     let n = width as usize * height as usize;
     if neutral.len() != n {
-        return Err(InvalidInput::new("--neutral", format!("expected {n} texels, got {}", neutral.len())));
+        return Err(InvalidInput::new("neutral", format!("expected {n} texels, got {}", neutral.len())));
     }
     for (i, (name, t)) in targets.iter().enumerate() {
-        check_target_name("--target", name)?;
+        check_target_name("target", name)?;
         if targets[..i].iter().any(|(o, _)| o == name) {
-            return Err(InvalidInput::new("--target", format!("target '{name}' is given twice")));
+            return Err(InvalidInput::new("target", format!("target '{name}' is given twice")));
         }
         if t.len() != n {
-            return Err(InvalidInput::new(format!("--target {name}"), format!("expected {n} texels, got {}", t.len())));
+            return Err(InvalidInput::new(format!("target {name}"), format!("expected {n} texels, got {}", t.len())));
         }
     }
     let (rw, rh) = rig_dims(width, height, settings.rig_size);
@@ -267,27 +267,27 @@ pub fn rig_weights(map_names: &[String], pairs: &[(String, f64)], normalize: boo
     for (name, v) in pairs {
         let Some(i) = map_names.iter().position(|m| m == name) else {
             return Err(InvalidInput::new(
-                "--weights",
+                "weights",
                 format!("unknown target '{name}'; the rig has: {}", map_names.join(", ")),
             ));
         };
         if seen[i] {
-            return Err(InvalidInput::new("--weights", format!("target '{name}' is given twice")));
+            return Err(InvalidInput::new("weights", format!("target '{name}' is given twice")));
         }
-        check_target_weight("--weights", name, *v)?;
+        check_target_weight("weights", name, *v)?;
         seen[i] = true;
         w[i] = *v;
     }
     let sum: f64 = w.iter().sum();
     if normalize {
         if sum.abs() < 1e-12 {
-            return Err(InvalidInput::new("--weights", "cannot normalise weights that sum to 0"));
+            return Err(InvalidInput::new("weights", "cannot normalise weights that sum to 0"));
         }
         w.iter_mut().for_each(|x| *x /= sum);
     } else if (sum - 1.0).abs() > 1e-6 {
         return Err(InvalidInput::new(
-            "--weights",
-            format!("must sum to 1 (eq. 7.6), got {sum}; pass --normalize-weights to divide by the sum"),
+            "weights",
+            format!("must sum to 1 (eq. 7.6), got {sum}; pass `normalize_weights` to divide by the sum"),
         ));
     }
     Ok(w)

@@ -138,7 +138,7 @@ fn select_channel(
             param,
             path,
             format!(
-                "expected a single-channel map, got {n} channels ({}); choose one with --channel {}",
+                "expected a single-channel map, got {n} channels ({}); choose one with `channel` {}",
                 names.join(", "),
                 CHANNEL_NAMES.join("|")
             ),
@@ -153,7 +153,7 @@ fn select_channel(
                     return Err(bad(
                         param,
                         path,
-                        format!("--channel luminance needs R, G and B channels; the map has {}", names.join(", ")),
+                        format!("`channel` luminance needs R, G and B channels; the map has {}", names.join(", ")),
                     ))
                 }
             };
@@ -170,7 +170,7 @@ fn select_channel(
         Some(sel) => match index(sel.as_str()) {
             Some(c) => Ok((pick(c), format!(" (channel {})", sel.as_str()))),
             None => {
-                Err(bad(param, path, format!("--channel {}: the map has channels {}", sel.as_str(), names.join(", "))))
+                Err(bad(param, path, format!("`channel` {}: the map has channels {}", sel.as_str(), names.join(", "))))
             }
         },
     }
@@ -254,7 +254,7 @@ pub fn decode_concentration_channel(
                     return Err(bad(
                         param,
                         path,
-                        "8-bit PNG maps need a declared value range: --value-range MIN,MAX maps samples 0..255 \
+                        "8-bit PNG maps need a declared value range: `value_range` MIN,MAX maps samples 0..255 \
                          linearly to concentrations MIN..MAX",
                     ))
                 }
@@ -354,7 +354,7 @@ mod tests {
     }
 
     fn decode(bytes: &[u8], sel: Option<ChannelSelect>) -> Result<ConcentrationMap, InvalidInput> {
-        decode_concentration_channel("--neutral", "n.exr", bytes, None, sel)
+        decode_concentration_channel("neutral", "n.exr", bytes, None, sel)
     }
 
     #[test]
@@ -362,8 +362,8 @@ mod tests {
         for ch in [3, 4] {
             let bytes = exr(ch);
             let e = decode(&bytes, None).unwrap_err();
-            assert_eq!(e.param, "--neutral");
-            assert!(e.message.contains("n.exr") && e.message.contains("--channel R|G|B|A|Y|luminance"), "{e}");
+            assert_eq!(e.param, "neutral");
+            assert!(e.message.contains("n.exr") && e.message.contains("`channel` R|G|B|A|Y|luminance"), "{e}");
             let r = decode(&bytes, Some(ChannelSelect::R)).unwrap();
             assert_eq!(r.image.channels, 1);
             assert_eq!(r.image.data, (0..6).map(|i| i as f32 / 10.0).collect::<Vec<_>>());
@@ -378,7 +378,7 @@ mod tests {
             }
         }
         let e = decode(&exr(3), Some(ChannelSelect::A)).unwrap_err();
-        assert!(e.message.contains("--channel A") && e.message.contains("R, G, B"), "{e}");
+        assert!(e.message.contains("`channel` A") && e.message.contains("R, G, B"), "{e}");
         assert_eq!(decode(&exr(4), Some(ChannelSelect::A)).unwrap().image.data, vec![1.0; 6]);
     }
 
@@ -393,10 +393,10 @@ mod tests {
 
     #[test]
     fn channel_names_parse_case_insensitively_and_bad_ones_name_the_flag() {
-        assert_eq!(ChannelSelect::parse("--channel", "r").unwrap(), ChannelSelect::R);
-        assert_eq!(ChannelSelect::parse("--channel", "Luminance").unwrap(), ChannelSelect::Luminance);
-        let e = ChannelSelect::parse("--channel", "X").unwrap_err();
-        assert_eq!(e.param, "--channel");
+        assert_eq!(ChannelSelect::parse("channel", "r").unwrap(), ChannelSelect::R);
+        assert_eq!(ChannelSelect::parse("channel", "Luminance").unwrap(), ChannelSelect::Luminance);
+        let e = ChannelSelect::parse("channel", "X").unwrap_err();
+        assert_eq!(e.param, "channel");
         assert!(e.message.contains("R, G, B, A, Y, luminance"));
     }
 

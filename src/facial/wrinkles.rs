@@ -140,7 +140,7 @@ pub fn normals_to_pd(
             param,
             format!(
                 "{clamped} texels lie outside the 45° cone that partial-derivative maps can represent; \
-                 use --cone clamp to clamp them"
+                 use `cone` clamp to clamp them"
             ),
         ));
     }

@@ -87,7 +87,7 @@ pub fn compare_profiles(
                 if !(t.is_finite() && t > 0.0) {
                     return Err(InvalidInput::new(
                         name,
-                        format!("total reflectance (channel {c}) is {t}; --normalize needs it finite and > 0"),
+                        format!("total reflectance (channel {c}) is {t}; `normalize` needs it finite and > 0"),
                     ));
                 }
             }

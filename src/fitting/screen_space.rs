@@ -41,9 +41,9 @@ impl Default for StretchParams {
 
 impl StretchParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--alpha", self.alpha, "")?;
-        check_non_negative("--beta", self.beta, "")?;
-        check_non_negative("--gamma", self.gamma, "")?;
+        check_positive("alpha", self.alpha, "")?;
+        check_non_negative("beta", self.beta, "")?;
+        check_non_negative("gamma", self.gamma, "")?;
         Ok(())
     }
 

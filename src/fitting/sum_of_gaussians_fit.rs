@@ -59,8 +59,8 @@ impl Default for FitSettings {
 
 impl FitSettings {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_range("--count", self.count, *COUNT_RANGE.start(), *COUNT_RANGE.end(), "Gaussians")?;
-        check_range("--starts", self.starts, 1, 64, "starts")?;
+        check_range("count", self.count, *COUNT_RANGE.start(), *COUNT_RANGE.end(), "Gaussians")?;
+        check_range("starts", self.starts, 1, 64, "starts")?;
         Ok(())
     }
 }
@@ -68,7 +68,7 @@ impl FitSettings {
 /// Errors of [`fit_sum_of_gaussians`].
 #[derive(Debug, thiserror::Error)]
 pub enum GaussianFitError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
     #[error("optimiser failed: {0}")]
     Optimiser(String),
@@ -319,7 +319,7 @@ pub fn fit_sum_of_gaussians(
         for c in 0..3 {
             if !(totals[c].is_finite() && totals[c] > 0.0) {
                 return Err(InvalidInput::new(
-                    "--normalize",
+                    "normalize",
                     format!("needs a positive total reflectance in every channel, channel {c} has {}", totals[c]),
                 )
                 .into());

@@ -41,7 +41,7 @@ use std::path::{Path, PathBuf};
 pub enum FileSetError {
     #[error(transparent)]
     Io(#[from] IoError),
-    #[error("{dir}: locked by another rtbake process{holder} (without --no-wait, rtbake waits for it)")]
+    #[error("{dir}: locked by another rtbake process{holder} (without `no_wait`, rtbake waits for it)")]
     Busy { dir: String, holder: String },
     #[error("{output}: refusing to overwrite the input {input} (choose another output path)")]
     OutputIsInput { output: String, input: String },

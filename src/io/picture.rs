@@ -35,10 +35,10 @@ mod tests {
         let mut png = Vec::new();
         let grey = image::GrayImage::from_raw(4, 4, vec![7u8; 16]).unwrap();
         grey.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
-        let img = decode_u8("--albedo", "grey.png", &png).unwrap();
+        let img = decode_u8("albedo_map", "grey.png", &png).unwrap();
         assert_eq!((img.width, img.height, img.channels, img.data[0]), (4, 4, 1, 7));
-        let e = decode_u8("--normal-map", "x.jpg", b"not a picture").unwrap_err();
-        assert_eq!(e.param, "--normal-map");
+        let e = decode_u8("normal_map", "x.jpg", b"not a picture").unwrap_err();
+        assert_eq!(e.param, "normal_map");
         assert!(e.message.contains("x.jpg"), "{e}");
     }
 }

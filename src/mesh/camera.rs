@@ -21,7 +21,7 @@ impl Camera {
     /// A camera `distance` units in front of the head (on +z), looking at the origin with a 30° vertical field
     /// of view (TAP 2009's heads: a close-up is ~0.5 m, "far" a few metres).
     pub fn facing(distance: f32) -> Result<Camera, InvalidInput> {
-        check_range("--distance", distance as f64, 0.2, 100.0, "m")?;
+        check_range("distance_m", distance as f64, 0.2, 100.0, "m")?;
         Ok(Camera {
             eye: [0.0, 0.0, distance],
             target: [0.0, 0.0, 0.0],

@@ -268,7 +268,7 @@ mod tests {
     #[test]
     fn units_convert_to_metres_and_auto_gives_a_head_height() {
         let m = box_mesh(1.0, [5.0, -3.0, 7.0]);
-        let cm = frame_in_metres(&m, MeshUnits::parse("--mesh-units", "cm").unwrap(), "--mesh-units").unwrap();
+        let cm = frame_in_metres(&m, MeshUnits::parse("mesh_units", "cm").unwrap(), "mesh_units").unwrap();
         assert_eq!(Bounds::of(&cm).size(), [0.02, 0.04, 0.0]);
         assert_eq!(Bounds::of(&cm).centre(), [0.0, 0.0, 0.0]);
         assert_eq!(cm.mm_per_unit, 1000.0);
@@ -314,10 +314,10 @@ mod tests {
     #[test]
     fn bad_units_name_the_flag_and_the_accepted_values() {
         for bad in ["furlong", "-3", "0", "nan", "inf"] {
-            let e = MeshUnits::parse("--mesh-units", bad).unwrap_err();
-            assert_eq!(e.param, "--mesh-units", "{bad}");
+            let e = MeshUnits::parse("mesh_units", bad).unwrap_err();
+            assert_eq!(e.param, "mesh_units", "{bad}");
         }
-        let e = MeshUnits::parse("--mesh-units", "furlong").unwrap_err().to_string();
+        let e = MeshUnits::parse("mesh_units", "furlong").unwrap_err().to_string();
         assert!(e.contains("mm, cm, m, in, auto"), "{e}");
     }
 
@@ -345,8 +345,8 @@ mod tests {
             let l = light_direction(az, TAP_LIGHT_ELEVATION_DEG, "a", "e").unwrap();
             assert!(((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) - 1.0).abs() < 1e-6);
         }
-        assert_eq!(light_direction(181.0, 0.0, "--light-azimuth", "e").unwrap_err().param, "--light-azimuth");
-        assert_eq!(light_direction(0.0, 95.0, "a", "--light-elevation").unwrap_err().param, "--light-elevation");
+        assert_eq!(light_direction(181.0, 0.0, "light_azimuth_deg", "e").unwrap_err().param, "light_azimuth_deg");
+        assert_eq!(light_direction(0.0, 95.0, "a", "light_elevation_deg").unwrap_err().param, "light_elevation_deg");
         assert!(light_direction(f32::NAN, 0.0, "a", "e").is_err());
     }
 }

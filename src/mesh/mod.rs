@@ -99,7 +99,7 @@ impl Mesh {
         }
         if !(mm_per_unit.is_finite() && mm_per_unit > 0.0) {
             return Err(InvalidInput::new(
-                "--mesh-mm-per-unit",
+                "mesh_mm_per_unit",
                 format!("must be a finite number > 0, got {mm_per_unit}"),
             ));
         }

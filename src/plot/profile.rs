@@ -212,10 +212,10 @@ mod tests {
 
     #[test]
     fn format_by_extension() {
-        assert_eq!(PlotFormat::from_path("--plot", Path::new("a/b.PNG")).unwrap(), PlotFormat::Png);
-        assert_eq!(PlotFormat::from_path("--plot", Path::new("b.svg")).unwrap(), PlotFormat::Svg);
+        assert_eq!(PlotFormat::from_path("plot", Path::new("a/b.PNG")).unwrap(), PlotFormat::Png);
+        assert_eq!(PlotFormat::from_path("plot", Path::new("b.svg")).unwrap(), PlotFormat::Svg);
         for bad in ["b.jpg", "b", "png"] {
-            assert_eq!(PlotFormat::from_path("--plot", Path::new(bad)).unwrap_err().param, "--plot");
+            assert_eq!(PlotFormat::from_path("plot", Path::new(bad)).unwrap_err().param, "plot");
         }
     }
 

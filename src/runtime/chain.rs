@@ -37,7 +37,7 @@ pub enum Antialiasing {
 pub fn to_rgba8(img: &Image<u8>) -> Result<Image<u8>, InvalidInput> {
     let ch = img.channels as usize;
     if !(1..=4).contains(&ch) {
-        return Err(InvalidInput::new("--input", format!("must have 1 to 4 channels, got {ch}")));
+        return Err(InvalidInput::new("input", format!("must have 1 to 4 channels, got {ch}")));
     }
     let mut out = Vec::with_capacity(img.data.len() / ch * 4);
     for p in img.data.chunks(ch) {
@@ -62,7 +62,7 @@ pub fn antialias<'g>(
         return Err(InvalidInput::new("image", format!("must be RGBA8, got {} channels", img.channels)).into());
     }
     let (w, h) = (img.width, img.height);
-    crate::error::check_size("--input", w as u64, h as u64)?;
+    crate::error::check_size("input", w as u64, h as u64)?;
     let gpu = gpu.into();
     let data = match aa {
         Antialiasing::Smaa(t) => gpu.run(
@@ -91,7 +91,7 @@ pub fn antialias_with<'g>(
         return Err(InvalidInput::new("image", format!("must be RGBA8, got {} channels", img.channels)).into());
     }
     let (w, h) = (img.width, img.height);
-    crate::error::check_size("--input", w as u64, h as u64)?;
+    crate::error::check_size("input", w as u64, h as u64)?;
     let masked = inputs.mask.is_some();
     let gpu = gpu.into();
     let exact = FilterPrecision::Exact;
@@ -200,7 +200,7 @@ pub fn subsurface<'g>(
     (w, h): (u32, u32),
     method: &Subsurface,
 ) -> Result<Vec<f32>, RuntimeError> {
-    crate::error::check_size("--width/--height", w as u64, h as u64)?;
+    crate::error::check_size("width/height", w as u64, h as u64)?;
     let gpu = gpu.into();
     match method {
         Subsurface::Separable { kernel, params } => gpu.run(

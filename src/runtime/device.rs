@@ -137,7 +137,7 @@ pub fn check_image_fits(
             "image",
             format!(
                 "{width}x{height} exceeds this GPU's largest 2-D texture, {edge}x{edge} texels \
-                 (max_texture_dimension_2d); use --cpu or an image of at most {edge} texels per side"
+                 (max_texture_dimension_2d); use `cpu` or an image of at most {edge} texels per side"
             ),
         )
         .into());
@@ -148,7 +148,7 @@ pub fn check_image_fits(
             "image",
             format!(
                 "{width}x{height} needs a {bytes}-byte GPU buffer, this GPU allows at most {} bytes (max_buffer_size); \
-                 use --cpu or a smaller image",
+                 use `cpu` or a smaller image",
                 limits.max_buffer_size
             ),
         )

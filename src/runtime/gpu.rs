@@ -207,10 +207,7 @@ pub fn upload_sss_frame(
     let (w, h) = (color_tex.width(), color_tex.height());
     let n = w as usize * h as usize;
     if color.len() != 4 * n || depth.len() != n {
-        return Err(crate::error::InvalidInput::new(
-            "--color/--depth",
-            format!("must be {w}x{h} (RGBA and one channel)"),
-        ));
+        return Err(crate::error::InvalidInput::new("color/depth", format!("must be {w}x{h} (RGBA and one channel)")));
     }
     let half: Vec<half::f16> = color.iter().map(|v| half::f16::from_f32(*v)).collect();
     upload(queue, color_tex, bytemuck::cast_slice(&half));

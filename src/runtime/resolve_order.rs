@@ -63,7 +63,7 @@ pub fn compare<'g>(
     map: &MlaaAreaMap,
 ) -> Result<ResolveOrderErrors, RuntimeError> {
     let gpu: Backend = gpu.into();
-    crate::error::check_size("--width/--height", w as u64, h as u64)?;
+    crate::error::check_size("width/height", w as u64, h as u64)?;
     let aa = Antialiasing::Mlaa(map.clone());
     let mlaa = |rgba: Vec<u8>| -> Result<Vec<u8>, RuntimeError> {
         Ok(antialias(gpu, &Image::from_vec(w, h, 4, rgba), &aa)?.data)

@@ -71,7 +71,7 @@ use super::{SeparableParams, CHANNELS, TABLE_6_1, TABLE_6_1_WIDTH};
 /// Errors of the separable fit.
 #[derive(Debug, thiserror::Error)]
 pub enum SeparableFitError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
     #[error("separable fit: optimiser failed: {0}")]
     Solver(String),
@@ -137,15 +137,15 @@ impl Default for ObjectiveSpec {
 impl ObjectiveSpec {
     /// Checks every field, naming the `rtbake fit separable` flag.
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_range("--width", self.width, 1e-5, 1.0, "world units")?;
-        check_range("--mm-per-world-unit", self.mm_per_world_unit, 1e-3, 1e6, "mm")?;
+        check_range("width", self.width, 1e-5, 1.0, "world units")?;
+        check_range("mm_per_world_unit", self.mm_per_world_unit, 1e-3, 1e6, "mm")?;
         let n = self.grid_nodes;
         if !(5..=401).contains(&n) || n.is_multiple_of(2) {
-            return Err(InvalidInput::new("--grid-nodes", format!("must be an odd number in 5..=401, got {n}")));
+            return Err(InvalidInput::new("grid_nodes", format!("must be an odd number in 5..=401, got {n}")));
         }
-        check_range("--grid-extent-mm", self.grid_extent_mm, 0.05, 100.0, "mm")?;
-        check_range("--grid-exponent", self.grid_exponent, 1.0, 4.0, "")?;
-        check_range("--pixel-mm", self.pixel_mm, 1e-3, 10.0, "mm")?;
+        check_range("grid_extent_mm", self.grid_extent_mm, 0.05, 100.0, "mm")?;
+        check_range("grid_exponent", self.grid_exponent, 1.0, 4.0, "")?;
+        check_range("pixel_mm", self.pixel_mm, 1e-3, 10.0, "mm")?;
         Ok(())
     }
 

@@ -113,15 +113,15 @@ impl KernelSpec {
         let n = self.samples;
         if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n) || n.is_multiple_of(2) {
             return Err(InvalidInput::new(
-                "--samples",
+                "samples",
                 format!("must be an odd number of taps in {MIN_SAMPLES}..={MAX_SAMPLES}, got {n}"),
             ));
         }
         validate_params(&self.params)?;
         if let Some(r) = self.range {
-            check_range("--range", r, 0.01, 100.0, "kernel units")?;
+            check_range("range", r, 0.01, 100.0, "kernel units")?;
         }
-        check_range("--exponent", self.exponent, 0.1, 10.0, "")?;
+        check_range("exponent", self.exponent, 0.1, 10.0, "")?;
         Ok(())
     }
 }
@@ -131,11 +131,11 @@ pub fn validate_params(p: &SeparableParams) -> Result<(), InvalidInput> {
     for (c, name) in CHANNELS.iter().enumerate() {
         let s = p.strength[c];
         if !(0.0..=1.0).contains(&s) {
-            return Err(InvalidInput::new("--strength", format!("({name}) must be in 0..=1, got {s}")));
+            return Err(InvalidInput::new("strength", format!("({name}) must be in 0..=1, got {s}")));
         }
         let f = p.falloff[c];
         if !(f.is_finite() && f >= 0.0) {
-            return Err(InvalidInput::new("--falloff", format!("({name}) must be a finite number >= 0, got {f}")));
+            return Err(InvalidInput::new("falloff", format!("({name}) must be a finite number >= 0, got {f}")));
         }
     }
     Ok(())

@@ -123,7 +123,7 @@ mod tests {
     #[test]
     fn albedo_is_decoded_from_srgb_and_alpha_dropped() {
         let img = ImageU8::from_vec(4, 4, 4, [255u8, 188, 0, 7].repeat(16));
-        let a = albedo_linear("--albedo", &img).unwrap();
+        let a = albedo_linear("albedo_map", &img).unwrap();
         assert_eq!(a.channels, 3);
         assert_eq!(a.data[0], 1.0);
         // sRGB 188/255 = 0.737 is linear 0.503.
@@ -134,23 +134,23 @@ mod tests {
     #[test]
     fn wrong_shapes_are_named() {
         let grey = ImageU8::from_vec(8, 8, 1, vec![128; 64]);
-        let e = albedo_linear("--albedo", &grey).unwrap_err();
-        assert_eq!(e.param, "--albedo");
+        let e = albedo_linear("albedo_map", &grey).unwrap_err();
+        assert_eq!(e.param, "albedo_map");
         assert!(e.message.contains("1 channel(s)"), "{e}");
         let tiny = ImageU8::from_vec(2, 8, 3, vec![128; 48]);
-        assert!(normals_unit("--normal-map", &tiny, GreenConvention::DirectX).unwrap_err().message.contains("width 2"));
+        assert!(normals_unit("normal_map", &tiny, GreenConvention::DirectX).unwrap_err().message.contains("width 2"));
     }
 
     #[test]
     fn a_normal_map_decodes_to_unit_vectors_in_either_green_convention() {
         let n = [0.3f32, -0.4, (1.0f32 - 0.25).sqrt()];
         let img = ImageU8::from_vec(8, 8, 3, encode_normal(n).repeat(64));
-        let (dx, stats) = normals_unit("--normal-map", &img, GreenConvention::DirectX).unwrap();
+        let (dx, stats) = normals_unit("normal_map", &img, GreenConvention::DirectX).unwrap();
         assert!(stats.non_unit_share == 0.0 && stats.mean_z > 0.8);
         let t = &dx.data[..3];
         assert!((t[0] - n[0]).abs() < 0.01 && (t[1] - n[1]).abs() < 0.01 && (t[2] - n[2]).abs() < 0.01, "{t:?}");
         assert!(((t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) - 1.0).abs() < 1e-5);
-        let (gl, _) = normals_unit("--normal-map", &img, GreenConvention::OpenGl).unwrap();
+        let (gl, _) = normals_unit("normal_map", &img, GreenConvention::OpenGl).unwrap();
         assert_eq!(gl.data[1], -dx.data[1]);
         assert_eq!(gl.data[0], dx.data[0]);
     }
@@ -159,11 +159,11 @@ mod tests {
     fn a_colour_picture_is_not_a_normal_map() {
         // A skin-coloured picture: lengths far from 1.
         let skin = ImageU8::from_vec(8, 8, 3, [200u8, 150, 120].repeat(64));
-        let e = normals_unit("--normal-map", &skin, GreenConvention::DirectX).unwrap_err();
-        assert_eq!(e.param, "--normal-map");
+        let e = normals_unit("normal_map", &skin, GreenConvention::DirectX).unwrap_err();
+        assert_eq!(e.param, "normal_map");
         assert!(e.message.contains("is not a tangent-space normal map"), "{e}");
         // Unit vectors pointing into the surface (an object-space map's back half): mean z < 0.5.
         let inward = ImageU8::from_vec(8, 8, 3, encode_normal([0.0, 0.6, -0.8]).repeat(64));
-        assert!(normals_unit("--normal-map", &inward, GreenConvention::DirectX).is_err());
+        assert!(normals_unit("normal_map", &inward, GreenConvention::DirectX).is_err());
     }
 }

@@ -74,7 +74,7 @@ impl Default for ModelOptions {
 /// Errors of the skin-colour model.
 #[derive(Debug, thiserror::Error)]
 pub enum SkinColorError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
 }
 

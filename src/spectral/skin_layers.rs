@@ -151,11 +151,8 @@ pub fn check_concentrations(
 ) -> Result<(), InvalidInput> {
     let (cm_max, chd_max) =
         if allow_unphysiological { (1.0, 1.0) } else { (MELANIN_FRACTION_MAX, DERMAL_HEMOGLOBIN_FRACTION_MAX) };
-    let hint = if allow_unphysiological {
-        "(volume fraction)"
-    } else {
-        "(Table 7.1; allow_unphysiological / --allow-unphysiological lifts it)"
-    };
+    let hint =
+        if allow_unphysiological { "(volume fraction)" } else { "(Table 7.1; `allow_unphysiological` lifts it)" };
     check_range(melanin_param, cm, 0.0, cm_max, hint)?;
     check_range(hemoglobin_param, chd, 0.0, chd_max, hint)?;
     let che = physiology.epidermal_hemoglobin(chd);

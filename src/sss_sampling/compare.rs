@@ -47,7 +47,7 @@ use std::f64::consts::PI;
 /// Errors of the comparison.
 #[derive(Debug, thiserror::Error)]
 pub enum CompareError {
-    #[error(transparent)]
+    #[error("{0}")]
     Invalid(#[from] InvalidInput),
     #[error("separable fit: {0}")]
     Separable(#[from] SeparableFitError),

@@ -66,11 +66,11 @@ fn the_scans_maps_decode_and_a_colour_picture_is_no_normal_map() {
     let mean = |c: usize| albedo.data.iter().skip(c).step_by(3).map(|&v| v as f64).sum::<f64>() / (1024.0 * 1024.0);
     let (r, g, bl) = (mean(0), mean(1), mean(2));
     assert!(r > g && g > bl && r < 1.0 && bl > 0.0, "{r} {g} {bl}");
-    let (n, stats) = normals_unit("--normal-map", &rgb8(&normal), GreenConvention::OpenGl).unwrap();
+    let (n, stats) = normals_unit("normal_map", &rgb8(&normal), GreenConvention::OpenGl).unwrap();
     assert_eq!((n.width, n.height), (1024, 1024));
     assert!(stats.mean_z > 0.8 && stats.non_unit_share < 0.02, "{stats:?}");
-    let e = normals_unit("--normal-map", &rgb8(&color), GreenConvention::OpenGl).unwrap_err();
-    assert_eq!(e.param, "--normal-map");
+    let e = normals_unit("normal_map", &rgb8(&color), GreenConvention::OpenGl).unwrap_err();
+    assert_eq!(e.param, "normal_map");
     assert!(e.message.contains("is not a tangent-space normal map"), "{e}");
 }
 

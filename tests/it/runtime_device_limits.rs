@@ -16,7 +16,7 @@ fn an_image_beyond_the_adapter_texture_limit_is_refused_not_a_panic() {
     assert!(matches!(err, RuntimeError::Invalid(_)), "{err}");
     let msg = err.to_string();
     assert!(
-        msg.contains("max_texture_dimension_2d") && msg.contains(&edge.to_string()) && msg.contains("--cpu"),
+        msg.contains("max_texture_dimension_2d") && msg.contains(&edge.to_string()) && msg.contains("`cpu`"),
         "{msg}"
     );
     // Through a pass: refused before allocating (by the adapter's limit where it is below rtbake's 16384, by

@@ -110,5 +110,5 @@ fn wrong_rig_weight_count_is_refused() {
     let g = gpu();
     let mut pass = SkinInputs::new(&g.device, &g.queue, 8, 8, &luts(), &rig()).unwrap();
     let e = pass.run(&g.device, &g.queue, &frame(8, 8), &[1.0], [0.0, 0.0, 1.0]).unwrap_err();
-    assert!(e.to_string().contains("--rig-weights"), "{e}");
+    assert!(e.to_string().contains("rig_weights needs one weight per rig target"), "{e}");
 }

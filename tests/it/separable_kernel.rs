@@ -224,20 +224,20 @@ fn smaller_falloff_concentrates_weight_near_the_centre() {
 }
 
 #[test]
-fn bad_input_names_the_flag() {
+fn bad_input_names_the_field() {
     let bad = [
-        (KernelSpec::new(16, PUBLISHED), "--samples"),
-        (KernelSpec::new(1, PUBLISHED), "--samples"),
-        (KernelSpec::new(65, PUBLISHED), "--samples"),
-        (KernelSpec::new(17, SeparableParams { strength: [1.2, 0.5, 0.5], ..PUBLISHED }), "--strength"),
-        (KernelSpec::new(17, SeparableParams { strength: [0.5, f64::NAN, 0.5], ..PUBLISHED }), "--strength"),
-        (KernelSpec::new(17, SeparableParams { falloff: [1.0, -0.1, 0.5], ..PUBLISHED }), "--falloff"),
-        (KernelSpec::new(17, SeparableParams { falloff: [1.0, 0.1, f64::INFINITY], ..PUBLISHED }), "--falloff"),
-        (KernelSpec { range: Some(0.0), ..KernelSpec::new(17, PUBLISHED) }, "--range"),
-        (KernelSpec { exponent: f64::NAN, ..KernelSpec::new(17, PUBLISHED) }, "--exponent"),
+        (KernelSpec::new(16, PUBLISHED), "samples"),
+        (KernelSpec::new(1, PUBLISHED), "samples"),
+        (KernelSpec::new(65, PUBLISHED), "samples"),
+        (KernelSpec::new(17, SeparableParams { strength: [1.2, 0.5, 0.5], ..PUBLISHED }), "strength"),
+        (KernelSpec::new(17, SeparableParams { strength: [0.5, f64::NAN, 0.5], ..PUBLISHED }), "strength"),
+        (KernelSpec::new(17, SeparableParams { falloff: [1.0, -0.1, 0.5], ..PUBLISHED }), "falloff"),
+        (KernelSpec::new(17, SeparableParams { falloff: [1.0, 0.1, f64::INFINITY], ..PUBLISHED }), "falloff"),
+        (KernelSpec { range: Some(0.0), ..KernelSpec::new(17, PUBLISHED) }, "range"),
+        (KernelSpec { exponent: f64::NAN, ..KernelSpec::new(17, PUBLISHED) }, "exponent"),
     ];
-    for (spec, flag) in bad {
+    for (spec, field) in bad {
         let e = generate(&spec).unwrap_err();
-        assert_eq!(e.param, flag, "{e}");
+        assert_eq!(e.param, field, "{e}");
     }
 }

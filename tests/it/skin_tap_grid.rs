@@ -47,8 +47,8 @@ fn the_single_light_points_where_tap_puts_it_and_mirrors_with_the_azimuth() {
     let h = 0.5f32.sqrt();
     assert!((l.key_view[0]).abs() < 1e-6 && (l.key_view[1] - h).abs() < 1e-6 && (l.key_view[2] - h).abs() < 1e-6);
     assert_eq!(l.key_view, l.back_view, "one light for both");
-    for (az, el, flag) in [(180.5, 45.0, "--light-azimuth"), (0.0, -90.5, "--light-elevation")] {
-        assert_eq!(SceneLights::single(az, el, &cam).unwrap_err().param, flag);
+    for (az, el, field) in [(180.5, 45.0, "light_azimuth_deg"), (0.0, -90.5, "light_elevation_deg")] {
+        assert_eq!(SceneLights::single(az, el, &cam).unwrap_err().param, field);
     }
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let head = default_head();

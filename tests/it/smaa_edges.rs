@@ -205,24 +205,24 @@ fn passes_refuse_bad_depth_and_mask() {
     let err = |o: &SmaaOptions, i: &AaInputs| {
         cpu::smaa::smaa_with_options(&img, (w, h), &luts, cpu::FilterPrecision::Exact, o, i).err().expect("refused")
     };
-    assert_eq!(err(&depth_opts, &AaInputs::default()).param, "--depth");
-    assert_eq!(err(&depth_opts, &AaInputs { depth: Some(&[1.0; 7]), mask: None }).param, "--depth");
+    assert_eq!(err(&depth_opts, &AaInputs::default()).param, "depth");
+    assert_eq!(err(&depth_opts, &AaInputs { depth: Some(&[1.0; 7]), mask: None }).param, "depth");
     let mut nan = vec![1.0f32; (w * h) as usize];
     nan[17] = f32::NAN;
     let e = err(&depth_opts, &AaInputs { depth: Some(&nan), mask: None });
-    assert!(e.param == "--depth" && e.message.contains("(1, 1)"), "{e}");
+    assert!(e.param == "depth" && e.message.contains("(1, 1)"), "{e}");
     let both = SmaaOptions { edges: settings(EdgeDetector::Depth, Some(Predication::SMAA)), ..Default::default() };
-    assert_eq!(err(&both, &AaInputs { depth: Some(&nan), mask: None }).param, "--predication");
+    assert_eq!(err(&both, &AaInputs { depth: Some(&nan), mask: None }).param, "predication");
     let bad_scale = Predication { scale: 6.0, ..Predication::SMAA };
     let o = SmaaOptions { edges: settings(EdgeDetector::Luma, Some(bad_scale)), ..Default::default() };
-    assert_eq!(err(&o, &AaInputs::default()).param, "--predication-scale");
+    assert_eq!(err(&o, &AaInputs::default()).param, "predication_scale");
     let masked = SmaaOptions { masked: true, ..Default::default() };
-    assert_eq!(err(&masked, &AaInputs { depth: None, mask: Some(&[255; 3]) }).param, "--mask");
+    assert_eq!(err(&masked, &AaInputs { depth: None, mask: Some(&[255; 3]) }).param, "mask");
     // The GPU pass checks the same way before it draws.
     let g = gpu();
     let pass = Smaa::with_options(&g.device, &g.queue, w, h, &luts, &depth_opts).unwrap();
     let e = pass.run_with(&g.device, &g.queue, &img, &AaInputs { depth: Some(&nan), mask: None }).err().unwrap();
-    assert!(e.to_string().contains("--depth"), "{e}");
+    assert!(e.to_string().contains("depth must be finite"), "{e}");
 }
 
 // ------------------------------------------------------------------------------------------------------------

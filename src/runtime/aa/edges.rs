@@ -63,9 +63,9 @@ impl Predication {
 
     /// Ranges of SMAA.hlsl's documentation: scale in 1..=5, strength in 0..=1, threshold finite and > 0.
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        positive("--predication-threshold", self.threshold)?;
-        check_range("--predication-scale", self.scale, 1.0, 5.0, "")?;
-        check_range("--predication-strength", self.strength, 0.0, 1.0, "")?;
+        positive("predication_threshold", self.threshold)?;
+        check_range("predication_scale", self.scale, 1.0, 5.0, "")?;
+        check_range("predication_strength", self.strength, 0.0, 1.0, "")?;
         Ok(())
     }
 }
@@ -102,12 +102,12 @@ impl Default for EdgeSettings {
 impl EdgeSettings {
     /// Thresholds finite and positive, predication in its ranges and only with luma or colour detection.
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        positive("--depth-threshold", self.depth_threshold)?;
+        positive("depth_threshold", self.depth_threshold)?;
         if let Some(p) = &self.predication {
             if self.detector == EdgeDetector::Depth {
                 return Err(InvalidInput::new(
-                    "--predication",
-                    "applies to --edges luma or color (it thresholds them from the depth); --edges depth already \
+                    "predication",
+                    "applies to `edges` luma or color (it thresholds them from the depth); `edges` depth already \
                      reads the depth",
                 ));
             }
@@ -142,20 +142,20 @@ impl AaInputs<'_> {
         match self.depth {
             None if settings.needs_depth() => {
                 return Err(InvalidInput::new(
-                    "--depth",
-                    "is required by --edges depth and by --predication (a one-channel depth image)",
+                    "depth",
+                    "is required by `edges` depth and by `predication` (a one-channel depth image)",
                 ))
             }
             Some(d) if settings.needs_depth() => {
                 if d.len() != n {
                     return Err(InvalidInput::new(
-                        "--depth",
+                        "depth",
                         format!("must hold {w}x{h} = {n} values (the colour image's size), got {}", d.len()),
                     ));
                 }
                 if let Some(i) = d.iter().position(|v| !v.is_finite()) {
                     return Err(InvalidInput::new(
-                        "--depth",
+                        "depth",
                         format!("must be finite; pixel ({}, {}) is {}", i % w as usize, i / w as usize, d[i]),
                     ));
                 }
@@ -163,10 +163,10 @@ impl AaInputs<'_> {
             _ => {}
         }
         match self.mask {
-            None if masked => return Err(InvalidInput::new("--mask", "is required by a masked pass")),
+            None if masked => return Err(InvalidInput::new("mask", "is required by a masked pass")),
             Some(m) if m.len() != n => {
                 return Err(InvalidInput::new(
-                    "--mask",
+                    "mask",
                     format!("must hold {w}x{h} = {n} bytes (the colour image's size), got {}", m.len()),
                 ))
             }

@@ -109,7 +109,7 @@ impl std::str::FromStr for SmaaMode {
         Self::ALL
             .into_iter()
             .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| InvalidInput::new("--mode", format!("must be one of 1x, s2x, t2x, 4x, got {s:?}")))
+            .ok_or_else(|| InvalidInput::new("mode", format!("must be one of 1x, s2x, t2x, 4x, got {s:?}")))
     }
 }
 
@@ -133,7 +133,7 @@ impl TemporalResolve {
     pub fn validate(&self) -> Result<(), InvalidInput> {
         match *self {
             Self::Reprojected { k } if !(k.is_finite() && (0.0..=1.0e4).contains(&k)) => {
-                Err(InvalidInput::new("--k", format!("must be finite and within 0..=10000, got {k}")))
+                Err(InvalidInput::new("k", format!("must be finite and within 0..=10000, got {k}")))
             }
             _ => Ok(()),
         }
@@ -465,7 +465,7 @@ mod tests {
         let t2x: Vec<_> = (0..2).map(|f| SmaaMode::T2x.samples(f)[0].subsample).collect();
         assert_eq!(s2x, t2x);
         assert_eq!("T2X".parse::<SmaaMode>().unwrap(), SmaaMode::T2x);
-        assert_eq!("8x".parse::<SmaaMode>().unwrap_err().param, "--mode");
+        assert_eq!("8x".parse::<SmaaMode>().unwrap_err().param, "mode");
     }
 
     #[test]

@@ -113,7 +113,7 @@ pub struct MovingScene {
 
 impl MovingScene {
     pub fn new(width: u32, height: u32, motion: SceneMotion) -> Result<Self, InvalidInput> {
-        crate::error::check_size("--width/--height", width as u64, height as u64)?;
+        crate::error::check_size("width/height", width as u64, height as u64)?;
         motion.validate()?;
         let (fw, fh) = (width as f64, height as f64);
         let s = fw.min(fh);

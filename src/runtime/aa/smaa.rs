@@ -68,7 +68,7 @@ impl SubsampleIndices {
         let [v, h, d1, d2] = self.0;
         if v > 6 || h > 6 || d1 > 4 || d2 > 4 {
             return Err(InvalidInput::new(
-                "--subsample",
+                "subsample",
                 format!("orthogonal indices must be in 0..=6 and diagonal ones in 0..=4, got {:?}", self.0),
             ));
         }

@@ -27,8 +27,8 @@ use crate::error::{check_range, InvalidInput};
 use crate::runtime::compute_chain::{self, Buffer, Stage};
 use crate::runtime::RuntimeError;
 
-/// The flag that switches bloom.
-pub const BLOOM_FLAG: &str = "--bloom";
+/// The parameter that switches bloom (its flag is in the CLI's table).
+pub const BLOOM_PARAM: &str = "bloom";
 
 /// Bloom parameters (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]

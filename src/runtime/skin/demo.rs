@@ -69,7 +69,7 @@ pub fn memory_estimate_bytes(w: u32, h: u32) -> u64 {
 }
 
 fn lit(gpu: Backend<'_>, w: u32, h: u32, assets: &DemoAssets) -> Result<Lit, RuntimeError> {
-    crate::error::check_size("--width/--height", w as u64, h as u64)?;
+    crate::error::check_size("width/height", w as u64, h as u64)?;
     lit_geometry(gpu, geometry(w, h, assets.baked_rig.as_ref()), assets)
 }
 
@@ -128,14 +128,14 @@ pub fn check_frame_fits(limits: &wgpu::Limits, w: u32, h: u32) -> Result<(), Inv
         return Ok(());
     }
     let largest = match crate::runtime::skin::frame::largest_fitting(w, h, fits) {
-        Some((fw, fh)) => format!("--width {fw} --height {fh} is the largest frame of this aspect that fits"),
+        Some((fw, fh)) => format!("`width` {fw} `height` {fh} is the largest frame of this aspect that fits"),
         None => "no frame of this aspect fits".to_string(),
     };
     Err(InvalidInput::new(
-        "--width/--height",
+        "width/height",
         format!(
             "{w}x{h}: the skin-inputs pass needs {LARGEST_BYTES_PER_PIXEL} bytes per pixel (a {}-byte read-back), \
-             over this GPU's limits (max_texture_dimension_2d {edge}, max_buffer_size {}); {largest}; or --cpu \
+             over this GPU's limits (max_texture_dimension_2d {edge}, max_buffer_size {}); {largest}; or `cpu` \
              (the CPU twins have no such limit)",
             crate::runtime::device::readback_bytes(w, h, LARGEST_BYTES_PER_PIXEL),
             limits.max_buffer_size
@@ -168,17 +168,17 @@ mod tests {
         assert_eq!(check_frame_fits(&l, 1920, 1080), Ok(()));
         // 8192² needs a 1 GiB read-back of RGBA f32.
         let err = check_frame_fits(&l, 8192, 8192).unwrap_err();
-        assert_eq!(err.param, "--width/--height");
-        for part in ["1073741824", "268435456", "--cpu", "max_buffer_size"] {
+        assert_eq!(err.param, "width/height");
+        for part in ["1073741824", "268435456", "`cpu`", "max_buffer_size"] {
             assert!(err.message.contains(part), "{part}: {err}");
         }
-        let rest = &err.message[err.message.find("--width ").expect("a suggestion") + 8..];
+        let rest = &err.message[err.message.find("`width` ").expect("a suggestion") + 8..];
         let w: u32 = rest.split_whitespace().next().unwrap().parse().unwrap();
         assert_eq!(check_frame_fits(&l, w, w), Ok(()), "the suggested {w}² fits");
         assert!(check_frame_fits(&l, w + 1, w + 1).is_err(), "{w}² is not the largest");
         // The texture edge alone.
         let small = wgpu::Limits { max_texture_dimension_2d: 2048, ..l };
         let err = check_frame_fits(&small, 4096, 1024).unwrap_err();
-        assert!(err.message.contains("--width 2048 --height 512"), "{err}");
+        assert!(err.message.contains("`width` 2048 `height` 512"), "{err}");
     }
 }

@@ -98,31 +98,31 @@ pub fn check_frame_fits(
     type PerPixel = (&'static str, fn(u32, u32) -> u64, &'static str);
     let mut per_pixel: Vec<PerPixel> = Vec::new();
     if passes.rig_pose.is_some() {
-        per_pixel.push(("the rig at uv (--rig-weights)", mesh_inputs::largest_buffer_bytes, ""));
+        per_pixel.push(("the rig at uv (`rig_weights`)", mesh_inputs::largest_buffer_bytes, ""));
     }
     if passes.wrinkles.is_some() {
-        per_pixel.push(("the wrinkle pass (--wrinkles)", wrinkles::largest_buffer_bytes, ""));
+        per_pixel.push(("the wrinkle pass (`wrinkles`)", wrinkles::largest_buffer_bytes, ""));
     }
     if matches!(s.shader, SkinShader::Ts(_)) {
         // A head covering every pixel gathers one RGBA f32 per pixel.
         let gather: fn(u32, u32) -> u64 = |w, h| texture_space::gather_buffer_bytes(w as u64 * h as u64);
-        per_pixel.push(("the texture-space gather (--shader ts)", gather, ""));
+        per_pixel.push(("the texture-space gather (`shader` ts)", gather, ""));
     }
     if passes.bloom.is_some() {
-        per_pixel.push(("bloom", bloom::largest_buffer_bytes, ", or --bloom off"));
+        per_pixel.push(("bloom", bloom::largest_buffer_bytes, ", or `bloom` off"));
     }
     let all_fit = |w: u32, h: u32| gbuffer_fits(w, h) && per_pixel.iter().all(|(_, bytes, _)| bytes(w, h) <= storage);
     let largest = || match largest_fitting(w, h, all_fit) {
-        Some((fw, fh)) => format!("--width {fw} --height {fh} is the largest frame of this aspect that fits"),
+        Some((fw, fh)) => format!("`width` {fw} `height` {fh} is the largest frame of this aspect that fits"),
         None => "no frame of this aspect fits".to_string(),
     };
-    let flag = "--width/--height";
+    let flag = "width/height";
     if !gbuffer_fits(w, h) {
         return Err(InvalidInput::new(
             flag,
             format!(
                 "{w}x{h}: the G-buffer ({gbuffer} bytes per pixel, a {}-byte read-back) exceeds this GPU's limits \
-                (max_texture_dimension_2d {edge}, max_buffer_size {}); {}; or --cpu (the CPU twins have no such \
+                (max_texture_dimension_2d {edge}, max_buffer_size {}); {}; or `cpu` (the CPU twins have no such \
                 limit)",
                 readback_bytes(w, h, gbuffer),
                 limits.max_buffer_size,
@@ -137,7 +137,7 @@ pub fn check_frame_fits(
                 flag,
                 format!(
                     "{w}x{h}: {pass} needs a {b}-byte storage buffer, over this GPU's limit of {storage} bytes \
-                    (max_storage_buffer_binding_size); {}{way_out}; or --cpu (the CPU twins have no such limit)",
+                    (max_storage_buffer_binding_size); {}{way_out}; or `cpu` (the CPU twins have no such limit)",
                     largest()
                 ),
             ));
@@ -155,11 +155,11 @@ pub fn check_frame_fits(
                 fit -= 1;
             }
             return Err(InvalidInput::new(
-                "--ts-map-size",
+                "ts_map_size",
                 format!(
                     "{}: the {0}² irradiance map needs {b}-byte storage buffers, over this GPU's limit of {storage} \
-                    bytes (max_storage_buffer_binding_size) or its {edge}-texel edge; use --ts-map-size {fit} or \
-                    less, or --cpu (the CPU twins have no such limit)",
+                    bytes (max_storage_buffer_binding_size) or its {edge}-texel edge; use `ts_map_size` {fit} or \
+                    less, or `cpu` (the CPU twins have no such limit)",
                     ts.map_size
                 ),
             ));
@@ -283,9 +283,9 @@ mod limits_tests {
     }
 
     fn suggested(msg: &str) -> (u32, u32) {
-        let rest = &msg[msg.find("--width ").expect(msg) + 8..];
+        let rest = &msg[msg.find("`width` ").expect(msg) + 8..];
         let w: u32 = rest.split_whitespace().next().unwrap().parse().unwrap();
-        let h: u32 = rest.split("--height ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+        let h: u32 = rest.split("`height` ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
         (w, h)
     }
 
@@ -294,8 +294,8 @@ mod limits_tests {
         let l = limits();
         let s = settings(SkinShader::Separable, 2560, 1440);
         let err = check_frame_fits(&l, &s, &SkinPasses::default()).unwrap_err();
-        assert_eq!(err.param, "--width/--height");
-        for part in ["bloom", "176947200", "134217728", "--bloom off", "--cpu", "max_storage_buffer_binding_size"] {
+        assert_eq!(err.param, "width/height");
+        for part in ["bloom", "176947200", "134217728", "`bloom` off", "`cpu`", "max_storage_buffer_binding_size"] {
             assert!(err.message.contains(part), "{part}: {err}");
         }
         let (w, h) = suggested(&err.message);
@@ -313,13 +313,13 @@ mod limits_tests {
     fn a_frame_beyond_the_texture_edge_and_an_oversized_irradiance_map_are_refused() {
         let l = wgpu::Limits { max_texture_dimension_2d: 2048, ..limits() };
         let err = check_frame_fits(&l, &settings(SkinShader::None, 4096, 1024), &SkinPasses::none()).unwrap_err();
-        assert!(err.message.contains("G-buffer") && err.message.contains("--cpu"), "{err}");
+        assert!(err.message.contains("G-buffer") && err.message.contains("`cpu`"), "{err}");
         assert_eq!(suggested(&err.message), (2048, 512));
         let small = wgpu::Limits { max_storage_buffer_binding_size: 1 << 20, ..limits() };
         let ts = SkinShader::Ts(TsSettings { map_size: 1024, ..Default::default() });
         let err = check_frame_fits(&small, &settings(ts, 64, 64), &SkinPasses::none()).unwrap_err();
-        assert_eq!(err.param, "--ts-map-size");
+        assert_eq!(err.param, "ts_map_size");
         // 256² RGBA f32 is exactly 1 MiB.
-        assert!(err.message.contains("--ts-map-size 256 ") && err.message.contains("--cpu"), "{err}");
+        assert!(err.message.contains("`ts_map_size` 256 ") && err.message.contains("`cpu`"), "{err}");
     }
 }

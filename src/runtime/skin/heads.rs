@@ -39,7 +39,7 @@ pub fn row_of_heads(mesh: &Mesh, heads: u32) -> Result<Mesh, InvalidInput> {
         uvs.extend_from_slice(&mesh.uvs);
         idx.extend(mesh.indices.iter().map(|i| i + k * n));
     }
-    Mesh::new("--heads", pos, nrm, uvs, idx, mesh.mm_per_unit)
+    Mesh::new("heads", pos, nrm, uvs, idx, mesh.mm_per_unit)
 }
 
 fn rasterise(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera, w: u32, h: u32) -> Result<MeshGBuffer, RuntimeError> {

@@ -267,7 +267,7 @@ impl SkinInputs {
         }
         if rig_weights.len() != self.params.cfg[0] as usize {
             return Err(invalid(
-                "--rig-weights",
+                "rig_weights",
                 format!("needs one weight per rig target ({}), got {}", self.params.cfg[0], rig_weights.len()),
             ));
         }

@@ -93,8 +93,12 @@ impl SceneLights {
         elevation_deg: f32,
         camera: &crate::mesh::camera::Camera,
     ) -> Result<Self, InvalidInput> {
-        let w =
-            crate::mesh::framing::light_direction(azimuth_deg, elevation_deg, "--light-azimuth", "--light-elevation")?;
+        let w = crate::mesh::framing::light_direction(
+            azimuth_deg,
+            elevation_deg,
+            "light_azimuth_deg",
+            "light_elevation_deg",
+        )?;
         let view = camera.view();
         let r = view.fixed_view::<3, 3>(0, 0) * nalgebra::Vector3::from(w);
         let v = normalise([r.x, r.y, r.z]);
@@ -170,12 +174,9 @@ impl TransmittanceMode {
     /// Green's law with Jensen et al. 2001's skin1: σt′ = σa + σs′ = (0.772, 1.05, 1.49) mm⁻¹.
     pub fn green_skin1() -> Self {
         let m = crate::diffusion::materials::find("skin1").expect("Jensen 2001 lists skin1");
-        let b = crate::transmittance::BeerLambert::from_reduced(
-            "--transmittance",
-            m.sigma_a_per_mm,
-            m.sigma_s_prime_per_mm,
-        )
-        .expect("skin1's coefficients are in range");
+        let b =
+            crate::transmittance::BeerLambert::from_reduced("transmittance", m.sigma_a_per_mm, m.sigma_s_prime_per_mm)
+                .expect("skin1's coefficients are in range");
         TransmittanceMode::Green(b)
     }
 }
@@ -199,7 +200,7 @@ impl DemoAssets {
     /// be a target of the rig, weights finite, and their sum 1 ± 1e-3 (eq. 7.6 blends the targets); targets not
     /// named get 0.
     pub fn set_rig_weights(&mut self, json: &serde_json::Value) -> Result<(), InvalidInput> {
-        let param = "--rig-weights";
+        let param = "rig_weights";
         let obj = json.as_object().ok_or_else(|| {
             InvalidInput::new(param, "must be a JSON object {\"target name\": weight, ...}".to_string())
         })?;
@@ -368,7 +369,7 @@ pub(crate) fn shade(
         SssMethod::Importance => chain::Subsurface::Importance {
             samples: assets.importance.as_ref().ok_or_else(|| {
                 InvalidInput::new(
-                    "--sss importance",
+                    "sss importance",
                     format!("needs {} in the bake directory", path::IMPORTANCE_KERNEL_DEFAULT),
                 )
             })?,

@@ -24,8 +24,8 @@ use crate::runtime::loader::BakedRig;
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
 use crate::runtime::RuntimeError;
 
-/// The flag that sets a [`RigPose`].
-pub const RIG_WEIGHTS_FLAG: &str = "--rig-weights";
+/// The parameter that sets a [`RigPose`] (its flag is in the CLI's table).
+pub const RIG_WEIGHTS_PARAM: &str = "rig_weights";
 
 /// The rig's pose: one weight per target (eq. 7.6, summing to 1) and the global state factor g.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,7 +50,7 @@ impl RigPose {
         names: &[String],
         global_scales: &[(String, f64)],
     ) -> Result<Self, InvalidInput> {
-        let param = RIG_WEIGHTS_FLAG;
+        let param = RIG_WEIGHTS_PARAM;
         let obj = json.as_object().ok_or_else(|| {
             InvalidInput::new(param, "must be a JSON object {\"target\": weight, ..., \"global\": {\"anger\": a}}")
         })?;
@@ -108,7 +108,7 @@ impl RigAtUv<'_> {
         self.rig.validate()?;
         if self.pose.weights.len() != self.rig.targets.len() || self.rig.targets.len() > MAX_RIG_TARGETS {
             return Err(InvalidInput::new(
-                RIG_WEIGHTS_FLAG,
+                RIG_WEIGHTS_PARAM,
                 format!(
                     "needs one weight per rig target ({}), got {}",
                     self.rig.targets.len(),
@@ -120,7 +120,7 @@ impl RigAtUv<'_> {
             return Err(InvalidInput::new("hemoglobin rig", "H0 must be a non-empty one-channel map"));
         }
         if !self.pose.global_scale.is_finite() || self.pose.global_scale < 0.0 {
-            return Err(InvalidInput::new(RIG_WEIGHTS_FLAG, "the global scale must be finite and >= 0"));
+            return Err(InvalidInput::new(RIG_WEIGHTS_PARAM, "the global scale must be finite and >= 0"));
         }
         Ok(())
     }
@@ -215,7 +215,7 @@ mod tests {
             serde_json::json!([1.0]),
         ] {
             let e = RigPose::from_json(&j, &names(), &globals).unwrap_err();
-            assert_eq!(e.param, RIG_WEIGHTS_FLAG, "{j}");
+            assert_eq!(e.param, RIG_WEIGHTS_PARAM, "{j}");
         }
     }
 }

@@ -79,7 +79,7 @@ pub const GBUFFER_BYTES_PER_TEXEL: u32 = GBUFFER_TARGETS * 8 + 4;
 /// Refuses a sample count other than 1 or 4 (`--msaa`).
 pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
     if !SAMPLE_COUNTS.contains(&samples) {
-        return Err(InvalidInput::new("--msaa", format!("must be 1 or 4 samples per pixel, got {samples}")));
+        return Err(InvalidInput::new("msaa", format!("must be 1 or 4 samples per pixel, got {samples}")));
     }
     Ok(())
 }
@@ -133,7 +133,7 @@ pub fn rasterise_with_tangents(
             let flags = f.guaranteed_format_features(device.features()).flags;
             let resolve = f.has_depth_aspect() || flags.contains(Fl::MULTISAMPLE_RESOLVE);
             if !flags.sample_count_supported(samples) || !resolve {
-                return Err(InvalidInput::new("--msaa", format!("{samples}x is not supported for {f:?} here")).into());
+                return Err(InvalidInput::new("msaa", format!("{samples}x is not supported for {f:?} here")).into());
             }
         }
     }
@@ -142,7 +142,7 @@ pub fn rasterise_with_tangents(
     let vertex_bytes = mesh.positions.len() as u64 * 48;
     if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
         return Err(InvalidInput::new(
-            "--mesh",
+            "mesh",
             format!("{vertex_bytes} bytes of vertices exceed the adapter's buffer limit"),
         )
         .into());

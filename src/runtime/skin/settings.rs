@@ -99,10 +99,10 @@ pub struct SkinRenderSettings {
 
 impl SkinRenderSettings {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_range("--heads", self.heads, 1, MAX_HEADS, "")?;
-        check_range("--distance", self.distance_m as f64, 0.2, 100.0, "m")?;
-        check_range("--melanin", self.melanin as f64, 0.0, 0.5, "(volume fraction)")?;
-        crate::error::check_size("--width/--height", self.width as u64, self.height as u64)?;
+        check_range("heads", self.heads, 1, MAX_HEADS, "")?;
+        check_range("distance_m", self.distance_m as f64, 0.2, 100.0, "m")?;
+        check_range("melanin", self.melanin as f64, 0.0, 0.5, "(volume fraction)")?;
+        crate::error::check_size("width/height", self.width as u64, self.height as u64)?;
         Ok(())
     }
 
@@ -146,7 +146,7 @@ impl TsSettings {
     }
 
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_range("--ts-map-size", self.map_size, MIN_MAP_SIZE, MAX_MAP_SIZE, "texels")?;
+        check_range("ts_map_size", self.map_size, MIN_MAP_SIZE, MAX_MAP_SIZE, "texels")?;
         Ok(())
     }
 }

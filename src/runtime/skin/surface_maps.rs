@@ -26,10 +26,10 @@ use crate::runtime::skin::mesh_raster::MeshGBuffer;
 use crate::runtime::skin::view_frame;
 use crate::runtime::RuntimeError;
 
-/// The flag of the albedo map.
-pub const ALBEDO_FLAG: &str = "--albedo";
-/// The flag of the tangent-space normal map.
-pub const NORMAL_MAP_FLAG: &str = "--normal-map";
+/// The parameter of the albedo map (its flag is in the CLI's table).
+pub const ALBEDO_PARAM: &str = "albedo_map";
+/// The parameter of the tangent-space normal map (its flag is in the CLI's table).
+pub const NORMAL_MAP_PARAM: &str = "normal_map";
 
 /// One decoded map: `width`×`height` texels of (x, y, z, 0), row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,7 +66,7 @@ pub struct SurfaceMaps {
 impl SurfaceMaps {
     /// The maps from 8-bit pictures: `albedo` sRGB-encoded, `normal` a tangent-space normal map whose green channel
     /// follows `green` — decoded and validated by [`crate::shading::material_maps`] (RGB or RGBA, edges in
-    /// range, a normal map's texels near unit length), refused naming [`ALBEDO_FLAG`] / [`NORMAL_MAP_FLAG`].
+    /// range, a normal map's texels near unit length), refused naming [`ALBEDO_PARAM`] / [`NORMAL_MAP_PARAM`].
     pub fn from_pictures(
         albedo: Option<&crate::image_buf::ImageU8>,
         normal: Option<&crate::image_buf::ImageU8>,
@@ -74,11 +74,11 @@ impl SurfaceMaps {
     ) -> Result<Self, InvalidInput> {
         use crate::shading::material_maps::{albedo_linear, normals_unit};
         let albedo = match albedo {
-            Some(img) => Some(SurfaceMap::from_rgb(ALBEDO_FLAG, &albedo_linear(ALBEDO_FLAG, img)?)?),
+            Some(img) => Some(SurfaceMap::from_rgb(ALBEDO_PARAM, &albedo_linear(ALBEDO_PARAM, img)?)?),
             None => None,
         };
         let normal = match normal {
-            Some(img) => Some(SurfaceMap::from_rgb(NORMAL_MAP_FLAG, &normals_unit(NORMAL_MAP_FLAG, img, green)?.0)?),
+            Some(img) => Some(SurfaceMap::from_rgb(NORMAL_MAP_PARAM, &normals_unit(NORMAL_MAP_PARAM, img, green)?.0)?),
             None => None,
         };
         Ok(SurfaceMaps { albedo, normal })
@@ -87,14 +87,14 @@ impl SurfaceMaps {
     /// Checks both maps against a storage-binding limit of `storage` bytes (the GPU pass stores a vec4 of f32 per
     /// texel), naming the flag and the limit.
     pub fn check_fits(&self, storage: u64) -> Result<(), InvalidInput> {
-        for (flag, m) in [(ALBEDO_FLAG, &self.albedo), (NORMAL_MAP_FLAG, &self.normal)] {
+        for (flag, m) in [(ALBEDO_PARAM, &self.albedo), (NORMAL_MAP_PARAM, &self.normal)] {
             let Some(m) = m else { continue };
             if m.buffer_bytes() > storage {
                 return Err(InvalidInput::new(
                     flag,
                     format!(
                         "{}x{} texels need a {}-byte storage buffer, over this GPU's limit of {storage} bytes \
-                         (max_storage_buffer_binding_size); use a smaller map, or --cpu",
+                         (max_storage_buffer_binding_size); use a smaller map, or `cpu`",
                         m.width,
                         m.height,
                         m.buffer_bytes()

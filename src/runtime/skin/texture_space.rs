@@ -393,7 +393,7 @@ impl TextureSpaceDiffusion {
         let limit = device.limits().max_storage_buffer_binding_size;
         if map_bytes > limit {
             return Err(InvalidInput::new(
-                "--ts-map-size",
+                "ts_map_size",
                 format!("{size}² RGBA f32 is {map_bytes} bytes, over the adapter's storage-binding limit {limit}"),
             )
             .into());

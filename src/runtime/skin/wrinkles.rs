@@ -30,8 +30,8 @@ use crate::runtime::skin::view_frame;
 use crate::runtime::RuntimeError;
 use std::path::Path;
 
-/// The flag that sets the wrinkle weights.
-pub const WRINKLES_FLAG: &str = "--wrinkles";
+/// The parameter of the wrinkle weights (its flag is in the CLI's table).
+pub const WRINKLES_PARAM: &str = "wrinkles";
 
 /// The baked wrinkle maps, decoded: PD slopes `2·texel − 1` and zone masks `texel/255`.
 #[derive(Clone, Debug, PartialEq)]
@@ -111,23 +111,23 @@ pub fn parse_wrinkle_weights(spec: &str) -> Result<[f32; 8], InvalidInput> {
     let mut pairs: Vec<(&str, f64)> = Vec::new();
     for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (name, w) = item.split_once('=').ok_or_else(|| {
-            InvalidInput::new(WRINKLES_FLAG, format!("{item:?}: expected NAME=WEIGHT with NAME one of {known:?}"))
+            InvalidInput::new(WRINKLES_PARAM, format!("{item:?}: expected NAME=WEIGHT with NAME one of {known:?}"))
         })?;
         let name = name.trim();
         if !known.contains(&name) {
-            return Err(InvalidInput::new(WRINKLES_FLAG, format!("unknown expression {name:?}; known: {known:?}")));
+            return Err(InvalidInput::new(WRINKLES_PARAM, format!("unknown expression {name:?}; known: {known:?}")));
         }
         if pairs.iter().any(|(n, _)| *n == name) {
-            return Err(InvalidInput::new(WRINKLES_FLAG, format!("expression {name:?} given twice")));
+            return Err(InvalidInput::new(WRINKLES_PARAM, format!("expression {name:?} given twice")));
         }
         let w: f64 = w.trim().parse().map_err(|_| {
-            InvalidInput::new(WRINKLES_FLAG, format!("weight of {name:?} must be a number in 0..=1, got {w:?}"))
+            InvalidInput::new(WRINKLES_PARAM, format!("weight of {name:?} must be a number in 0..=1, got {w:?}"))
         })?;
-        crate::error::check_range(WRINKLES_FLAG, w, 0.0, 1.0, &format!("(weight of {name})"))?;
+        crate::error::check_range(WRINKLES_PARAM, w, 0.0, 1.0, &format!("(weight of {name})"))?;
         pairs.push((name, w));
     }
     if pairs.is_empty() {
-        return Err(InvalidInput::new(WRINKLES_FLAG, format!("needs NAME=WEIGHT pairs, NAME one of {known:?}")));
+        return Err(InvalidInput::new(WRINKLES_PARAM, format!("needs NAME=WEIGHT pairs, NAME one of {known:?}")));
     }
     Ok(zone_weights(&pairs)?.map(|v| v as f32))
 }
@@ -189,7 +189,7 @@ mod tests {
         assert_eq!(w[2], 0.0);
         assert_eq!(w[6], 1.0);
         for bad in ["", "smile=1", "joy", "joy=2", "joy=-0.1", "joy=x", "joy=1,joy=0.5"] {
-            assert_eq!(parse_wrinkle_weights(bad).unwrap_err().param, WRINKLES_FLAG, "{bad:?}");
+            assert_eq!(parse_wrinkle_weights(bad).unwrap_err().param, WRINKLES_PARAM, "{bad:?}");
         }
     }
 }

@@ -81,10 +81,10 @@ impl GaussianSssParams {
     }
 
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--alpha", self.alpha as f64, "")?;
-        check_non_negative("--beta", self.beta as f64, "")?;
-        check_non_negative("--gamma", self.gamma as f64, "")?;
-        check_positive("--lod-factor", self.lod_factor as f64, "")?;
+        check_positive("alpha", self.alpha as f64, "")?;
+        check_non_negative("beta", self.beta as f64, "")?;
+        check_non_negative("gamma", self.gamma as f64, "")?;
+        check_positive("lod_factor", self.lod_factor as f64, "")?;
         Ok(())
     }
 }

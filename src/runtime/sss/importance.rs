@@ -91,7 +91,7 @@ impl Default for ImportanceSssParams {
 
 impl ImportanceSssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--mm-per-world-unit", self.mm_per_world_unit as f64, "mm")?;
+        check_positive("mm_per_world_unit", self.mm_per_world_unit as f64, "mm")?;
         super::check_fovy(self.fovy_deg)
     }
     /// 1/tan(0.5·FOVy): distance to the projection window ([`super::dist_to_window`]).

@@ -36,7 +36,7 @@ pub fn dist_to_window(fovy_deg: f32) -> f32 {
 
 /// The vertical field of view every pass accepts: 1° to 179°.
 pub(crate) fn check_fovy(fovy_deg: f32) -> Result<(), InvalidInput> {
-    check_range("--fovy", fovy_deg, 1.0, 179.0, "degrees").map(drop)
+    check_range("fovy_deg", fovy_deg, 1.0, 179.0, "degrees").map(drop)
 }
 
 /// The frame every screen-space SSS pass reads: the irradiance (`Rgba16Float`, linear, alpha = per-pixel strength,

@@ -52,7 +52,7 @@ impl Default for SssParams {
 
 impl SssParams {
     pub fn validate(&self) -> Result<(), InvalidInput> {
-        check_positive("--sss-width", self.sss_width as f64, "world units")?;
+        check_positive("sss_width", self.sss_width as f64, "world units")?;
         super::check_fovy(self.fovy_deg)
     }
     /// 1/tan(0.5·FOVy): distance to the projection window ([`super::dist_to_window`]).
