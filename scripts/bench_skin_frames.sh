@@ -17,10 +17,14 @@ trap 'rm -rf "$dir"' EXIT
 mkdir -p "$dir/src" && git archive "$BASE" | tar -x -C "$dir/src"
 # One target directory for both builds: only rtbake itself is compiled twice.
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$PWD/target}
+# Same package in two places: cargo's freshness check compares mtimes, so touch the crate root before each build.
+touch "$dir/src/src/lib.rs"
 (cd "$dir/src" && cargo build $flag --example bench_skin_frames --quiet)
 cp "$CARGO_TARGET_DIR/$PROFILE/examples/bench_skin_frames" "$dir/before"
+touch src/lib.rs
 cargo build $flag --example bench_skin_frames --quiet
 cp "$CARGO_TARGET_DIR/$PROFILE/examples/bench_skin_frames" "$dir/after"
+cmp -s "$dir/before" "$dir/after" && { echo "before and after binaries are identical: nothing to compare" >&2; exit 1; }
 echo "before: $(git rev-parse --short "$BASE"), after: $(git rev-parse --short HEAD) ($(git status --porcelain | grep -q . && echo 'with uncommitted changes' || echo clean)), $PROFILE build, ${W}x${H}, $N frames"
 "$dir/before" "$W" "$H" "$N" 2>/dev/null | tee "$dir/before.txt"
 "$dir/after" "$W" "$H" "$N" 2>/dev/null | tee "$dir/after.txt"
