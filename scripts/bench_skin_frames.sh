@@ -15,7 +15,8 @@ flag=$([ "$PROFILE" = release ] && echo --release || true)
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 mkdir -p "$dir/src" && git archive "$BASE" | tar -x -C "$dir/src"
-# One target directory for both builds: only rtbake itself is compiled twice.
+# One target directory for both builds: only rtbake itself is compiled twice (run no other cargo command on that
+# target directory meanwhile: the before build replaces the library there until the after build).
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$PWD/target}
 # Same package in two places: cargo's freshness check compares mtimes, so touch the crate root before each build.
 touch "$dir/src/src/lib.rs"
