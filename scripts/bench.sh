@@ -6,6 +6,7 @@
 #   skin LUT 0.95 GFLOP (15 ms at 63.5 GFLOP/s), hemoglobin rig 79 GFLOP (1.25 s at 63.5 GFLOP/s, its loads counted
 #   as flops), CPU SMAA 44.9 MB moved (2.3 ms at 19.5 GB/s) — the rates of the AVX-512F AMD EPYC the performance analysis used.
 #   scripts/bench.sh [BENCH ...]     (default: all; logs in bench-out/<bench>.txt)
+#   scripts/bench_skin_frames.sh [W H N]   (`run skin` frames per shader, before vs after a change, one adapter)
 # Run it on an idle machine: the figures are wall-clock medians.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -7,13 +7,13 @@ use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{check_frame_fits, SkinRenderSettings, SkinShader, StretchPreset};
 use std::time::Instant;
 
-/// The smallest frame, as wide as possible, whose bloom buffer (48 bytes per pixel) exceeds the adapter's
+/// The smallest frame, as wide as possible, whose bloom buffer (the frame, 16 bytes per pixel) exceeds the adapter's
 /// storage-binding limit while its G-buffer still fits; `None` where no frame rtbake accepts does.
 fn frame_over_bloom_limit(limits: &wgpu::Limits) -> Option<(u32, u32)> {
     let storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     let edge = limits.max_texture_dimension_2d.min(rtbake::error::MAX_TEXTURE_EDGE);
-    let side = ((storage / 48) as f64).sqrt() as u64 + 1;
-    let (w, h) = if side <= edge as u64 { (side, side) } else { (edge as u64, (storage / 48 / edge as u64) + 1) };
+    let side = ((storage / 16) as f64).sqrt() as u64 + 1;
+    let (w, h) = if side <= edge as u64 { (side, side) } else { (edge as u64, (storage / 16 / edge as u64) + 1) };
     (h <= edge as u64 && rtbake::runtime::bloom::largest_buffer_bytes(w as u32, h as u32) > storage)
         .then_some((w as u32, h as u32))
 }

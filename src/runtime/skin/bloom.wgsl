@@ -1,103 +1,157 @@
-// Bloom on the HDR frame before tone mapping (runtime/bloom.rs): bright part B = max(I - threshold, 0), a weighted
-// sum of three separable Gaussian blurs K*B (taps beyond the image read 0), out = I + weight * (K*B - B).
-// Stage bright writes B, stage h_blur the three horizontal blurs (one walk over the widest radius, each B read
-// once), stage v_blur the vertical ones summed and the result.
-// CPU twin: runtime/cpu/bloom.rs.
+// Bloom on the HDR frame before tone mapping (runtime/skin/bloom.rs): a downsampled pyramid after Jimenez 2014
+// ("Next Generation Post Processing in Call of Duty: Advanced Warfare", SIGGRAPH course): the bright part
+// B = max(I - threshold, 0) is reduced level by level with the 13-tap filter (five overlapping 2x2 boxes: the
+// central one weighted 0.5, the four corner ones 0.125 each), then accumulated back from the coarsest level with
+// a 3x3 tent on bilinear reads, U_l = mix * D_l + tent(U_{l+1}); out = I + weight * (tent(U_1) - B).
+// Texels beyond a level read 0. CPU twin: runtime/skin/bloom_cpu.rs (the same sums in the same order).
 
 struct Params {
     // width, height, threshold, weight
     size: vec4<f32>,
-    // tap radius of blur 0, 1, 2, 0
-    radius: vec4<f32>,
-    // mix a_k of blur 0, 1, 2 (sum 1), 0
-    mix: vec4<f32>,
+    // levels N, mix per level (1 / N), 0, 0
+    lv: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
 @group(0) @binding(1) var<storage, read_write> hdr: array<vec4<f32>>;
-// the three kernels, 2r + 1 taps each, one after the other
-@group(0) @binding(2) var<storage, read_write> taps: array<f32>;
-// three horizontal blurs of B, each width x height
-@group(0) @binding(3) var<storage, read_write> tmp: array<vec4<f32>>;
+// D_1..D_N, one level after the other
+@group(0) @binding(2) var<storage, read_write> down_px: array<vec4<f32>>;
+// U_1..U_N, laid out as down_px
+@group(0) @binding(3) var<storage, read_write> up_px: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> result: array<vec4<f32>>;
-// B per pixel
-@group(0) @binding(5) var<storage, read_write> bright_px: array<vec4<f32>>;
 
-@compute @workgroup_size(8, 8, 1)
-fn bright(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = u32(p.size.x);
-    if (id.x >= w || id.y >= u32(p.size.y)) {
-        return;
+fn dims(l: u32) -> vec2<u32> {
+    var d = vec2<u32>(u32(p.size.x), u32(p.size.y));
+    for (var k = 0u; k < l; k = k + 1u) {
+        d = (d + vec2<u32>(1u)) / 2u;
     }
-    let v = hdr[id.y * w + id.x];
-    bright_px[id.y * w + id.x] = vec4<f32>(max(v.xyz - vec3<f32>(p.size.z), vec3<f32>(0.0)), 0.0);
+    return d;
 }
 
-fn kernel_start(k: u32) -> u32 {
+// Offset of level l >= 1 in down_px / up_px.
+fn offset(l: u32) -> u32 {
     var o = 0u;
-    for (var j = 0u; j < k; j = j + 1u) {
-        o = o + 2u * u32(p.radius[j]) + 1u;
+    for (var k = 1u; k < l; k = k + 1u) {
+        let d = dims(k);
+        o = o + d.x * d.y;
     }
     return o;
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn h_blur(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = u32(p.size.x);
-    let h = u32(p.size.y);
-    if (id.x >= w || id.y >= h) {
+fn bright(i: u32) -> vec4<f32> {
+    return vec4<f32>(max(hdr[i].xyz - vec3<f32>(p.size.z), vec3<f32>(0.0)), 0.0);
+}
+
+// Texel (x, y) of D_l (D_0 = B), 0 outside.
+fn src(l: u32, x: i32, y: i32) -> vec4<f32> {
+    let d = dims(l);
+    if (x < 0 || y < 0 || x >= i32(d.x) || y >= i32(d.y)) {
+        return vec4<f32>(0.0);
+    }
+    let i = u32(y) * d.x + u32(x);
+    if (l == 0u) {
+        return bright(i);
+    }
+    return down_px[offset(l) + i];
+}
+
+// The 2x2 box anchored at (x, y): one bilinear read halfway between texels.
+fn box(l: u32, x: i32, y: i32) -> vec4<f32> {
+    return 0.25 * (src(l, x, y) + src(l, x + 1, y) + src(l, x, y + 1) + src(l, x + 1, y + 1));
+}
+
+fn down(l: u32, id: vec3<u32>) {
+    let d = dims(l);
+    if (id.x >= d.x || id.y >= d.y) {
         return;
     }
-    let n = w * h;
-    let r = vec3<i32>(i32(p.radius.x), i32(p.radius.y), i32(p.radius.z));
-    let o = vec3<u32>(0u, kernel_start(1u), kernel_start(2u));
-    let rmax = max(r.x, max(r.y, r.z));
-    var s0 = vec4<f32>(0.0);
-    var s1 = vec4<f32>(0.0);
-    var s2 = vec4<f32>(0.0);
-    for (var j = -rmax; j <= rmax; j = j + 1) {
-        let x = i32(id.x) + j;
-        if (x < 0 || x >= i32(w)) {
-            continue;
-        }
-        let b = bright_px[id.y * w + u32(x)];
-        if (abs(j) <= r.x) {
-            s0 = s0 + taps[o.x + u32(j + r.x)] * b;
-        }
-        if (abs(j) <= r.y) {
-            s1 = s1 + taps[o.y + u32(j + r.y)] * b;
-        }
-        if (abs(j) <= r.z) {
-            s2 = s2 + taps[o.z + u32(j + r.z)] * b;
+    let s = l - 1u;
+    let x = 2 * i32(id.x);
+    let y = 2 * i32(id.y);
+    var v = 0.125 * (box(s, x - 1, y - 1) + box(s, x + 1, y - 1) + box(s, x - 1, y + 1) + box(s, x + 1, y + 1));
+    v = v + 0.125 * box(s, x, y);
+    v = v + 0.0625 * (box(s, x - 2, y) + box(s, x + 2, y) + box(s, x, y - 2) + box(s, x, y + 2));
+    v = v + 0.03125 * (box(s, x - 2, y - 2) + box(s, x + 2, y - 2) + box(s, x - 2, y + 2) + box(s, x + 2, y + 2));
+    let i = offset(l) + id.y * d.x + id.x;
+    down_px[i] = v;
+    if (l == u32(p.lv.x)) {
+        up_px[i] = p.lv.y * v;
+    }
+}
+
+// Texel (x, y) of U_l, 0 outside.
+fn acc(l: u32, x: i32, y: i32) -> vec4<f32> {
+    let d = dims(l);
+    if (x < 0 || y < 0 || x >= i32(d.x) || y >= i32(d.y)) {
+        return vec4<f32>(0.0);
+    }
+    return up_px[offset(l) + u32(y) * d.x + u32(x)];
+}
+
+fn bilinear(l: u32, u: f32, v: f32) -> vec4<f32> {
+    let fx = floor(u);
+    let fy = floor(v);
+    let a = u - fx;
+    let b = v - fy;
+    let x = i32(fx);
+    let y = i32(fy);
+    let top = (1.0 - a) * acc(l, x, y) + a * acc(l, x + 1, y);
+    let bottom = (1.0 - a) * acc(l, x, y + 1) + a * acc(l, x + 1, y + 1);
+    return (1.0 - b) * top + b * bottom;
+}
+
+// The 3x3 tent (1 2 1)^2 / 16 over U_c read at the centre of texel (x, y) of the level below c.
+fn tent(c: u32, x: u32, y: u32) -> vec4<f32> {
+    let u = (f32(x) + 0.5) * 0.5 - 0.5;
+    let v = (f32(y) + 0.5) * 0.5 - 0.5;
+    var s = vec4<f32>(0.0);
+    for (var j = -1; j <= 1; j = j + 1) {
+        for (var i = -1; i <= 1; i = i + 1) {
+            let w = f32((2 - abs(i)) * (2 - abs(j))) / 16.0;
+            s = s + w * bilinear(c, u + f32(i), v + f32(j));
         }
     }
-    let i = id.y * w + id.x;
-    tmp[i] = s0;
-    tmp[n + i] = s1;
-    tmp[2u * n + i] = s2;
+    return s;
+}
+
+fn up(l: u32, id: vec3<u32>) {
+    let d = dims(l);
+    if (id.x >= d.x || id.y >= d.y) {
+        return;
+    }
+    let i = offset(l) + id.y * d.x + id.x;
+    up_px[i] = p.lv.y * down_px[i] + tent(l + 1u, id.x, id.y);
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn v_blur(@builtin(global_invocation_id) id: vec3<u32>) {
+fn combine(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = u32(p.size.x);
-    let h = u32(p.size.y);
-    if (id.x >= w || id.y >= h) {
+    if (id.x >= w || id.y >= u32(p.size.y)) {
         return;
     }
-    let n = w * h;
-    var kb = vec4<f32>(0.0);
-    for (var k = 0u; k < 3u; k = k + 1u) {
-        let r = i32(p.radius[k]);
-        let o = kernel_start(k);
-        var s = vec4<f32>(0.0);
-        for (var j = -r; j <= r; j = j + 1) {
-            let y = i32(id.y) + j;
-            if (y >= 0 && y < i32(h)) {
-                s = s + taps[o + u32(j + r)] * tmp[k * n + u32(y) * w + id.x];
-            }
-        }
-        kb = kb + p.mix[k] * s;
-    }
     let i = id.y * w + id.x;
-    result[i] = hdr[i] + p.size.w * (kb - bright_px[i]);
+    result[i] = hdr[i] + p.size.w * (tent(1u, id.x, id.y) - bright(i));
 }
+
+@compute @workgroup_size(8, 8, 1)
+fn down_1(@builtin(global_invocation_id) id: vec3<u32>) { down(1u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn down_2(@builtin(global_invocation_id) id: vec3<u32>) { down(2u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn down_3(@builtin(global_invocation_id) id: vec3<u32>) { down(3u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn down_4(@builtin(global_invocation_id) id: vec3<u32>) { down(4u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn down_5(@builtin(global_invocation_id) id: vec3<u32>) { down(5u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn down_6(@builtin(global_invocation_id) id: vec3<u32>) { down(6u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn up_1(@builtin(global_invocation_id) id: vec3<u32>) { up(1u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn up_2(@builtin(global_invocation_id) id: vec3<u32>) { up(2u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn up_3(@builtin(global_invocation_id) id: vec3<u32>) { up(3u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn up_4(@builtin(global_invocation_id) id: vec3<u32>) { up(4u, id); }
+@compute @workgroup_size(8, 8, 1)
+fn up_5(@builtin(global_invocation_id) id: vec3<u32>) { up(5u, id); }

@@ -292,16 +292,19 @@ mod limits_tests {
     #[test]
     fn bloom_over_the_storage_limit_is_refused_naming_the_flags_and_the_largest_frame() {
         let l = limits();
-        let s = settings(SkinShader::Separable, 2560, 1440);
+        // The pyramid's largest buffer is the frame (16 bytes per pixel): 2560x1440 (refused with the
+        // full-resolution blur's 176947200-byte buffer) now fits; 4096x2304 does not.
+        assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, 2560, 1440), &SkinPasses::default()), Ok(()));
+        let s = settings(SkinShader::Separable, 4096, 2304);
         let err = check_frame_fits(&l, &s, &SkinPasses::default()).unwrap_err();
         assert_eq!(err.param, "width/height");
-        for part in ["bloom", "176947200", "134217728", "`bloom` off", "`cpu`", "max_storage_buffer_binding_size"] {
+        for part in ["bloom", "150994944", "134217728", "`bloom` off", "`cpu`", "max_storage_buffer_binding_size"] {
             assert!(err.message.contains(part), "{part}: {err}");
         }
         let (w, h) = suggested(&err.message);
         assert!(bloom_bytes(w, h) <= 1 << 27, "{w}x{h}");
         // The next wider frame of the same aspect does not fit.
-        assert!(bloom_bytes(w + 1, (w + 1) * 1440 / 2560) > 1 << 27, "{w}x{h} is not the largest");
+        assert!(bloom_bytes(w + 1, (w + 1) * 2304 / 4096) > 1 << 27, "{w}x{h} is not the largest");
         // 16:9 kept to a pixel.
         assert!((w as f64 / h as f64 - 16.0 / 9.0).abs() < 0.01, "{w}x{h}");
         // Without bloom the same frame fits; so does the suggested one with bloom.
