@@ -126,8 +126,8 @@ impl TransportModel {
 /// hemoglobin grid and the baked skins; README, "Skins: spectral profiles and Monte Carlo"); recorded in the
 /// provenance of every spectral multipole profile.
 pub const SKIN_MULTIPOLE_ERROR: &str = "total R above Monte Carlo transport (same sigma_s'): +18 to +43 % at g = 0, \
-    +30 to +199 % at g = 0.8 for the baked skins; +15 to +50 % at g = 0 and +20 to +243 % at g = 0.8 over the \
-    transport-report's skins (Cm 0.01-0.45, Chd 0.01-0.3; darker skins worst); --model mc gives the transport \
+    +30 to +199 % at g = 0.8 for the baked skins; +14 to +50 % at g = 0 and +21 to +216 % at g = 0.8 over the \
+    transport-report's two-layer skins (Cm 0.01-0.45, Chd 0.01-0.3; darker skins worst); --model mc gives the transport \
     solution";
 
 /// A spectral material as per-wavelength layer stacks, three wavelengths per stack (channel k of stack j is
