@@ -112,7 +112,7 @@ fn importance_sss_through_the_chain_and_bad_input() {
     let method = Subsurface::Importance { samples: &samples, params: &bad_params };
     for gpu in [Some(&g), None] {
         let e = chain::subsurface(gpu, &color, &depth, (w, h), &method).unwrap_err().to_string();
-        assert!(e.contains("--mm-per-world-unit"), "{e}");
+        assert!(e.contains("mm_per_world_unit"), "{e}");
     }
     let empty = ImportanceSamples { offsets_mm: vec![], weights: vec![], cutoff_mm: 1.0 };
     let e = ImportanceSss::new(&g.device, w, h, &empty, &params).err().unwrap().to_string();

@@ -96,13 +96,13 @@ fn linear16_png_stores_round_65535_t() {
 }
 
 #[test]
-fn invalid_settings_are_rejected_with_the_flag_name() {
+fn invalid_settings_are_rejected_with_the_field_name() {
     for (settings, flag) in [
-        (TableSettings { samples: 1, ..TableSettings::default() }, "--samples"),
-        (TableSettings { samples: 20000, ..TableSettings::default() }, "--samples"),
-        (TableSettings { s_max_mm: 0.0, ..TableSettings::default() }, "--s-max"),
-        (TableSettings { s_max_mm: f64::NAN, ..TableSettings::default() }, "--s-max"),
-        (TableSettings { height: 0, ..TableSettings::default() }, "--height"),
+        (TableSettings { samples: 1, ..TableSettings::default() }, "samples"),
+        (TableSettings { samples: 20000, ..TableSettings::default() }, "samples"),
+        (TableSettings { s_max_mm: 0.0, ..TableSettings::default() }, "s_max_mm"),
+        (TableSettings { s_max_mm: f64::NAN, ..TableSettings::default() }, "s_max_mm"),
+        (TableSettings { height: 0, ..TableSettings::default() }, "height"),
     ] {
         let err = table(&sum(), &settings).unwrap_err().to_string();
         assert!(err.contains(flag), "{err}");
