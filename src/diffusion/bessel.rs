@@ -129,30 +129,10 @@ pub fn j0(x: f64) -> f64 {
     }
 }
 
-/// Taylor coefficients (−1)ⁿ/(2n + 1)! and (−1)ⁿ/(2n)!, n = 1.., of sin and cos on |θ| ≤ π/4 (the first omitted
-/// terms are below 10⁻¹⁶): the one copy, used by [`sin_cos`] here and by the photon lanes' azimuth
-/// (`transport::lanes`).
-pub(crate) const SIN_TAYLOR: [f64; 8] = [
-    -1.0 / 6.0,
-    1.0 / 120.0,
-    -1.0 / 5040.0,
-    1.0 / 362_880.0,
-    -1.0 / 39_916_800.0,
-    1.0 / 6_227_020_800.0,
-    -1.0 / 1_307_674_368_000.0,
-    1.0 / 355_687_428_096_000.0,
-];
-pub(crate) const COS_TAYLOR: [f64; 9] = [
-    -1.0 / 2.0,
-    1.0 / 24.0,
-    -1.0 / 720.0,
-    1.0 / 40_320.0,
-    -1.0 / 3_628_800.0,
-    1.0 / 479_001_600.0,
-    -1.0 / 87_178_291_200.0,
-    1.0 / 20_922_789_888_000.0,
-    -1.0 / 6_402_373_705_728_000.0,
-];
+// Taylor coefficients (−1)ⁿ/(2n + 1)! and (−1)ⁿ/(2n)!, n = 1.., of sin and cos on |θ| ≤ π/4 (the first omitted
+// terms are below 10⁻¹⁶): the one copy lives in the photon-lane crate (its azimuth uses them too); `sin_cos` here
+// evaluates them.
+use rtbake_lanes::{COS_TAYLOR, SIN_TAYLOR};
 
 /// (sin x, cos x) for 0 ≤ x < ~1e7: x = n·π/2 + y with π/2 split in three parts (the first two with 30
 /// significant bits, so n·part is exact), then Taylor polynomials on |y| ≤ π/4 (next terms < 5e−17).
