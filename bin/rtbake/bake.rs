@@ -88,6 +88,7 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
             (*asset, p)
         })
         .collect();
+    check_time(&jobs, a.asset_params.is_some(), ctx)?;
     check_out_dir(&a.out)?;
     let pb = ctx.progress(jobs.len() as u64, "baking");
     pb.set_style(
@@ -114,6 +115,31 @@ pub fn run_bake(a: BakeArgs, ctx: &Ctx) -> anyhow::Result<()> {
         t0.elapsed().as_secs_f64()
     ));
     Ok(())
+}
+
+/// Refuses (exit 2), before any work, a bake whose assets' time estimates ([`rtbake::bake::Asset::time_estimate`],
+/// on this process' threads) add up to more than the time budget (`--max-seconds`); a parameter the estimate
+/// cannot read is named as the bake would name it.
+fn check_time(jobs: &[(&rtbake::bake::Asset, Value)], from_file: bool, ctx: &Ctx) -> anyhow::Result<()> {
+    let threads = rayon::current_num_threads();
+    let mut seconds = 0.0;
+    let mut costly = Vec::new();
+    for (asset, params) in jobs {
+        let s = asset.time_estimate_seconds(params, threads).map_err(|e| match e {
+            rtbake::bake::BakeError::Invalid(_) => usage(anyhow::anyhow!("asset {}: {e}", asset.name)),
+            other => anyhow::Error::new(other),
+        })?;
+        if s >= 1.0 {
+            costly.push(format!("{} ~{}", asset.name, crate::cli::fmt_seconds(s)));
+        }
+        seconds += s;
+    }
+    let what = format!(
+        "bake{} ({})",
+        if from_file { " --asset-params" } else { "" },
+        if costly.is_empty() { "every asset under a second".to_string() } else { costly.join(", ") }
+    );
+    ctx.check_time(&what, seconds)
 }
 
 /// Bad parameters and unusable directories are the user's to fix (exit 2); a directory locked by another process

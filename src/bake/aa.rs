@@ -275,6 +275,7 @@ fn bake_mlaa(asset: &str, version: MlaaVersion, params: &Value) -> Result<Vec<Ba
 pub fn assets() -> Vec<Asset> {
     vec![
         Asset {
+            time_estimate: None,
             name: "smaa-area",
             summary: "SMAA area texture 160x560 RG8 (SMAA 2.8+, U-shape smoothing) + AreaTex.h / AreaTex.rs",
             default_params: || json(SmaaAreaParams::default()),
@@ -291,6 +292,7 @@ pub fn assets() -> Vec<Asset> {
             },
         },
         Asset {
+            time_estimate: None,
             name: "smaa-area-v2.8",
             summary: "SMAA area texture 160x560 RG8 as in v2.8 (no U-shape smoothing)",
             default_params: || json(SmaaAreaParams::v2_8()),
@@ -300,6 +302,7 @@ pub fn assets() -> Vec<Asset> {
             },
         },
         Asset {
+            time_estimate: None,
             name: "smaa-search",
             summary: "SMAA search texture 64x16 R8 + SearchTex.h / SearchTex.rs",
             default_params: || json(NoParams {}),
@@ -317,6 +320,7 @@ pub fn assets() -> Vec<Asset> {
             },
         },
         Asset {
+            time_estimate: None,
             name: "smaa-search-v2.8",
             summary: "SMAA v2.8 search table 66x33 (0/1/2) and the logical pre-crop table (0/127/254)",
             default_params: || json(NoParams {}),
@@ -334,18 +338,21 @@ pub fn assets() -> Vec<Asset> {
             },
         },
         Asset {
+            time_estimate: None,
             name: "mlaa-v1.4",
             summary: "Jimenez MLAA v1.4+ area maps AreaMap{9,17,33,65,129} (5N x 5N RG8)",
             default_params: || mlaa_defaults(MlaaVersion::V1_4),
             bake: |v| bake_mlaa("mlaa-v1.4", MlaaVersion::V1_4, v),
         },
         Asset {
+            time_estimate: None,
             name: "mlaa-v1.3",
             summary: "Jimenez MLAA v1.3 area maps AreaMap{9,16,32} (5N x 5N RG8)",
             default_params: || mlaa_defaults(MlaaVersion::V1_3),
             bake: |v| bake_mlaa("mlaa-v1.3", MlaaVersion::V1_3, v),
         },
         Asset {
+            time_estimate: None,
             name: "mlaa-v2",
             summary: "MLAA 2.0 area texture 75x75 RG8 (15x15 cells, quadratic distances)",
             default_params: || mlaa_defaults(MlaaVersion::V2),

@@ -422,6 +422,7 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
 
 pub fn assets() -> Vec<Asset> {
     vec![Asset {
+        time_estimate: None,
         name: "burley-profiles",
         summary: "Burley normalized diffusion fitted to the Jensen 2001 dipoles and the physiological skins (and the \
                   artist mapping A, 1/sigma_tr), with plots and transmission profiles T(s) from Burley and from Gaussians",

@@ -412,18 +412,21 @@ fn bake_weights(_params: &Value) -> Result<Vec<BakedFile>, BakeError> {
 pub fn assets() -> Vec<Asset> {
     vec![
         Asset {
+            time_estimate: None,
             name: "hemoglobin-rig-example",
             summary: "Example hemoglobin appearance rig (eq. 7.1-7.6) on the synthetic neutral + expression maps",
             default_params: || serde_json::to_value(RigExampleParams::default()).expect("params serialise"),
             bake: bake_rig_example,
         },
         Asset {
+            time_estimate: None,
             name: "wrinkle-expression-weights",
             summary: "Thesis Table 8.1 wrinkle zone weights per expression (preset JSON)",
             default_params: || json!({}),
             bake: bake_weights,
         },
         Asset {
+            time_estimate: None,
             name: "wrinkle-maps-example",
             summary: "Example partial-derivative wrinkle map and packed zone masks from a synthetic normal map",
             default_params: || serde_json::to_value(WrinkleExampleParams::default()).expect("params serialise"),

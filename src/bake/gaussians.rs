@@ -168,6 +168,7 @@ fn bake_fit(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
 pub fn assets() -> Vec<Asset> {
     vec![
         Asset {
+            time_estimate: None,
             name: "sss-gaussians",
             summary:
                 "screen-space SSS parameters of d'Eon's 6- and 4-Gaussian skin presets (JSON, HLSL/GLSL/WGSL, plot)",
@@ -181,6 +182,7 @@ pub fn assets() -> Vec<Asset> {
             bake: bake_presets,
         },
         Asset {
+            time_estimate: None,
             name: "sss-gaussians-fit",
             summary: "shared 6-Gaussian fit of the Jensen 2001 skin1 dipole with its screen-space parameters",
             default_params: || {

@@ -25,6 +25,7 @@ pub const BINARY_LAYOUT: &str = "little-endian f32, no header, N records of 8 fl
 
 pub fn assets() -> Vec<Asset> {
     vec![Asset {
+        time_estimate: None,
         name: "sss-importance-kernels",
         summary: "Importance-sampled SSS disk kernels (skin1 dipole, deon6, Burley skin; N=20/40/80): JSON + HLSL/GLSL/WGSL + f32 table",
         default_params,

@@ -24,6 +24,9 @@ pub enum BakeError {
     Other(String),
 }
 
+/// Parameters and threads → upper estimate of an asset's bake time, seconds ([`Asset::time_estimate`]).
+pub type TimeEstimate = fn(&Value, usize) -> Result<f64, BakeError>;
+
 /// A bakeable asset.
 pub struct Asset {
     /// Name used on the command line (`rtbake bake NAME`) and in the manifest.
@@ -33,6 +36,12 @@ pub struct Asset {
     pub default_params: fn() -> Value,
     /// Pure function: parameters → files. Must be deterministic for any thread count.
     pub bake: fn(&Value) -> Result<Vec<BakedFile>, BakeError>,
+    /// Upper estimate of the wall time of [`Asset::bake`] on a number of threads, seconds, from the same
+    /// parameters (validated the same way, so a bad parameter is named here first). Given for every asset whose
+    /// parameters can make it run for minutes or more (Monte Carlo photon counts, table sizes); `rtbake bake`
+    /// refuses a bake over its time budget (`--max-seconds`) before any work. `None`: the asset's accepted
+    /// parameter ranges keep it to seconds.
+    pub time_estimate: Option<TimeEstimate>,
 }
 
 /// The parameter key every asset accepts beside its own: `"ktx2_zstd": LEVEL` (1..=22) rewrites the asset's
@@ -52,6 +61,16 @@ impl Asset {
         }
         add_bevy_meta_files(&mut files);
         Ok(files)
+    }
+
+    /// [`Asset::time_estimate`] of `params` on `threads` threads (the common [`KTX2_ZSTD_PARAM`] key stripped as
+    /// [`Asset::run`] does); 0 for an asset without one.
+    pub fn time_estimate_seconds(&self, params: &Value, threads: usize) -> Result<f64, BakeError> {
+        let (_, own) = split_zstd_param(self.name, params)?;
+        match self.time_estimate {
+            Some(estimate) => estimate(&own, threads.max(1)),
+            None => Ok(0.0),
+        }
     }
 }
 
@@ -444,5 +463,27 @@ fn type_mismatch(template: &Value, given: &Value, path: String) -> Option<String
         }
         (Value::Bool(_), Value::Bool(_)) | (Value::String(_), Value::String(_)) => None,
         _ => Some(here()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_bake_is_estimated_within_the_cli_time_budget() {
+        // `rtbake bake` refuses a bake whose estimates add up to more than --max-seconds (600 s by default): the
+        // README's bake command depends on the default parameters staying under it, and the Monte Carlo assets
+        // (whose photon counts a user can raise without bound in time) must carry an estimate.
+        let mut total = 0.0;
+        for asset in registry() {
+            let s = asset.time_estimate_seconds(&(asset.default_params)(), 2).unwrap();
+            assert!(s.is_finite() && s >= 0.0, "{}: {s}", asset.name);
+            total += s;
+        }
+        assert!(total > 1.0 && total < 600.0, "{total}");
+        for name in ["diffusion-profiles", "transport-report", "skin-color-mc-difference"] {
+            assert!(registry().iter().any(|a| a.name == name && a.time_estimate.is_some()), "{name}");
+        }
     }
 }

@@ -336,6 +336,13 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     Ok(files)
 }
 
+/// [`Asset::time_estimate`]: every profile's own estimate ([`ProfileSource::time_estimate_seconds`] at the grid's
+/// radii: the layered multipole's tabulation, or the Monte Carlo photons of `skin_model` mc), summed.
+fn time_estimate(params: &Value, threads: usize) -> Result<f64, BakeError> {
+    let p: ProfilesParams = parse_params("diffusion-profiles", params)?;
+    Ok(sources(&p)?.iter().map(|(_, _, source, _)| source.time_estimate_seconds(p.grid.count, threads)).sum())
+}
+
 pub fn assets() -> Vec<Asset> {
     vec![Asset {
         name: "diffusion-profiles",
@@ -343,6 +350,7 @@ pub fn assets() -> Vec<Asset> {
                   physiological two-layer skin and an example 3-layer stack",
         default_params: || serde_json::to_value(default_params()).expect("params serialise"),
         bake,
+        time_estimate: Some(time_estimate),
     }]
 }
 

@@ -21,12 +21,14 @@ pub use crate::baked_layout::path::SEPARABLE_DIR as DIR;
 pub fn assets() -> Vec<Asset> {
     vec![
         Asset {
+            time_estimate: None,
             name: "sss-separable-kernels",
             summary: "Separable-SSS kernel taps (published presets N=11/17/25, thesis Table 6.1 N=9/17/33): JSON + HLSL/GLSL/WGSL",
             default_params: default_kernels_params,
             bake: bake_kernels,
         },
         Asset {
+            time_estimate: None,
             name: "sss-separable-fit",
             summary: "Separable-SSS strength/falloff fitted to d'Eon's 6-Gaussian skin profile (eq. 6.3), with the 17-tap kernel",
             default_params: default_fit_params,

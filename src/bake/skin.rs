@@ -36,6 +36,12 @@ pub fn assets() -> Vec<Asset> {
                 let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
                 skin_color_lut_files(&p)
             },
+            time_estimate: Some(|v, threads| {
+                let p: SkinColorParams = parse_params(SKIN_COLOR_LUT, v)?;
+                let layout = p.layout().map_err(invalid)?;
+                let bands = p.model().map_err(invalid)?.wavelengths_nm().len();
+                Ok(crate::skin_color::lut::time_estimate_seconds(&layout, p.lut_evaluation, bands, threads))
+            }),
         },
         Asset {
             name: SKIN_COLOR_MC_DIFFERENCE,
@@ -45,6 +51,10 @@ pub fn assets() -> Vec<Asset> {
                 let p: McColorParams = parse_params(SKIN_COLOR_MC_DIFFERENCE, v)?;
                 skin_color_mc_difference_files(&p)
             },
+            time_estimate: Some(|v, threads| {
+                let p: McColorParams = parse_params(SKIN_COLOR_MC_DIFFERENCE, v)?;
+                Ok(p.time_estimate_seconds(&SkinColorParams::default().physiology(), threads)?)
+            }),
         },
     ]
 }

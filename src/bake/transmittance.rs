@@ -114,6 +114,10 @@ pub fn assets() -> Vec<Asset> {
                 .expect("params serialise")
         },
         bake,
+        time_estimate: Some(|v, _threads| {
+            let p: Params = parse_params("transmittance", v)?;
+            Ok(p.table.time_estimate_seconds())
+        }),
     }]
 }
 

@@ -226,8 +226,11 @@ fn check_photons(name: &str, photons: u64) -> Result<(), InvalidInput> {
     Ok(())
 }
 
-fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
-    let p: ReportParams = parse_params("transport-report", params)?;
+/// A Jensen material's case: name, Monte Carlo stack and single-scattering albedo per channel.
+type MaterialCase = (String, McStack, [f64; 3]);
+
+/// The report's validated cases: the materials and the skins (every parameter checked, errors naming it).
+fn cases(p: &ReportParams) -> Result<(Vec<MaterialCase>, Vec<SkinInputs>), BakeError> {
     check_photons("photons", p.photons)?;
     check_photons("skin_photons", p.skin_photons)?;
     McSettings::new(p.photons, p.seed, p.batches, p.bin_mm, p.bins)?;
@@ -263,6 +266,34 @@ fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
     for (i, &chd) in p.dermis_only.iter().enumerate() {
         skins.push(skin_inputs(SkinCase::DermisOnly { chd }, &format!("dermis_only[{i}]"), p.step_nm)?);
     }
+    Ok((material_stacks, skins))
+}
+
+/// [`Asset::time_estimate`] of the report: every Monte Carlo run's own estimate
+/// ([`McSettings::time_estimate_for_stack`]) summed — the materials at `photons`, each skin at `skin_photons` per
+/// wavelength group and g (the diffusion models' share is small beside them).
+fn time_estimate(params: &Value, threads: usize) -> Result<f64, BakeError> {
+    let p: ReportParams = parse_params("transport-report", params)?;
+    let (material_stacks, skins) = cases(&p)?;
+    let mut seconds = 0.0;
+    for (_, stack, _) in &material_stacks {
+        seconds +=
+            McSettings::new(p.photons, p.seed, p.batches, p.bin_mm, p.bins)?.time_estimate_for_stack(stack, threads);
+    }
+    let skin_settings = McSettings::new(p.skin_photons, p.seed, p.batches, p.bin_mm, p.bins)?;
+    for skin in &skins {
+        for &g in &p.g {
+            for (stack, _) in &skin.spectral {
+                seconds += skin_settings.time_estimate_for_stack(&McStack::from_layer_stack(stack, g)?, threads);
+            }
+        }
+    }
+    Ok(seconds)
+}
+
+fn bake(params: &Value) -> Result<Vec<BakedFile>, BakeError> {
+    let p: ReportParams = parse_params("transport-report", params)?;
+    let (material_stacks, skins) = cases(&p)?;
     let names: Vec<String> =
         material_stacks.iter().map(|m| m.0.clone()).chain(skins.iter().map(|s| s.case.name())).collect();
     for (i, plot) in p.plots.iter().enumerate() {
@@ -624,6 +655,7 @@ pub fn assets() -> Vec<Asset> {
                   r R(r) differences, table, summary and figures",
         default_params: || serde_json::to_value(default_params()).expect("params serialise"),
         bake,
+        time_estimate: Some(time_estimate),
     }]
 }
 

@@ -119,7 +119,13 @@ mod tests {
     }
 
     fn registry() -> Vec<Asset> {
-        vec![Asset { name: "ramp", summary: "test", default_params: || serde_json::json!({"size": 8}), bake: ramp }]
+        vec![Asset {
+            name: "ramp",
+            summary: "test",
+            default_params: || serde_json::json!({"size": 8}),
+            bake: ramp,
+            time_estimate: None,
+        }]
     }
 
     /// Entries of `dir` other than lock files.
@@ -221,6 +227,7 @@ mod tests {
             name: "ramp2",
             summary: "test",
             default_params: || serde_json::json!({"size": 5}),
+            time_estimate: None,
             bake: |v| {
                 let files = ramp(v)?;
                 Ok(files

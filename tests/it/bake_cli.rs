@@ -118,6 +118,57 @@ fn bad_asset_parameters_touch_nothing() {
 }
 
 #[test]
+fn asset_params_over_the_time_budget_are_refused_before_any_work() {
+    // Monte Carlo skins at 10^8 photons per wavelength: hours by the photon kernel's estimate. The bake is refused
+    // before anything is written (the existing bake stays as it was, a new directory is not created), naming the
+    // asset, the estimate and the budget; under a raised budget the estimate is no longer the refusal.
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("b");
+    assert!(rtbake(&["bake", SMALL, "--out", out.to_str().unwrap(), "-q"]).status.success());
+    let before = snapshot(&out);
+    let params = t.path().join("p.json");
+    let skin_mc = |photons: u64| {
+        serde_json::json!({"diffusion-profiles": {"skin_model": {"model": "mc", "photons": photons}}}).to_string()
+    };
+    std::fs::write(&params, skin_mc(100_000_000)).unwrap();
+    for dir in [&out, &t.path().join("new")] {
+        let o = rtbake(&[
+            "bake",
+            "diffusion-profiles",
+            "--out",
+            dir.to_str().unwrap(),
+            "--asset-params",
+            params.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains("diffusion-profiles ~") && e.contains("time budget of 600 s") && e.contains("--max-seconds"),
+            "{e}"
+        );
+    }
+    assert_eq!(before, snapshot(&out));
+    assert!(!t.path().join("new").exists());
+    // The default transport report is estimated, and within the default budget; a smaller budget refuses it.
+    let o = rtbake(&["bake", "transport-report", "--out", out.to_str().unwrap(), "--max-seconds", "1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("transport-report ~"), "{}", stderr(&o));
+    // A bad parameter the estimate reads is named as the bake names it.
+    std::fs::write(&params, r#"{"diffusion-profiles": {"skin_model": {"model": "mc", "g": 1.5}}}"#).unwrap();
+    let o = rtbake(&[
+        "bake",
+        "diffusion-profiles",
+        "--out",
+        out.to_str().unwrap(),
+        "--asset-params",
+        params.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("skin_model.g must be in the open interval (-1, 1)"), "{}", stderr(&o));
+    assert_eq!(before, snapshot(&out));
+}
+
+#[test]
 fn params_file_sets_flags_and_explicit_flags_override_it() {
     let t = tempfile::tempdir().unwrap();
     let params = t.path().join("p.json");
