@@ -138,11 +138,10 @@ pub trait SeparableForm: SssBlur + Sized + sealed::Sealed {
     ) -> Result<Self, RuntimeError>;
 }
 
-mod sealed {
-    /// Only this module's two forms are [`super::SeparableForm`]s.
+pub(super) mod sealed {
+    /// Only the two forms of this room are [`super::SeparableForm`]s (each module implements it for its own).
     pub trait Sealed {}
     impl Sealed for super::SeparableBlur {}
-    impl Sealed for crate::runtime::sss::separable_tiled::TiledBlur {}
 }
 
 impl<B: SeparableForm> SssPass<B> {

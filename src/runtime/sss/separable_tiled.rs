@@ -8,7 +8,7 @@
 //! the apron read the textures. The result is written through a storage texture (`Rgba16Float`).
 
 use crate::runtime::gpu::{self, GpuTimer};
-use crate::runtime::sss::separable::SeparableForm;
+use crate::runtime::sss::separable::{sealed, SeparableForm};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
@@ -25,6 +25,8 @@ pub struct TiledBlur {
     groups: [wgpu::BindGroup; 2],
     dispatch: [[u32; 3]; 2],
 }
+
+impl sealed::Sealed for TiledBlur {}
 
 impl SeparableForm for TiledBlur {
     const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::storage_texture;
