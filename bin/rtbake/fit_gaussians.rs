@@ -2,7 +2,6 @@
 //! error table.
 
 use crate::cli::{prepare_out_dir, usage, usage_msg, Ctx};
-use crate::profile_source::Named;
 use rtbake::diffusion::RadialProfile;
 use rtbake::fitting::screen_space::{ScreenSpaceParams, StretchParams, DEFAULT_ALPHA, DEFAULT_BETA, DEFAULT_GAMMA};
 use rtbake::fitting::{error_table, fit_sum_of_gaussians, FitSettings, GaussianFitError};
@@ -12,15 +11,8 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct FitGaussiansArgs {
-    /// Jensen 2001 material fitted as a dipole (η = 1.3, DJ05 Fdr): apple, chicken1, …, wholemilk.
-    #[arg(long, value_name = "NAME", conflicts_with = "profile_preset")]
-    pub material: Option<String>,
-    /// Fit a sum-of-Gaussians preset instead: deon6 | deon4.
-    #[arg(long, value_name = "NAME")]
-    pub profile_preset: Option<String>,
-    /// Layered targets: --layers FILE or the physiological skin --skin-melanin/--skin-hemoglobin.
     #[command(flatten)]
-    pub layered: crate::profile_source::LayeredArgs,
+    pub target: super::FitTarget,
     /// Number of Gaussians (2..=8).
     #[arg(long, default_value_t = 4, allow_hyphen_values = true)]
     pub count: i64,
@@ -61,30 +53,6 @@ pub fn fit_error(e: GaussianFitError) -> anyhow::Error {
     }
 }
 
-/// The profile to fit, its provenance and a file stem.
-fn profile_from_args(a: &FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<(Box<dyn RadialProfile>, Value, String)> {
-    if a.layered.is_set() && (a.material.is_some() || a.profile_preset.is_some()) {
-        return Err(usage_msg(
-            "give one target: --material, --profile-preset, --layers or --skin-melanin/--skin-hemoglobin",
-        ));
-    }
-    if let Some(resolved) = a.layered.resolve(ctx)? {
-        return Ok(resolved);
-    }
-    let named = match (&a.material, &a.profile_preset) {
-        (Some(name), _) => Some(Named::Material { flag: "--material", name }),
-        (None, Some(name)) => Some(Named::Preset { flag: "--profile-preset", name }),
-        (None, None) => None,
-    };
-    if let Some(n) = named {
-        let (src, profile, stem) = crate::profile_source::named(n)?;
-        return Ok((profile, src.provenance(), stem));
-    }
-    Err(usage_msg(
-        "one of --material NAME, --profile-preset NAME, --layers FILE, --skin-melanin CM --skin-hemoglobin CHD or --error-table is required",
-    ))
-}
-
 fn run_error_table(ctx: &Ctx) -> anyhow::Result<()> {
     let rows = error_table().map_err(fit_error)?;
     if ctx.json {
@@ -117,7 +85,12 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
     settings.validate().map_err(usage)?;
     let stretch = StretchParams { alpha: a.alpha, beta: a.beta, gamma: a.gamma };
     stretch.validate().map_err(usage)?;
-    let (profile, source, stem) = profile_from_args(&a, ctx)?;
+    let (profile, source, stem) = a.target.resolve(ctx)?.ok_or_else(|| {
+        usage_msg(
+            "one of --material NAME, --profile-preset NAME, --layers FILE, --skin-melanin CM --skin-hemoglobin CHD, \
+             --profile-csv FILE or --error-table is required",
+        )
+    })?;
     let fit = fit_sum_of_gaussians(profile.as_ref(), &settings).map_err(fit_error)?;
     let ss = ScreenSpaceParams::new(&fit.sum, stretch)?;
     let mut obj = ss.to_json();
@@ -147,7 +120,7 @@ pub fn run(a: FitGaussiansArgs, ctx: &Ctx) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!(e))?;
         prepare_out_dir("--out", dir)?;
         let inputs: Vec<&std::path::Path> =
-            a.layered.layers.iter().chain(&a.layered.profile_csv).map(|p| p.as_path()).collect();
+            a.target.layered.layers.iter().chain(&a.target.layered.profile_csv).map(|p| p.as_path()).collect();
         crate::cli::write_set(ctx, "--out", dir, &files, &inputs)?;
         obj.insert(
             "files".into(),

@@ -265,14 +265,14 @@ fn params(a: &ModelFlags) -> anyhow::Result<SkinColorParams> {
     Ok(p)
 }
 
-/// Renames a library parameter (JSON field) to the flag the user typed.
+/// A library error as bad usage (exit 2): `cli::exit_with` names its field by the flag `flags`' table maps it to. The
+/// table's size, the library's `width` and `height`, is the one flag `--resolution WxH` here.
 fn flag_error(e: SkinColorError) -> anyhow::Error {
-    let SkinColorError::Invalid(InvalidInput { param, message }) = e;
-    let flag = match param.as_str() {
-        "width" | "height" => "--resolution".to_string(),
-        p => format!("--{}", p.replace('_', "-")),
-    };
-    usage(InvalidInput::new(flag, message))
+    let SkinColorError::Invalid(e) = e;
+    match e.param.as_str() {
+        "width" | "height" => usage(InvalidInput::new("--resolution", e.message)),
+        _ => usage(e),
+    }
 }
 
 pub fn run(a: SkinColorArgs, ctx: &Ctx) -> anyhow::Result<()> {

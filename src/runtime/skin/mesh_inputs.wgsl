@@ -15,8 +15,9 @@ struct Params {
 @group(0) @binding(3) var<storage, read_write> h0: array<f32>;
 @group(0) @binding(4) var<storage, read_write> hb: array<f32>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
-// (pixel_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*` (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc` and the entry point `main`, which calls
+// `covered` and `uncovered` below per pixel (pixel_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
+// (bilinear_taps.wgsl).
 
 fn rig_at(k: u32, t: Taps) -> vec2<f32> {
     let w = u32(p.size.z);
@@ -30,18 +31,12 @@ fn h0_at(t: Taps) -> f32 {
     return bilerp1(t, h0[q.x], h0[q.y], h0[q.z], h0[q.w]);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (outside_frame(id)) {
-        return;
-    }
-    let i = frame_pixel(id);
-    let c = uvc[i];
-    if (c.z < 0.5) {
-        hb[i] = 0.0;
-        return;
-    }
-    let tr = taps(c.x, c.y, p.size.z, p.size.w);
+fn uncovered(i: u32) {
+    hb[i] = 0.0;
+}
+
+fn covered(i: u32, uv: vec2<f32>) {
+    let tr = taps(uv.x, uv.y, p.size.z, p.size.w);
     var scale = 0.0;
     var bias = 0.0;
     for (var k = 0u; k < u32(p.cfg.z); k = k + 1u) {
@@ -50,6 +45,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         scale = scale + wk * sb.x;
         bias = bias + wk * sb.y;
     }
-    let th = taps(c.x, c.y, p.cfg.x, p.cfg.y);
+    let th = taps(uv.x, uv.y, p.cfg.x, p.cfg.y);
     hb[i] = p.cfg.w * (bias + h0_at(th) * scale); // eq. 7.6
 }

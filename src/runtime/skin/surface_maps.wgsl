@@ -16,9 +16,9 @@ struct Params {
 // per pixel: (normal, 0), (albedo, 0)
 @group(0) @binding(6) var<storage, read_write> outp: array<vec4<f32>>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
-// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
-// (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc` and the entry point `main`, which calls
+// `covered` and `uncovered` below per pixel (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`,
+// `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn albedo_at(t: Taps) -> vec4<f32> {
     let q = tap_index(t, 0u, u32(p.size.z));
@@ -30,26 +30,21 @@ fn normal_at(t: Taps) -> vec4<f32> {
     return bilerp4(t, nmap[q.x], nmap[q.y], nmap[q.z], nmap[q.w]);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (outside_frame(id)) {
-        return;
-    }
-    let i = frame_pixel(id);
-    let c = uvc[i];
+// Off the mesh: the G-buffer's normal, no albedo.
+fn uncovered(i: u32) {
+    outp[2u * i] = vec4<f32>(nrm[i].xyz, 0.0);
+    outp[2u * i + 1u] = vec4<f32>(0.0);
+}
+
+fn covered(i: u32, uv: vec2<f32>) {
     let n = nrm[i].xyz;
-    if (c.z < 0.5) {
-        outp[2u * i] = vec4<f32>(n, 0.0);
-        outp[2u * i + 1u] = vec4<f32>(0.0);
-        return;
-    }
     var a = vec3<f32>(0.0);
     if (p.normal.z > 0.5) {
-        a = albedo_at(taps(c.x, c.y, p.size.z, p.size.w)).xyz;
+        a = albedo_at(taps(uv.x, uv.y, p.size.z, p.size.w)).xyz;
     }
     var out_n = n;
     if (p.normal.w > 0.5) {
-        let s = normal_at(taps(c.x, c.y, p.normal.x, p.normal.y)).xyz;
+        let s = normal_at(taps(uv.x, uv.y, p.normal.x, p.normal.y)).xyz;
         let ls = sqrt(dot(s, s));
         let t4 = tng[i];
         let t = t4.xyz;

@@ -17,9 +17,9 @@ struct Params {
 @group(0) @binding(5) var<storage, read_write> masks: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> out_n: array<vec4<f32>>;
 
-// Prepended by the host module: `p` (binding 0, this `Params`), `uvc`, `outside_frame` and `frame_pixel`
-// (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
-// (bilinear_taps.wgsl).
+// Prepended by the host module: `p` (binding 0, this `Params`), `uvc` and the entry point `main`, which calls
+// `covered` and `uncovered` below per pixel (pixel_frame.wgsl); `nrm` and `tng` (view_frame.wgsl); `Taps`, `taps`,
+// `tap_index` and `bilerp*` (bilinear_taps.wgsl).
 
 fn pd_at(t: Taps) -> vec2<f32> {
     let q = tap_index(t, 0u, u32(p.size.z));
@@ -33,21 +33,16 @@ fn mask_at(k: u32, t: Taps) -> vec4<f32> {
     return bilerp4(t, masks[q.x], masks[q.y], masks[q.z], masks[q.w]);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (outside_frame(id)) {
-        return;
-    }
-    let i = frame_pixel(id);
-    let c = uvc[i];
+// Off the mesh: the G-buffer's normal.
+fn uncovered(i: u32) {
+    out_n[i] = vec4<f32>(nrm[i].xyz, 0.0);
+}
+
+fn covered(i: u32, uv: vec2<f32>) {
     let n = nrm[i].xyz;
-    if (c.z < 0.5) {
-        out_n[i] = vec4<f32>(n, 0.0);
-        return;
-    }
     // Listing 8.1
-    let wr = pd_at(taps(c.x, c.y, p.size.z, p.size.w));
-    let tm = taps(c.x, c.y, p.mask.x, p.mask.y);
+    let wr = pd_at(taps(uv.x, uv.y, p.size.z, p.size.w));
+    let tm = taps(uv.x, uv.y, p.mask.x, p.mask.y);
     let m1 = mask_at(0u, tm) * p.weights[0];
     let m2 = mask_at(1u, tm) * p.weights[1];
     var xy = vec2<f32>(0.0, 0.0);

@@ -40,8 +40,9 @@ pub(crate) fn check_fovy(fovy_deg: f32) -> Result<(), InvalidInput> {
 }
 
 /// The frame every screen-space SSS pass reads: the irradiance (`Rgba16Float`, linear, alpha = per-pixel strength,
-/// 0 = not skin) and the linear depth (`R32Float`, loaded, never filtered).
-pub(crate) struct SssInputs {
+/// 0 = not skin) and the linear depth (`R32Float`, loaded, never filtered). Public only as the frame a
+/// [`separable::SeparableForm`] builds on; its textures and methods are the passes' own.
+pub struct SssInputs {
     pub(crate) color: wgpu::Texture,
     pub(crate) depth: wgpu::Texture,
 }
@@ -106,7 +107,7 @@ pub trait SssBlur {
 /// A screen-space SSS pass for one frame size: its input frame (irradiance and linear depth), its output
 /// (`Rgba16Float`) and the blur `B` that reads the one and writes the other ([`separable::SeparableSss`],
 /// [`gaussian::GaussianSss`], [`importance::ImportanceSss`], [`separable_tiled::SeparableSssTiled`]). Created by
-/// each blur's `new`.
+/// each blur's `new` (one for both separable forms, [`separable::SeparableForm`]).
 pub struct SssPass<B> {
     inputs: SssInputs,
     output: wgpu::Texture,

@@ -121,7 +121,32 @@ pub struct SeparableBlur {
     targets: [wgpu::TextureView; 2],
 }
 
-impl SeparableSss {
+/// A form of the separable pass: [`SeparableBlur`] (fragment) or [`super::separable_tiled::TiledBlur`] (compute),
+/// built by the one constructor of both, [`SssPass::new`].
+pub trait SeparableForm: SssBlur + Sized + sealed::Sealed {
+    /// Makes the form's intermediate and output textures (a render target or a storage texture).
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture;
+
+    /// The form's pipeline and bind groups over a frame of `size`: the horizontal pass reads `inputs`' colour with
+    /// uniform block `ubo[0]` into `targets[0]`, the vertical pass reads that with `ubo[1]` into `targets[1]`.
+    fn build(
+        device: &wgpu::Device,
+        inputs: &SssInputs,
+        ubo: [wgpu::Buffer; 2],
+        targets: [&wgpu::Texture; 2],
+        size: (u32, u32),
+    ) -> Result<Self, RuntimeError>;
+}
+
+pub(super) mod sealed {
+    /// Only the two forms of this room are [`super::SeparableForm`]s (each module implements it for its own).
+    pub trait Sealed {}
+    impl Sealed for super::SeparableBlur {}
+}
+
+impl<B: SeparableForm> SssPass<B> {
+    /// Checks the frame size and the parameters (before any work), then creates the frame, the uniform blocks of
+    /// both directions, the two targets and the form's passes.
     pub fn new(
         device: &wgpu::Device,
         width: u32,
@@ -129,20 +154,35 @@ impl SeparableSss {
         kernel: &SssKernel,
         params: &SssParams,
     ) -> Result<Self, RuntimeError> {
-        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
+        let ubo = Params::buffers(device, (width, height), kernel, params)?;
         let inputs = SssInputs::new(device, "sss", width, height);
-        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::texture);
+        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), B::TARGET);
+        let blur = B::build(device, &inputs, ubo, [&tmp, &output], (width, height))?;
+        Ok(SssPass { inputs, output, blur })
+    }
+}
+
+impl SeparableForm for SeparableBlur {
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::texture;
+
+    fn build(
+        device: &wgpu::Device,
+        inputs: &SssInputs,
+        [ubo_h, ubo_v]: [wgpu::Buffer; 2],
+        [tmp, output]: [&wgpu::Texture; 2],
+        _size: (u32, u32),
+    ) -> Result<Self, RuntimeError> {
         let module = gpu::shader(device, "separable_sss.wgsl", SHADER);
         let pipe = gpu::fullscreen_pipeline(device, "sss blur", &module, "fs_blur", wgpu::TextureFormat::Rgba16Float);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, tv) = (view(&inputs.color), view(&tmp));
+        let (cv, tv) = (view(&inputs.color), view(tmp));
         let layout = pipe.get_bind_group_layout(0);
         let groups = [
             inputs.blur_group(device, "sss h", &layout, (&ubo_h, &cv), &[]),
             inputs.blur_group(device, "sss v", &layout, (&ubo_v, &tv), &[]),
         ];
-        let targets = [tv, view(&output)];
-        Ok(SssPass { inputs, output, blur: SeparableBlur { pipe, groups, targets } })
+        let targets = [tv, view(output)];
+        Ok(SeparableBlur { pipe, groups, targets })
     }
 }
 

@@ -8,7 +8,7 @@
 //! the apron read the textures. The result is written through a storage texture (`Rgba16Float`).
 
 use crate::runtime::gpu::{self, GpuTimer};
-use crate::runtime::sss::separable::{Params, SssKernel, SssParams};
+use crate::runtime::sss::separable::{sealed, SeparableForm};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
@@ -26,22 +26,23 @@ pub struct TiledBlur {
     dispatch: [[u32; 3]; 2],
 }
 
-impl SeparableSssTiled {
-    pub fn new(
+impl sealed::Sealed for TiledBlur {}
+
+impl SeparableForm for TiledBlur {
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::storage_texture;
+
+    fn build(
         device: &wgpu::Device,
-        width: u32,
-        height: u32,
-        kernel: &SssKernel,
-        params: &SssParams,
+        inputs: &SssInputs,
+        [ubo_h, ubo_v]: [wgpu::Buffer; 2],
+        [tmp, output]: [&wgpu::Texture; 2],
+        (width, height): (u32, u32),
     ) -> Result<Self, RuntimeError> {
-        let [ubo_h, ubo_v] = Params::buffers(device, (width, height), kernel, params)?;
-        let inputs = SssInputs::new(device, "sss", width, height);
-        let [tmp, output] = SssInputs::targets(device, "sss", (width, height), gpu::storage_texture);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = gpu::shader(device, "separable_tiled.wgsl", SHADER);
         let pipe = gpu::compute_pipeline(device, &module, "blur");
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, tv, dv, ov) = (view(&inputs.color), view(&tmp), view(&inputs.depth), view(&output));
+        let (cv, tv, dv, ov) = (view(&inputs.color), view(tmp), view(&inputs.depth), view(output));
         let layout = pipe.get_bind_group_layout(0);
         use wgpu::BindingResource as R;
         let group = |label, ubo: &wgpu::Buffer, src: &wgpu::TextureView, dst: &wgpu::TextureView| {
@@ -58,7 +59,7 @@ impl SeparableSssTiled {
             return Err(RuntimeError::Gpu(format!("separable SSS (compute): {e}")));
         }
         let dispatch = [[width.div_ceil(SEGMENT), height, 1], [height.div_ceil(SEGMENT), width, 1]];
-        Ok(SssPass { inputs, output, blur: TiledBlur { pipe, groups, dispatch } })
+        Ok(TiledBlur { pipe, groups, dispatch })
     }
 }
 

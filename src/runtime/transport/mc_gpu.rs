@@ -494,5 +494,20 @@ mod tests {
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
             .validate(&module)
             .expect("WGSL validates");
+        // The host structs mirror the shader's: the same size (the shader's Params spells its pad as two u32 members).
+        let shader_struct = |name: &str| {
+            module
+                .types
+                .iter()
+                .find_map(|(_, t)| match &t.inner {
+                    naga::TypeInner::Struct { members, span } if t.name.as_deref() == Some(name) => {
+                        Some((*span as usize, members.len()))
+                    }
+                    _ => None,
+                })
+                .unwrap_or_else(|| panic!("no struct {name} in the shader"))
+        };
+        assert_eq!(shader_struct("Params"), (std::mem::size_of::<Params>(), 14));
+        assert_eq!(shader_struct("Medium"), (std::mem::size_of::<GpuMedium>(), 8));
     }
 }
