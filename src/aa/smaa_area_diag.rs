@@ -47,26 +47,19 @@ const A: u8 = 0;
 const B: u8 = 1;
 const O: u8 = 2;
 
-/// Candidate lines `(S, E)` of diagonal pattern `p` as indices into [`POINTS`]; one line, or two that are averaged.
+/// Candidate lines `(S, E)` of each diagonal pattern (indexed by pattern number; Fig. 10.8, four patterns a row) as
+/// indices into [`POINTS`]; one line, or two that are averaged.
+#[rustfmt::skip]
+const CANDIDATES: [&[(u8, u8)]; 16] = [
+    /*  0 */ &[(A, A), (B, B)], /*  1 */ &[(B, O), (B, B)], /*  2 */ &[(O, B), (B, B)], /*  3 */ &[(B, B)],
+    /*  4 */ &[(A, O), (A, B)], /*  5 */ &[(A, O), (B, B)], /*  6 */ &[(A, B)],         /*  7 */ &[(A, B), (B, B)],
+    /*  8 */ &[(O, A), (B, A)], /*  9 */ &[(B, A)],         /* 10 */ &[(O, A), (B, B)], /* 11 */ &[(B, A), (B, B)],
+    /* 12 */ &[(A, A)],         /* 13 */ &[(A, A), (B, A)], /* 14 */ &[(A, A), (A, B)], /* 15 */ &[(A, A), (B, B)],
+];
+
+/// The candidate lines of diagonal pattern `pattern` (`0..16`).
 fn candidates(pattern: u8) -> &'static [(u8, u8)] {
-    match pattern {
-        0 => &[(A, A), (B, B)],
-        1 => &[(B, O), (B, B)],
-        2 => &[(O, B), (B, B)],
-        3 => &[(B, B)],
-        4 => &[(A, O), (A, B)],
-        5 => &[(A, O), (B, B)],
-        6 => &[(A, B)],
-        7 => &[(A, B), (B, B)],
-        8 => &[(O, A), (B, A)],
-        9 => &[(B, A)],
-        10 => &[(O, A), (B, B)],
-        11 => &[(B, A), (B, B)],
-        12 => &[(A, A)],
-        13 => &[(A, A), (B, A)],
-        14 => &[(A, A), (A, B)],
-        _ => &[(A, A), (B, B)],
-    }
+    CANDIDATES[pattern as usize]
 }
 
 /// Sample positions `base + i/29` of one pixel axis.
@@ -86,6 +79,15 @@ fn terms(k: f64, base: f64, mid: f64) -> [f64; SAMPLES_DIAG] {
     t
 }
 
+/// The half-plane test of line `p1 → p2` as the reference generator writes it: a point is inside when
+/// `a·(x − xm) + b·(y − ym) > 0` with `a = p2.y − p1.y`, `b = p1.x − p2.x` and `m` the segment midpoint. Returns
+/// `(m, a, b)`, each rounded as the reference rounds it.
+fn half_plane(p1: Pt, p2: Pt) -> (Pt, f64, f64) {
+    let xm = (p1.0 + p2.0) / 2.0;
+    let ym = (p1.1 + p2.1) / 2.0;
+    ((xm, ym), p2.1 - p1.1, p1.0 - p2.0)
+}
+
 /// Fraction of the 30×30 samples of the pixel with corner `p` strictly on the positive side of `p1 → p2`
 /// (1 when the points coincide). Counts `ax[i] + by[j] > 0` ⟺ `by[j] > −ax[i]` with a merge over the two sorted
 /// term lists (see the module docs): identical to [`pixel_coverage_brute_force`].
@@ -93,10 +95,7 @@ pub fn pixel_coverage(p1: Pt, p2: Pt, p: Pt) -> f64 {
     if p1 == p2 {
         return 1.0;
     }
-    let xm = (p1.0 + p2.0) / 2.0;
-    let ym = (p1.1 + p2.1) / 2.0;
-    let a = p2.1 - p1.1;
-    let b = p1.0 - p2.0;
+    let ((xm, ym), a, b) = half_plane(p1, p2);
     let ax = terms(a, p.0, xm);
     let by = terms(b, p.1, ym);
     // For ascending ax the threshold −ax falls, so k = #{j : by[j] ≤ −ax[i]} only decreases.
@@ -117,10 +116,7 @@ pub fn pixel_coverage_brute_force(p1: Pt, p2: Pt, p: Pt) -> f64 {
     if p1 == p2 {
         return 1.0;
     }
-    let xm = (p1.0 + p2.0) / 2.0;
-    let ym = (p1.1 + p2.1) / 2.0;
-    let a = p2.1 - p1.1;
-    let b = p1.0 - p2.0;
+    let ((xm, ym), a, b) = half_plane(p1, p2);
     let mut count = 0usize;
     for i in 0..SAMPLES_DIAG {
         for j in 0..SAMPLES_DIAG {

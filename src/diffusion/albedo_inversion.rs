@@ -113,6 +113,7 @@ pub fn dipole_coefficients(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diffusion::ReducedCoefficients;
 
     fn albedos() -> Vec<f64> {
         let mut v = vec![0.0, 1e-9, 1e-6, 1e-3, 0.999, 0.999_999, 1.0 - 1e-12, 1.0];

@@ -8,7 +8,7 @@
 //!
 //! Total diffuse reflectance (closed form): Rd = (α′/2)(1 + e^(−(4/3) A sqrt(3(1 − α′)))) e^(−sqrt(3(1 − α′))).
 
-use super::{boundary_a, FdrForm};
+use super::{boundary_a, FdrForm, ReducedCoefficients};
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use std::f64::consts::PI;
 
@@ -20,6 +20,15 @@ pub struct Dipole {
     /// Relative index η = n_inside / n_outside.
     pub eta: f64,
     pub fdr_form: FdrForm,
+}
+
+impl ReducedCoefficients for Dipole {
+    fn sigma_a_per_mm(&self) -> f64 {
+        self.sigma_a_per_mm
+    }
+    fn sigma_s_prime_per_mm(&self) -> f64 {
+        self.sigma_s_prime_per_mm
+    }
 }
 
 impl Dipole {
@@ -34,19 +43,6 @@ impl Dipole {
         check_positive("sigma_s_prime", sigma_s_prime_per_mm, "mm^-1")?;
         check_positive("eta", eta, "relative index")?;
         Ok(Self { sigma_a_per_mm, sigma_s_prime_per_mm, eta, fdr_form })
-    }
-
-    pub fn sigma_t_prime(&self) -> f64 {
-        self.sigma_a_per_mm + self.sigma_s_prime_per_mm
-    }
-
-    pub fn albedo_prime(&self) -> f64 {
-        self.sigma_s_prime_per_mm / self.sigma_t_prime()
-    }
-
-    /// Effective transport coefficient σtr = sqrt(3 σa σt′), mm⁻¹.
-    pub fn sigma_tr(&self) -> f64 {
-        (3.0 * self.sigma_a_per_mm * self.sigma_t_prime()).sqrt()
     }
 
     /// Depths of the real and virtual sources (zr, zv), mm.

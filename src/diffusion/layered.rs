@@ -24,8 +24,8 @@
 //! direct inverse transform of R̂stack to 1e−8.
 
 use super::hankel::InverseHankel;
-use super::multipole::{slab_for_layer, Series, Slab};
-use super::{FdrForm, RadialProfile};
+use super::multipole::{Series, Slab};
+use super::{FdrForm, RadialProfile, ReducedCoefficients};
 use crate::error::InvalidInput;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -158,17 +158,13 @@ impl LayerStack {
         for (j, layer) in self.layers.iter().enumerate() {
             let n_above = if j == 0 { self.eta_above } else { self.layers[j - 1].eta };
             let n_below = if j + 1 == n { self.eta_below } else { self.layers[j + 1].eta };
+            let (eta_top, eta_bottom) = (layer.eta / n_above, layer.eta / n_below);
             let mut slabs = Vec::with_capacity(3);
             for c in 0..3 {
-                slabs.push(slab_for_layer(
-                    j,
-                    layer.sigma_a[c],
-                    layer.sigma_s_prime[c],
-                    layer.thickness_mm,
-                    layer.eta / n_above,
-                    layer.eta / n_below,
-                    fdr_form,
-                )?);
+                let (sigma_a, sigma_s_prime) = (layer.sigma_a[c], layer.sigma_s_prime[c]);
+                let slab = Slab::new(sigma_a, sigma_s_prime, layer.thickness_mm, eta_top, eta_bottom, fdr_form)
+                    .map_err(|e| InvalidInput::new(format!("layers[{j}].{}", e.param), e.message))?;
+                slabs.push(slab);
             }
             out.push([slabs[0], slabs[1], slabs[2]]);
         }

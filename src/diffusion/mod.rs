@@ -31,6 +31,28 @@ pub mod sum_of_gaussians;
 pub mod table;
 pub mod tabulated;
 
+/// One channel's absorption σa and reduced scattering σs′ (mm⁻¹), and the diffusion-theory quantities built from
+/// them, shared by the dipole and the multipole (Jensen et al. 2001, thesis eq. 2.1; Donner & Jensen 2005):
+/// σt′ = σa + σs′, α′ = σs′/σt′, σtr = sqrt(3 σa σt′).
+pub trait ReducedCoefficients {
+    /// σa, mm⁻¹.
+    fn sigma_a_per_mm(&self) -> f64;
+    /// σs′ = σs (1 − g), mm⁻¹.
+    fn sigma_s_prime_per_mm(&self) -> f64;
+    /// Reduced extinction coefficient σt′ = σa + σs′, mm⁻¹.
+    fn sigma_t_prime(&self) -> f64 {
+        self.sigma_a_per_mm() + self.sigma_s_prime_per_mm()
+    }
+    /// Reduced albedo α′ = σs′/σt′.
+    fn albedo_prime(&self) -> f64 {
+        self.sigma_s_prime_per_mm() / self.sigma_t_prime()
+    }
+    /// Effective transport coefficient σtr = sqrt(3 σa σt′), mm⁻¹.
+    fn sigma_tr(&self) -> f64 {
+        (3.0 * self.sigma_a_per_mm() * self.sigma_t_prime()).sqrt()
+    }
+}
+
 /// An RGB radial diffusion profile R(r) in mm⁻² (r in mm), with its total ∫₀^∞ 2πr R(r) dr.
 ///
 /// Implemented by the dipole, the multipole, layered stacks and sums of Gaussians, so fitting,

@@ -11,7 +11,7 @@
 //! The exact infinite series is geometric in q = e^(−2Ls); it is evaluated here in a form that neither
 //! overflows for large s nor cancels for s → 0 (where it tends to Ohm's law T = (l + zb0)/L).
 
-use super::{boundary_a, FdrForm};
+use super::{boundary_a, FdrForm, ReducedCoefficients};
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 
 /// How the image series is summed.
@@ -36,6 +36,15 @@ pub struct Slab {
     /// n_slab / n_below.
     pub eta_bottom: f64,
     pub fdr_form: FdrForm,
+}
+
+impl ReducedCoefficients for Slab {
+    fn sigma_a_per_mm(&self) -> f64 {
+        self.sigma_a_per_mm
+    }
+    fn sigma_s_prime_per_mm(&self) -> f64 {
+        self.sigma_s_prime_per_mm
+    }
 }
 
 impl Slab {
@@ -68,16 +77,6 @@ impl Slab {
     /// The same slab lit from below (face indices swapped): gives R↑, T↑.
     pub fn flipped(&self) -> Self {
         Self { eta_top: self.eta_bottom, eta_bottom: self.eta_top, ..*self }
-    }
-
-    pub fn sigma_t_prime(&self) -> f64 {
-        self.sigma_a_per_mm + self.sigma_s_prime_per_mm
-    }
-    pub fn albedo_prime(&self) -> f64 {
-        self.sigma_s_prime_per_mm / self.sigma_t_prime()
-    }
-    pub fn sigma_tr(&self) -> f64 {
-        (3.0 * self.sigma_a_per_mm * self.sigma_t_prime()).sqrt()
     }
 
     /// (l, zb0, zbd, L) in mm.
@@ -328,20 +327,6 @@ impl super::RadialProfile for SlabRgb {
     fn total_transmittance(&self) -> Option<[f64; 3]> {
         Some([0, 1, 2].map(|c| self.channels[c].totals(self.series).1))
     }
-}
-
-/// Validates a slab and returns it, naming the layer in errors (`layers[i].field`).
-pub fn slab_for_layer(
-    index: usize,
-    sigma_a_per_mm: f64,
-    sigma_s_prime_per_mm: f64,
-    thickness_mm: f64,
-    eta_top: f64,
-    eta_bottom: f64,
-    fdr_form: FdrForm,
-) -> Result<Slab, InvalidInput> {
-    Slab::new(sigma_a_per_mm, sigma_s_prime_per_mm, thickness_mm, eta_top, eta_bottom, fdr_form)
-        .map_err(|e| InvalidInput::new(format!("layers[{index}].{}", e.param), e.message))
 }
 
 #[cfg(test)]

@@ -374,6 +374,28 @@ impl Context<'_> {
     }
 }
 
+/// `fn $name(args)`: `$body(args)` compiled for AVX2 (the twin `$avx2`) where the CPU has it (detected at run time)
+/// and the optional condition holds, else the baseline build. The bodies use only correctly rounded IEEE operations
+/// in a fixed order (no FMA contraction), so both builds give the same bits; only the vector width differs.
+macro_rules! avx2_dispatch {
+    ($name:ident, $avx2:ident, $body:ident($($arg:ident: $ty:ty),* $(,)?) $(, if $when:expr)? $(,)?) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        fn $avx2($($arg: $ty),*) {
+            $body($($arg),*)
+        }
+
+        fn $name($($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            if $($when &&)? std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2 (checked at run time).
+                return unsafe { $avx2($($arg),*) };
+            }
+            $body($($arg),*)
+        }
+    };
+}
+
 /// μ = c + Σ/n, σ = sqrt(max(Σ²/n − (Σ/n)², 0)) of texels sharing the count `n`.
 #[inline(always)]
 fn finish_body(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
@@ -385,21 +407,14 @@ fn finish_body(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &
     }
 }
 
-/// [`finish_body`] compiled for AVX2 (correctly rounded division and square root: the same bits, four lanes).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn finish_avx2(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
-    finish_body(acc, n, shift, out_m, out_s)
-}
-
-fn finish(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    if acc.len() > 1 && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked at run time).
-        return unsafe { finish_avx2(acc, n, shift, out_m, out_s) };
-    }
-    finish_body(acc, n, shift, out_m, out_s)
-}
+// [`finish_body`] compiled for AVX2 (correctly rounded division and square root: the same bits, four lanes), for
+// rows of more than one texel.
+avx2_dispatch!(
+    finish,
+    finish_avx2,
+    finish_body(acc: &[[f64; 2]], n: f64, shift: f64, out_m: &mut [f64], out_s: &mut [f64]),
+    if acc.len() > 1
+);
 
 /// `acc[x] = Σ_chords P(x + hw + 1) − P(x − hw)` for the tile's columns, chords in disk order: the O(r) inner
 /// loop. `chords` holds each chord's two prefix offsets (of the tile's first column) in `pre`. Blocks of
@@ -478,94 +493,62 @@ fn accumulate_pair_body(
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn accumulate_pair_avx2(
-    pre: &[[f64; 2]],
-    ext: usize,
-    offsets: &[(usize, usize)],
-    acc_a: &mut [[f64; 2]],
-    acc_b: &mut [[f64; 2]],
-) {
-    accumulate_pair_body(pre, ext, offsets, acc_a, acc_b)
-}
+// [`accumulate_pair_body`], AVX2 where the CPU has it.
+avx2_dispatch!(
+    accumulate_pair,
+    accumulate_pair_avx2,
+    accumulate_pair_body(
+        pre: &[[f64; 2]],
+        ext: usize,
+        offsets: &[(usize, usize)],
+        acc_a: &mut [[f64; 2]],
+        acc_b: &mut [[f64; 2]],
+    )
+);
 
-fn accumulate_pair(
-    pre: &[[f64; 2]],
-    ext: usize,
-    offsets: &[(usize, usize)],
-    acc_a: &mut [[f64; 2]],
-    acc_b: &mut [[f64; 2]],
-) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked at run time).
-        return unsafe { accumulate_pair_avx2(pre, ext, offsets, acc_a, acc_b) };
-    }
-    accumulate_pair_body(pre, ext, offsets, acc_a, acc_b)
-}
-
-/// The same loop compiled for AVX2: identical IEEE operations in the same order (no FMA contraction), so the
-/// results are bit-identical to the baseline build; only the vector width differs.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn accumulate_avx2(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64; 2]]) {
-    accumulate_body(pre, chords, acc)
-}
-
-fn accumulate(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64; 2]]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2 (checked at run time).
-        return unsafe { accumulate_avx2(pre, chords, acc) };
-    }
-    accumulate_body(pre, chords, acc)
-}
-
-/// Reference implementation: visits every texel of the disk (O(r²) per texel) and uses the two-pass
-/// variance. For tests and small maps only.
-pub fn disk_stats_brute_force(
-    data: &[f32],
-    width: u32,
-    height: u32,
-    radius: u32,
-    border: Border,
-) -> Result<LocalStats, InvalidInput> {
-    check_radius("radius", radius, width, height)?;
-    let (w, h, r) = (width as i64, height as i64, radius as i64);
-    let mut mean = vec![0.0; (w * h) as usize];
-    let mut sigma = vec![0.0; (w * h) as usize];
-    let mut texels = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            texels.clear();
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx * dx + dy * dy > r * r {
-                        continue;
-                    }
-                    let (sx, sy) = (x + dx, y + dy);
-                    let v = match border {
-                        Border::Clip if sx < 0 || sy < 0 || sx >= w || sy >= h => continue,
-                        Border::Clip => data[(sy * w + sx) as usize],
-                        Border::Wrap => data[(sy.rem_euclid(h) * w + sx.rem_euclid(w)) as usize],
-                    };
-                    texels.push(v as f64);
-                }
-            }
-            let n = texels.len() as f64;
-            let m = texels.iter().sum::<f64>() / n;
-            let var = texels.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n;
-            mean[(y * w + x) as usize] = m;
-            sigma[(y * w + x) as usize] = var.sqrt();
-        }
-    }
-    Ok(LocalStats { width, height, mean, sigma })
-}
+// [`accumulate_body`], AVX2 where the CPU has it.
+avx2_dispatch!(
+    accumulate,
+    accumulate_avx2,
+    accumulate_body(pre: &[[f64; 2]], chords: &[(usize, usize)], acc: &mut [[f64; 2]])
+);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reference: visits every texel of the disk (O(r²) per texel) and uses the two-pass variance.
+    fn brute_force(data: &[f32], (width, height): (u32, u32), radius: u32, border: Border) -> LocalStats {
+        let (w, h, r) = (width as i64, height as i64, radius as i64);
+        let mut mean = vec![0.0; (w * h) as usize];
+        let mut sigma = vec![0.0; (w * h) as usize];
+        let mut texels = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                texels.clear();
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if dx * dx + dy * dy > r * r {
+                            continue;
+                        }
+                        let (sx, sy) = (x + dx, y + dy);
+                        let v = match border {
+                            Border::Clip if sx < 0 || sy < 0 || sx >= w || sy >= h => continue,
+                            Border::Clip => data[(sy * w + sx) as usize],
+                            Border::Wrap => data[(sy.rem_euclid(h) * w + sx.rem_euclid(w)) as usize],
+                        };
+                        texels.push(v as f64);
+                    }
+                }
+                let n = texels.len() as f64;
+                let m = texels.iter().sum::<f64>() / n;
+                let var = texels.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n;
+                mean[(y * w + x) as usize] = m;
+                sigma[(y * w + x) as usize] = var.sqrt();
+            }
+        }
+        LocalStats { width, height, mean, sigma }
+    }
 
     fn noise_map(w: u32, h: u32, seed: u32, offset: f32) -> Vec<f32> {
         let mut s = seed.wrapping_mul(2654435761).wrapping_add(1);
@@ -600,7 +583,7 @@ mod tests {
             let data = noise_map(w, h, w * 31 + h, 0.0);
             for border in [Border::Clip, Border::Wrap] {
                 let fast = disk_stats(&data, w, h, r, border).unwrap();
-                let slow = disk_stats_brute_force(&data, w, h, r, border).unwrap();
+                let slow = brute_force(&data, (w, h), r, border);
                 for i in 0..(w * h) as usize {
                     assert!((fast.mean[i] - slow.mean[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} mean at {i}");
                     assert!((fast.sigma[i] - slow.sigma[i]).abs() < 1e-9, "{w}x{h} r={r} {border:?} sigma at {i}");
@@ -615,7 +598,7 @@ mod tests {
         let (w, h, r) = (24u32, 20u32, 4u32);
         let data: Vec<f32> = noise_map(w, h, 7, 0.0).iter().map(|v| 1.0e4 + v * 0.01).collect();
         let fast = disk_stats(&data, w, h, r, Border::Clip).unwrap();
-        let slow = disk_stats_brute_force(&data, w, h, r, Border::Clip).unwrap();
+        let slow = brute_force(&data, (w, h), r, Border::Clip);
         for i in 0..(w * h) as usize {
             assert!(slow.sigma[i] > 1e-3);
             assert!((fast.sigma[i] - slow.sigma[i]).abs() <= 1e-6 * slow.sigma[i], "sigma at {i}");

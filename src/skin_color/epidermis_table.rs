@@ -193,6 +193,87 @@ pub(super) fn accumulate_symmetric_row(
     accumulate_scalar(table, k, melanin, acc, 0..melanin.len())
 }
 
+/// `accumulate_symmetric_row` (the entry point of a vector path) over vectors of `$lanes` f64, written once for
+/// the AVX2 and the AVX-512F loop: `$feature` is the target feature, `$cubics` gives the (R1, T1) cubics of `$lanes`
+/// texels at their local coordinates, `$store_interval` stores `$lanes` i32 interval indices, and the rest are the
+/// width's f64 intrinsics. The last `len % $lanes` texels take the scalar loop. Two passes over the row: (1) σa,
+/// √σa and the interval (k, t) of every texel into `scratch`, (2) the look-up, adding and accumulation. Splitting
+/// the long dependency chain (square root → index → load → cubic → division) lets the out-of-order core overlap many
+/// more texels than one fused loop does (measured 2× faster). The same IEEE operations in the same order per lane
+/// as [`symmetric_texel`] (no FMA contraction), so the same bits as the scalar loop.
+#[cfg(target_arch = "x86_64")]
+macro_rules! two_pass_row {
+    (
+        $feature:literal, $lanes:literal, $cubics:ident, $store_interval:ident,
+        [$set1:ident, $setzero:ident, $loadu:ident, $storeu:ident, $add:ident, $sub:ident, $mul:ident, $div:ident,
+         $sqrt:ident, $min:ident, $max:ident, $cvtt:ident, $cvt:ident]
+    ) => {
+        #[target_feature(enable = $feature)]
+        pub(super) fn accumulate_symmetric_row(
+            table: &EpidermisTable,
+            k: &BandRow,
+            melanin: &[f64],
+            [acc_r, acc_g, acc_b]: [&mut [f64]; 3],
+            scratch: &mut RowScratch,
+        ) {
+            let cubics: &[IntervalCubic; TABLE_INTERVALS] =
+                table.down.as_slice().try_into().expect("one cubic per interval");
+            let n = melanin.len();
+            let nv = n - n % $lanes;
+            scratch.interval.resize(nv, 0);
+            scratch.t.resize(nv, 0.0);
+            let one = $set1(1.0);
+            {
+                let (zero, k_max) = ($setzero(), $set1((TABLE_INTERVALS - 1) as f64));
+                let mel = $set1(k.melanin_sigma_a_per_mm);
+                let che_blood = $set1(k.che_blood_sigma_a_per_mm);
+                let che = $set1(k.che);
+                let base = $set1(k.baseline_sigma_a_per_mm);
+                let (y_lo, inv_h) = ($set1(table.y_lo), $set1(table.inv_h));
+                let intervals = scratch.interval.chunks_exact_mut($lanes);
+                let lanes = melanin.chunks_exact($lanes).zip(intervals).zip(scratch.t.chunks_exact_mut($lanes));
+                for ((cm_v, k_v), t_v) in lanes {
+                    // SAFETY: `cm_v` is `$lanes` readable f64; the unaligned load has no alignment requirement.
+                    let cm = unsafe { $loadu(cm_v.as_ptr()) };
+                    // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base
+                    let sigma_a = $add($add($mul(cm, mel), che_blood), $mul($sub($sub(one, cm), che), base));
+                    let x = $mul($sub($sqrt(sigma_a), y_lo), inv_h);
+                    // max(x, 0) returns 0 for NaN (second operand) like f64::max; the clamp keeps the conversion
+                    // in range.
+                    let ki = $cvtt($min($max(x, zero), k_max));
+                    let t = $sub(x, $cvt(ki));
+                    // SAFETY: `k_v` is `$lanes` writable i32 and `t_v` `$lanes` writable f64; the unaligned stores
+                    // have no alignment requirement.
+                    unsafe {
+                        $store_interval(k_v.as_mut_ptr().cast(), ki);
+                        $storeu(t_v.as_mut_ptr(), t);
+                    }
+                }
+            }
+            let r2 = $set1(k.r2);
+            let w = k.weights.map(|c| $set1(c));
+            let lanes = scratch.interval.chunks_exact($lanes).zip(scratch.t.chunks_exact($lanes));
+            let planes = acc_r.chunks_exact_mut($lanes).zip(acc_g.chunks_exact_mut($lanes));
+            for ((k_v, t_v), ((ar, ag), ab)) in lanes.zip(planes.zip(acc_b.chunks_exact_mut($lanes))) {
+                let (r1, t1) = $cubics(cubics, k_v, t_v);
+                // R = R1 + T1² R2 / (1 − R1 R2)
+                let refl = $add(r1, $div($mul($mul(t1, t1), r2), $sub(one, $mul(r1, r2))));
+                for (a, wc) in [(ar, w[0]), (ag, w[1]), (ab, w[2])] {
+                    // SAFETY: `a` is `$lanes` readable and writable f64; the unaligned accesses have no alignment
+                    // requirement.
+                    unsafe {
+                        let sum = $add($loadu(a.as_ptr()), $mul(wc, refl));
+                        $storeu(a.as_mut_ptr(), sum);
+                    }
+                }
+            }
+            accumulate_scalar(table, k, melanin, [acc_r, acc_g, acc_b], nv..n);
+        }
+    };
+}
+
+/// Four texels at a time with AVX2: the four intervals' coefficients are loaded as one 256-bit vector each and
+/// transposed, so the look-up needs no gather.
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::{accumulate_scalar, BandRow, EpidermisTable, IntervalCubic, RowScratch, TABLE_INTERVALS};
@@ -201,7 +282,7 @@ mod avx2 {
     /// Loads four f64.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn load(c: &[f64; 4]) -> __m256d {
+    fn load(c: &[f64; 4]) -> __m256d {
         // SAFETY: `c` is a valid, readable [f64; 4]; the unaligned load has no alignment requirement.
         unsafe { _mm256_loadu_pd(c.as_ptr()) }
     }
@@ -209,7 +290,7 @@ mod avx2 {
     /// Transposes four rows of four lanes: out[i] = (a[i], b[i], c[i], d[i]).
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn transpose(a: __m256d, b: __m256d, c: __m256d, d: __m256d) -> [__m256d; 4] {
+    fn transpose(a: __m256d, b: __m256d, c: __m256d, d: __m256d) -> [__m256d; 4] {
         let ab_lo = _mm256_unpacklo_pd(a, b); // a0 b0 a2 b2
         let ab_hi = _mm256_unpackhi_pd(a, b); // a1 b1 a3 b3
         let cd_lo = _mm256_unpacklo_pd(c, d);
@@ -225,83 +306,44 @@ mod avx2 {
     /// c0 + t (c1 + t (c2 + t c3)) per lane.
     #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn horner(c: [__m256d; 4], t: __m256d) -> __m256d {
+    fn horner(c: [__m256d; 4], t: __m256d) -> __m256d {
         let v = _mm256_add_pd(c[2], _mm256_mul_pd(t, c[3]));
         let v = _mm256_add_pd(c[1], _mm256_mul_pd(t, v));
         _mm256_add_pd(c[0], _mm256_mul_pd(t, v))
     }
 
-    /// [`super::accumulate_symmetric_row`] four texels at a time; the last `len % 4` texels take the scalar loop.
-    /// Two passes over the row: (1) σa, √σa and the interval (k, t) of every texel into `scratch`, (2) the look-up,
-    /// adding and accumulation. Splitting the long dependency chain (square root → index → load → cubic → division)
-    /// lets the out-of-order core overlap many more texels than one fused loop does (measured 2× faster).
+    /// The (R1, T1) cubics of four texels at their local coordinates, as two 4-lane vectors.
+    #[inline]
     #[target_feature(enable = "avx2")]
-    pub(super) fn accumulate_symmetric_row(
-        table: &EpidermisTable,
-        k: &BandRow,
-        melanin: &[f64],
-        acc: [&mut [f64]; 3],
-        scratch: &mut RowScratch,
-    ) {
-        let cubics: &[IntervalCubic; TABLE_INTERVALS] =
-            table.down.as_slice().try_into().expect("one cubic per interval");
-        let n = melanin.len();
-        let n4 = n - n % 4;
-        scratch.interval.resize(n4, 0);
-        scratch.t.resize(n4, 0.0);
-        let one = _mm256_set1_pd(1.0);
-        {
-            let (zero, k_max) = (_mm256_setzero_pd(), _mm256_set1_pd((TABLE_INTERVALS - 1) as f64));
-            let mel = _mm256_set1_pd(k.melanin_sigma_a_per_mm);
-            let che_blood = _mm256_set1_pd(k.che_blood_sigma_a_per_mm);
-            let che = _mm256_set1_pd(k.che);
-            let base = _mm256_set1_pd(k.baseline_sigma_a_per_mm);
-            let (y_lo, inv_h) = (_mm256_set1_pd(table.y_lo), _mm256_set1_pd(table.inv_h));
-            let lanes =
-                melanin.chunks_exact(4).zip(scratch.interval.chunks_exact_mut(4)).zip(scratch.t.chunks_exact_mut(4));
-            for ((cm4, k4), t4) in lanes {
-                let cm = load(cm4.try_into().expect("4 lanes"));
-                // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base
-                let sigma_a = _mm256_add_pd(
-                    _mm256_add_pd(_mm256_mul_pd(cm, mel), che_blood),
-                    _mm256_mul_pd(_mm256_sub_pd(_mm256_sub_pd(one, cm), che), base),
-                );
-                let x = _mm256_mul_pd(_mm256_sub_pd(_mm256_sqrt_pd(sigma_a), y_lo), inv_h);
-                // max(x, 0) returns 0 for NaN like f64::max; the clamp keeps the conversion in range.
-                let ki = _mm256_cvttpd_epi32(_mm256_min_pd(_mm256_max_pd(x, zero), k_max));
-                let t = _mm256_sub_pd(x, _mm256_cvtepi32_pd(ki));
-                // SAFETY: `k4` is a valid, writable [i32; 4] (16 bytes) and `t4` a valid, writable [f64; 4]; the
-                // unaligned stores have no alignment requirement.
-                unsafe {
-                    _mm_storeu_si128(k4.as_mut_ptr().cast(), ki);
-                    _mm256_storeu_pd(t4.as_mut_ptr(), t);
-                }
-            }
-        }
-        let r2 = _mm256_set1_pd(k.r2);
-        let w = k.weights.map(|c| _mm256_set1_pd(c));
-        let [acc_r, acc_g, acc_b] = acc;
-        let lanes = scratch.interval.chunks_exact(4).zip(scratch.t.chunks_exact(4));
-        let planes = acc_r.chunks_exact_mut(4).zip(acc_g.chunks_exact_mut(4)).zip(acc_b.chunks_exact_mut(4));
-        for ((k4, t4), ((ar, ag), ab)) in lanes.zip(planes) {
-            let t = load(t4.try_into().expect("4 lanes"));
-            let c = [0, 1, 2, 3].map(|j| &cubics[k4[j] as usize & (TABLE_INTERVALS - 1)]);
-            let r1 = horner(transpose(load(&c[0].r), load(&c[1].r), load(&c[2].r), load(&c[3].r)), t);
-            let t1 = horner(transpose(load(&c[0].t), load(&c[1].t), load(&c[2].t), load(&c[3].t)), t);
-            // R = R1 + T1² R2 / (1 − R1 R2)
-            let refl = _mm256_add_pd(
-                r1,
-                _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(t1, t1), r2), _mm256_sub_pd(one, _mm256_mul_pd(r1, r2))),
-            );
-            for (a, wc) in [(ar, w[0]), (ag, w[1]), (ab, w[2])] {
-                let a: &mut [f64; 4] = a.try_into().expect("4 lanes");
-                let sum = _mm256_add_pd(load(a), _mm256_mul_pd(wc, refl));
-                // SAFETY: `a` is a valid, writable [f64; 4]; the unaligned store has no alignment requirement.
-                unsafe { _mm256_storeu_pd(a.as_mut_ptr(), sum) };
-            }
-        }
-        accumulate_scalar(table, k, melanin, [acc_r, acc_g, acc_b], n4..n);
+    pub(super) fn cubics4(cubics: &[IntervalCubic; TABLE_INTERVALS], k4: &[i32], t4: &[f64]) -> (__m256d, __m256d) {
+        let t = load(t4.try_into().expect("4 lanes"));
+        let c = [0, 1, 2, 3].map(|j| &cubics[k4[j] as usize & (TABLE_INTERVALS - 1)]);
+        let r1 = horner(transpose(load(&c[0].r), load(&c[1].r), load(&c[2].r), load(&c[3].r)), t);
+        let t1 = horner(transpose(load(&c[0].t), load(&c[1].t), load(&c[2].t), load(&c[3].t)), t);
+        (r1, t1)
     }
+
+    two_pass_row!(
+        "avx2",
+        4,
+        cubics4,
+        _mm_storeu_si128,
+        [
+            _mm256_set1_pd,
+            _mm256_setzero_pd,
+            _mm256_loadu_pd,
+            _mm256_storeu_pd,
+            _mm256_add_pd,
+            _mm256_sub_pd,
+            _mm256_mul_pd,
+            _mm256_div_pd,
+            _mm256_sqrt_pd,
+            _mm256_min_pd,
+            _mm256_max_pd,
+            _mm256_cvttpd_epi32,
+            _mm256_cvtepi32_pd
+        ]
+    );
 }
 
 /// The same loop eight texels at a time with AVX-512F: the square root and the division, which bound the AVX2
@@ -310,19 +352,17 @@ mod avx2 {
 /// operations in the same order per lane (no FMA contraction), so the same bits as the scalar loop.
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::avx2::{horner, load, transpose};
+    use super::avx2::cubics4;
     use super::{accumulate_scalar, BandRow, EpidermisTable, IntervalCubic, RowScratch, TABLE_INTERVALS};
     use std::arch::x86_64::*;
 
-    /// The (R1, T1) cubics of four texels at their local coordinates, as two 4-lane vectors.
+    /// The (R1, T1) cubics of eight texels: two groups of four (lo in lanes 0–3).
     #[inline]
     #[target_feature(enable = "avx512f")]
-    fn cubics4(cubics: &[IntervalCubic; TABLE_INTERVALS], k4: &[i32], t4: &[f64]) -> (__m256d, __m256d) {
-        let t = load(t4.try_into().expect("4 lanes"));
-        let c = [0, 1, 2, 3].map(|j| &cubics[k4[j] as usize & (TABLE_INTERVALS - 1)]);
-        let r1 = horner(transpose(load(&c[0].r), load(&c[1].r), load(&c[2].r), load(&c[3].r)), t);
-        let t1 = horner(transpose(load(&c[0].t), load(&c[1].t), load(&c[2].t), load(&c[3].t)), t);
-        (r1, t1)
+    fn cubics8(cubics: &[IntervalCubic; TABLE_INTERVALS], k8: &[i32], t8: &[f64]) -> (__m512d, __m512d) {
+        let (r_lo, t_lo) = cubics4(cubics, &k8[..4], &t8[..4]);
+        let (r_hi, t_hi) = cubics4(cubics, &k8[4..], &t8[4..]);
+        (join(r_lo, r_hi), join(t_lo, t_hi))
     }
 
     /// Two 4-lane vectors as one 8-lane vector (lo in lanes 0–3).
@@ -332,77 +372,27 @@ mod avx512 {
         _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo), hi)
     }
 
-    /// [`super::accumulate_symmetric_row`] eight texels at a time; the last `len % 8` texels take the scalar loop.
-    /// The two passes of the AVX2 loop (see there).
-    #[target_feature(enable = "avx512f")]
-    pub(super) fn accumulate_symmetric_row(
-        table: &EpidermisTable,
-        k: &BandRow,
-        melanin: &[f64],
-        acc: [&mut [f64]; 3],
-        scratch: &mut RowScratch,
-    ) {
-        let cubics: &[IntervalCubic; TABLE_INTERVALS] =
-            table.down.as_slice().try_into().expect("one cubic per interval");
-        let n = melanin.len();
-        let n8 = n - n % 8;
-        scratch.interval.resize(n8, 0);
-        scratch.t.resize(n8, 0.0);
-        let one = _mm512_set1_pd(1.0);
-        {
-            let (zero, k_max) = (_mm512_setzero_pd(), _mm512_set1_pd((TABLE_INTERVALS - 1) as f64));
-            let mel = _mm512_set1_pd(k.melanin_sigma_a_per_mm);
-            let che_blood = _mm512_set1_pd(k.che_blood_sigma_a_per_mm);
-            let che = _mm512_set1_pd(k.che);
-            let base = _mm512_set1_pd(k.baseline_sigma_a_per_mm);
-            let (y_lo, inv_h) = (_mm512_set1_pd(table.y_lo), _mm512_set1_pd(table.inv_h));
-            let lanes =
-                melanin.chunks_exact(8).zip(scratch.interval.chunks_exact_mut(8)).zip(scratch.t.chunks_exact_mut(8));
-            for ((cm8, k8), t8) in lanes {
-                // SAFETY: `cm8` is eight readable f64; the unaligned load has no alignment requirement.
-                let cm = unsafe { _mm512_loadu_pd(cm8.as_ptr()) };
-                // σa = Cm·σa,m + Che·σa,blood + ((1 − Cm) − Che)·σa,base
-                let sigma_a = _mm512_add_pd(
-                    _mm512_add_pd(_mm512_mul_pd(cm, mel), che_blood),
-                    _mm512_mul_pd(_mm512_sub_pd(_mm512_sub_pd(one, cm), che), base),
-                );
-                let x = _mm512_mul_pd(_mm512_sub_pd(_mm512_sqrt_pd(sigma_a), y_lo), inv_h);
-                // max(x, 0) returns 0 for NaN (second operand), as the AVX2 loop and f64::max do.
-                let ki = _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(x, zero), k_max));
-                let t = _mm512_sub_pd(x, _mm512_cvtepi32_pd(ki));
-                // SAFETY: `k8` is eight writable i32 (32 bytes) and `t8` eight writable f64; the unaligned stores
-                // have no alignment requirement.
-                unsafe {
-                    _mm256_storeu_si256(k8.as_mut_ptr().cast(), ki);
-                    _mm512_storeu_pd(t8.as_mut_ptr(), t);
-                }
-            }
-        }
-        let r2 = _mm512_set1_pd(k.r2);
-        let w = k.weights.map(|c| _mm512_set1_pd(c));
-        let [acc_r, acc_g, acc_b] = acc;
-        let lanes = scratch.interval.chunks_exact(8).zip(scratch.t.chunks_exact(8));
-        let planes = acc_r.chunks_exact_mut(8).zip(acc_g.chunks_exact_mut(8)).zip(acc_b.chunks_exact_mut(8));
-        for ((k8, t8), ((ar, ag), ab)) in lanes.zip(planes) {
-            let (r_lo, t_lo) = cubics4(cubics, &k8[..4], &t8[..4]);
-            let (r_hi, t_hi) = cubics4(cubics, &k8[4..], &t8[4..]);
-            let (r1, t1) = (join(r_lo, r_hi), join(t_lo, t_hi));
-            // R = R1 + T1² R2 / (1 − R1 R2)
-            let refl = _mm512_add_pd(
-                r1,
-                _mm512_div_pd(_mm512_mul_pd(_mm512_mul_pd(t1, t1), r2), _mm512_sub_pd(one, _mm512_mul_pd(r1, r2))),
-            );
-            for (a, wc) in [(ar, w[0]), (ag, w[1]), (ab, w[2])] {
-                // SAFETY: `a` is eight readable and writable f64; the unaligned accesses have no alignment
-                // requirement.
-                unsafe {
-                    let sum = _mm512_add_pd(_mm512_loadu_pd(a.as_ptr()), _mm512_mul_pd(wc, refl));
-                    _mm512_storeu_pd(a.as_mut_ptr(), sum);
-                }
-            }
-        }
-        accumulate_scalar(table, k, melanin, [acc_r, acc_g, acc_b], n8..n);
-    }
+    two_pass_row!(
+        "avx512f",
+        8,
+        cubics8,
+        _mm256_storeu_si256,
+        [
+            _mm512_set1_pd,
+            _mm512_setzero_pd,
+            _mm512_loadu_pd,
+            _mm512_storeu_pd,
+            _mm512_add_pd,
+            _mm512_sub_pd,
+            _mm512_mul_pd,
+            _mm512_div_pd,
+            _mm512_sqrt_pd,
+            _mm512_min_pd,
+            _mm512_max_pd,
+            _mm512_cvttpd_epi32,
+            _mm512_cvtepi32_pd
+        ]
+    );
 }
 
 #[cfg(test)]

@@ -18,14 +18,11 @@
 //! is the simpler formula to check by hand.
 
 use super::two_layer::TwoLayerSkinModel;
-use crate::diffusion::layered::Adding;
-use crate::diffusion::multipole::Series;
 use crate::diffusion::source::TransportModel;
-use crate::diffusion::FdrForm;
 use crate::error::InvalidInput;
 use crate::spectral::colorimetry::{Illuminant, SpectralGrid, SRGB_FROM_XYZ};
 use crate::spectral::skin_layers::{
-    physiological_skin_source, spectral_weights, SkinPhysiology, SkinProjection, DERMAL_HEMOGLOBIN_FRACTION_MAX,
+    physiological_skin_source_dj05, spectral_weights, SkinPhysiology, SkinProjection, DERMAL_HEMOGLOBIN_FRACTION_MAX,
     MELANIN_FRACTION_MAX,
 };
 use serde::{Deserialize, Serialize};
@@ -95,17 +92,7 @@ impl McColorParams {
         let (cm, chd) = self.node(i, j);
         let transport = TransportModel::monte_carlo(self.g, self.photons_at(i), self.seed.wrapping_add(k as u64))?;
         let projection = SkinProjection::Spectral { illuminant: Illuminant::D65, step_nm: self.mc_step_nm };
-        let (src, _) = physiological_skin_source(
-            physiology,
-            &projection,
-            cm,
-            chd,
-            Adding::Symmetric,
-            Series::Exact,
-            FdrForm::Dj05,
-            transport,
-        )?;
-        Ok(src)
+        physiological_skin_source_dj05(physiology, &projection, cm, chd, transport)
     }
 
     /// Upper estimate of the wall time of [`McColorGrid::simulate`] on `threads` threads, seconds.

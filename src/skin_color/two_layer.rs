@@ -24,7 +24,7 @@
 //! implementations do silently), recorded in the outputs' parameters.
 
 use crate::diffusion::multipole::{Series, Slab};
-use crate::diffusion::FdrForm;
+use crate::diffusion::{FdrForm, ReducedCoefficients};
 use crate::error::InvalidInput;
 use crate::spectral::chromophores::ChromophoreSpectra;
 use crate::spectral::colorimetry::{srgb8, ColorWeights, Illuminant, SpectralGrid};

@@ -494,6 +494,29 @@ pub fn physiological_skin_source(
     Ok((source, provenance))
 }
 
+/// [`physiological_skin_source`] with Donner & Jensen 2005's solver as printed (the defaults): symmetric adding of
+/// the layers' transforms, the exact infinite image series and their F_dr polynomial; the source alone.
+pub fn physiological_skin_source_dj05(
+    physiology: &SkinPhysiology,
+    projection: &SkinProjection,
+    cm: f64,
+    chd: f64,
+    transport: crate::diffusion::source::TransportModel,
+) -> Result<crate::diffusion::source::ProfileSource, InvalidInput> {
+    use crate::diffusion::{layered::Adding, multipole::Series, FdrForm};
+    physiological_skin_source(
+        physiology,
+        projection,
+        cm,
+        chd,
+        Adding::Symmetric,
+        Series::Exact,
+        FdrForm::Dj05,
+        transport,
+    )
+    .map(|(source, _)| source)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -504,18 +527,8 @@ mod tests {
     use crate::skin_color::two_layer::{ModelOptions, TwoLayerSkinModel};
 
     fn spectral(cm: f64, chd: f64, transport: TransportModel) -> ProfileSource {
-        let (src, _) = physiological_skin_source(
-            &SkinPhysiology::default(),
-            &SkinProjection::default(),
-            cm,
-            chd,
-            Adding::Symmetric,
-            Series::Exact,
-            FdrForm::Dj05,
-            transport,
-        )
-        .unwrap();
-        src
+        physiological_skin_source_dj05(&SkinPhysiology::default(), &SkinProjection::default(), cm, chd, transport)
+            .unwrap()
     }
 
     /// The spectral profile's total is the skin-colour LUT's colour of that skin (same spectral step), exactly up

@@ -5,7 +5,7 @@ use rtbake::diffusion::dipole::Dipole;
 use rtbake::diffusion::materials::{self, JENSEN_2001};
 use rtbake::diffusion::multipole::{Series, Slab};
 use rtbake::diffusion::quadrature::radial_total;
-use rtbake::diffusion::{fdr, FdrForm, RadialProfile};
+use rtbake::diffusion::{fdr, FdrForm, RadialProfile, ReducedCoefficients};
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
