@@ -30,6 +30,7 @@ const FIELD_FLAGS: &[(&str, &str)] = &[
     ("hemoglobin", "--hemoglobin"),
     ("melanin_blend", "--melanin-blend"),
     ("epidermal_hemoglobin_ratio", "--epidermal-hemoglobin-ratio"),
+    ("thin_layer", "--thin-layer"),
     ("oxygenation", "--oxygenation"),
     ("hemoglobin_g_per_l", "--hemoglobin-g-per-l"),
     ("hemoglobin_molar_mass_g_per_mol", "--hemoglobin-molar-mass-g-per-mol"),

@@ -240,7 +240,7 @@ impl TwoLayerSkinModel {
                     format!(
                         "must exceed the {layer}'s transport mean free path 1/sigma_t' = {l:.5} mm at {lambda} nm \
                          (Cm = {cm}, Chd = {chd}; too thin from {} to {} nm) for the multipole diffusion source to lie \
-                         inside the layer, got {thickness} (thin_layer = clamp-transmittance evaluates it anyway)",
+                         inside the layer, got {thickness} (`thin_layer` clamp-transmittance evaluates it anyway)",
                         span.0, span.1
                     ),
                 )

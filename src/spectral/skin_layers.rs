@@ -160,8 +160,8 @@ pub fn check_concentrations(
         return Err(InvalidInput::new(
             hemoglobin_param,
             format!(
-                "gives an epidermal hemoglobin Che = epidermal_hemoglobin_ratio × Chd = {che} above Table 7.1's 0.1 \
-                 (lower the ratio or allow_unphysiological), got Chd = {chd}"
+                "gives an epidermal hemoglobin Che = `epidermal_hemoglobin_ratio` × Chd = {che} above Table 7.1's 0.1 \
+                 (lower the ratio or set `allow_unphysiological`), got Chd = {chd}"
             ),
         ));
     }
