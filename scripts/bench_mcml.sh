@@ -2,7 +2,8 @@
 # Photons per CPU second of rtbake's lane kernel on each instruction-set path against the original MCML 1.2.2
 # (Wang, Jacques & Zheng 1995) on the same problems, one core each.
 #
-#   MCML_BIN=/path/to/mcml [MCML_BIN2=/path/to/other-mcml] [RUNS=3] bash scripts/bench_mcml.sh
+#   MCML_BIN=/path/to/mcml [MCML_BIN2=/path/to/other-mcml] [LANE_BEFORE=/path/to/lane_paths] [RUNS=3]
+#   [PHOTONS=300000] bash scripts/bench_mcml.sh
 #
 # rtbake side: `crates/rtbake-lanes/examples/lane_paths` (the kernel `rtbake transport` runs, one thread, chunks of
 # 4096 photons), built with `cargo build --release -p rtbake-lanes --example lane_paths`; each path is forced with
@@ -11,6 +12,9 @@
 # with /usr/bin/time (user + system CPU seconds of the process, so the load of a shared machine does not count);
 # RUNS runs each, alternated, medians and the ratio rtbake photons/s over MCML photons/s printed. Without MCML_BIN
 # (or if it is not executable) the MCML side is left out and the script says so.
+# LANE_BEFORE names another build of the example (e.g. an older commit's, built the same way in a checkout of it, to
+# compare a kernel change): it is timed on every path in the same rounds ("before PATH"), its checksums must equal
+# the current build's (the line "checksums equal" covers both), and each path's speed-up over it is printed.
 #
 # Problems (mm, mm^-1; sigma_s = sigma_s'/(1 - g), sigma_s' kept), at g = 0 and g = 0.8:
 #   skin:   two layers at one wavelength, air above: epidermis 0.25 mm, eta 1.4, mu_a 1.5, mu_s' 5.0;
@@ -21,6 +25,8 @@ cd "$(dirname "$0")/.."
 RUNS=${RUNS:-3}
 PHOTONS=${PHOTONS:-300000}
 TARGET=${CARGO_TARGET_DIR:-target}
+BEFORE=${LANE_BEFORE:-}
+if [ -n "$BEFORE" ] && [ ! -x "$BEFORE" ]; then echo "LANE_BEFORE=$BEFORE is not executable" >&2; exit 2; fi
 cargo build --release --locked -p rtbake-lanes --example lane_paths >&2
 LANE="$TARGET/release/examples/lane_paths"
 WORK=$(mktemp -d)
@@ -68,6 +74,10 @@ for g in 0 0.8; do
         t[$path]+="$(RTBAKE_LANE_PATH=$path cpu "$LANE" "$PHOTONS" 1.0 "$eb" "${layers[@]}") "
         sums+="$(awk '{print $NF}' "$WORK/out") "
         rd=$(grep -o 'Rd [0-9.]*' "$WORK/out" || true)
+        if [ -n "$BEFORE" ]; then
+          t[before-$path]+="$(RTBAKE_LANE_PATH=$path cpu "$BEFORE" "$PHOTONS" 1.0 "$eb" "${layers[@]}") "
+          sums+="$(awk '{print $NF}' "$WORK/out") "
+        fi
       done
       for i in "${!MCMLS[@]}"; do
         t[mcml$i]+="$(cd "$WORK" && cpu "${MCMLS[$i]}" in.mci) "
@@ -78,13 +88,17 @@ for g in 0 0.8; do
     for i in "${!MCMLS[@]}"; do
       [ -f "$WORK/out.mco" ] && echo "   MCML ${MCMLS[$i]}: Rd $(grep -m1 'Diffuse reflectance' "$WORK/out.mco" | awk '{print $1}')"
     done
-    for key in avx512 avx2 portable $(for i in "${!MCMLS[@]}"; do echo mcml$i; done); do
+    for key in avx512 avx2 portable before-avx512 before-avx2 before-portable $(for i in "${!MCMLS[@]}"; do echo mcml$i; done); do
       [ -n "${t[$key]:-}" ] || continue
       m=$(echo ${t[$key]} | tr ' ' '\n' | median)
       rate=$(awk -v n="$PHOTONS" -v m="$m" 'BEGIN {printf "%.3f", n / m / 1e6}')
       name=$key; [[ $key == mcml* ]] && name="MCML ${MCMLS[${key#mcml}]}"
       line=$(printf '   %-28s median %6.3f CPU-s (runs: %s) %s M photons/s' "$name" "$m" "$(echo ${t[$key]})" "$rate")
       if [[ $key != mcml* ]]; then
+        if [[ $key != before-* && -n "${t[before-$key]:-}" ]]; then
+          mb=$(echo ${t[before-$key]} | tr ' ' '\n' | median)
+          line+=$(awk -v a="$m" -v b="$mb" 'BEGIN {printf "; %.2fx before", b / a}')
+        fi
         for i in "${!MCMLS[@]}"; do
           mm=$(echo ${t[mcml$i]} | tr ' ' '\n' | median)
           line+=$(awk -v a="$m" -v b="$mm" -v n="$(basename "${MCMLS[$i]}")" 'BEGIN {printf "; %.2fx %s", b / a, n}')
