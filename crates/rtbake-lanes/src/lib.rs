@@ -20,7 +20,8 @@
 //! **Groups**: a step runs the 32 lanes as 32/G groups of G lanes, one after the other, each group's whole step in
 //! registers of the path's width — G = 32 on AVX-512F, 16 on AVX2, 4 on the portable path (`GROUP_*`). At SSE2's
 //! width a 32-lane value is sixteen registers, so every intermediate of the step went through memory; in groups of
-//! 4 a value is two registers and the portable path runs 1.6–1.9× faster (BENCHMARKS.md, "Monte Carlo per core").
+//! 4 a value is two registers, and the portable path takes 0.5–0.6 of its former CPU time (BENCHMARKS.md, "Monte
+//! Carlo per core").
 //! The grouping keeps every byte: lane i is lane i mod G of group ⌊i/G⌋ and traces the same photon as before; a
 //! group's step reads and writes only its own lanes, with the same IEEE operations in the same order per lane; its
 //! two branches on lane data (`isotropic.all()`, `at_face.any()`, now taken per group) only skip work whose results
@@ -170,9 +171,11 @@ impl Tally {
 pub const LANES: usize = 32;
 const _: () = assert!(LANES <= 32, "the outcome mask of a step is a u32");
 
-/// Lanes per group on each path (crate docs, "Groups"): the widths that ran fastest on the project's machine
-/// (`scripts/bench_mcml.sh`, 2026-11-26): the whole 32 with AVX-512F's 32 registers of 8 doubles, 16 with AVX2's
-/// 16 registers of 4, 4 with SSE2's 16 registers of 2 (also the baseline of aarch64's NEON, 32 registers of 2).
+/// Lanes per group on each path (crate docs, "Groups"): the widths that ran fastest in CPU seconds of
+/// `examples/lane_paths` on the problems of `scripts/bench_mcml.sh` (project's 2-core AMD EPYC, 2026-11-26):
+/// AVX-512F (32 registers of 8 doubles) the whole 32, 16 lanes 3–6 % slower; AVX2 (16 registers of 4) 16, with
+/// 32 lanes 10–23 % slower and 8 lanes 0–9 %; SSE2 (16 registers of 2) 4, with 8 lanes 5–17 % and 2 lanes
+/// 12–18 % slower. aarch64's NEON also has registers of 2 doubles and takes the portable width, not measured here.
 const GROUP_AVX512: usize = 32;
 const GROUP_AVX2: usize = 16;
 const GROUP_PORTABLE: usize = 4;
@@ -508,10 +511,11 @@ fn round_keys(seed: u64) -> [[u32; 2]; 10] {
 
 /// Philox4x32-10 of the counters `c` per lane under the round keys `keys` (Salmon et al., SC'11): per round the
 /// 32×32 → 64-bit products M0·c₀ and M1·c₂ split into high and low words. Written as products of zero-extended
-/// words in a group of a few lanes, the compiler forms them with packed 32×32 → 64 multiplies on every path
-/// (SSE2 `pmuludq`, two per instruction; AVX2/AVX-512F `vpmuludq`). (Over the whole 32 lanes at SSE2's width it
-/// multiplied one lane at a time; the 16-bit schoolbook products the crate used then are slower in groups.)
-/// Exact integer arithmetic, so the same words on every path.
+/// words, at the paths' group widths the compiler forms them with packed 32×32 → 64 multiplies (SSE2 `pmuludq`,
+/// AVX2/AVX-512F `vpmuludq`; seen in the disassembly). Over the whole 32 lanes at SSE2's width it multiplied one
+/// lane at a time, hence the 16-bit schoolbook products the kernel used before its groups; in groups of 4 those
+/// are the slower form (the portable path took 1.5× the CPU time with them). Exact integer arithmetic, so the same
+/// words on every path.
 #[inline(always)]
 fn block<const N: usize>(c: [W<N>; 4], keys: &[[u32; 2]; 10]) -> [W<N>; 4] {
     let [mut c0, mut c1, mut c2, mut c3] = c;
