@@ -1,7 +1,8 @@
 //! The photon-lane engine [`super::mc`] runs: the `rtbake-lanes` workspace crate (32 packets per step in packed
-//! arithmetic, AVX-512F / AVX2 / portable paths chosen at run time, the same bytes on each; its crate docs give the
-//! draws, the determinism argument and why it is a crate of its own: it is built with opt-level 3 in the dev
-//! profile too). This module hands it a channel's media and takes its tallies.
+//! arithmetic, in groups of the path's register width; AVX-512F / AVX2 / portable paths chosen at run time, the
+//! same bytes on each; its crate docs give the draws, the determinism argument and why it is a crate of its own:
+//! it is built with opt-level 3 in the dev profile too). This module hands it a channel's media and takes its
+//! tallies.
 
 use super::mc::{Channel, Tally};
 pub use rtbake_lanes::{Path, LANES};

@@ -2,9 +2,10 @@
 //! per step, without branches on the photons' histories (MCML, Wang, Jacques & Zheng 1995, §3.2–3.8; the physics
 //! is the one of the module docs of `rtbake::transport::mc`).
 //!
-//! Every step computes, for all lanes at once in packed arithmetic (`[f64; LANES]` structure-of-arrays values whose
-//! every operation is one short loop the compiler vectorises): one Philox4x32-10 block per lane (`rtbake::transport::rng`,
-//! counter (photon index lo, photon index hi, channel, event number): the photon's stream is fixed by its index),
+//! Every step computes, for all lanes of a group at once in packed arithmetic (`[f64; G]` structure-of-arrays
+//! values whose every operation is one short loop the compiler vectorises; groups below): one Philox4x32-10 block
+//! per lane (`rtbake::transport::rng`, counter (photon index lo, photon index hi, channel, event number): the
+//! photon's stream is fixed by its index),
 //! both the interaction (implicit capture, Henyey–Greenstein polar angle, azimuth, spin, Russian roulette; MCML
 //! eq. 3.28–3.31) and the arrival at the face the packet heads for (Fresnel reflectance, MCML eq. 3.36–3.38,
 //! reflection or Snell refraction), and keeps one of the two per lane by mask. The per-lane outcomes that need
@@ -16,6 +17,22 @@
 //! processor overlap them (measured: 8 → 16 → 32 lanes took the van de Hulst slab from 0.25 to 0.14 to 0.12 CPU
 //! seconds, `examples/bench_transport`).
 //!
+//! **Groups**: a step runs the 32 lanes as 32/G groups of G lanes, one after the other, each group's whole step in
+//! registers of the path's width — G = 32 on AVX-512F, 16 on AVX2, 4 on the portable path (`GROUP_*`). At SSE2's
+//! width a 32-lane value is sixteen registers, so every intermediate of the step went through memory; in groups of
+//! 4 a value is two registers, and the portable path takes 0.5–0.6 of its former CPU time (BENCHMARKS.md, "Monte
+//! Carlo per core").
+//! The grouping keeps every byte: lane i is lane i mod G of group ⌊i/G⌋ and traces the same photon as before; a
+//! group's step reads and writes only its own lanes, with the same IEEE operations in the same order per lane; its
+//! two branches on lane data (`isotropic.all()`, `at_face.any()`, now taken per group) only skip work whose results
+//! every lane of the group discards by its selects; and everything after the step — exits and refills in lane
+//! order 0..31, absorption in per-lane, per-layer sums added in lane order at the end of the chunk — is the same
+//! loop over the same 32 lanes whatever G is. A lane's absorbed weight is added to its own layer's sum only (the
+//! kernel used to add zero to the other layers' sums, which leaves a sum of non-negative weights, never −0.0,
+//! bit-identical).
+//! Tests: `every_group_width_gives_the_same_bytes` (G = 1 … 32) and the checksums of the ungrouped kernel on every
+//! path.
+//!
 //! **Draws**: each event uses the four words of its block: word 0 → the optical depth s = −ln ξ when none is
 //! pending (ξ = (w + 1)/2³² ∈ (0, 1]; fdlibm's logarithm, branch-free); word 1 → the HG ξ at an interaction or
 //! the Fresnel ξ at a face; word 2 → the azimuth φ (2 bits of quadrant and 30 bits within it, sin and cos by
@@ -24,8 +41,8 @@
 //!
 //! **Determinism**: only IEEE-754 additions, multiplications, divisions, square roots, comparisons, selects and
 //! exact conversions are used, and "fma" is never enabled, so the AVX-512F, AVX2 and portable paths ([`Path`])
-//! round identically and give the same bytes; lanes keep their own absorption sums, added in lane order at the end
-//! of a chunk, and exits are scored in lane order.
+//! round identically and give the same bytes whatever their group width; lanes keep their own absorption sums,
+//! added in lane order at the end of a chunk, and exits are scored in lane order.
 
 //! **Why a crate of its own**: this is the hot loop of every Monte Carlo asset and it depends on nothing else of
 //! rtbake, so the workspace gives it `opt-level = 3` in the dev profile too (`[profile.dev.package.rtbake-lanes]`
@@ -154,6 +171,15 @@ impl Tally {
 pub const LANES: usize = 32;
 const _: () = assert!(LANES <= 32, "the outcome mask of a step is a u32");
 
+/// Lanes per group on each path (crate docs, "Groups"): the widths that ran fastest in CPU seconds of
+/// `examples/lane_paths` on the problems of `scripts/bench_mcml.sh` (project's 2-core AMD EPYC, 2026-11-26):
+/// AVX-512F (32 registers of 8 doubles) the whole 32, 16 lanes 3–6 % slower; AVX2 (16 registers of 4) 16, with
+/// 32 lanes 10–23 % slower and 8 lanes 0–9 %; SSE2 (16 registers of 2) 4, with 8 lanes 5–17 % and 2 lanes
+/// 12–18 % slower. aarch64's NEON also has registers of 2 doubles and takes the portable width, not measured here.
+const GROUP_AVX512: usize = 32;
+const GROUP_AVX2: usize = 16;
+const GROUP_PORTABLE: usize = 4;
+
 /// The instruction set the lane loops are compiled for; every path gives the same bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Path {
@@ -216,36 +242,36 @@ pub fn trace_chunk(path: Path, ch: &Channel<'_>, bin_mm: f64, first: u64, count:
         #[cfg(target_arch = "x86_64")]
         // SAFETY: the CPU supports AVX2 (checked above).
         Path::Avx2 => unsafe { x86::trace_avx2(ch, bin_mm, first, count, tally) },
-        _ => trace(ch, bin_mm, first, count, tally),
+        _ => trace::<GROUP_PORTABLE>(ch, bin_mm, first, count, tally),
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{trace, Channel, Tally};
+    use super::{trace, Channel, Tally, GROUP_AVX2, GROUP_AVX512};
 
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn trace_avx512(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
-        trace(ch, bin_mm, first, count, tally)
+        trace::<GROUP_AVX512>(ch, bin_mm, first, count, tally)
     }
 
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn trace_avx2(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
-        trace(ch, bin_mm, first, count, tally)
+        trace::<GROUP_AVX2>(ch, bin_mm, first, count, tally)
     }
 }
 
-/// `LANES` f64 values, one per lane. Every operation is a fixed-length loop of one IEEE operation, which the
+/// `N` f64 values, one per lane of a group. Every operation is a fixed-length loop of one IEEE operation, which the
 /// compiler turns into packed instructions of the enabled width (a long fused loop body is not vectorised).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct V([f64; LANES]);
-/// `LANES` u32 values.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct W([u32; LANES]);
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct V<const N: usize>([f64; N]);
+/// `N` u32 values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct W<const N: usize>([u32; N]);
 /// A per-lane condition: all ones (true) or zero (false) in 64 bits, the form of a packed comparison's result, so
 /// that selects are bitwise on every instruction set.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct M([u64; LANES]);
+struct M<const N: usize>([u64; N]);
 
 /// The mask lane of a condition.
 #[inline(always)]
@@ -254,9 +280,9 @@ fn mask(b: bool) -> u64 {
 }
 
 macro_rules! lanewise {
-    ($out:ident, |$($a:ident),*| $e:expr) => {{
-        let mut r = $out::default();
-        for i in 0..LANES {
+    ($out:ty, |$($a:ident),*| $e:expr) => {{
+        let mut r = <$out>::default();
+        for i in 0..r.0.len() {
             $(let $a = $a.0[i];)*
             r.0[i] = $e;
         }
@@ -264,75 +290,87 @@ macro_rules! lanewise {
     }};
 }
 
-impl Default for M {
+impl<const N: usize> Default for V<N> {
     fn default() -> Self {
-        M([0; LANES])
+        V([0.0; N])
     }
 }
 
-impl V {
+impl<const N: usize> Default for W<N> {
+    fn default() -> Self {
+        W([0; N])
+    }
+}
+
+impl<const N: usize> Default for M<N> {
+    fn default() -> Self {
+        M([0; N])
+    }
+}
+
+impl<const N: usize> V<N> {
     #[inline(always)]
-    fn splat(v: f64) -> V {
-        V([v; LANES])
+    fn splat(v: f64) -> V<N> {
+        V([v; N])
     }
     #[inline(always)]
-    fn lt(self, o: V) -> M {
+    fn lt(self, o: V<N>) -> M<N> {
         let a = self;
-        lanewise!(M, |a, o| mask(a < o))
+        lanewise!(M<N>, |a, o| mask(a < o))
     }
     #[inline(always)]
-    fn le(self, o: V) -> M {
+    fn le(self, o: V<N>) -> M<N> {
         let a = self;
-        lanewise!(M, |a, o| mask(a <= o))
+        lanewise!(M<N>, |a, o| mask(a <= o))
     }
     #[inline(always)]
-    fn eq(self, o: V) -> M {
+    fn eq(self, o: V<N>) -> M<N> {
         let a = self;
-        lanewise!(M, |a, o| mask(a == o))
+        lanewise!(M<N>, |a, o| mask(a == o))
     }
     #[inline(always)]
-    fn sqrt(self) -> V {
+    fn sqrt(self) -> V<N> {
         let a = self;
-        lanewise!(V, |a| a.sqrt())
+        lanewise!(V<N>, |a| a.sqrt())
     }
     /// max(v, 0) as a select (no NaN handling needed: the arguments are finite or discarded).
     #[inline(always)]
-    fn pos(self) -> V {
+    fn pos(self) -> V<N> {
         let a = self;
-        lanewise!(V, |a| if a > 0.0 { a } else { 0.0 })
+        lanewise!(V<N>, |a| if a > 0.0 { a } else { 0.0 })
     }
     #[inline(always)]
-    fn abs(self) -> V {
+    fn abs(self) -> V<N> {
         let a = self;
-        lanewise!(V, |a| a.abs())
+        lanewise!(V<N>, |a| a.abs())
     }
 }
 
-impl M {
+impl<const N: usize> M<N> {
     #[inline(always)]
-    fn select(self, a: V, b: V) -> V {
+    fn select(self, a: V<N>, b: V<N>) -> V<N> {
         let m = self;
-        lanewise!(V, |m, a, b| f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m)))
+        lanewise!(V<N>, |m, a, b| f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m)))
     }
     #[inline(always)]
-    fn select_w(self, a: W, b: W) -> W {
+    fn select_w(self, a: W<N>, b: W<N>) -> W<N> {
         let m = self;
-        lanewise!(W, |m, a, b| (a & m as u32) | (b & !(m as u32)))
+        lanewise!(W<N>, |m, a, b| (a & m as u32) | (b & !(m as u32)))
     }
     #[inline(always)]
-    fn and(self, o: M) -> M {
+    fn and(self, o: M<N>) -> M<N> {
         let a = self;
-        lanewise!(M, |a, o| a & o)
+        lanewise!(M<N>, |a, o| a & o)
     }
     #[inline(always)]
-    fn or(self, o: M) -> M {
+    fn or(self, o: M<N>) -> M<N> {
         let a = self;
-        lanewise!(M, |a, o| a | o)
+        lanewise!(M<N>, |a, o| a | o)
     }
     #[inline(always)]
-    fn not(self) -> M {
+    fn not(self) -> M<N> {
         let a = self;
-        lanewise!(M, |a| !a)
+        lanewise!(M<N>, |a| !a)
     }
     #[inline(always)]
     fn all(self) -> bool {
@@ -346,21 +384,21 @@ impl M {
 
 macro_rules! binop {
     ($tr:ident, $f:ident, $op:tt) => {
-        impl std::ops::$tr for V {
-            type Output = V;
+        impl<const N: usize> std::ops::$tr for V<N> {
+            type Output = V<N>;
             #[inline(always)]
-            fn $f(self, o: V) -> V {
+            fn $f(self, o: V<N>) -> V<N> {
                 let a = self;
-                lanewise!(V, |a, o| a $op o)
+                lanewise!(V<N>, |a, o| a $op o)
             }
         }
-        impl std::ops::$tr<f64> for V {
-            type Output = V;
+        impl<const N: usize> std::ops::$tr<f64> for V<N> {
+            type Output = V<N>;
             #[inline(always)]
-            fn $f(self, o: f64) -> V {
+            fn $f(self, o: f64) -> V<N> {
                 let a = self;
-                let o = V::splat(o);
-                lanewise!(V, |a, o| a $op o)
+                let o = V::<N>::splat(o);
+                lanewise!(V<N>, |a, o| a $op o)
             }
         }
     };
@@ -370,12 +408,12 @@ binop!(Sub, sub, -);
 binop!(Mul, mul, *);
 binop!(Div, div, /);
 
-impl std::ops::Neg for V {
-    type Output = V;
+impl<const N: usize> std::ops::Neg for V<N> {
+    type Output = V<N>;
     #[inline(always)]
-    fn neg(self) -> V {
+    fn neg(self) -> V<N> {
         let a = self;
-        lanewise!(V, |a| -a)
+        lanewise!(V<N>, |a| -a)
     }
 }
 
@@ -399,10 +437,10 @@ const LG: [f64; 7] = [
 /// −ln x for normal x in (0, 1] per lane, branch-free (fdlibm's `__ieee754_log`: x = 2ᵏ·(1 + f) with 1 + f in
 /// `[√2/2, √2)`, ln(1 + f) = f − (f²/2 − s·(f²/2 + R(s²))), s = f/(2 + f); within an ulp or two).
 #[inline(always)]
-fn neg_ln(x: V) -> V {
+fn neg_ln<const N: usize>(x: V<N>) -> V<N> {
     let mut y = V::default();
     let mut dk = V::default();
-    for i in 0..LANES {
+    for i in 0..N {
         let bits = x.0[i].to_bits();
         let hx = (bits >> 32) as u32;
         let hm = hx & 0x000f_ffff;
@@ -429,8 +467,8 @@ use {COS_TAYLOR as COS, SIN_TAYLOR as SIN};
 /// polynomials and selects (no table, no branch): cos(π/4 + θ) = (cos θ − sin θ)/√2,
 /// sin(π/4 + θ) = (cos θ + sin θ)/√2, then q quarter turns.
 #[inline(always)]
-fn azimuth_cos_sin(word: W) -> (V, V) {
-    let low = lanewise!(V, |word| f64::from((word & 0x3fff_ffff) as i32));
+fn azimuth_cos_sin<const N: usize>(word: W<N>) -> (V<N>, V<N>) {
+    let low = lanewise!(V<N>, |word| f64::from((word & 0x3fff_ffff) as i32));
     let t = ((low + 0.5) * (1.0 / 1_073_741_824.0) - 0.5) * std::f64::consts::FRAC_PI_2;
     let z = t * t;
     let mut ps = V::splat(SIN[7]);
@@ -446,16 +484,16 @@ fn azimuth_cos_sin(word: W) -> (V, V) {
     let c = (cos_t - sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     let s = (cos_t + sin_t) * std::f64::consts::FRAC_1_SQRT_2;
     // Quarter turns: q = 1: (−s, c); q = 2: (−c, −s); q = 3: (s, −c).
-    let odd = lanewise!(M, |word| mask(word & 0x4000_0000 != 0));
-    let half = lanewise!(M, |word| mask(word & 0x8000_0000 != 0));
+    let odd = lanewise!(M<N>, |word| mask(word & 0x4000_0000 != 0));
+    let half = lanewise!(M<N>, |word| mask(word & 0x8000_0000 != 0));
     let (c1, s1) = (odd.select(-s, c), odd.select(c, s));
     (half.select(-c1, c1), half.select(-s1, s1))
 }
 
 /// Per lane a uniform in (0, 1] on the grid k/2³² (k = 1..=2³²) from a word, by an exact signed conversion.
 #[inline(always)]
-fn unit(word: W) -> V {
-    lanewise!(V, |word| (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0))
+fn unit<const N: usize>(word: W<N>) -> V<N> {
+    lanewise!(V<N>, |word| (f64::from((word ^ 0x8000_0000) as i32) + 2_147_483_649.0) * (1.0 / 4_294_967_296.0))
 }
 
 /// The ten round keys of Philox4x32-10 under `seed` (the key bumped by the Weyl constants between rounds).
@@ -471,31 +509,25 @@ fn round_keys(seed: u64) -> [[u32; 2]; 10] {
     keys
 }
 
-/// Philox4x32-10 of the counters `c` per lane under the round keys `keys` (Salmon et al., SC'11). Each
-/// 32×32 → 64-bit product is formed by 16-bit schoolbook multiplication (a = a₁·2¹⁶ + a₀, m = m₁·2¹⁶ + m₀: four
-/// 16×16 → 32-bit products and their carries) in 32-bit lanes, which the compiler turns into packed 16-bit
-/// multiplies (`pmullw`/`pmulhuw`) on every path: with the words carried in 64-bit lanes instead, the portable
-/// path (SSE2) multiplied them one lane at a time, which took most of its time. Exact integer arithmetic, so the
-/// same words on every path.
+/// Philox4x32-10 of the counters `c` per lane under the round keys `keys` (Salmon et al., SC'11): per round the
+/// 32×32 → 64-bit products M0·c₀ and M1·c₂ split into high and low words. Written as products of zero-extended
+/// words, at the paths' group widths the compiler forms them with packed 32×32 → 64 multiplies (SSE2 `pmuludq`,
+/// AVX2/AVX-512F `vpmuludq`; seen in the disassembly). Over the whole 32 lanes at SSE2's width it multiplied one
+/// lane at a time, hence the 16-bit schoolbook products the kernel used before its groups; in groups of 4 those
+/// are the slower form (the portable path took 1.5× the CPU time with them). Exact integer arithmetic, so the same
+/// words on every path.
 #[inline(always)]
-fn block(c: [W; 4], keys: &[[u32; 2]; 10]) -> [W; 4] {
-    #[inline(always)]
-    fn mul_hi_lo(a: u32, m: u32) -> (u32, u32) {
-        let (a0, a1, m0, m1) = (a & 0xffff, a >> 16, m & 0xffff, m >> 16);
-        let (t00, t10, t01, t11) = (a0 * m0, a1 * m0, a0 * m1, a1 * m1);
-        let mid = (t00 >> 16) + (t10 & 0xffff) + (t01 & 0xffff);
-        (t11 + (t10 >> 16) + (t01 >> 16) + (mid >> 16), (mid << 16) | (t00 & 0xffff))
-    }
+fn block<const N: usize>(c: [W<N>; 4], keys: &[[u32; 2]; 10]) -> [W<N>; 4] {
     let [mut c0, mut c1, mut c2, mut c3] = c;
     for k in keys {
         let mut n = [W::default(); 4];
-        for i in 0..LANES {
-            let (h0, l0) = mul_hi_lo(c0.0[i], M0);
-            let (h1, l1) = mul_hi_lo(c2.0[i], M1);
-            n[0].0[i] = h1 ^ c1.0[i] ^ k[0];
-            n[1].0[i] = l1;
-            n[2].0[i] = h0 ^ c3.0[i] ^ k[1];
-            n[3].0[i] = l0;
+        for i in 0..N {
+            let p0 = u64::from(c0.0[i]) * u64::from(M0);
+            let p1 = u64::from(c2.0[i]) * u64::from(M1);
+            n[0].0[i] = (p1 >> 32) as u32 ^ c1.0[i] ^ k[0];
+            n[1].0[i] = p1 as u32;
+            n[2].0[i] = (p0 >> 32) as u32 ^ c3.0[i] ^ k[1];
+            n[3].0[i] = p0 as u32;
         }
         [c0, c1, c2, c3] = n;
     }
@@ -523,39 +555,37 @@ struct LayerConsts {
 
 /// Structure-of-arrays state of the lanes.
 #[derive(Clone, Debug, Default)]
-struct Lanes {
-    x: V,
-    y: V,
-    z: V,
-    ux: V,
-    uy: V,
-    uz: V,
-    w: V,
+struct Lanes<const N: usize> {
+    x: V<N>,
+    y: V<N>,
+    z: V<N>,
+    ux: V<N>,
+    uy: V<N>,
+    uz: V<N>,
+    w: V<N>,
     /// Optical depth left of the current step (0: draw a new one).
-    s: V,
-    z_top: V,
-    z_bottom: V,
-    sigma_t: V,
-    inv_sigma_t: V,
-    absorb: V,
-    isotropic: M,
-    hg: [V; 5],
-    ratio_above: V,
-    ratio_below: V,
-    top: M,
-    bottom: M,
-    photon_lo: W,
-    photon_hi: W,
-    event: W,
+    s: V<N>,
+    z_top: V<N>,
+    z_bottom: V<N>,
+    sigma_t: V<N>,
+    inv_sigma_t: V<N>,
+    absorb: V<N>,
+    isotropic: M<N>,
+    hg: [V<N>; 5],
+    ratio_above: V<N>,
+    ratio_below: V<N>,
+    top: M<N>,
+    bottom: M<N>,
+    photon_lo: W<N>,
+    photon_hi: W<N>,
+    event: W<N>,
     /// Whether the lane traces a photon of the chunk (false once the chunk has none left for it).
-    live: M,
+    live: M<N>,
     /// Per lane: weight absorbed in this step (0 elsewhere), the outcome code (`END_*`, 0 = continues) and 1 where
     /// a live packet interacted.
-    dw: V,
-    code: W,
-    interacted: W,
-    /// 1 − Rsp.
-    start_weight: f64,
+    dw: V<N>,
+    code: W<N>,
+    interacted: W<N>,
 }
 
 const END_TOP: u32 = 1;
@@ -564,7 +594,7 @@ const END_ROULETTE: u32 = 3;
 const END_GLIDE: u32 = 4;
 const CROSSED: u32 = 5;
 
-impl Lanes {
+impl<const N: usize> Lanes<N> {
     fn load_layer(&mut self, i: usize, m: &LayerConsts) {
         self.z_top.0[i] = m.z_top;
         self.z_bottom.0[i] = m.z_bottom;
@@ -582,15 +612,15 @@ impl Lanes {
     }
 
     /// Lane `i` starts photon `k` (or, with `live` false, a placeholder whose tallies are masked out) with weight
-    /// `start_weight`; its layer constants are the caller's (those of the first layer).
-    fn launch(&mut self, i: usize, k: u64, live: bool) {
+    /// `start_weight` (1 − Rsp); its layer constants are the caller's (those of the first layer).
+    fn launch(&mut self, i: usize, k: u64, live: bool, start_weight: f64) {
         self.x.0[i] = 0.0;
         self.y.0[i] = 0.0;
         self.z.0[i] = 0.0;
         self.ux.0[i] = 0.0;
         self.uy.0[i] = 0.0;
         self.uz.0[i] = 1.0;
-        self.w.0[i] = self.start_weight;
+        self.w.0[i] = start_weight;
         self.s.0[i] = 0.0;
         self.photon_lo.0[i] = k as u32;
         self.photon_hi.0[i] = (k >> 32) as u32;
@@ -601,9 +631,9 @@ impl Lanes {
     /// One event of every lane (module docs). Writes `dw`, `code` and `interacted`; no branch on lane data.
     #[inline(always)]
     fn step(&mut self, channel: u32, keys: &[[u32; 2]; 10]) {
-        let [r0, r1, r2, r3] = block([self.photon_lo, self.photon_hi, W([channel; LANES]), self.event], keys);
+        let [r0, r1, r2, r3] = block([self.photon_lo, self.photon_hi, W([channel; N]), self.event], keys);
         let event = self.event;
-        self.event = lanewise!(W, |event| event.wrapping_add(1));
+        self.event = lanewise!(W<N>, |event| event.wrapping_add(1));
         let xi1 = unit(r1);
         let zero = V::splat(0.0);
 
@@ -647,7 +677,7 @@ impl Lanes {
 
         // Face (only when some lane is at one): Fresnel reflection or refraction into the neighbour.
         let at_face = interact.not();
-        let splat = |v: u32| W([v; LANES]);
+        let splat = |v: u32| W([v; N]);
         let (d, fx, fy, fz, s_face, face_code) = if at_face.any() {
             let d_face = (face_z - z) / uz;
             let glide = interact.or(d_face.abs().lt(V::splat(f64::INFINITY))).not();
@@ -691,22 +721,23 @@ impl Lanes {
         self.s = interact.select(zero, s_face);
         let live = self.live;
         self.dw = interact.and(live).select(dw, zero);
-        self.interacted = lanewise!(W, |interact, live| (interact & live) as u32 & 1);
+        self.interacted = lanewise!(W<N>, |interact, live| (interact & live) as u32 & 1);
         self.code = interact.select_w(lost.select_w(splat(END_ROULETTE), splat(0)), face_code);
     }
 }
 
-impl M {
+impl<const N: usize> M<N> {
     #[inline(always)]
-    fn select_m(self, a: M, b: M) -> M {
+    fn select_m(self, a: M<N>, b: M<N>) -> M<N> {
         let m = self;
-        lanewise!(M, |m, a, b| (a & m) | (b & !m))
+        lanewise!(M<N>, |m, a, b| (a & m) | (b & !m))
     }
 }
 
 /// The lane engine over one chunk (module docs); compiled into each [`Path`]'s target-feature function.
 #[inline(always)]
-fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
+fn trace<const G: usize>(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tally) {
+    const { assert!(G > 0 && LANES.is_multiple_of(G), "a group width divides LANES") };
     let media = ch.media;
     let last = media.len() - 1;
     let consts: Vec<LayerConsts> = media
@@ -731,11 +762,13 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
     let bins = tally.r.len();
     let end = first + count;
     let mut next = first;
-    let mut lanes = Lanes { start_weight: ch.start_weight, ..Lanes::default() };
+    // Lane i is lane i % G of group i / G (crate docs: the grouping changes no lane's arithmetic).
+    let mut groups = vec![Lanes::<G>::default(); LANES / G];
     let mut layer = [0usize; LANES];
     for i in 0..LANES {
-        lanes.load_layer(i, &consts[0]);
-        lanes.launch(i, next, next < end);
+        let lanes = &mut groups[i / G];
+        lanes.load_layer(i % G, &consts[0]);
+        lanes.launch(i % G, next, next < end, ch.start_weight);
         next = (next + 1).min(end);
     }
     // Exit weights (R then T, module docs of the loop below) and the totals Rd, Td.
@@ -745,34 +778,30 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
     let mut absorbed = vec![[0.0f64; LANES]; media.len()];
     let mut live_count = LANES.min(count as usize);
     while live_count > 0 {
-        lanes.step(ch.index, &keys);
-        if media.len() == 1 {
-            for (a, dw) in absorbed[0].iter_mut().zip(&lanes.dw.0) {
-                *a += dw;
-            }
-        } else {
-            for (j, acc) in absorbed.iter_mut().enumerate() {
-                for i in 0..LANES {
-                    acc[i] += if layer[i] == j { lanes.dw.0[i] } else { 0.0 };
-                }
-            }
-        }
         let mut interactions = 0u32;
         let mut special = 0u32;
-        for i in 0..LANES {
-            interactions += lanes.interacted.0[i];
-            special |= u32::from(lanes.code.0[i] != 0) << i;
+        for (g, lanes) in groups.iter_mut().enumerate() {
+            lanes.step(ch.index, &keys);
+            for (j, &dw) in lanes.dw.0.iter().enumerate() {
+                let i = g * G + j;
+                absorbed[layer[i]][i] += dw;
+            }
+            for (j, (&n, &code)) in lanes.interacted.0.iter().zip(&lanes.code.0).enumerate() {
+                interactions += n;
+                special |= u32::from(code != 0) << (g * G + j);
+            }
         }
         tally.interactions += u64::from(interactions);
         while special != 0 {
             let i = special.trailing_zeros() as usize;
             special &= special - 1;
-            let live = lanes.live.0[i] != 0;
-            let w = lanes.w.0[i];
-            let code = lanes.code.0[i];
+            let (lanes, j) = (&mut groups[i / G], i % G);
+            let live = lanes.live.0[j] != 0;
+            let w = lanes.w.0[j];
+            let code = lanes.code.0[j];
             if code == CROSSED {
-                layer[i] = if lanes.uz.0[i] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
-                lanes.load_layer(i, &consts[layer[i]]);
+                layer[i] = if lanes.uz.0[j] > 0.0 { layer[i] + 1 } else { layer[i] - 1 };
+                lanes.load_layer(j, &consts[layer[i]]);
                 continue;
             }
             if code == END_GLIDE && live {
@@ -780,7 +809,7 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
             }
             // Exits (and, adding zero, roulette losses and placeholders) scored without a branch: R bins at
             // 0..bins, T bins at bins + 1.., each followed by an overflow slot for radii beyond the last bin.
-            let (x, y) = (lanes.x.0[i], lanes.y.0[i]);
+            let (x, y) = (lanes.x.0[j], lanes.y.0[j]);
             let bin = (((x * x + y * y).sqrt() * inv_bin) as usize).min(bins);
             let w_exit = if live && code <= END_BOTTOM { w } else { 0.0 };
             let bottom = code == END_BOTTOM;
@@ -794,9 +823,9 @@ fn trace(ch: &Channel<'_>, bin_mm: f64, first: u64, count: u64, tally: &mut Tall
             }
             if layer[i] != 0 {
                 layer[i] = 0;
-                lanes.load_layer(i, &consts[0]);
+                lanes.load_layer(j, &consts[0]);
             }
-            lanes.launch(i, next, more);
+            lanes.launch(j, next, more, ch.start_weight);
             next += u64::from(more);
         }
     }
@@ -844,7 +873,7 @@ mod tests {
     }
 
     /// Words spread over the whole u32 range, `LANES` at a time.
-    fn words(j: u64) -> W {
+    fn words(j: u64) -> W<LANES> {
         let mut w = W::default();
         for (i, v) in w.0.iter_mut().enumerate() {
             let n = j * LANES as u64 + i as u64;
@@ -910,10 +939,87 @@ mod tests {
             let expected = philox4x32_10(c, [seed as u32, (seed >> 32) as u32]);
             assert_eq!(got.map(|w| w.0[i]), expected, "lane {i}");
         }
-        let w = W(std::array::from_fn(|i| [0, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX, 3, 4, 5][i % 8]));
+        let w: W<LANES> = W(std::array::from_fn(|i| [0, 1, 0x7fff_ffff, 0x8000_0000, u32::MAX, 3, 4, 5][i % 8]));
         let u = unit(w);
         for i in 0..LANES {
             assert_eq!(u.0[i], (f64::from(w.0[i]) + 1.0) / 4_294_967_296.0);
+        }
+    }
+
+    /// A layer of the test stacks: thickness (mm, `inf` for a semi-infinite one), η, σa, σs′ (mm⁻¹), HG g.
+    fn medium(z_top_mm: f64, thickness_mm: f64, eta: f64, sigma_a: f64, sigma_s_prime: f64, g: f64) -> Medium {
+        let sigma_t = sigma_a + sigma_s_prime / (1.0 - g);
+        Medium {
+            z_top_mm,
+            z_bottom_mm: z_top_mm + thickness_mm,
+            sigma_t_per_mm: sigma_t,
+            inv_sigma_t_mm: if sigma_t > 0.0 { 1.0 / sigma_t } else { 0.0 },
+            absorb_fraction: if sigma_t > 0.0 { sigma_a / sigma_t } else { 0.0 },
+            isotropic: g.abs() < 1e-6,
+            hg: [1.0 - g * g, 1.0 - g, 2.0 * g, 1.0 + g * g, 0.5 / g],
+            eta,
+        }
+    }
+
+    /// Every branch of the step: a clear top layer (packets cross it without interacting, reflect at its faces and
+    /// cross into the next layer), a forward-scattering layer (g 0.8), an isotropic slab over a mismatched boundary
+    /// (transmission, T(r)).
+    fn three_layers() -> Vec<Medium> {
+        vec![
+            medium(0.0, 0.1, 1.45, 0.0, 0.0, 0.0),
+            medium(0.1, 0.3, 1.4, 1.2, 4.0, 0.8),
+            medium(0.4, 0.6, 1.33, 0.2, 2.0, 0.0),
+        ]
+    }
+
+    /// Photons `0..photons` of channel 1 under seed 7 in chunks of 1000 (the last one partial, so lanes idle at
+    /// its end), summed chunk by chunk as `rtbake::transport::mc` does.
+    fn run(media: &[Medium], photons: u64, chunk: impl Fn(&Channel<'_>, u64, u64, &mut Tally)) -> Tally {
+        let ch = Channel { media, eta_above: 1.0, eta_below: 1.0, start_weight: 0.966, index: 1, seed: 7 };
+        let mut tally = Tally::new(40, media.len());
+        for first in (0..photons).step_by(1000) {
+            let mut t = Tally::new(40, media.len());
+            chunk(&ch, first, 1000.min(photons - first), &mut t);
+            tally.add(&t);
+        }
+        tally
+    }
+
+    /// FNV-1a over the bits of every tally (the checksum `examples/lane_paths` prints).
+    fn checksum(t: &Tally) -> u64 {
+        let words = t.r.iter().chain(&t.t).chain(&t.absorbed).chain([&t.rd, &t.td]).map(|v| v.to_bits());
+        words.chain([t.interactions]).fold(0xcbf2_9ce4_8422_2325, |h, w| (h ^ w).wrapping_mul(0x0000_0100_0000_01b3))
+    }
+
+    /// Every group width gives the same tallies, bit for bit, on every branch of the step: the grouping changes
+    /// which instructions run, not any lane's arithmetic or the order of the sums (crate docs, "Groups").
+    #[test]
+    fn every_group_width_gives_the_same_bytes() {
+        let media = three_layers();
+        let whole = run(&media, 2500, |ch, first, n, t| trace::<32>(ch, 0.05, first, n, t));
+        assert!(whole.rd > 0.0 && whole.td > 0.0 && whole.absorbed[1] > 0.0 && whole.absorbed[2] > 0.0, "{whole:?}");
+        assert_eq!(run(&media, 2500, |ch, first, n, t| trace::<16>(ch, 0.05, first, n, t)), whole, "16");
+        assert_eq!(run(&media, 2500, |ch, first, n, t| trace::<8>(ch, 0.05, first, n, t)), whole, "8");
+        assert_eq!(run(&media, 2500, |ch, first, n, t| trace::<4>(ch, 0.05, first, n, t)), whole, "4");
+        assert_eq!(run(&media, 2500, |ch, first, n, t| trace::<2>(ch, 0.05, first, n, t)), whole, "2");
+        assert_eq!(run(&media, 2500, |ch, first, n, t| trace::<1>(ch, 0.05, first, n, t)), whole, "1");
+    }
+
+    /// FNV-1a checksums of [`three_layers`] and of a semi-infinite isotropic layer (η 1.3, σa 0.1, σs′ 1.0),
+    /// 2500 photons each, from the kernel of commit 56f3260 (all three paths agreed).
+    const GOLDEN_THREE_LAYERS: u64 = 0x906e_47c1_e619_f557;
+    const GOLDEN_SEMI_INFINITE: u64 = 0x6bbc_1894_6efc_e27e;
+
+    /// Every path this CPU supports gives the tallies of the 32-lane kernel before the paths were grouped
+    /// (commit 56f3260, whose `trace_chunk` printed these checksums for the same runs on its AVX-512F, AVX2 and
+    /// portable paths): grouping and the Philox products' new form changed no byte.
+    #[test]
+    fn every_path_gives_the_bytes_of_the_ungrouped_kernel() {
+        let single = [medium(0.0, f64::INFINITY, 1.3, 0.1, 1.0, 0.0)];
+        for path in [Path::Avx512, Path::Avx2, Path::Portable].into_iter().filter(|p| p.supported()) {
+            let trace = |ch: &Channel<'_>, first, n, t: &mut Tally| trace_chunk(path, ch, 0.05, first, n, t);
+            assert_eq!(checksum(&run(&three_layers(), 2500, trace)), GOLDEN_THREE_LAYERS, "{path:?}");
+            assert_eq!(checksum(&run(&single, 2500, trace)), GOLDEN_SEMI_INFINITE, "{path:?}");
         }
     }
 }
