@@ -58,3 +58,46 @@ fn the_copy_bandwidth_the_bounds_divide_by_is_measured() {
     assert!(!c.by_timestamps || g.timestamps);
     assert!(c.describe().contains("GB/s"), "{}", c.describe());
 }
+
+/// The shading of a `run skin` frame on a device is recorded into one command encoder (skin inputs, lit layer,
+/// SSS, composite, bloom, tone map) and read back once, whatever the shader and with or without bloom: a frame
+/// makes one submission and one read-back for its G-buffer, one for the back light's shadow map, one for the rig
+/// at the mesh's uv (the committed bake has the rig) and one for all of its shading. The frame agrees with the
+/// CPU twin as the per-pass frame did (within 2/255 on 99 % of the channels).
+#[test]
+fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_frame() {
+    use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    assert!(assets.baked_rig.is_some(), "the committed bake has the example rig");
+    let head = default_head();
+    let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered];
+    for shader in shaders {
+        for passes in [SkinPasses::default(), SkinPasses::none()] {
+            let s = SkinRenderSettings {
+                shader,
+                heads: 1,
+                distance_m: 0.6,
+                width: 160,
+                height: 96,
+                melanin: 0.02,
+                stretch: StretchPreset::Tap2009,
+            };
+            // The first frame builds the pipelines; count the second.
+            render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+            let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
+            let frame = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+            let (sub, read) = (submissions_on_this_thread() - sub, read_backs_on_this_thread() - read);
+            let bloom = passes.bloom.is_some();
+            // G-buffer, shadow map, rig at uv, shading.
+            assert_eq!((sub, read), (4, 4), "{shader:?} bloom {bloom}: {sub} submissions, {read} read-backs");
+            let cpu = render_with(None, &head, &s, &passes, &assets).unwrap();
+            let close = frame.data.iter().zip(&cpu.data).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+            assert!(
+                close as f64 >= 0.99 * frame.data.len() as f64,
+                "{shader:?} bloom {bloom}: {close} of {} channels within 2/255 of the CPU twin",
+                frame.data.len()
+            );
+        }
+    }
+}

@@ -178,7 +178,7 @@ pub fn hemoglobin_at_uv(
             Buffer::Data(bytemuck::cast_slice(&maps.h0.data)),
             Buffer::Zeroed(4 * n as u64),
         ],
-        &[Stage { entry: "main", groups: compute_chain::groups_8x8(width, height) }],
+        &[Stage::new("main", compute_chain::groups_8x8(width, height))],
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())

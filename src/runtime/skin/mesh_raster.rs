@@ -84,6 +84,14 @@ pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
     Ok(())
 }
 
+/// Checks what both rasterisers take besides the mesh: one tangent per vertex, 1 or 4 samples per pixel.
+pub(crate) fn check_raster_inputs(mesh: &Mesh, tangents: &[[f32; 4]], samples: u32) -> Result<(), InvalidInput> {
+    if tangents.len() != mesh.positions.len() {
+        return Err(InvalidInput::new("tangents", "need one tangent per vertex of the mesh"));
+    }
+    check_samples(samples)
+}
+
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
 pub fn rasterise(
     device: &wgpu::Device,
@@ -123,10 +131,7 @@ pub fn rasterise_with_tangents(
     height: u32,
     samples: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
-    if tangents.len() != mesh.positions.len() {
-        return Err(InvalidInput::new("tangents", "need one tangent per vertex of the mesh").into());
-    }
-    check_samples(samples)?;
+    check_raster_inputs(mesh, tangents, samples)?;
     if samples > 1 {
         use wgpu::TextureFormatFeatureFlags as Fl;
         for f in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Depth32Float] {
@@ -295,9 +300,13 @@ pub fn rasterise_with_tangents(
         pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..mesh.indices.len() as u32, 0, 0..1);
     }
-    queue.submit([enc.finish()]);
-    let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
-    let c = gpu::read_texture_f16(device, queue, &g2)?;
+    // One submission, the three targets read back with one wait.
+    let [a, b, c]: [Vec<f32>; 3] = gpu::read_textures(device, queue, enc, &[&g0, &g1, &g2])?
+        .iter()
+        .map(|t| gpu::f16_to_f32(t))
+        .collect::<Vec<_>>()
+        .try_into()
+        .expect("three targets");
     let mut g = MeshGBuffer::empty(width, height);
     if samples > 1 {
         resolve_coverage(&mut g, &a, &b, &c);
