@@ -61,8 +61,8 @@ fn the_copy_bandwidth_the_bounds_divide_by_is_measured() {
 
 /// The shading of a `run skin` frame on a device is recorded into one command encoder (skin inputs, lit layer,
 /// SSS, composite, bloom, tone map) and read back once, whatever the shader and with or without bloom: a frame
-/// makes one submission and one read-back for its G-buffer, one for the back light's shadow map, one for the rig
-/// at the mesh's uv (the committed bake has the rig) and one for all of its shading. The frame agrees with the
+/// makes one submission and one read-back for its G-buffer and the back light's shadow map together, one for the
+/// rig at the mesh's uv (the committed bake has the rig) and one for all of its shading. The frame agrees with the
 /// CPU twin as the per-pass frame did (within 2/255 on 99 % of the channels).
 #[test]
 fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_frame() {
@@ -89,8 +89,8 @@ fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_f
             let frame = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
             let (sub, read) = (submissions_on_this_thread() - sub, read_backs_on_this_thread() - read);
             let bloom = passes.bloom.is_some();
-            // G-buffer, shadow map, rig at uv, shading.
-            assert_eq!((sub, read), (4, 4), "{shader:?} bloom {bloom}: {sub} submissions, {read} read-backs");
+            // G-buffer and shadow map, rig at uv, shading.
+            assert_eq!((sub, read), (3, 3), "{shader:?} bloom {bloom}: {sub} submissions, {read} read-backs");
             let cpu = render_with(None, &head, &s, &passes, &assets).unwrap();
             let close = frame.data.iter().zip(&cpu.data).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
             assert!(
