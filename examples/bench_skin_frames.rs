@@ -6,13 +6,18 @@
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 5
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures. Each frame includes
-//! what `run skin` does per frame today (uploads, host read-backs between the stages, the final read-back). Tables
-//! come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
+//! what `run skin` does per frame (uploads, the G-buffer read-back the host's geometry needs, the final read-back);
+//! the last two columns count the queue submissions and host read-backs of a steady-state frame
+//! (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`). `scripts/bench_skin_frames.sh` runs
+//! this binary built from the tree before (each pass submitted and read back on its own) and after, in one run.
+//! Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
 
 use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::create_headless;
-use rtbake::runtime::gpu::{pipelines_created_on_this_thread, set_object_cache_enabled};
+use rtbake::runtime::gpu::{
+    pipelines_created_on_this_thread, read_backs_on_this_thread, set_object_cache_enabled, submissions_on_this_thread,
+};
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, TsSettings};
 use std::path::PathBuf;
@@ -42,8 +47,17 @@ fn main() {
         head.triangle_count()
     );
     println!(
-        "{:<12} {:>14} {:>14} {:>10} {:>14} {:>14} {:>10} {:>9}",
-        "shader", "uncached 1st", "uncached 2..N", "pipes/fr", "cached 1st", "cached 2..N", "pipes 2..N", "speed-up"
+        "{:<12} {:>14} {:>14} {:>10} {:>14} {:>14} {:>10} {:>9} {:>8} {:>8}",
+        "shader",
+        "uncached 1st",
+        "uncached 2..N",
+        "pipes/fr",
+        "cached 1st",
+        "cached 2..N",
+        "pipes 2..N",
+        "speed-up",
+        "submits",
+        "reads"
     );
     for (name, shader) in [
         ("none", SkinShader::None),
@@ -66,19 +80,22 @@ fn main() {
             set_object_cache_enabled(cached);
             let mut times = Vec::new();
             let mut pipes = Vec::new();
+            let mut counts = (0, 0);
             for _ in 0..frames {
                 let (t, p) = (Instant::now(), pipelines_created_on_this_thread());
+                let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
                 render_with(Some(&g), &head, &s, &passes, &assets).expect("render");
                 times.push(t.elapsed().as_secs_f64() * 1e3);
                 pipes.push(pipelines_created_on_this_thread() - p);
+                counts = (submissions_on_this_thread() - sub, read_backs_on_this_thread() - read);
             }
             eprintln!("  {name} ({}): {times:.0?} ms", if cached { "cached" } else { "uncached" });
-            (times[0], median(times[1..].to_vec()), pipes[1..].iter().sum::<u64>())
+            (times[0], median(times[1..].to_vec()), pipes[1..].iter().sum::<u64>(), counts)
         };
-        let (u1, us, up) = run(false);
-        let (c1, cs, cp) = run(true);
+        let (u1, us, up, _) = run(false);
+        let (c1, cs, cp, (subs, reads)) = run(true);
         println!(
-            "{name:<12} {u1:>14.1} {us:>14.1} {:>10.1} {c1:>14.1} {cs:>14.1} {cp:>10} {:>8.2}x",
+            "{name:<12} {u1:>14.1} {us:>14.1} {:>10.1} {c1:>14.1} {cs:>14.1} {cp:>10} {:>8.2}x {subs:>8} {reads:>8}",
             up as f64 / (frames - 1) as f64,
             us / cs
         );

@@ -2,7 +2,8 @@
 # `run skin` frames before and after, in one run on one adapter: builds examples/bench_skin_frames at BASE (default:
 # the merge-base with main, the runtime before this branch) from a `git archive` copy and at HEAD, runs both binaries
 # back to back and prints, per shader, frame 1 and the median of frames 2..N (the "cached" columns: the runtime's
-# per-device caches on, as `run skin` runs) before and after and the speed-ups.
+# per-device caches on, as `run skin` runs) before and after and the speed-ups, and the queue submissions and host
+# read-backs of a steady-state frame after (the before binary may predate the counters).
 #   scripts/bench_skin_frames.sh [WIDTH HEIGHT FRAMES]        (default 1280 720 5; PROFILE=debug for a quick run)
 #   BASE=<commit> scripts/bench_skin_frames.sh ...
 # The adapter is the one wgpu picks (WGPU_ADAPTER_NAME / WGPU_BACKEND to choose); both binaries print it.
@@ -35,5 +36,6 @@ for s in none ss-jittered ss-full separable ts; do
     b=$(awk -v s="$s" '$1 == s { print $5, $6 }' "$dir/before.txt")
     a=$(awk -v s="$s" '$1 == s { print $5, $6 }' "$dir/after.txt")
     [ -n "$b" ] && [ -n "$a" ] || continue
-    echo "$s $b $a" | awk '{ printf "%-12s %12.1f %12.1f %7.2fx %12.1f %12.1f %7.2fx\n", $1, $2, $4, $2 / $4, $3, $5, $3 / $5 }'
+    c=$(awk -v s="$s" '$1 == s && NF >= 10 { print $9, $10 }' "$dir/after.txt")
+    echo "$s $b $a ${c:-- -}" | awk '{ printf "%-12s %12.1f %12.1f %7.2fx %12.1f %12.1f %7.2fx   after: %s submissions, %s read-backs per frame\n", $1, $2, $4, $2 / $4, $3, $5, $3 / $5, $6, $7 }'
 done
