@@ -32,6 +32,21 @@ impl<'a> Stage<'a> {
     }
 }
 
+/// The uniform block of a per-pixel chain that reads baked maps: the frame's and a map's size, a second map's
+/// size or counts, and eight weights (the rig at uv, the wrinkle pass; each module names the fields).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct MapParams {
+    pub size: [f32; 4],
+    pub cfg: [f32; 4],
+    pub weights: [[f32; 4]; 2],
+}
+
+/// Bytes of a per-pixel buffer of one vec4 of f32 over a `width`×`height` frame.
+pub(crate) fn vec4_per_pixel_bytes(width: u32, height: u32) -> u64 {
+    16 * width as u64 * height as u64
+}
+
 /// Workgroups of 8×8 covering a `w`×`h` image.
 pub(crate) fn groups_8x8(w: u32, h: u32) -> [u32; 3] {
     [w.div_ceil(8), h.div_ceil(8), 1]

@@ -9,6 +9,11 @@ use rtbake::runtime::gpu::{cached_objects, pipelines_created_on_this_thread};
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset, TsSettings};
 
+/// One head at 0.6 m in a 160×96 frame.
+fn small_frame(shader: SkinShader, stretch: StretchPreset) -> SkinRenderSettings {
+    SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width: 160, height: 96, melanin: 0.02, stretch }
+}
+
 #[test]
 fn no_pipeline_is_compiled_after_the_first_frame_of_each_shader() {
     let g = gpu();
@@ -20,15 +25,7 @@ fn no_pipeline_is_compiled_after_the_first_frame_of_each_shader() {
     // Bloom on: the compute chain (bloom) runs in every frame too.
     let passes = SkinPasses::default();
     for shader in shaders {
-        let s = SkinRenderSettings {
-            shader,
-            heads: 1,
-            distance_m: 0.6,
-            width: 160,
-            height: 96,
-            melanin: 0.02,
-            stretch: StretchPreset::Thesis,
-        };
+        let s = small_frame(shader, StretchPreset::Thesis);
         let before = pipelines_created_on_this_thread();
         let first = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
         let compiled_first = pipelines_created_on_this_thread() - before;
@@ -63,10 +60,11 @@ fn the_copy_bandwidth_the_bounds_divide_by_is_measured() {
 /// SSS, composite, bloom, tone map) and read back once, whatever the shader and with or without bloom: a frame
 /// makes one submission and one read-back for its G-buffer and the back light's shadow map together, one for the
 /// rig at the mesh's uv (the committed bake has the rig) and one for all of its shading. The frame agrees with the
-/// CPU twin as the per-pass frame did (within 2/255 on 99 % of the channels).
+/// CPU twin and with the per-pass GPU path (within 2/255 on 99 % of the channels), which makes more of both.
 #[test]
 fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_frame() {
     use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
+    use rtbake::runtime::skin::lighting::set_shading_in_one_encoder;
     let g = gpu();
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     assert!(assets.baked_rig.is_some(), "the committed bake has the example rig");
@@ -74,15 +72,7 @@ fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_f
     let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered];
     for shader in shaders {
         for passes in [SkinPasses::default(), SkinPasses::none()] {
-            let s = SkinRenderSettings {
-                shader,
-                heads: 1,
-                distance_m: 0.6,
-                width: 160,
-                height: 96,
-                melanin: 0.02,
-                stretch: StretchPreset::Tap2009,
-            };
+            let s = small_frame(shader, StretchPreset::Tap2009);
             // The first frame builds the pipelines; count the second.
             render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
             let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
@@ -91,13 +81,25 @@ fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_f
             let bloom = passes.bloom.is_some();
             // G-buffer and shadow map, rig at uv, shading.
             assert_eq!((sub, read), (3, 3), "{shader:?} bloom {bloom}: {sub} submissions, {read} read-backs");
+            // The per-pass path submits and reads back each pass on its own: the skin-inputs pass, the SSS pass and
+            // bloom, so as many as the one encoder only with neither SSS nor bloom.
+            set_shading_in_one_encoder(false);
+            let (sub_p, read_p) = (submissions_on_this_thread(), read_backs_on_this_thread());
+            let per_pass = render_with(Some(&g), &head, &s, &passes, &assets);
+            let (sub_p, read_p) = (submissions_on_this_thread() - sub_p, read_backs_on_this_thread() - read_p);
+            set_shading_in_one_encoder(true);
+            let per_pass = per_pass.unwrap();
+            let more = (shader != SkinShader::None) as u64 + bloom as u64;
+            assert_eq!((sub_p, read_p), (sub + more, read + more), "{shader:?} bloom {bloom}: per pass");
             let cpu = render_with(None, &head, &s, &passes, &assets).unwrap();
-            let close = frame.data.iter().zip(&cpu.data).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
-            assert!(
-                close as f64 >= 0.99 * frame.data.len() as f64,
-                "{shader:?} bloom {bloom}: {close} of {} channels within 2/255 of the CPU twin",
-                frame.data.len()
-            );
+            for (other, name) in [(&cpu, "the CPU twin"), (&per_pass, "the per-pass GPU frame")] {
+                let close = frame.data.iter().zip(&other.data).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+                assert!(
+                    close as f64 >= 0.99 * frame.data.len() as f64,
+                    "{shader:?} bloom {bloom}: {close} of {} channels within 2/255 of {name}",
+                    frame.data.len()
+                );
+            }
         }
     }
 }

@@ -119,7 +119,7 @@ pub fn storage_buffer_bytes(width: u32, height: u32, p: &BloomParams) -> [u64; 4
 /// The largest buffer [`bloom`] allocates for a `width`×`height` frame, bytes: the frame itself, 16 bytes per
 /// pixel (checked against the adapter's storage-binding limit before a frame is rendered).
 pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
-    16 * width as u64 * height as u64
+    compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
 /// The uniform block and the dispatches of bloom over a `width`×`height` frame with `p`.

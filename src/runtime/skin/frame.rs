@@ -249,7 +249,7 @@ pub fn render_with<'g>(
         SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
     let background = BACKGROUND.repeat((s.width * s.height) as usize);
-    let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
+    let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
     blend_coverage(&mut frame, &coverage);
     Ok(frame)
 }

@@ -155,7 +155,7 @@ impl<B: SssBlur> SssPass<B> {
         self.upload(queue, color, depth)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss") });
         self.encode(&mut enc, None);
-        gpu::submit(queue, enc.finish());
-        gpu::read_texture_f16(device, queue, &self.output)
+        // One submission: the read-back's copy joins the blur's encoder.
+        Ok(gpu::f16_to_f32(&gpu::read_textures(device, queue, enc, &[&self.output])?[0]))
     }
 }
