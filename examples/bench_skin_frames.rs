@@ -58,7 +58,14 @@ fn main() {
     );
     println!(
         "{:<12} {:>13} {:>13} {:>13} {:>13} {:>8} {:>13} {:>13}",
-        "shader", "1st per-pass", "1st one-enc", "2..N per-pass", "2..N one-enc", "ratio", "per-pass s/r", "one-enc s/r"
+        "shader",
+        "1st per-pass",
+        "1st one-enc",
+        "2..N per-pass",
+        "2..N one-enc",
+        "ratio",
+        "per-pass s/r",
+        "one-enc s/r"
     );
     for (name, shader) in [
         ("none", SkinShader::None),

@@ -73,14 +73,18 @@ pub(crate) fn check_buffers(device: &wgpu::Device, what: &str, sizes: &[u64]) ->
 }
 
 /// A storage buffer of at least `bytes` (rounded up to 16: bindings must not be empty and copies are 4-byte
-/// multiples), holding `data` at its start when given, zero elsewhere.
+/// multiples), holding `data` at its start when given, zero elsewhere (wgpu zeroes a buffer created unmapped, on
+/// the device: no host copy of zeros).
 pub(crate) fn storage_buffer(device: &wgpu::Device, what: &str, bytes: u64, data: Option<&[u8]>) -> wgpu::Buffer {
     let buf = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(what),
         size: bytes.div_ceil(16).max(1) * 16,
         usage: STORAGE_USAGE,
-        mapped_at_creation: true,
+        mapped_at_creation: data.is_some(),
     });
+    if data.is_none() {
+        return buf;
+    }
     if let Some(d) = data.filter(|d| !d.is_empty()) {
         let mut view = buf.slice(..d.len() as u64).get_mapped_range_mut().expect("mapped at creation");
         view.copy_from_slice(d);

@@ -260,7 +260,11 @@ pub fn padded_row_bytes(tex: &wgpu::Texture) -> u32 {
 }
 
 /// The layout of the whole of `tex` at `offset` bytes of a buffer, rows of [`padded_row_bytes`].
-fn padded_copy<'a>(tex: &'a wgpu::Texture, buffer: &'a wgpu::Buffer, offset: u64) -> [wgpu::TexelCopyBufferInfo<'a>; 1] {
+fn padded_copy<'a>(
+    tex: &'a wgpu::Texture,
+    buffer: &'a wgpu::Buffer,
+    offset: u64,
+) -> [wgpu::TexelCopyBufferInfo<'a>; 1] {
     let layout = wgpu::TexelCopyBufferLayout {
         offset,
         bytes_per_row: Some(padded_row_bytes(tex)),
@@ -280,14 +284,24 @@ fn whole(tex: &wgpu::Texture) -> (wgpu::TexelCopyTextureInfo<'_>, wgpu::Extent3d
 }
 
 /// Records a copy of the whole of `tex` into `buffer` at `offset` (rows of [`padded_row_bytes`]).
-pub fn encode_texture_to_buffer(enc: &mut wgpu::CommandEncoder, tex: &wgpu::Texture, buffer: &wgpu::Buffer, offset: u64) {
+pub fn encode_texture_to_buffer(
+    enc: &mut wgpu::CommandEncoder,
+    tex: &wgpu::Texture,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+) {
     let (info, size) = whole(tex);
     let [dst] = padded_copy(tex, buffer, offset);
     enc.copy_texture_to_buffer(info, dst, size);
 }
 
 /// Records a copy of `buffer` from `offset` (rows of [`padded_row_bytes`]) into the whole of `tex`.
-pub fn encode_buffer_to_texture(enc: &mut wgpu::CommandEncoder, buffer: &wgpu::Buffer, offset: u64, tex: &wgpu::Texture) {
+pub fn encode_buffer_to_texture(
+    enc: &mut wgpu::CommandEncoder,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    tex: &wgpu::Texture,
+) {
     let (info, size) = whole(tex);
     let [src] = padded_copy(tex, buffer, offset);
     enc.copy_buffer_to_texture(src, info, size);

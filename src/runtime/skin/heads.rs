@@ -178,7 +178,14 @@ pub(crate) fn geometry(
         |d| {
             let jobs = [
                 RasterJob { mesh: split, tangents, camera: &cam, width: w, height: h, samples: msaa },
-                RasterJob { mesh, tangents: &light_tangents, camera: &light, width: s_map, height: s_map, samples: one },
+                RasterJob {
+                    mesh,
+                    tangents: &light_tangents,
+                    camera: &light,
+                    width: s_map,
+                    height: s_map,
+                    samples: one,
+                },
             ];
             let mut maps = mesh_raster::rasterise_jobs(&d.device, &d.queue, &jobs)?;
             let shadow = maps.pop().expect("two G-buffers");

@@ -365,7 +365,10 @@ pub(crate) fn render_geometry(
 }
 
 /// The SSS pass of `method` with `assets`' tables (None: no SSS pass).
-fn subsurface_of(assets: &DemoAssets, method: Option<SssMethod>) -> Result<Option<chain::Subsurface<'_>>, InvalidInput> {
+fn subsurface_of(
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+) -> Result<Option<chain::Subsurface<'_>>, InvalidInput> {
     let Some(method) = method else { return Ok(None) };
     Ok(Some(match method {
         SssMethod::Separable => chain::Subsurface::Separable { kernel: &assets.kernel, params: &assets.sss },

@@ -169,7 +169,11 @@ pub fn rasterise_jobs(
 
 /// Records the G-buffer pass of `job` into `enc`; returns its three targets (normal + depth, uv + coverage,
 /// tangent; resolved when multisampled).
-fn record(device: &wgpu::Device, enc: &mut wgpu::CommandEncoder, job: &RasterJob<'_>) -> Result<[wgpu::Texture; 3], RuntimeError> {
+fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    job: &RasterJob<'_>,
+) -> Result<[wgpu::Texture; 3], RuntimeError> {
     let RasterJob { mesh, tangents, camera, width, height, samples } = *job;
     check_raster_inputs(mesh, tangents, samples)?;
     if samples > 1 {
