@@ -1,7 +1,7 @@
 //! Frames shaped like an engine's: `run skin`'s frame (default passes: bloom on) per shader on a device, its
 //! shading recorded into one command encoder with one read-back ("one encoder", the runtime's path) against each
 //! pass submitted and read back on its own ("per pass", the path before;
-//! `runtime::skin::lighting::set_shading_in_one_encoder(false)`), in one run on one adapter: the first frame of
+//! `runtime::skin::shade_frame::set_shading_in_one_encoder(false)`), in one run on one adapter: the first frame of
 //! each on a fresh device (shader modules and pipelines compiled), then frames of the two paths alternating on one
 //! device, and the median of frames 2..=N of each, their ratio and the queue submissions and host read-backs of a
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
@@ -17,7 +17,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, Gpu};
 use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
-use rtbake::runtime::skin::lighting::set_shading_in_one_encoder;
+use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, TsSettings};
 use std::path::PathBuf;

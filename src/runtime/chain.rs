@@ -228,7 +228,7 @@ pub fn subsurface<'g>(
 pub(crate) enum SubsurfaceGpu {
     Separable(SeparableSss),
     Tiled(SeparableSssTiled),
-    Gaussians(GaussianSss),
+    Gaussians(Box<GaussianSss>),
     Importance(ImportanceSss),
 }
 
@@ -257,7 +257,7 @@ impl SubsurfaceGpu {
             Subsurface::Separable { kernel, params } => Self::Tiled(SeparableSssTiled::new(d, w, h, kernel, params)?),
             // The α·h/720 viewport scaling of eq. 4.1, the same for both backends.
             Subsurface::Gaussians { blurs, params } => {
-                Self::Gaussians(GaussianSss::new(d, w, h, blurs, &params.for_viewport_height(h))?)
+                Self::Gaussians(Box::new(GaussianSss::new(d, w, h, blurs, &params.for_viewport_height(h))?))
             }
             Subsurface::Importance { samples, params } => {
                 Self::Importance(ImportanceSss::new(d, w, h, samples, params)?)

@@ -64,7 +64,7 @@ fn the_copy_bandwidth_the_bounds_divide_by_is_measured() {
 #[test]
 fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_frame() {
     use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
-    use rtbake::runtime::skin::lighting::set_shading_in_one_encoder;
+    use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
     let g = gpu();
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     assert!(assets.baked_rig.is_some(), "the committed bake has the example rig");

@@ -32,9 +32,10 @@ use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
 use crate::runtime::skin::heads::{blend_coverage, geometry, row_of_heads, BACKGROUND};
 use crate::runtime::skin::inputs::RigScaleBiasMaps;
-use crate::runtime::skin::lighting::{render_geometry, DemoAssets, SssMethod};
+use crate::runtime::skin::lighting::{DemoAssets, SssMethod};
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS_PER_M};
+use crate::runtime::skin::shade_frame::render_geometry;
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 

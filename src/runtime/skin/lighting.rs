@@ -18,7 +18,6 @@ use crate::runtime::chain::{self, Antialiasing};
 use crate::runtime::loader::{self, BakedDir, LutError};
 use crate::runtime::sampler;
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, SkinFrame, SkinInputs, SkinLuts};
-use crate::runtime::skin::shade_frame;
 use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSssParams};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::sss::separable::{SssKernel, SssParams};
@@ -323,49 +322,8 @@ pub(crate) fn lit_geometry(gpu: Backend<'_>, geo: Geometry, assets: &DemoAssets)
     Ok(Lit { geo, albedo, diffuse })
 }
 
-thread_local! {
-    static SHADING_IN_ONE_ENCODER: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
-}
-
-/// On a device, frames rendered on the calling thread record their shading into one command encoder with one
-/// read-back (true, the default), or run each pass with its own submission and read-back (false: the per-pass
-/// path, for inspecting the stages and for benchmarks that compare the two in one run). The CPU twins are the
-/// same either way.
-pub fn set_shading_in_one_encoder(on: bool) {
-    SHADING_IN_ONE_ENCODER.with(|c| c.set(on));
-}
-
-/// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
-/// `method` (None: no SSS; the transmitted light is in that layer), tone-mapped and encoded.
-pub(crate) fn render_geometry(
-    gpu: Backend<'_>,
-    geo: Geometry,
-    assets: &DemoAssets,
-    method: Option<SssMethod>,
-    background: Vec<u8>,
-) -> Result<Image<u8>, RuntimeError> {
-    // Both closures are FnOnce; the one that runs takes the frame.
-    let parts = std::cell::Cell::new(Some((geo, background)));
-    let take = || parts.take().expect("one backend runs");
-    let per_pass = |(geo, background): (Geometry, Vec<u8>)| {
-        let lit = lit_geometry(gpu, geo, assets)?;
-        shade(gpu, lit, assets, method, background, None)
-    };
-    gpu.run(
-        // On a device: every stage recorded into one command encoder, one read-back.
-        |g| {
-            if !SHADING_IN_ONE_ENCODER.with(|c| c.get()) {
-                return per_pass(take());
-            }
-            let (geo, background) = take();
-            shade_frame::shade(g, &geo, assets, subsurface_of(assets, method)?.as_ref(), background)
-        },
-        || per_pass(take()),
-    )
-}
-
 /// The SSS pass of `method` with `assets`' tables (None: no SSS pass).
-fn subsurface_of(
+pub(crate) fn subsurface_of(
     assets: &DemoAssets,
     method: Option<SssMethod>,
 ) -> Result<Option<chain::Subsurface<'_>>, InvalidInput> {

@@ -6,7 +6,7 @@
 //! texture-space diffusion, TAP's "TS").
 //! Frames: [`lighting`] (the shared lighting and compositing every frame goes through: skin inputs → diffuse +
 //! transmitted light → SSS → post-scatter albedo, specular, bloom → tone map; on a device recorded into one command
-//! encoder by `shade_frame`, one read-back), [`demo`] (the procedural spheres),
+//! encoder by [`shade_frame`], one read-back), [`demo`] (the procedural spheres),
 //! [`heads`] (heads from a mesh: G-buffer, shadow-map thickness), [`frame`] (`run skin`: picks the SSS shader),
 //! [`settings`], [`passes`] (the optional passes of `run skin`).
 
@@ -24,7 +24,7 @@ pub mod mesh_raster;
 pub mod mesh_raster_cpu;
 pub mod passes;
 pub mod settings;
-mod shade_frame;
+pub mod shade_frame;
 pub mod surface_maps;
 pub mod surface_maps_cpu;
 pub mod tap_grid;

@@ -4,7 +4,7 @@
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
-//! and read back on its own, for inspection and for texture-space diffusion).
+//! and read back on its own, for inspection and for texture-space diffusion): [`render_geometry`] picks one.
 //!
 //! Where a texture pass and a buffer pass meet, the data is converted on the device: the skin-inputs targets
 //! (`Rgba16Float`) and the SSS pass's output are copied into buffers with padded rows and unpacked by
@@ -13,14 +13,57 @@
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
+use crate::runtime::backend::Backend;
 use crate::runtime::chain::{Subsurface, SubsurfaceGpu};
 use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::device::Gpu;
 use crate::runtime::gpu;
 use crate::runtime::skin::bloom::{self, BloomBuffers};
 use crate::runtime::skin::inputs::SkinInputs;
+use crate::runtime::skin::lighting::{self, lit_geometry, subsurface_of, SssMethod};
 use crate::runtime::skin::lighting::{DemoAssets, Geometry, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
 use crate::runtime::RuntimeError;
+
+thread_local! {
+    static SHADING_IN_ONE_ENCODER: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
+}
+
+/// On a device, frames rendered on the calling thread record their shading into one command encoder with one
+/// read-back (true, the default), or run each pass with its own submission and read-back (false: the per-pass
+/// path, for inspecting the stages and for benchmarks that compare the two in one run). The CPU twins are the
+/// same either way.
+pub fn set_shading_in_one_encoder(on: bool) {
+    SHADING_IN_ONE_ENCODER.with(|c| c.set(on));
+}
+
+/// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
+/// `method` (None: no SSS; the transmitted light is in that layer), tone-mapped and encoded.
+pub(crate) fn render_geometry(
+    gpu: Backend<'_>,
+    geo: Geometry,
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+    background: Vec<u8>,
+) -> Result<Image<u8>, RuntimeError> {
+    // Both closures are FnOnce; the one that runs takes the frame.
+    let parts = std::cell::Cell::new(Some((geo, background)));
+    let take = || parts.take().expect("one backend runs");
+    let per_pass = |(geo, background): (Geometry, Vec<u8>)| {
+        let lit = lit_geometry(gpu, geo, assets)?;
+        lighting::shade(gpu, lit, assets, method, background, None)
+    };
+    gpu.run(
+        // On a device: every stage recorded into one command encoder, one read-back.
+        |g| {
+            if !SHADING_IN_ONE_ENCODER.with(|c| c.get()) {
+                return per_pass(take());
+            }
+            let (geo, background) = take();
+            shade(g, &geo, assets, subsurface_of(assets, method)?.as_ref(), background)
+        },
+        || per_pass(take()),
+    )
+}
 
 const SOURCE: &str = concat!(include_str!("../aa/srgb.wgsl"), include_str!("shade_frame.wgsl"));
 
