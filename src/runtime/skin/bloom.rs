@@ -38,7 +38,7 @@
 //!
 //! Stages over flat f32 buffers (`skin/bloom.wgsl`: `down` for l = 1..N, `up` for l = N−1..1, the level a
 //! per-dispatch argument, then `combine`), one submission ([`bloom`]) or recorded into a frame's encoder
-//! ([`record`]);
+//! (`record`);
 //! CPU twin [`crate::runtime::skin::bloom_cpu`] (the same sums in the same order).
 
 use crate::error::{check_range, InvalidInput};

@@ -25,6 +25,12 @@
 //!    after the SSS pass, never blurred (ch. 4, separate render targets; the demo has none); bloom on the final
 //!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
 //!    over a grey background.
+//!
+//! On a device the G-buffer and the shadow map are rasterised in one submission and read back together (the host
+//! computes thickness and the specular layer from them), and everything from the skin-inputs pass to the tone map
+//! is recorded into one command encoder and read back once, as the RGBA8 frame
+//! ([`crate::runtime::skin::shade_frame`]); the rig at uv is one more submission. Texture-space diffusion
+//! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;

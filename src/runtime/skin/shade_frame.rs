@@ -4,12 +4,12 @@
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
-//! and read back on its own, for inspection and for texture-space diffusion): [`render_geometry`] picks one.
+//! and read back on its own, for inspection and for texture-space diffusion): `render_geometry` picks one.
 //!
 //! Where a texture pass and a buffer pass meet, the data is converted on the device: the skin-inputs targets
 //! (`Rgba16Float`) and the SSS pass's output are copied into buffers with padded rows and unpacked by
 //! `shade_frame.wgsl`, which also packs the lit layer as the SSS pass's half-float input (a buffer-to-texture copy).
-//! `shade_frame.wgsl` runs through [`compute_chain::record`], bloom through [`bloom::record`].
+//! `shade_frame.wgsl` runs through `compute_chain::record`, bloom through `bloom::record`.
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
