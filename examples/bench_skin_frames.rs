@@ -1,18 +1,23 @@
-//! Frames shaped like an engine's: `run skin`'s frame (default passes: bloom on) per shader, first frame and
-//! steady state (median of frames 2..=N), with the runtime's per-frame caches off — every frame compiles its shader
-//! modules and pipelines and rasterises the texture-space UV maps on the host, as the runtime did before the
-//! caches — and on, in one run on one adapter, and the ratio.
+//! Frames shaped like an engine's: `run skin`'s frame (default passes: bloom on) per shader on a device, its
+//! shading recorded into one command encoder with one read-back ("one encoder", the runtime's path) against each
+//! pass submitted and read back on its own ("per pass", the path before;
+//! `runtime::skin::shade_frame::set_shading_in_one_encoder(false)`), in one run on one adapter: the first frame of
+//! each on a fresh device (shader modules and pipelines compiled), then frames of the two paths alternating on one
+//! device, and the median of frames 2..=N of each, their ratio and the queue submissions and host read-backs of a
+//! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
-//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 5
+//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 7
 //!
-//! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures. Each frame includes
-//! what `run skin` does per frame today (uploads, host read-backs between the stages, the final read-back). Tables
-//! come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
+//! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
+//! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the G-buffer read-back
+//! the host's geometry needs, the final read-back). Texture-space diffusion ("ts") has no one-encoder path yet: both
+//! columns run its per-pass path. Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
 
 use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
-use rtbake::runtime::device::create_headless;
-use rtbake::runtime::gpu::{pipelines_created_on_this_thread, set_object_cache_enabled};
+use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
+use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, TsSettings};
 use std::path::PathBuf;
@@ -23,27 +28,44 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// One frame on `g` through the one-encoder path or not: wall ms, submissions, read-backs.
+fn frame(g: &Gpu, one_encoder: bool, s: &SkinRenderSettings, passes: &SkinPasses, assets: &DemoAssets) -> [f64; 3] {
+    set_shading_in_one_encoder(one_encoder);
+    let head = default_head();
+    let (sub, read, t) = (submissions_on_this_thread(), read_backs_on_this_thread(), Instant::now());
+    render_with(Some(g), &head, s, passes, assets).expect("render");
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    [ms, (submissions_on_this_thread() - sub) as f64, (read_backs_on_this_thread() - read) as f64]
+}
+
 fn main() {
     let args: Vec<u32> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (width, height) = (args.first().copied().unwrap_or(1280), args.get(1).copied().unwrap_or(720));
-    let frames = args.get(2).copied().unwrap_or(5).max(3) as usize;
+    let frames = args.get(2).copied().unwrap_or(7).max(3) as usize;
     let bloom = !std::env::args().any(|a| a == "no-bloom");
     let dir = std::env::var_os("RTBAKE_BAKED_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"));
     let assets = DemoAssets::load(&dir).expect("baked tables");
-    let g = create_headless(&Default::default()).expect("an adapter");
+    let device = || create_headless(&Default::default()).expect("an adapter");
+    let g = device();
     println!("adapter: {}", g.describe());
-    let head = default_head();
     println!(
-        "run skin frame, {} the default head ({} triangles), {width}x{height}; frame 1 and \
-         the median of frames 2..={frames} (wall ms, host read-backs included); pipelines compiled per frame",
+        "run skin frame, {} the default head ({} triangles), {width}x{height}; frame 1 (a fresh device) and the \
+         median of frames 2..={frames} (the two paths alternating), wall ms; submissions / read-backs per frame",
         if bloom { "default passes (bloom on)," } else { "no bloom," },
-        head.triangle_count()
+        default_head().triangle_count()
     );
     println!(
-        "{:<12} {:>14} {:>14} {:>10} {:>14} {:>14} {:>10} {:>9}",
-        "shader", "uncached 1st", "uncached 2..N", "pipes/fr", "cached 1st", "cached 2..N", "pipes 2..N", "speed-up"
+        "{:<12} {:>13} {:>13} {:>13} {:>13} {:>8} {:>13} {:>13}",
+        "shader",
+        "1st per-pass",
+        "1st one-enc",
+        "2..N per-pass",
+        "2..N one-enc",
+        "ratio",
+        "per-pass s/r",
+        "one-enc s/r"
     );
     for (name, shader) in [
         ("none", SkinShader::None),
@@ -62,25 +84,23 @@ fn main() {
             stretch: Default::default(),
         };
         let passes = if bloom { SkinPasses::default() } else { SkinPasses::none() };
-        let run = |cached: bool| {
-            set_object_cache_enabled(cached);
-            let mut times = Vec::new();
-            let mut pipes = Vec::new();
-            for _ in 0..frames {
-                let (t, p) = (Instant::now(), pipelines_created_on_this_thread());
-                render_with(Some(&g), &head, &s, &passes, &assets).expect("render");
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-                pipes.push(pipelines_created_on_this_thread() - p);
-            }
-            eprintln!("  {name} ({}): {times:.0?} ms", if cached { "cached" } else { "uncached" });
-            (times[0], median(times[1..].to_vec()), pipes[1..].iter().sum::<u64>())
-        };
-        let (u1, us, up) = run(false);
-        let (c1, cs, cp) = run(true);
+        let first = [false, true].map(|one| frame(&device(), one, &s, &passes, &assets)[0]);
+        let (mut per_pass, mut one_enc) = (Vec::new(), Vec::new());
+        for _ in 0..frames {
+            per_pass.push(frame(&g, false, &s, &passes, &assets));
+            one_enc.push(frame(&g, true, &s, &passes, &assets));
+        }
+        let ms = |v: &[[f64; 3]]| median(v[1..].iter().map(|f| f[0]).collect());
+        let (p, o) = (ms(&per_pass), ms(&one_enc));
+        let counts = |v: &[[f64; 3]]| format!("{}/{}", v[frames - 1][1], v[frames - 1][2]);
+        eprintln!("  {name}: per pass {:.0?} ms, one encoder {:.0?} ms", per_pass, one_enc);
         println!(
-            "{name:<12} {u1:>14.1} {us:>14.1} {:>10.1} {c1:>14.1} {cs:>14.1} {cp:>10} {:>8.2}x",
-            up as f64 / (frames - 1) as f64,
-            us / cs
+            "{name:<12} {:>13.1} {:>13.1} {p:>13.1} {o:>13.1} {:>7.2}x {:>13} {:>13}",
+            first[0],
+            first[1],
+            p / o,
+            counts(&per_pass),
+            counts(&one_enc)
         );
     }
 }

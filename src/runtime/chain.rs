@@ -12,6 +12,7 @@ use crate::runtime::aa::modes_cpu::SmaaModesCpu;
 use crate::runtime::aa::smaa::{Smaa, SmaaOptions, SmaaTextures};
 use crate::runtime::aa::smaa_cpu;
 use crate::runtime::backend::{Backend, Prepared};
+use crate::runtime::device::Gpu;
 use crate::runtime::loader::BakedRig;
 use crate::runtime::sampler::FilterPrecision;
 use crate::runtime::skin::bloom::{self, BloomParams};
@@ -204,38 +205,89 @@ pub fn subsurface<'g>(
     let gpu = gpu.into();
     match method {
         Subsurface::Separable { kernel, params } => gpu.run(
-            // The compute pass over workgroup-memory line tiles on GPUs; the fragment pass on software adapters,
-            // where workgroup barriers are emulated and the tiles are slower (same arithmetic, same twin).
-            |g| {
-                if g.is_software() {
-                    SeparableSss::new(&g.device, w, h, kernel, params)?.run(&g.device, &g.queue, rgba, depth_linear)
-                } else {
-                    SeparableSssTiled::new(&g.device, w, h, kernel, params)?.run(
-                        &g.device,
-                        &g.queue,
-                        rgba,
-                        depth_linear,
-                    )
-                }
-            },
+            |g| SubsurfaceGpu::new(g, (w, h), method)?.run(g, rgba, depth_linear),
             || Ok(separable_cpu::separable_sss(rgba, depth_linear, w, h, kernel, params)),
         ),
-        Subsurface::Gaussians { blurs, params } => {
-            // The α·h/720 viewport scaling of eq. 4.1, the same for both backends.
-            let gp = params.for_viewport_height(h);
-            gpu.run(
-                |g| GaussianSss::new(&g.device, w, h, blurs, &gp)?.run(&g.device, &g.queue, rgba, depth_linear),
-                || Ok(gaussian_cpu::gaussian_sss(rgba, depth_linear, w, h, blurs, &gp)),
-            )
-        }
+        Subsurface::Gaussians { blurs, params } => gpu.run(
+            |g| SubsurfaceGpu::new(g, (w, h), method)?.run(g, rgba, depth_linear),
+            || Ok(gaussian_cpu::gaussian_sss(rgba, depth_linear, w, h, blurs, &params.for_viewport_height(h))),
+        ),
         Subsurface::Importance { samples, params } => gpu.run(
-            |g| ImportanceSss::new(&g.device, w, h, samples, params)?.run(&g.device, &g.queue, rgba, depth_linear),
+            |g| SubsurfaceGpu::new(g, (w, h), method)?.run(g, rgba, depth_linear),
             || {
                 samples.validate()?;
                 params.validate()?;
                 Ok(importance_cpu::importance_sss(rgba, depth_linear, w, h, samples, params))
             },
         ),
+    }
+}
+
+/// The GPU pass [`subsurface`] runs for a method, built for one frame size: its input, output and recorded passes
+/// ([`crate::runtime::sss::SssPass`]), so a frame can record it into its own command encoder.
+pub(crate) enum SubsurfaceGpu {
+    Separable(SeparableSss),
+    Tiled(SeparableSssTiled),
+    Gaussians(Box<GaussianSss>),
+    Importance(ImportanceSss),
+}
+
+/// `$body` with `$p` bound to the [`crate::runtime::sss::SssPass`] of any [`SubsurfaceGpu`].
+macro_rules! with_pass {
+    ($s:expr, $p:ident => $body:expr) => {
+        match $s {
+            SubsurfaceGpu::Separable($p) => $body,
+            SubsurfaceGpu::Tiled($p) => $body,
+            SubsurfaceGpu::Gaussians($p) => $body,
+            SubsurfaceGpu::Importance($p) => $body,
+        }
+    };
+}
+
+impl SubsurfaceGpu {
+    /// The pass of `method` for a `w`×`h` frame on `g`.
+    pub(crate) fn new(g: &Gpu, (w, h): (u32, u32), method: &Subsurface) -> Result<Self, RuntimeError> {
+        let d = &g.device;
+        Ok(match method {
+            // The compute pass over workgroup-memory line tiles on GPUs; the fragment pass on software adapters,
+            // where workgroup barriers are emulated and the tiles are slower (same arithmetic, same twin).
+            Subsurface::Separable { kernel, params } if g.is_software() => {
+                Self::Separable(SeparableSss::new(d, w, h, kernel, params)?)
+            }
+            Subsurface::Separable { kernel, params } => Self::Tiled(SeparableSssTiled::new(d, w, h, kernel, params)?),
+            // The α·h/720 viewport scaling of eq. 4.1, the same for both backends.
+            Subsurface::Gaussians { blurs, params } => {
+                Self::Gaussians(Box::new(GaussianSss::new(d, w, h, blurs, &params.for_viewport_height(h))?))
+            }
+            Subsurface::Importance { samples, params } => {
+                Self::Importance(ImportanceSss::new(d, w, h, samples, params)?)
+            }
+        })
+    }
+
+    /// Uploads a frame, runs the pass and reads back RGBA f32.
+    pub(crate) fn run(&self, g: &Gpu, rgba: &[f32], depth: &[f32]) -> Result<Vec<f32>, RuntimeError> {
+        with_pass!(self, p => p.run(&g.device, &g.queue, rgba, depth))
+    }
+
+    /// The irradiance input (`Rgba16Float`).
+    pub(crate) fn input(&self) -> &wgpu::Texture {
+        with_pass!(self, p => p.input())
+    }
+
+    /// The blurred result (`Rgba16Float`).
+    pub(crate) fn output(&self) -> &wgpu::Texture {
+        with_pass!(self, p => p.output())
+    }
+
+    /// Uploads the linear depth alone.
+    pub(crate) fn upload_depth(&self, queue: &wgpu::Queue, depth: &[f32]) -> Result<(), InvalidInput> {
+        with_pass!(self, p => p.upload_depth(queue, depth))
+    }
+
+    /// Records the pass.
+    pub(crate) fn encode(&self, enc: &mut wgpu::CommandEncoder) {
+        with_pass!(self, p => p.encode(enc, None))
     }
 }
 

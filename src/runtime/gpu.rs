@@ -30,6 +30,26 @@ static CACHE_ENABLED: AtomicBool = AtomicBool::new(true);
 
 thread_local! {
     static PIPELINES_CREATED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    static SUBMISSIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    static READ_BACKS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Queue submissions made through [`submit`] on the calling thread since it started (every submission of the
+/// skin frame's passes goes through it).
+pub fn submissions_on_this_thread() -> u64 {
+    SUBMISSIONS.with(|c| c.get())
+}
+
+/// Host read-backs ([`map_read`]: the host waits for the GPU and copies a buffer out) on the calling thread since
+/// it started.
+pub fn read_backs_on_this_thread() -> u64 {
+    READ_BACKS.with(|c| c.get())
+}
+
+/// Submits `commands` to `queue`, counted in [`submissions_on_this_thread`].
+pub fn submit(queue: &wgpu::Queue, commands: wgpu::CommandBuffer) {
+    SUBMISSIONS.with(|c| c.set(c.get() + 1));
+    queue.submit([commands]);
 }
 
 /// Turns the per-device object cache on (the default) or off. Off, every pass constructed recompiles its shader
@@ -232,39 +252,105 @@ pub fn upload(queue: &wgpu::Queue, tex: &wgpu::Texture, data: &[u8]) {
     );
 }
 
+/// Bytes of one row of `tex` in a buffer a texture copy reads or writes: its texels rounded up to
+/// `COPY_BYTES_PER_ROW_ALIGNMENT`.
+pub fn padded_row_bytes(tex: &wgpu::Texture) -> u32 {
+    let row = tex.width() * bytes_per_texel(tex.format());
+    row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
+}
+
+/// The layout of the whole of `tex` at `offset` bytes of a buffer, rows of [`padded_row_bytes`].
+fn padded_copy<'a>(
+    tex: &'a wgpu::Texture,
+    buffer: &'a wgpu::Buffer,
+    offset: u64,
+) -> [wgpu::TexelCopyBufferInfo<'a>; 1] {
+    let layout = wgpu::TexelCopyBufferLayout {
+        offset,
+        bytes_per_row: Some(padded_row_bytes(tex)),
+        rows_per_image: Some(tex.height()),
+    };
+    [wgpu::TexelCopyBufferInfo { buffer, layout }]
+}
+
+fn whole(tex: &wgpu::Texture) -> (wgpu::TexelCopyTextureInfo<'_>, wgpu::Extent3d) {
+    let info = wgpu::TexelCopyTextureInfo {
+        texture: tex,
+        mip_level: 0,
+        origin: wgpu::Origin3d::ZERO,
+        aspect: wgpu::TextureAspect::All,
+    };
+    (info, wgpu::Extent3d { width: tex.width(), height: tex.height(), depth_or_array_layers: 1 })
+}
+
+/// Records a copy of the whole of `tex` into `buffer` at `offset` (rows of [`padded_row_bytes`]).
+pub fn encode_texture_to_buffer(
+    enc: &mut wgpu::CommandEncoder,
+    tex: &wgpu::Texture,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+) {
+    let (info, size) = whole(tex);
+    let [dst] = padded_copy(tex, buffer, offset);
+    enc.copy_texture_to_buffer(info, dst, size);
+}
+
+/// Records a copy of `buffer` from `offset` (rows of [`padded_row_bytes`]) into the whole of `tex`.
+pub fn encode_buffer_to_texture(
+    enc: &mut wgpu::CommandEncoder,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    tex: &wgpu::Texture,
+) {
+    let (info, size) = whole(tex);
+    let [src] = padded_copy(tex, buffer, offset);
+    enc.copy_buffer_to_texture(src, info, size);
+}
+
 /// Reads a whole texture back as tightly packed texels (top row first). Blocks until the GPU is done.
 pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, tex: &wgpu::Texture) -> Result<Vec<u8>, RuntimeError> {
-    let bpt = bytes_per_texel(tex.format());
-    let (w, h) = (tex.width(), tex.height());
-    let row = w * bpt;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    Ok(read_textures(device, queue, enc, &[tex])?.remove(0))
+}
+
+/// Submits `enc` with copies of the whole of each of `textures` appended, and reads them back with one wait:
+/// tightly packed texels (top row first) per texture.
+pub fn read_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    mut enc: wgpu::CommandEncoder,
+    textures: &[&wgpu::Texture],
+) -> Result<Vec<Vec<u8>>, RuntimeError> {
+    let sizes: Vec<u64> = textures.iter().map(|t| padded_row_bytes(t) as u64 * t.height() as u64).collect();
     let buf = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
-        size: (padded * h) as u64,
+        size: sizes.iter().sum::<u64>().max(4),
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: tex,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buf,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
-        },
-        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-    );
-    queue.submit([enc.finish()]);
-    let bytes = map_read(device, &buf)?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for y in 0..h as usize {
-        out.extend_from_slice(&bytes[y * padded as usize..y * padded as usize + row as usize]);
+    let mut offset = 0;
+    for (t, size) in textures.iter().zip(&sizes) {
+        encode_texture_to_buffer(&mut enc, t, &buf, offset);
+        offset += size;
     }
-    Ok(out)
+    submit(queue, enc.finish());
+    let bytes = map_read(device, &buf)?;
+    let mut offset = 0;
+    Ok(textures
+        .iter()
+        .zip(&sizes)
+        .map(|(t, size)| {
+            let (padded, row) = (padded_row_bytes(t) as usize, (t.width() * bytes_per_texel(t.format())) as usize);
+            let img = &bytes[offset..offset + *size as usize];
+            offset += *size as usize;
+            img.chunks_exact(padded).flat_map(|r| &r[..row]).copied().collect()
+        })
+        .collect())
+}
+
+/// Half floats (`Rgba16Float`, `R16Float`…) as f32 values.
+pub fn f16_to_f32(bytes: &[u8]) -> Vec<f32> {
+    bytemuck::cast_slice::<u8, half::f16>(bytes).iter().map(|v| v.to_f32()).collect()
 }
 
 /// Reads a whole half-float texture (`Rgba16Float`, `R16Float`…) back as f32 values (top row first).
@@ -273,12 +359,12 @@ pub fn read_texture_f16(
     queue: &wgpu::Queue,
     tex: &wgpu::Texture,
 ) -> Result<Vec<f32>, RuntimeError> {
-    let b = read_texture(device, queue, tex)?;
-    Ok(bytemuck::cast_slice::<u8, half::f16>(&b).iter().map(|v| v.to_f32()).collect())
+    Ok(f16_to_f32(&read_texture(device, queue, tex)?))
 }
 
 /// Maps a `MAP_READ` buffer and copies its content out.
 pub fn map_read(device: &wgpu::Device, buf: &wgpu::Buffer) -> Result<Vec<u8>, RuntimeError> {
+    READ_BACKS.with(|c| c.set(c.get() + 1));
     let (tx, rx) = std::sync::mpsc::channel();
     buf.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);

@@ -36,7 +36,9 @@
 //! pixels, which the old blur kept half of within σ = 0.54 px (`bloom_pyramid_against_the_full_resolution_blur`
 //! in tests/it/skin_passes.rs, which holds the old blur as its reference).
 //!
-//! Stages over flat f32 buffers (`skin/bloom.wgsl`: `down_1..down_N`, `up_{N−1}..up_1`, `combine`), one submission;
+//! Stages over flat f32 buffers (`skin/bloom.wgsl`: `down` for l = 1..N, `up` for l = N−1..1, the level a
+//! per-dispatch argument, then `combine`), one submission ([`bloom`]) or recorded into a frame's encoder
+//! (`record`);
 //! CPU twin [`crate::runtime::skin::bloom_cpu`] (the same sums in the same order).
 
 use crate::error::{check_range, InvalidInput};
@@ -63,7 +65,7 @@ impl Default for BloomParams {
     }
 }
 
-/// Most levels of the pyramid (the entry points `skin/bloom.wgsl` has).
+/// Most levels of the pyramid.
 pub const MAX_LEVELS: u32 = 6;
 
 impl BloomParams {
@@ -117,8 +119,55 @@ pub fn storage_buffer_bytes(width: u32, height: u32, p: &BloomParams) -> [u64; 4
 /// The largest buffer [`bloom`] allocates for a `width`×`height` frame, bytes: the frame itself, 16 bytes per
 /// pixel (checked against the adapter's storage-binding limit before a frame is rendered).
 pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
-    16 * width as u64 * height as u64
+    compute_chain::vec4_per_pixel_bytes(width, height)
 }
+
+/// The uniform block and the dispatches of bloom over a `width`×`height` frame with `p`.
+fn stages(width: u32, height: u32, p: &BloomParams) -> (Params, Vec<Stage<'static>>) {
+    let levels = p.levels(height);
+    let params = Params {
+        size: [width as f32, height as f32, p.threshold, p.weight],
+        lv: [levels as f32, 1.0 / levels as f32, 0.0, 0.0],
+    };
+    let sizes = level_sizes(width, height, levels);
+    let at = |entry, l: u32| {
+        let (w, h) = sizes[l as usize - 1];
+        Stage { entry, groups: compute_chain::groups_8x8(w, h), args: [l, 0, 0, 0] }
+    };
+    let mut stages: Vec<Stage<'static>> = (1..=levels).map(|l| at("down", l)).collect();
+    stages.extend((1..levels).rev().map(|l| at("up", l)));
+    stages.push(Stage::new("combine", compute_chain::groups_8x8(width, height)));
+    (params, stages)
+}
+
+/// GPU buffers of bloom for one frame size, in binding order: the HDR frame (RGBA f32, written by the frame's
+/// composite), the pyramid and its accumulation, the result (RGBA f32; its alpha is not written).
+pub(crate) struct BloomBuffers(pub(crate) [wgpu::Buffer; 4]);
+
+impl BloomBuffers {
+    pub(crate) fn new(device: &wgpu::Device, width: u32, height: u32, p: &BloomParams) -> Result<Self, RuntimeError> {
+        p.validate()?;
+        let bytes = storage_buffer_bytes(width, height, p);
+        compute_chain::check_buffers(device, "bloom", &bytes)?;
+        Ok(Self(bytes.map(|b| compute_chain::storage_buffer(device, "bloom", b, None))))
+    }
+}
+
+/// Records bloom of the HDR frame in `b.0[0]` into `b.0[3]` (rgb) into `enc`: no submission, no read-back.
+pub(crate) fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    width: u32,
+    height: u32,
+    p: &BloomParams,
+    b: &BloomBuffers,
+) {
+    let (params, stages) = stages(width, height, p);
+    let bound: Vec<&wgpu::Buffer> = b.0.iter().collect();
+    compute_chain::record(device, enc, "bloom", SOURCE, bytemuck::bytes_of(&params), &bound, &stages);
+}
+
+const SOURCE: &str = include_str!("bloom.wgsl");
 
 /// Blooms a `width`×`height` linear HDR frame (RGBA, alpha passed through) on the GPU.
 pub fn bloom(
@@ -134,30 +183,13 @@ pub fn bloom(
     if hdr_rgba.len() != 4 * n {
         return Err(InvalidInput::new("bloom input", format!("needs {width}x{height} RGBA values")).into());
     }
-    let levels = p.levels(height);
-    let params = Params {
-        size: [width as f32, height as f32, p.threshold, p.weight],
-        lv: [levels as f32, 1.0 / levels as f32, 0.0, 0.0],
-    };
-    let sizes = level_sizes(width, height, levels);
-    let names_down: Vec<String> = (1..=levels).map(|l| format!("down_{l}")).collect();
-    let names_up: Vec<String> = (1..levels).rev().map(|l| format!("up_{l}")).collect();
-    let mut stages: Vec<Stage<'_>> = names_down
-        .iter()
-        .zip(&sizes)
-        .map(|(e, &(w, h))| Stage { entry: e, groups: compute_chain::groups_8x8(w, h) })
-        .collect();
-    for (e, l) in names_up.iter().zip((1..levels).rev()) {
-        let (w, h) = sizes[l as usize - 1];
-        stages.push(Stage { entry: e, groups: compute_chain::groups_8x8(w, h) });
-    }
-    stages.push(Stage { entry: "combine", groups: compute_chain::groups_8x8(width, height) });
+    let (params, stages) = stages(width, height, p);
     let bytes = storage_buffer_bytes(width, height, p);
     let out = compute_chain::run(
         device,
         queue,
         "bloom",
-        include_str!("bloom.wgsl"),
+        SOURCE,
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(hdr_rgba)),

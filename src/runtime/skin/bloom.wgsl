@@ -10,6 +10,8 @@ struct Params {
     size: vec4<f32>,
     // levels N, mix per level (1 / N), 0, 0
     lv: vec4<f32>,
+    // per dispatch (compute_chain's stage arguments): the level l a `down` / `up` dispatch writes, 0, 0, 0
+    stage: vec4<u32>,
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
@@ -60,7 +62,7 @@ fn box(l: u32, x: i32, y: i32) -> vec4<f32> {
     return 0.25 * (src(l, x, y) + src(l, x + 1, y) + src(l, x, y + 1) + src(l, x + 1, y + 1));
 }
 
-fn down(l: u32, id: vec3<u32>) {
+fn down_level(l: u32, id: vec3<u32>) {
     let d = dims(l);
     if (id.x >= d.x || id.y >= d.y) {
         return;
@@ -114,7 +116,7 @@ fn tent(c: u32, x: u32, y: u32) -> vec4<f32> {
     return s;
 }
 
-fn up(l: u32, id: vec3<u32>) {
+fn up_level(l: u32, id: vec3<u32>) {
     let d = dims(l);
     if (id.x >= d.x || id.y >= d.y) {
         return;
@@ -133,25 +135,14 @@ fn combine(@builtin(global_invocation_id) id: vec3<u32>) {
     result[i] = hdr[i] + p.size.w * (tent(1u, id.x, id.y) - bright(i));
 }
 
+// D_l from D_{l-1}, l = p.stage.x in 1..=N.
 @compute @workgroup_size(8, 8, 1)
-fn down_1(@builtin(global_invocation_id) id: vec3<u32>) { down(1u, id); }
+fn down(@builtin(global_invocation_id) id: vec3<u32>) {
+    down_level(p.stage.x, id);
+}
+
+// U_l from D_l and U_{l+1}, l = p.stage.x in 1..N-1.
 @compute @workgroup_size(8, 8, 1)
-fn down_2(@builtin(global_invocation_id) id: vec3<u32>) { down(2u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn down_3(@builtin(global_invocation_id) id: vec3<u32>) { down(3u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn down_4(@builtin(global_invocation_id) id: vec3<u32>) { down(4u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn down_5(@builtin(global_invocation_id) id: vec3<u32>) { down(5u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn down_6(@builtin(global_invocation_id) id: vec3<u32>) { down(6u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn up_1(@builtin(global_invocation_id) id: vec3<u32>) { up(1u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn up_2(@builtin(global_invocation_id) id: vec3<u32>) { up(2u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn up_3(@builtin(global_invocation_id) id: vec3<u32>) { up(3u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn up_4(@builtin(global_invocation_id) id: vec3<u32>) { up(4u, id); }
-@compute @workgroup_size(8, 8, 1)
-fn up_5(@builtin(global_invocation_id) id: vec3<u32>) { up(5u, id); }
+fn up(@builtin(global_invocation_id) id: vec3<u32>) {
+    up_level(p.stage.x, id);
+}

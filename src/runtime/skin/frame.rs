@@ -25,6 +25,12 @@
 //!    after the SSS pass, never blurred (ch. 4, separate render targets; the demo has none); bloom on the final
 //!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
 //!    over a grey background.
+//!
+//! On a device the G-buffer and the shadow map are rasterised in one submission and read back together (the host
+//! computes thickness and the specular layer from them), and everything from the skin-inputs pass to the tone map
+//! is recorded into one command encoder and read back once, as the RGBA8 frame
+//! ([`crate::runtime::skin::shade_frame`]); the rig at uv is one more submission. Texture-space diffusion
+//! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
@@ -32,9 +38,10 @@ use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
 use crate::runtime::skin::heads::{blend_coverage, geometry, row_of_heads, BACKGROUND};
 use crate::runtime::skin::inputs::RigScaleBiasMaps;
-use crate::runtime::skin::lighting::{render_geometry, DemoAssets, SssMethod};
+use crate::runtime::skin::lighting::{DemoAssets, SssMethod};
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS_PER_M};
+use crate::runtime::skin::shade_frame::render_geometry;
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
@@ -249,7 +256,7 @@ pub fn render_with<'g>(
         SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
     let background = BACKGROUND.repeat((s.width * s.height) as usize);
-    let mut frame = render_geometry(gpu, geo, &assets, method, background, None)?;
+    let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
     blend_coverage(&mut frame, &coverage);
     Ok(frame)
 }

@@ -11,7 +11,7 @@ use crate::runtime::backend::Backend;
 use crate::runtime::sampler;
 use crate::runtime::skin::inputs::SkinFrame;
 use crate::runtime::skin::lighting::{key_light_view, DemoAssets, Geometry, KEY_LIGHT_INTENSITY};
-use crate::runtime::skin::mesh_raster::{self, MeshGBuffer};
+use crate::runtime::skin::mesh_raster::{self, MeshGBuffer, RasterJob};
 use crate::runtime::skin::mesh_raster_cpu;
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{
@@ -40,13 +40,6 @@ pub fn row_of_heads(mesh: &Mesh, heads: u32) -> Result<Mesh, InvalidInput> {
         idx.extend(mesh.indices.iter().map(|i| i + k * n));
     }
     Mesh::new("heads", pos, nrm, uvs, idx, mesh.mm_per_unit)
-}
-
-fn rasterise(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera, w: u32, h: u32) -> Result<MeshGBuffer, RuntimeError> {
-    gpu.run(
-        |g| mesh_raster::rasterise(&g.device, &g.queue, mesh, cam, w, h),
-        || Ok(mesh_raster_cpu::rasterise(mesh, cam, w, h)),
-    )
 }
 
 /// The light camera of the shadow map: 1.5 m from the heads towards the back light (`back`, view space), looking at
@@ -80,12 +73,12 @@ pub(crate) struct ShadowMap {
 }
 
 impl ShadowMap {
-    /// `mesh` rasterised from the camera of the back light `back` (view space) of the frame seen by `cam`.
-    pub(crate) fn new(gpu: Backend<'_>, mesh: &Mesh, cam: &Camera, back: [f32; 3]) -> Result<Self, RuntimeError> {
+    /// The shadow map `map` rasterised by [`light_camera`] for the back light `back` of the frame seen by `cam`,
+    /// of a mesh of `mm_per_unit`.
+    fn new(map: MeshGBuffer, cam: &Camera, back: [f32; 3], mm_per_unit: f32) -> Self {
         let light = light_camera(cam, back);
-        let map = rasterise(gpu, mesh, &light, SHADOW_MAP_SIZE, SHADOW_MAP_SIZE)?;
         let light_view = light.view();
-        Ok(Self { map, light_view, light_vp: light.projection(1.0) * light_view, mm_per_unit: mesh.mm_per_unit })
+        Self { map, light_view, light_vp: light.projection(1.0) * light_view, mm_per_unit }
     }
 
     /// The thickness (mm) the back light crosses to reach the surface point `p_world` with unit normal `n_world`
@@ -171,20 +164,38 @@ pub(crate) fn geometry(
 ) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
     let (w, h, msaa) = (s.width, s.height, passes.msaa);
-    let mut g = match &passes.surface_maps {
-        // A normal map is baked in MikkTSpace: the mesh's frame, with vertices split where its corners disagree.
-        Some(_) => {
-            let (split, t) = crate::mesh::tangents::mikktspace_tangents(mesh);
-            gpu.run(
-                |d| mesh_raster::rasterise_with_tangents(&d.device, &d.queue, &split, &t, &cam, w, h, msaa),
-                || Ok(mesh_raster_cpu::rasterise_with_tangents(&split, &t, &cam, w, h, msaa)?),
-            )?
-        }
-        None => gpu.run(
-            |d| mesh_raster::rasterise_samples(&d.device, &d.queue, mesh, &cam, w, h, msaa),
-            || Ok(mesh_raster_cpu::rasterise_samples(mesh, &cam, w, h, msaa)?),
-        )?,
+    // The view's G-buffer and the back light's shadow map (one sample), on a device in one submission.
+    let light = light_camera(&cam, assets.lights.back_view);
+    let (s_map, one) = (SHADOW_MAP_SIZE, 1);
+    let light_tangents = crate::mesh::tangents::vertex_tangents(mesh);
+    // A normal map is baked in MikkTSpace: the mesh's frame, with vertices split where its corners disagree.
+    let mikk = passes.surface_maps.as_ref().map(|_| crate::mesh::tangents::mikktspace_tangents(mesh));
+    let (split, tangents) = match &mikk {
+        Some((m, t)) => (m, t.as_slice()),
+        None => (mesh, light_tangents.as_slice()),
     };
+    let (mut g, shadow_map) = gpu.run(
+        |d| {
+            let jobs = [
+                RasterJob { mesh: split, tangents, camera: &cam, width: w, height: h, samples: msaa },
+                RasterJob {
+                    mesh,
+                    tangents: &light_tangents,
+                    camera: &light,
+                    width: s_map,
+                    height: s_map,
+                    samples: one,
+                },
+            ];
+            let mut maps = mesh_raster::rasterise_jobs(&d.device, &d.queue, &jobs)?;
+            let shadow = maps.pop().expect("two G-buffers");
+            Ok((maps.pop().expect("two G-buffers"), shadow))
+        },
+        || {
+            let g = mesh_raster_cpu::rasterise_with_tangents(split, tangents, &cam, w, h, msaa)?;
+            Ok((g, mesh_raster_cpu::rasterise(mesh, &light, s_map, s_map)))
+        },
+    )?;
     let mut albedo = None;
     if let Some(maps) = &passes.surface_maps {
         let px = crate::runtime::chain::surface_pixels_for(gpu, &g, maps)?;
@@ -194,7 +205,7 @@ pub(crate) fn geometry(
     if let Some(w) = &passes.wrinkles {
         g.normal_view = crate::runtime::chain::wrinkled_normals_for(gpu, &g, &w.maps, &w.zone_weights)?;
     }
-    let shadow = ShadowMap::new(gpu, mesh, &cam, assets.lights.back_view)?;
+    let shadow = ShadowMap::new(shadow_map, &cam, assets.lights.back_view, mesh.mm_per_unit);
     let thickness = thickness_mm(&g, &cam, &shadow, mesh.mm_per_unit);
     let specular = specular_layer_lit(&g, &cam, assets.lights.key_view);
     let n = (s.width * s.height) as usize;

@@ -324,8 +324,9 @@ impl SkinInputs {
         self.upload(queue, frame, rig_weights, light_dir)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin") });
         self.encode(&mut enc);
-        queue.submit([enc.finish()]);
-        let read = |t| gpu::read_texture_f16(device, queue, t);
-        Ok((read(&self.albedo)?, read(&self.transmitted)?))
+        // One submission, both targets read back with one wait.
+        let mut read = gpu::read_textures(device, queue, enc, &[&self.albedo, &self.transmitted])?;
+        let transmitted = gpu::f16_to_f32(&read.pop().expect("two targets"));
+        Ok((gpu::f16_to_f32(&read.pop().expect("two targets")), transmitted))
     }
 }

@@ -322,20 +322,29 @@ pub(crate) fn lit_geometry(gpu: Backend<'_>, geo: Geometry, assets: &DemoAssets)
     Ok(Lit { geo, albedo, diffuse })
 }
 
-/// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
-/// `method` (None: no SSS; the transmitted light is in that layer), tone-mapped and encoded, then antialiased.
-pub(crate) fn render_geometry(
-    gpu: Backend<'_>,
-    geo: Geometry,
+/// The SSS pass of `method` with `assets`' tables (None: no SSS pass).
+pub(crate) fn subsurface_of(
     assets: &DemoAssets,
     method: Option<SssMethod>,
-    background: Vec<u8>,
-    aa: Option<&Antialiasing>,
-) -> Result<Image<u8>, RuntimeError> {
-    let lit = lit_geometry(gpu, geo, assets)?;
-    shade(gpu, lit, assets, method, background, aa)
+) -> Result<Option<chain::Subsurface<'_>>, InvalidInput> {
+    let Some(method) = method else { return Ok(None) };
+    Ok(Some(match method {
+        SssMethod::Separable => chain::Subsurface::Separable { kernel: &assets.kernel, params: &assets.sss },
+        SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },
+        SssMethod::Importance => chain::Subsurface::Importance {
+            samples: assets.importance.as_ref().ok_or_else(|| {
+                InvalidInput::new(
+                    "sss importance",
+                    format!("needs {} in the bake directory", path::IMPORTANCE_KERNEL_DEFAULT),
+                )
+            })?,
+            params: &assets.importance_params,
+        },
+    }))
 }
 
+/// The lit frame `lit` through `method` (None: no SSS), composited over `rgba` and antialiased: each pass
+/// submitted and read back on its own (the CPU twin, the procedural demo).
 pub(crate) fn shade(
     gpu: Backend<'_>,
     lit: Lit,
@@ -346,8 +355,6 @@ pub(crate) fn shade(
 ) -> Result<Image<u8>, RuntimeError> {
     let Lit { geo, albedo, diffuse } = lit;
     let (w, h) = (geo.frame.width, geo.frame.height);
-    let (kernel, params) = (&assets.kernel, &assets.sss);
-    let importance_params = assets.importance_params;
     let bloom = assets.bloom.as_ref();
     // Post-scatter texturing: the albedo multiplies the (blurred) irradiance.
     let textured = |mut v: Vec<f32>| {
@@ -360,21 +367,8 @@ pub(crate) fn shade(
         }
         v
     };
-    let Some(method) = method else {
+    let Some(sss) = subsurface_of(assets, method)? else {
         return composite(gpu, &geo, &textured(diffuse), rgba, bloom, aa);
-    };
-    let sss = match method {
-        SssMethod::Separable => chain::Subsurface::Separable { kernel, params },
-        SssMethod::Gaussians => chain::Subsurface::Gaussians { blurs: &assets.blurs, params: assets.gaussian_params },
-        SssMethod::Importance => chain::Subsurface::Importance {
-            samples: assets.importance.as_ref().ok_or_else(|| {
-                InvalidInput::new(
-                    "sss importance",
-                    format!("needs {} in the bake directory", path::IMPORTANCE_KERNEL_DEFAULT),
-                )
-            })?,
-            params: &importance_params,
-        },
     };
     let blurred = chain::subsurface(gpu, &diffuse, &geo.depth, (w, h), &sss)?;
     composite(gpu, &geo, &textured(blurred), rgba, bloom, aa)

@@ -126,18 +126,10 @@ impl RigAtUv<'_> {
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Params {
-    size: [f32; 4],
-    cfg: [f32; 4],
-    weights: [[f32; 4]; 2],
-}
-
 /// The largest per-pixel buffer [`hemoglobin_at_uv`] allocates for a `width`×`height` G-buffer, bytes: uv and
 /// coverage, one vec4 of f32 per pixel (the rig and H₀ maps are the baked maps, independent of the frame).
 pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
-    16 * width as u64 * height as u64
+    compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
 /// Per pixel of a `width`×`height` frame, (u, v, covered) → H (0 where not covered), on the GPU.
@@ -159,7 +151,7 @@ pub fn hemoglobin_at_uv(
     for (i, v) in maps.pose.weights.iter().enumerate() {
         w[i / 4][i % 4] = *v;
     }
-    let params = Params {
+    let params = compute_chain::MapParams {
         size: [width as f32, height as f32, maps.rig.width as f32, maps.rig.height as f32],
         cfg: [maps.h0.width as f32, maps.h0.height as f32, maps.rig.targets.len() as f32, maps.pose.global_scale],
         weights: w,
@@ -178,7 +170,7 @@ pub fn hemoglobin_at_uv(
             Buffer::Data(bytemuck::cast_slice(&maps.h0.data)),
             Buffer::Zeroed(4 * n as u64),
         ],
-        &[Stage { entry: "main", groups: compute_chain::groups_8x8(width, height) }],
+        &[Stage::new("main", compute_chain::groups_8x8(width, height))],
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())

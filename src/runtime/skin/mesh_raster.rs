@@ -84,6 +84,14 @@ pub fn check_samples(samples: u32) -> Result<(), InvalidInput> {
     Ok(())
 }
 
+/// Checks what both rasterisers take besides the mesh: one tangent per vertex, 1 or 4 samples per pixel.
+pub(crate) fn check_raster_inputs(mesh: &Mesh, tangents: &[[f32; 4]], samples: u32) -> Result<(), InvalidInput> {
+    if tangents.len() != mesh.positions.len() {
+        return Err(InvalidInput::new("tangents", "need one tangent per vertex of the mesh"));
+    }
+    check_samples(samples)
+}
+
 /// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
 pub fn rasterise(
     device: &wgpu::Device,
@@ -123,10 +131,51 @@ pub fn rasterise_with_tangents(
     height: u32,
     samples: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
-    if tangents.len() != mesh.positions.len() {
-        return Err(InvalidInput::new("tangents", "need one tangent per vertex of the mesh").into());
-    }
-    check_samples(samples)?;
+    let job = RasterJob { mesh, tangents, camera, width, height, samples };
+    Ok(rasterise_jobs(device, queue, &[job])?.remove(0))
+}
+
+/// One G-buffer to rasterise: `mesh` with its per-vertex `tangents` seen by `camera`, `width`×`height`, `samples`
+/// per pixel (the arguments of [`rasterise_with_tangents`]).
+pub struct RasterJob<'a> {
+    pub mesh: &'a Mesh,
+    pub tangents: &'a [[f32; 4]],
+    pub camera: &'a Camera,
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+}
+
+/// The G-buffers of `jobs` (a frame's view and its shadow map, say), recorded into one command encoder, submitted
+/// once and read back with one wait.
+pub fn rasterise_jobs(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    jobs: &[RasterJob<'_>],
+) -> Result<Vec<MeshGBuffer>, RuntimeError> {
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
+    let targets = jobs.iter().map(|j| record(device, &mut enc, j)).collect::<Result<Vec<_>, _>>()?;
+    let all: Vec<&wgpu::Texture> = targets.iter().flatten().collect();
+    let read = gpu::read_textures(device, queue, enc, &all)?;
+    Ok(jobs
+        .iter()
+        .zip(read.chunks_exact(3))
+        .map(|(j, t)| {
+            let [a, b, c] = [0, 1, 2].map(|k| gpu::f16_to_f32(&t[k]));
+            decode(j.width, j.height, j.samples, &a, &b, &c)
+        })
+        .collect())
+}
+
+/// Records the G-buffer pass of `job` into `enc`; returns its three targets (normal + depth, uv + coverage,
+/// tangent; resolved when multisampled).
+fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    job: &RasterJob<'_>,
+) -> Result<[wgpu::Texture; 3], RuntimeError> {
+    let RasterJob { mesh, tangents, camera, width, height, samples } = *job;
+    check_raster_inputs(mesh, tangents, samples)?;
     if samples > 1 {
         use wgpu::TextureFormatFeatureFlags as Fl;
         for f in [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Depth32Float] {
@@ -263,7 +312,6 @@ pub fn rasterise_with_tangents(
         g2.create_view(&Default::default()),
         depth.create_view(&Default::default()),
     );
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mesh") });
     {
         let attach = |k: usize, single| {
             let (view, resolve_target) = if samples > 1 { (&ms[k], Some(single)) } else { (single, None) };
@@ -295,13 +343,15 @@ pub fn rasterise_with_tangents(
         pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..mesh.indices.len() as u32, 0, 0..1);
     }
-    queue.submit([enc.finish()]);
-    let (a, b) = (gpu::read_texture_f16(device, queue, &g0)?, gpu::read_texture_f16(device, queue, &g1)?);
-    let c = gpu::read_texture_f16(device, queue, &g2)?;
+    Ok([g0, g1, g2])
+}
+
+/// The G-buffer from its three targets read back as f32 (see [`record`]).
+fn decode(width: u32, height: u32, samples: u32, a: &[f32], b: &[f32], c: &[f32]) -> MeshGBuffer {
     let mut g = MeshGBuffer::empty(width, height);
     if samples > 1 {
-        resolve_coverage(&mut g, &a, &b, &c);
-        return Ok(g);
+        resolve_coverage(&mut g, a, b, c);
+        return g;
     }
     for i in 0..(width * height) as usize {
         if b[4 * i + 2] > 0.5 {
@@ -313,7 +363,7 @@ pub fn rasterise_with_tangents(
             g.tangent_view[i] = [c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]];
         }
     }
-    Ok(g)
+    g
 }
 
 /// The G-buffer from the resolved (sample-averaged) targets: coverage = the averaged flag, attributes = averaged

@@ -154,10 +154,7 @@ pub fn rasterise_with_tangents(
     height: u32,
     samples: u32,
 ) -> Result<MeshGBuffer, crate::error::InvalidInput> {
-    crate::runtime::skin::mesh_raster::check_samples(samples)?;
-    if tangents.len() != mesh.positions.len() {
-        return Err(crate::error::InvalidInput::new("tangents", "need one tangent per vertex of the mesh"));
-    }
+    crate::runtime::skin::mesh_raster::check_raster_inputs(mesh, tangents, samples)?;
     if samples == 1 {
         return Ok(rasterise_one(mesh, tangents, camera, width, height));
     }

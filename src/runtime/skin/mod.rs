@@ -5,7 +5,8 @@
 //! eq. 7.6 at the mesh's uv), [`wrinkles`] (Listing 8.1), [`surface_maps`] (a scan's albedo and normal map at the mesh's uv), [`bloom`], [`texture_space`] (d'Eon et al.'s
 //! texture-space diffusion, TAP's "TS").
 //! Frames: [`lighting`] (the shared lighting and compositing every frame goes through: skin inputs → diffuse +
-//! transmitted light → SSS → post-scatter albedo, specular, bloom → tone map), [`demo`] (the procedural spheres),
+//! transmitted light → SSS → post-scatter albedo, specular, bloom → tone map; on a device recorded into one command
+//! encoder by [`shade_frame`], one read-back), [`demo`] (the procedural spheres),
 //! [`heads`] (heads from a mesh: G-buffer, shadow-map thickness), [`frame`] (`run skin`: picks the SSS shader),
 //! [`settings`], [`passes`] (the optional passes of `run skin`).
 
@@ -23,6 +24,7 @@ pub mod mesh_raster;
 pub mod mesh_raster_cpu;
 pub mod passes;
 pub mod settings;
+pub mod shade_frame;
 pub mod surface_maps;
 pub mod surface_maps_cpu;
 pub mod tap_grid;

@@ -484,7 +484,7 @@ impl TextureSpaceDiffusion {
             pass.dispatch_workgroups(groups.min(GATHER_ROW_GROUPS), groups.div_ceil(GATHER_ROW_GROUPS), 1);
         }
         enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
-        queue.submit([enc.finish()]);
+        gpu::submit(queue, enc.finish());
         let bytes = gpu::map_read(device, &readback)?;
         let v: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         Ok(v[..uvs.len()].to_vec())

@@ -36,7 +36,7 @@ pub(crate) fn run(
         &[PRELUDES, pass_wgsl].concat(),
         params,
         &[uvc, nrm, tng, map_a, map_b, Buffer::Zeroed(out_bytes)],
-        &[Stage { entry: "main", groups: compute_chain::groups_8x8(g.width, g.height) }],
+        &[Stage::new("main", compute_chain::groups_8x8(g.width, g.height))],
         5,
     )
 }

@@ -23,7 +23,7 @@ use crate::baked_layout::path;
 use crate::error::InvalidInput;
 use crate::facial::wrinkles::{zone_weights, TABLE_8_1};
 use crate::io::PixelFormat;
-use crate::runtime::compute_chain::Buffer;
+use crate::runtime::compute_chain::{self, Buffer};
 use crate::runtime::loader::{BakedDir, LutError, LutSpec};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
 use crate::runtime::skin::view_frame;
@@ -132,19 +132,11 @@ pub fn parse_wrinkle_weights(spec: &str) -> Result<[f32; 8], InvalidInput> {
     Ok(zone_weights(&pairs)?.map(|v| v as f32))
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Params {
-    size: [f32; 4],
-    mask: [f32; 4],
-    weights: [[f32; 4]; 2],
-}
-
 /// The largest per-pixel buffer [`wrinkled_normals`] allocates for a `width`×`height` G-buffer, bytes: the uv and
 /// coverage, the normals, the tangents and the result, each one vec4 of f32 per pixel (the PD map and zone masks
 /// are the baked maps, independent of the frame).
 pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
-    16 * width as u64 * height as u64
+    compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
 /// The wrinkled view-space normals of `g` (uncovered pixels keep theirs), on the GPU.
@@ -156,9 +148,9 @@ pub fn wrinkled_normals(
     weights: &[f32; 8],
 ) -> Result<Vec<[f32; 3]>, RuntimeError> {
     maps.validate()?;
-    let params = Params {
+    let params = compute_chain::MapParams {
         size: [g.width as f32, g.height as f32, maps.pd_size.0 as f32, maps.pd_size.1 as f32],
-        mask: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
+        cfg: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
         weights: [[weights[0], weights[1], weights[2], weights[3]], [weights[4], weights[5], weights[6], weights[7]]],
     };
     let masks: Vec<f32> = maps.masks.iter().flatten().flatten().copied().collect();

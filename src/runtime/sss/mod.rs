@@ -129,6 +129,17 @@ impl<B: SssBlur> SssPass<B> {
         self.inputs.upload(queue, color, depth)
     }
 
+    /// Uploads the linear depth alone (top row first): the irradiance comes from an earlier pass of the same
+    /// command encoder, copied into [`SssPass::input`].
+    pub fn upload_depth(&self, queue: &wgpu::Queue, depth: &[f32]) -> Result<(), InvalidInput> {
+        let d = &self.inputs.depth;
+        if depth.len() != d.width() as usize * d.height() as usize {
+            return Err(InvalidInput::new("depth", format!("must be {}x{} values", d.width(), d.height())));
+        }
+        gpu::upload(queue, d, bytemuck::cast_slice(depth));
+        Ok(())
+    }
+
     /// Records the blur's passes; the k-th (0-based) uses timer slot `first + k`.
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         self.blur.encode(enc, timer)
@@ -145,7 +156,7 @@ impl<B: SssBlur> SssPass<B> {
         self.upload(queue, color, depth)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss") });
         self.encode(&mut enc, None);
-        queue.submit([enc.finish()]);
-        gpu::read_texture_f16(device, queue, &self.output)
+        // One submission: the read-back's copy joins the blur's encoder.
+        Ok(gpu::f16_to_f32(&gpu::read_textures(device, queue, enc, &[&self.output])?[0]))
     }
 }

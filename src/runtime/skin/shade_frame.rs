@@ -1,0 +1,183 @@
+//! The shading of a skin frame resident on the GPU, as an engine records a frame: the skin-inputs pass, the lit
+//! diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
+//! specular layer, bloom (thesis ch. 4) and the tone map are recorded into **one** command encoder, hand textures
+//! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
+//! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
+//! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
+//! and read back on its own, for inspection and for texture-space diffusion): `render_geometry` picks one.
+//!
+//! Where a texture pass and a buffer pass meet, the data is converted on the device: the skin-inputs targets
+//! (`Rgba16Float`) and the SSS pass's output are copied into buffers with padded rows and unpacked by
+//! `shade_frame.wgsl`, which also packs the lit layer as the SSS pass's half-float input (a buffer-to-texture copy).
+//! `shade_frame.wgsl` runs through `compute_chain::record`, bloom through `bloom::record`.
+
+use crate::error::InvalidInput;
+use crate::image_buf::Image;
+use crate::runtime::backend::Backend;
+use crate::runtime::chain::{Subsurface, SubsurfaceGpu};
+use crate::runtime::compute_chain::{self, Stage};
+use crate::runtime::device::Gpu;
+use crate::runtime::gpu;
+use crate::runtime::skin::bloom::{self, BloomBuffers};
+use crate::runtime::skin::inputs::SkinInputs;
+use crate::runtime::skin::lighting::{self, lit_geometry, subsurface_of, SssMethod};
+use crate::runtime::skin::lighting::{DemoAssets, Geometry, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
+use crate::runtime::RuntimeError;
+
+thread_local! {
+    static SHADING_IN_ONE_ENCODER: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
+}
+
+/// On a device, frames rendered on the calling thread record their shading into one command encoder with one
+/// read-back (true, the default), or run each pass with its own submission and read-back (false: the per-pass
+/// path, for inspecting the stages and for benchmarks that compare the two in one run). The CPU twins are the
+/// same either way.
+pub fn set_shading_in_one_encoder(on: bool) {
+    SHADING_IN_ONE_ENCODER.with(|c| c.set(on));
+}
+
+/// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
+/// `method` (None: no SSS; the transmitted light is in that layer), tone-mapped and encoded.
+pub(crate) fn render_geometry(
+    gpu: Backend<'_>,
+    geo: Geometry,
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+    background: Vec<u8>,
+) -> Result<Image<u8>, RuntimeError> {
+    // Both closures are FnOnce; the one that runs takes the frame.
+    let parts = std::cell::Cell::new(Some((geo, background)));
+    let take = || parts.take().expect("one backend runs");
+    let per_pass = |(geo, background): (Geometry, Vec<u8>)| {
+        let lit = lit_geometry(gpu, geo, assets)?;
+        lighting::shade(gpu, lit, assets, method, background, None)
+    };
+    gpu.run(
+        // On a device: every stage recorded into one command encoder, one read-back.
+        |g| {
+            if !SHADING_IN_ONE_ENCODER.with(|c| c.get()) {
+                return per_pass(take());
+            }
+            let (geo, background) = take();
+            shade(g, &geo, assets, subsurface_of(assets, method)?.as_ref(), background)
+        },
+        || per_pass(take()),
+    )
+}
+
+const SOURCE: &str = concat!(include_str!("../aa/srgb.wgsl"), include_str!("shade_frame.wgsl"));
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    size: [f32; 4],
+    key: [f32; 4],
+    cfg: [f32; 4],
+}
+
+/// Per pixel of `geo` the two vec4 `shade_frame.wgsl` reads: (view-space normal, skin 1/0), (albedo map, specular).
+fn geometry_texels(geo: &Geometry) -> Vec<f32> {
+    let n = geo.skin.len();
+    let mut out = vec![0.0f32; 8 * n];
+    for (i, px) in out.chunks_exact_mut(8).enumerate() {
+        let nv = geo.frame.normals[i];
+        px[..3].copy_from_slice(&nv);
+        px[3] = if geo.skin[i] { 1.0 } else { 0.0 };
+        if let Some(a) = &geo.albedo {
+            px[4..7].copy_from_slice(&a[i]);
+        }
+        px[7] = geo.specular.as_ref().map_or(0.0, |s| s[i]);
+    }
+    out
+}
+
+/// The frame of `geo` shaded through `sss` (None: no SSS pass) over `background` (RGBA8 sRGB of the frame's size),
+/// with `assets`' tables, lights, post-scatter switch and bloom: one submission, one read-back (the RGBA8 frame).
+pub(crate) fn shade(
+    g: &Gpu,
+    geo: &Geometry,
+    assets: &DemoAssets,
+    sss: Option<&Subsurface>,
+    background: Vec<u8>,
+) -> Result<Image<u8>, RuntimeError> {
+    let (device, queue) = (&g.device, &g.queue);
+    let (w, h) = (geo.frame.width, geo.frame.height);
+    let n = w as u64 * h as u64;
+    if background.len() as u64 != 4 * n {
+        return Err(InvalidInput::new("background", format!("must be {w}x{h} RGBA8")).into());
+    }
+    let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
+    inputs.upload(queue, &geo.frame, &assets.rig_weights, assets.lights.back_view)?;
+    let blur = match sss {
+        Some(m) => Some(SubsurfaceGpu::new(g, (w, h), m)?),
+        None => None,
+    };
+    if let Some(b) = &blur {
+        b.upload_depth(queue, &geo.depth)?;
+    }
+    let bloom_buffers = match &assets.bloom {
+        Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
+        None => None,
+    };
+    // Half-float images (the skin-inputs targets, the SSS frame) share one padded row: all are w×h Rgba16Float.
+    let row = gpu::padded_row_bytes(inputs.albedo()) as u64;
+    let what = "skin frame";
+    let sizes = [2 * row * h as u64, 32 * n, 16 * n, row * h as u64, 16 * n, 16, 4 * n];
+    compute_chain::check_buffers(device, what, &sizes)?;
+    let texels = geometry_texels(geo);
+    let make = |k: usize, data: Option<&[u8]>| compute_chain::storage_buffer(device, what, sizes[k], data);
+    let skin16 = make(0, None);
+    let geo_buf = make(1, Some(bytemuck::cast_slice(&texels)));
+    let diffuse = make(2, None);
+    let sss16 = make(3, None);
+    let rgba = make(6, Some(&background));
+    // Bloom reads the HDR frame from its first buffer and leaves its result in its last.
+    let (hdr, bloomed) = match &bloom_buffers {
+        Some(b) => (b.0[0].clone(), b.0[3].clone()),
+        None => (make(4, None), make(5, None)),
+    };
+    let key = assets.lights.key_view;
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
+    let params = Params {
+        size: [w as f32, h as f32, (row / 4) as f32, flag(assets.post_scatter_albedo)],
+        key: [key[0], key[1], key[2], flag(geo.albedo.is_some())],
+        cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, flag(bloom_buffers.is_some()), flag(blur.is_some())],
+    };
+    let bound = [&skin16, &geo_buf, &diffuse, &sss16, &hdr, &bloomed, &rgba];
+    let groups = compute_chain::groups_8x8(w, h);
+    let stages = |names: &[&'static str]| names.iter().map(|e| Stage::new(e, groups)).collect::<Vec<_>>();
+    let uniform = bytemuck::bytes_of(&params);
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+    inputs.encode(&mut enc);
+    gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
+    gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row * h as u64);
+    match &blur {
+        Some(b) => {
+            compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["lit", "pack"]));
+            gpu::encode_buffer_to_texture(&mut enc, &sss16, 0, b.input());
+            b.encode(&mut enc);
+            gpu::encode_texture_to_buffer(&mut enc, b.output(), &sss16, 0);
+            compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["composite"]));
+        }
+        None => compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["lit", "composite"])),
+    }
+    if let (Some(p), Some(b)) = (&assets.bloom, &bloom_buffers) {
+        bloom::record(device, &mut enc, w, h, p, b);
+    }
+    compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["tonemap"]));
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: rgba.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    enc.copy_buffer_to_buffer(&rgba, 0, &readback, 0, rgba.size());
+    gpu::submit(queue, enc.finish());
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(RuntimeError::Gpu(format!("{what}: {e}")));
+    }
+    let mut out = gpu::map_read(device, &readback)?;
+    out.truncate(4 * n as usize);
+    Ok(Image::from_vec(w, h, 4, out))
+}
