@@ -174,5 +174,5 @@ fn the_pass_shape_is_compute_or_fragment() {
     assert_eq!(PassShape::parse("compute").unwrap(), PassShape::Compute);
     assert_eq!(PassShape::parse("fragment").unwrap(), PassShape::Fragment);
     let e = PassShape::parse("vertex").unwrap_err().to_string();
-    assert!(e.contains("RTBAKE_AA_PASSES") && e.contains("`compute` or `fragment`, got `vertex`"), "{e}");
+    assert!(e.contains("RTBAKE_AA_PASSES") && e.contains("must be compute or fragment, got \"vertex\""), "{e}");
 }

@@ -48,7 +48,7 @@ impl PassShape {
         [Self::Compute, Self::Fragment]
             .into_iter()
             .find(|s| s.name() == value)
-            .ok_or_else(|| InvalidInput::new(Self::ENV, format!("must be `compute` or `fragment`, got `{value}`")))
+            .ok_or_else(|| InvalidInput::new(Self::ENV, format!("must be compute or fragment, got {value:?}")))
     }
 
     /// [`Self::ENV`] when set ([`Self::parse`]), else [`PassShape::Compute`].
