@@ -158,6 +158,10 @@ impl ThreePass {
         (edge_settings, lca, masked): (&EdgeSettings, f32, bool),
     ) -> Result<Self, RuntimeError> {
         let name = spec.name;
+        // The edge rows are one storage binding; a frame whose rows exceed the device's binding limit takes the
+        // fragment shape (same bytes) rather than failing.
+        let rows_fit = edge_row_bytes(width) as u64 * height as u64 <= device.limits().max_storage_buffer_binding_size;
+        let shape = if rows_fit { shape } else { PassShape::Fragment };
         let label = |what: &str| format!("{name} {what}");
         let size = (width, height);
         let color = gpu::texture(device, &label("colour"), width, height, wgpu::TextureFormat::Rgba8Unorm);
