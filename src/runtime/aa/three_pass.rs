@@ -3,8 +3,9 @@
 //! and read-back. [`crate::runtime::aa::smaa::Smaa`] and [`crate::runtime::aa::mlaa::Mlaa`] hand over their shader
 //! module, uniform buffer and look-up tables ([`PassSpec`]); [`ThreePass::build`] makes the rest.
 //!
-//! Two shapes of the same arithmetic ([`PassShape`]): three compute passes over 8×8-thread workgroups
-//! (`three_pass.wgsl`, the default) or the three full-screen fragment passes they replace. Both call the same
+//! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
+//! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
+//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace. Both call the same
 //! per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes (tested); the compute
 //! shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline spans (on an NVIDIA
 //! H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment` selects the fragment
@@ -24,7 +25,7 @@ const WORKGROUP: u32 = 8;
 /// The form the three passes take on the GPU; the output bytes are the same.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum PassShape {
-    /// Three compute passes over 8×8-thread workgroups, storage-texture writes.
+    /// Compute passes: edges and blending over 8×8-thread workgroups, the weights on a list of the edge pixels.
     #[default]
     Compute,
     /// Three full-screen fragment passes into render targets (the shape before the compute passes).
@@ -72,11 +73,15 @@ pub(crate) struct PassSpec<'a> {
 pub(crate) enum Passes {
     /// Render targets: the edges, weights and output views.
     Fragment { pipes: [wgpu::RenderPipeline; 3], groups: [wgpu::BindGroup; 3], views: [wgpu::TextureView; 3] },
-    /// The edge rows buffer (copied into the edges texture) and the edges view another detector renders into.
+    /// Edges, edge list, dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
+    /// edges texture), the edge list (count first), the weights pass's indirect arguments and the edges view another
+    /// detector renders into.
     Compute {
-        pipes: [wgpu::ComputePipeline; 3],
-        groups: [wgpu::BindGroup; 3],
+        pipes: [wgpu::ComputePipeline; 5],
+        groups: [wgpu::BindGroup; 5],
         edge_rows: wgpu::Buffer,
+        edge_list: wgpu::Buffer,
+        weights_args: wgpu::Buffer,
         edges_view: wgpu::TextureView,
     },
 }
@@ -158,10 +163,13 @@ impl ThreePass {
         (edge_settings, lca, masked): (&EdgeSettings, f32, bool),
     ) -> Result<Self, RuntimeError> {
         let name = spec.name;
-        // The edge rows are one storage binding; a frame whose rows exceed the device's binding limit takes the
-        // fragment shape (same bytes) rather than failing.
-        let rows_fit = edge_row_bytes(width) as u64 * height as u64 <= device.limits().max_storage_buffer_binding_size;
-        let shape = if rows_fit { shape } else { PassShape::Fragment };
+        // The edge rows and the edge list are storage bindings; a frame whose buffers exceed the device's limits
+        // takes the fragment shape (same bytes) rather than failing.
+        let (rows_bytes, list_bytes) =
+            (edge_row_bytes(width) as u64 * height as u64, 4 + 4 * width as u64 * height as u64);
+        let limits = device.limits();
+        let fits = rows_bytes.max(list_bytes) <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let shape = if fits { shape } else { PassShape::Fragment };
         let label = |what: &str| format!("{name} {what}");
         let size = (width, height);
         let color = gpu::texture(device, &label("colour"), width, height, wgpu::TextureFormat::Rgba8Unorm);
@@ -174,14 +182,13 @@ impl ThreePass {
         let ubo = || (0, spec.ubo.as_entire_binding());
         let mut weights_entries = vec![ubo(), (2, R::TextureView(&ev))];
         weights_entries.extend(spec.weight_luts.iter().cloned());
-        let mut entries = [
+        let entries = [
             vec![ubo(), (1, R::TextureView(&cv))],
             weights_entries,
             vec![ubo(), (1, R::TextureView(&cv)), (5, R::TextureView(&wv))],
         ];
-        let stages = ["edges", "weights", "blend"];
-        let group = |k: usize, layout: &wgpu::BindGroupLayout, entries: &[(u32, R<'_>)]| {
-            gpu::bind_group(device, &label(stages[k]), layout, entries)
+        let group = |stage: &str, layout: &wgpu::BindGroupLayout, entries: &[(u32, R<'_>)]| {
+            gpu::bind_group(device, &label(stage), layout, entries)
         };
         let extra = EdgeStage::new(device, size, (&cv, &ov), edge_settings, lca, masked)?;
         let passes = match shape {
@@ -194,23 +201,35 @@ impl ThreePass {
                             gpu::fullscreen_pipeline(device, &label(stage), spec.module, entry, format)
                         },
                     );
-                let groups = [0, 1, 2].map(|k| group(k, &pipes[k].get_bind_group_layout(0), &entries[k]));
+                let stages = ["edges", "weights", "blend"];
+                let groups = [0, 1, 2].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
                 Passes::Fragment { pipes, groups, views: [ev.clone(), wv.clone(), ov.clone()] }
             }
             PassShape::Compute => {
-                let edge_rows = device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(&label("edge rows")),
-                    size: edge_row_bytes(width) as u64 * height as u64,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                });
-                entries[0].push((8, edge_rows.as_entire_binding()));
-                entries[1].push((9, R::TextureView(&wv)));
-                entries[2].push((10, R::TextureView(&ov)));
-                let pipes =
-                    ["cs_edges", "cs_weights", "cs_blend"].map(|e| gpu::compute_pipeline(device, spec.module, e));
-                let groups = [0, 1, 2].map(|k| group(k, &pipes[k].get_bind_group_layout(0), &entries[k]));
-                Passes::Compute { pipes, groups, edge_rows, edges_view: ev.clone() }
+                let buffer = |what: &str, size: u64, usage: wgpu::BufferUsages| {
+                    let usage = usage | wgpu::BufferUsages::STORAGE;
+                    let desc =
+                        wgpu::BufferDescriptor { label: Some(&label(what)), size, usage, mapped_at_creation: false };
+                    device.create_buffer(&desc)
+                };
+                use wgpu::BufferUsages as B;
+                let edge_rows = buffer("edge rows", rows_bytes, B::COPY_SRC);
+                let edge_list = buffer("edge list", list_bytes, B::COPY_DST);
+                let weights_args = buffer("weights dispatch", 12, B::INDIRECT);
+                let [edges_entries, mut weights_entries, blend_entries] = entries;
+                let list = || (11, edge_list.as_entire_binding());
+                weights_entries.extend([(9, R::TextureView(&wv)), list()]);
+                let entries = [
+                    [edges_entries, vec![(8, edge_rows.as_entire_binding())]].concat(),
+                    vec![ubo(), (2, R::TextureView(&ev)), (9, R::TextureView(&wv)), list()],
+                    vec![list(), (12, weights_args.as_entire_binding())],
+                    weights_entries,
+                    [blend_entries, vec![(10, R::TextureView(&ov))]].concat(),
+                ];
+                let stages = ["cs_edges", "cs_edge_list", "cs_edge_args", "cs_weights_list", "cs_blend"];
+                let pipes = stages.map(|e| gpu::compute_pipeline(device, spec.module, e));
+                let groups = [0, 1, 2, 3, 4].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
+                Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view: ev.clone() }
             }
         };
         Ok(Self { width, height, color, edges, weights, output, passes, extra, name })
@@ -224,8 +243,9 @@ impl ThreePass {
         }
     }
 
-    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps (the compute shape's
-    /// edges slot spans its pass and the copy of the edge rows into the edges texture).
+    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps (in the compute shape the
+    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the edge
+    /// list, the dispatch arguments and the weights).
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
         match &self.passes {
@@ -238,24 +258,31 @@ impl ThreePass {
                     gpu::draw_fullscreen(enc, &label, &pipes[k], &groups[k], &views[k], slot(k as u32));
                 }
             }
-            Passes::Compute { pipes, groups, edge_rows, edges_view } => {
+            Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view } => {
                 let (w, h) = (self.width, self.height);
-                let dispatch = |enc: &mut wgpu::CommandEncoder, k: usize, groups_x: u32, writes| {
+                // One compute pass of pipeline `k`: a grid of `groups_xy` workgroups, or the indirect arguments.
+                let dispatch = |enc: &mut wgpu::CommandEncoder, k: usize, groups_xy: Option<(u32, u32)>, writes| {
                     let desc = wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: writes };
                     let mut pass = enc.begin_compute_pass(&desc);
                     pass.set_pipeline(&pipes[k]);
                     pass.set_bind_group(0, &groups[k], &[]);
-                    pass.dispatch_workgroups(groups_x, h.div_ceil(WORKGROUP), 1);
+                    match groups_xy {
+                        Some((x, y)) => pass.dispatch_workgroups(x, y, 1),
+                        None => pass.dispatch_workgroups_indirect(weights_args, 0),
+                    }
                 };
+                // The begin (or end) timestamp of slot `k` alone: a slot spanning several passes.
+                let half = |k: u32, begin: bool| {
+                    slot(k).map(|(t, i)| wgpu::ComputePassTimestampWrites {
+                        query_set: &t.query_set,
+                        beginning_of_pass_write_index: begin.then_some(2 * i),
+                        end_of_pass_write_index: (!begin).then_some(2 * i + 1),
+                    })
+                };
+                let grid = |threads_x: u32| Some((threads_x.div_ceil(WORKGROUP), h.div_ceil(WORKGROUP)));
+                enc.clear_buffer(edge_list, 0, Some(4));
                 if !self.extra.encode_edges(enc, edges_view, slot(0)) {
-                    let half = |begin: bool| {
-                        slot(0).map(|(t, i)| wgpu::ComputePassTimestampWrites {
-                            query_set: &t.query_set,
-                            beginning_of_pass_write_index: begin.then_some(2 * i),
-                            end_of_pass_write_index: (!begin).then_some(2 * i + 1),
-                        })
-                    };
-                    dispatch(enc, 0, w.div_ceil(2).div_ceil(WORKGROUP), half(true));
+                    dispatch(enc, 0, grid(w.div_ceil(2)), half(0, true));
                     enc.copy_buffer_to_texture(
                         wgpu::TexelCopyBufferInfo {
                             buffer: edge_rows,
@@ -269,16 +296,17 @@ impl ThreePass {
                         wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
                     );
                     // An empty pass closes the edges slot after the copy.
-                    if let Some(writes) = half(false) {
+                    if let Some(writes) = half(0, false) {
                         drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                             label: Some("edges copied"),
                             timestamp_writes: Some(writes),
                         }));
                     }
                 }
-                for k in 1..3 {
-                    dispatch(enc, k, w.div_ceil(WORKGROUP), slot(k as u32).map(|(t, i)| t.compute_pass_writes(i)));
-                }
+                dispatch(enc, 1, grid(w), half(1, true));
+                dispatch(enc, 2, Some((1, 1)), None);
+                dispatch(enc, 3, None, half(1, false));
+                dispatch(enc, 4, grid(w), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
             }
         }
         self.extra.encode_mask(enc);

@@ -1,6 +1,7 @@
-// The three morphological antialiasing passes of SMAA (smaa.wgsl) and MLAA (mlaa.wgsl) as compute passes over
-// 8×8-thread workgroups: the same per-pixel functions `edges_px`, `weights_px` and `blend_px` as the fragment entry
-// points, so every arithmetic step is the fragment path's. Appended after smaa.wgsl or mlaa.wgsl by
+// The three morphological antialiasing passes of SMAA (smaa.wgsl) and MLAA (mlaa.wgsl) as compute passes (edges
+// and blending over 8×8-thread workgroups, the weights over a list of the edge pixels): the same per-pixel functions
+// `edges_px`, `weights_px` and `blend_px` as the fragment entry points, so every arithmetic step is the fragment
+// path's. Appended after smaa.wgsl or mlaa.wgsl by
 // `runtime/aa/three_pass.rs`; the including shader declares `P` with `rt` = (1/width, 1/height, width, height).
 //
 // Why compute: on GPUs whose graphics pipeline reaches only part of the chip (NVIDIA H100/H200: two TPCs of the
@@ -37,12 +38,73 @@ fn cs_edges(@builtin(global_invocation_id) id: vec3<u32>) {
     edge_rows[id.y * edge_row_words() + id.x] = pack4x8unorm(vec4<f32>(e0, e1));
 }
 
+// Weights on edge pixels only (the compute form of the stencil SMAA's weights pass runs under, thesis §9.3): a list
+// pass writes zero weights everywhere and appends each edge pixel to `edge_list` (one global atomic per workgroup),
+// one thread turns the count into the indirect dispatch, and `cs_weights_list` runs `weights_px` on the listed pixels,
+// packed 64 to a workgroup. Pixels without an edge have zero weights in both shapes (`weights_px` returns 0 there).
+struct EdgeList {
+    count: atomic<u32>,
+    // x | y << 16 of each edge pixel, in no particular order (each pixel writes only its own weights).
+    pixels: array<u32>,
+}
+
+@group(0) @binding(11) var<storage, read_write> edge_list: EdgeList;
+@group(0) @binding(12) var<storage, read_write> weights_args: array<u32, 3>;
+
+// Threads per workgroup of `cs_weights_list`, and the most workgroups one dispatch dimension takes.
+const LIST_GROUP: u32 = 64u;
+const MAX_GROUPS_X: u32 = 65535u;
+
+var<workgroup> group_count: atomic<u32>;
+var<workgroup> group_base: u32;
+
 @compute @workgroup_size(8, 8)
-fn cs_weights(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (any(id.xy >= vec2<u32>(P.rt.zw))) {
+fn cs_edge_list(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    var is_edge = false;
+    if (all(id.xy < vec2<u32>(P.rt.zw))) {
+        let e = textureLoad(edges_tex, vec2<i32>(id.xy), 0).rg;
+        is_edge = e.x > 0.0 || e.y > 0.0;
+        textureStore(weights_out, id.xy, vec4<f32>(0.0));
+    }
+    if (li == 0u) {
+        atomicStore(&group_count, 0u);
+    }
+    workgroupBarrier();
+    var slot = 0u;
+    if (is_edge) {
+        slot = atomicAdd(&group_count, 1u);
+    }
+    workgroupBarrier();
+    if (li == 0u) {
+        group_base = atomicAdd(&edge_list.count, atomicLoad(&group_count));
+    }
+    workgroupBarrier();
+    if (is_edge) {
+        edge_list.pixels[group_base + slot] = id.x | (id.y << 16u);
+    }
+}
+
+@compute @workgroup_size(1)
+fn cs_edge_args() {
+    let groups = (atomicLoad(&edge_list.count) + LIST_GROUP - 1u) / LIST_GROUP;
+    weights_args[0] = min(groups, MAX_GROUPS_X);
+    weights_args[1] = (groups + MAX_GROUPS_X - 1u) / MAX_GROUPS_X;
+    weights_args[2] = 1u;
+}
+
+@compute @workgroup_size(LIST_GROUP)
+fn cs_weights_list(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let i = (group.y * groups.x + group.x) * LIST_GROUP + li;
+    if (i >= atomicLoad(&edge_list.count)) {
         return;
     }
-    textureStore(weights_out, id.xy, weights_px(vec2<f32>(id.xy) + vec2<f32>(0.5, 0.5)));
+    let packed = edge_list.pixels[i];
+    let p = vec2<u32>(packed & 0xffffu, packed >> 16u);
+    textureStore(weights_out, p, weights_px(vec2<f32>(p) + vec2<f32>(0.5, 0.5)));
 }
 
 @compute @workgroup_size(8, 8)
