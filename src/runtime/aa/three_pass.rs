@@ -163,12 +163,13 @@ impl ThreePass {
         (edge_settings, lca, masked): (&EdgeSettings, f32, bool),
     ) -> Result<Self, RuntimeError> {
         let name = spec.name;
-        // The edge rows and the edge list are storage bindings; a frame whose buffers exceed the device's limits
-        // takes the fragment shape (same bytes) rather than failing.
+        // The edge rows and the edge list are storage bindings, and the list packs x and y in 16 bits each; a frame
+        // beyond the device's limits or 65536 pixels a side takes the fragment shape (same bytes) rather than failing.
         let (rows_bytes, list_bytes) =
             (edge_row_bytes(width) as u64 * height as u64, 4 + 4 * width as u64 * height as u64);
         let limits = device.limits();
-        let fits = rows_bytes.max(list_bytes) <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let fits = rows_bytes.max(list_bytes) <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
+            && width.max(height) <= 1 << 16;
         let shape = if fits { shape } else { PassShape::Fragment };
         let label = |what: &str| format!("{name} {what}");
         let size = (width, height);
