@@ -5,11 +5,11 @@
 //!
 //! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
 //! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
-//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace. Both call the same
-//! per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes (tested); the compute
-//! shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline spans (on an NVIDIA
-//! H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment` selects the fragment
-//! shape for the default constructors, so one benchmark binary measures both.
+//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace.
+//! Both call the same per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes
+//! (tested); the compute shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline
+//! spans (on an NVIDIA H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment`
+//! selects the fragment shape for the default constructors, so one benchmark binary measures both.
 
 use crate::error::InvalidInput;
 use crate::runtime::aa::edges::{AaInputs, EdgeSettings, EdgeStage};
