@@ -1,7 +1,7 @@
 //! The three passes SMAA 1x and MLAA share (thesis ch. 9–10): edge detection (or the `EdgeStage` of another
 //! detector), blending weights, neighbourhood blending, then the optional mask; the frame's textures, its upload
 //! and read-back. [`crate::runtime::aa::smaa::Smaa`] and [`crate::runtime::aa::mlaa::Mlaa`] hand over their shader
-//! module, uniform buffer and look-up tables ([`PassSpec`]); [`ThreePass::build`] makes the rest.
+//! module, uniform buffer and look-up tables (`PassSpec`); `ThreePass::build` makes the rest.
 //!
 //! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
 //! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
