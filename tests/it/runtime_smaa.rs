@@ -176,3 +176,33 @@ fn the_pass_shape_is_compute_or_fragment() {
     let e = PassShape::parse("vertex").unwrap_err().to_string();
     assert!(e.contains("RTBAKE_AA_PASSES") && e.contains("must be compute or fragment, got \"vertex\""), "{e}");
 }
+
+/// The compute shape's edge list at its extremes: a flat frame (no edge pixel: an empty indirect dispatch, zero
+/// weights, the input unchanged) and a 2048×2048 one-pixel checkerboard (every pixel an edge pixel: 65536 workgroups
+/// of 64, more than one dispatch row of 65535), against the fragment shape's bytes.
+#[test]
+fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
+    use rtbake::runtime::aa::three_pass::PassShape;
+    use rtbake::runtime::smaa::SmaaOptions;
+    let g = gpu();
+    let luts = baked_smaa();
+    let read = |t: &wgpu::Texture| rtbake::runtime::gpu::read_texture(&g.device, &g.queue, t).unwrap();
+    let run = |(w, h): (u32, u32), img: &[u8], shape| {
+        let pass = Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), shape).unwrap();
+        let out = pass.run(&g.device, &g.queue, img).unwrap();
+        (read(pass.weights()), out)
+    };
+    let flat = vec![90u8; 64 * 48 * 4];
+    let (weights, out) = run((64, 48), &flat, PassShape::Compute);
+    assert!(weights.iter().all(|v| *v == 0), "a flat frame has no blending weights");
+    assert_eq!(out, flat, "a flat frame leaves SMAA unchanged");
+    let n = 2048u32;
+    let board: Vec<u8> = (0..n * n)
+        .flat_map(|i| if (i % n + i / n) % 2 == 0 { [230, 230, 230, 255] } else { [20, 20, 20, 255] })
+        .collect();
+    let (wc, oc) = run((n, n), &board, PassShape::Compute);
+    let (wf, of) = run((n, n), &board, PassShape::Fragment);
+    assert!(wf.iter().any(|v| *v > 0), "the checkerboard must produce blending weights");
+    assert!(wc == wf, "weights differ in {} bytes", wc.iter().zip(&wf).filter(|(a, b)| a != b).count());
+    assert!(oc == of, "outputs differ in {} bytes", oc.iter().zip(&of).filter(|(a, b)| a != b).count());
+}
