@@ -198,7 +198,7 @@ fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
     assert_eq!(out, flat, "a flat frame leaves SMAA unchanged");
     let n = 2048u32;
     let board: Vec<u8> = (0..n * n)
-        .flat_map(|i| if (i % n + i / n) % 2 == 0 { [230, 230, 230, 255] } else { [20, 20, 20, 255] })
+        .flat_map(|i| if (i % n + i / n).is_multiple_of(2) { [230, 230, 230, 255] } else { [20, 20, 20, 255] })
         .collect();
     let (wc, oc) = run((n, n), &board, PassShape::Compute);
     let (wf, of) = run((n, n), &board, PassShape::Fragment);
