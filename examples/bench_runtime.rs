@@ -11,6 +11,13 @@
 //! bandwidth, measured first in the same run with buffer-to-buffer copies (read + write bytes per second), and
 //! the ratio time / bound.
 //!
+//! SMAA 1x and MLAA run twice, in their fragment shape (three full-screen fragment passes, as before) and their
+//! compute shape (three compute passes, the default; `rtbake::runtime::aa::three_pass::PassShape`), and a line per
+//! pass gives the speed-up and time/bound of both. On a GPU (exact command, from the repository root):
+//!
+//!     cargo build --release --example bench_runtime --example bench_smaa_modes && \
+//!         scripts/gpu_bench.sh target/release/examples 1920x1080
+//!
 //! GPU passes are timed with timestamp queries when the adapter supports them, else by wall time of
 //! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
 //! rasteriser (lavapipe/llvmpipe) are CPU figures, not GPU figures. Thesis anchors: SMAA 1x 1.02 ms at 1080p
@@ -18,15 +25,17 @@
 //! Tables: the committed bake (`baked/` beside the crate, or $RTBAKE_BAKED_DIR) through the manifest-checked
 //! loader: SMAA area/search, MLAA AreaMap33 v1.4, the published 17-tap separable kernel, d'Eon's 6 Gaussians.
 
+use rtbake::runtime::aa::three_pass::PassShape;
 use rtbake::runtime::cpu::{self, FilterPrecision, Tex8};
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gaussian_sss::GaussianSss;
 use rtbake::runtime::gpu::GpuTimer;
 use rtbake::runtime::loader;
-use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap};
+use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
+use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
 use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
-use rtbake::runtime::smaa::{Smaa, SubsampleIndices};
+use rtbake::runtime::smaa::{Smaa, SmaaOptions, SubsampleIndices};
 use rtbake::runtime::sss::separable_tiled::SeparableSssTiled;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -110,23 +119,16 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures,
         .unwrap_or_else(|e| panic!("{e}"));
     let fit =
         loader::load_gaussians(dir, rtbake::baked_layout::path::GAUSSIANS_DEFAULT).unwrap_or_else(|e| panic!("{e}"));
-    println!("medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene)");
+    println!(
+        "medians of {RUNS} runs; scene: procedural shapes (rtbake::runtime::scene), for SMAA and MLAA also the moving \
+         scene's textured frame (rtbake::runtime::moving_scene, edges almost everywhere)"
+    );
     for &(w, h) in sizes {
         let px = w as u64 * h as u64;
         let img = render_shapes(w, h, 1);
-        let smaa = Smaa::new(&g.device, &g.queue, w, h, luts).unwrap();
-        smaa.upload(&g.queue, &img).unwrap();
-        let (pp, wall) = time_passes(&g, 3, &|e, t| smaa.encode(e, t));
-        print_line(&format!("SMAA 1x {w}x{h}"), &pp, wall, "thesis 1.02 ms @1080p GTX 470");
-        // Edges: colour RGBA8 in, edges RG8 out; weights: edges in, weights RGBA8 out; blend: colour + weights in,
-        // RGBA8 out.
-        let aa_bytes = [6 * px, 6 * px, 12 * px];
-        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
-        let mlaa = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
-        mlaa.upload(&g.queue, &img).unwrap();
-        let (pp, wall) = time_passes(&g, 3, &|e, t| mlaa.encode(e, t));
-        print_line(&format!("MLAA N={n} {w}x{h}"), &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
-        print_bounds(&["edges", "weights", "blend"], &pp, wall, &aa_bytes, bw);
+        aa_shapes(&g, luts, &map, (w, h), &img, "shapes", bw);
+        let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
+        aa_shapes(&g, luts, &map, (w, h), &moving, "moving scene", bw);
         // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
         let (color, depth) = sss_frame(w, h);
         let sss = SeparableSss::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
@@ -150,6 +152,57 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures,
             (0..gs.passes()).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
         let bytes: Vec<u64> = (0..gs.passes()).map(|i| if i % 2 == 0 { 28 * px } else { 44 * px }).collect();
         print_bounds(&names.iter().map(String::as_str).collect::<Vec<_>>(), &pp, wall, &bytes, bw);
+    }
+}
+
+/// SMAA 1x and MLAA on `img` in the fragment shape (three full-screen fragment passes, before) and the compute shape
+/// (three compute passes, after; the same output bytes), each pass beside its bytes-moved bound, then the speed-up.
+fn aa_shapes(
+    g: &rtbake::runtime::device::Gpu,
+    luts: &rtbake::runtime::smaa::SmaaTextures,
+    map: &MlaaAreaMap,
+    (w, h): (u32, u32),
+    img: &[u8],
+    scene: &str,
+    bw: f64,
+) {
+    let px = w as u64 * h as u64;
+    // Edges: colour RGBA8 in, edges RG8 out; weights: edges in, weights RGBA8 out; blend: colour + weights in, RGBA8
+    // out. The look-up tables and the texels the searches read twice are left out: a bound, not a model.
+    let aa_bytes = [6 * px, 6 * px, 12 * px];
+    let names = ["edges", "weights", "blend"];
+    let mut totals = Vec::new();
+    for shape in [PassShape::Fragment, PassShape::Compute] {
+        let smaa = Smaa::with_shape(&g.device, &g.queue, (w, h), luts, &SmaaOptions::default(), shape).unwrap();
+        smaa.upload(&g.queue, img).unwrap();
+        let (pp, wall) = time_passes(g, 3, &|e, t| smaa.encode(e, t));
+        let name = format!("SMAA 1x {w}x{h} {scene}, {}", shape.name());
+        print_line(&name, &pp, wall, "thesis 1.02 ms @1080p GTX 470; goal 0.2 ms @1080p H100");
+        print_bounds(&names, &pp, wall, &aa_bytes, bw);
+        totals.push(("SMAA 1x", total_ms(&pp, wall), wall));
+    }
+    for shape in [PassShape::Fragment, PassShape::Compute] {
+        let mlaa = Mlaa::with_shape(&g.device, &g.queue, (w, h), map, &MlaaOptions::default(), shape).unwrap();
+        mlaa.upload(&g.queue, img).unwrap();
+        let (pp, wall) = time_passes(g, 3, &|e, t| mlaa.encode(e, t));
+        let name = format!("MLAA N={} {w}x{h} {scene}, {}", map.n, shape.name());
+        print_line(&name, &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
+        print_bounds(&names, &pp, wall, &aa_bytes, bw);
+        totals.push(("MLAA", total_ms(&pp, wall), wall));
+    }
+    // Software adapters do not time compute passes faithfully (their timestamps miss the work): the wall times of
+    // submit + wait are printed beside the timestamp sums, and on such an adapter only they compare.
+    let bound = aa_bytes.iter().sum::<u64>() as f64 / bw * 1e3;
+    for pair in totals.chunks(2) {
+        let ((pass, old, old_wall), (_, new, new_wall)) = (pair[0], pair[1]);
+        println!(
+            "{pass} {w}x{h} {scene}: fragment {old:.3} ms -> compute {new:.3} ms ({:.2}x); bound {bound:.4} ms, \
+             time/bound {:.1} -> {:.1}; wall {old_wall:.3} -> {new_wall:.3} ms ({:.2}x)",
+            old / new,
+            old / bound,
+            new / bound,
+            old_wall / new_wall
+        );
     }
 }
 
@@ -266,6 +319,15 @@ fn print_bounds(names: &[&str], per_pass: &[f64], wall: f64, bytes: &[u64], bw: 
             bound_ms(*b),
             ms / bound_ms(*b)
         );
+    }
+}
+
+/// The sum of the per-pass timestamps, else the wall time.
+fn total_ms(per_pass: &[f64], wall: f64) -> f64 {
+    if per_pass.is_empty() {
+        wall
+    } else {
+        per_pass.iter().sum()
     }
 }
 

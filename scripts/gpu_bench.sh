@@ -5,6 +5,15 @@
 #
 #   scripts/gpu_bench.sh BIN_DIR [WIDTHxHEIGHT]      # default 1920x1080
 #
+# On a GPU machine, from the repository root (the exact command; release build of the examples, then the run):
+#   cargo build --release --example bench_runtime --example bench_smaa_modes && \
+#     scripts/gpu_bench.sh target/release/examples 1920x1080 2>&1 | tee gpu_bench.log
+#
+# SMAA 1x and MLAA are measured in both shapes in one run: bench_runtime times the fragment passes (before) and the
+# compute passes (after, the default) side by side, each pass beside its bytes-moved bound, and prints the speed-up;
+# bench_smaa_modes runs once per shape (RTBAKE_AA_PASSES=fragment, then compute). The per-shape byte identity is
+# a test: `cargo test --test it runtime_smaa::compute_and_fragment` (run it on the GPU too).
+#
 # BIN_DIR holds release builds of the examples (`cargo build --release --example bench_runtime --example
 # bench_smaa_modes` puts them in target/release/examples). The same command runs binaries built from an older tree
 # (e.g. main): bench_runtime there ignores the size argument and prints both 1280x720 and 1920x1080 without the
@@ -28,8 +37,10 @@ echo "== gpu_bench $(date -u +%FT%TZ) bin=$bin size=$size"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv || true
 echo "== bench_runtime $size gpu-only"
 "$bin/bench_runtime" "$size" gpu-only
-echo "== bench_smaa_modes"
-"$bin/bench_smaa_modes"
+for shape in fragment compute; do
+  echo "== bench_smaa_modes RTBAKE_AA_PASSES=$shape"
+  RTBAKE_AA_PASSES=$shape "$bin/bench_smaa_modes"
+done
 if [[ -x $bin/bench_skin_frames ]]; then
   # run skin's whole frame per shader, the runtime's caches off (as before them) and on; absent from older trees.
   echo "== bench_skin_frames ${size/x/ } 5"

@@ -117,3 +117,92 @@ fn smaa_subsample_slices_gpu_matches_cpu() {
     }
     assert!(SubsampleIndices([7, 0, 0, 0]).validate().is_err());
 }
+
+/// The compute and fragment shapes of the SMAA and MLAA passes (`runtime::aa::three_pass::PassShape`) write the same
+/// bytes: edges, blending weights and output, on the shapes scene (odd size: partial workgroups and an odd last
+/// edge pair), the moving scene's textured frame (edges almost everywhere), with colour edges (another detector
+/// feeding the compute weights pass) and with a mask.
+#[test]
+fn compute_and_fragment_passes_write_the_same_bytes() {
+    use rtbake::runtime::aa::edges::{AaInputs, EdgeDetector, EdgeSettings};
+    use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
+    use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
+    use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
+    use rtbake::runtime::smaa::SmaaOptions;
+    let g = gpu();
+    let (luts, map) = (baked_smaa(), MlaaAreaMap::new(33, baked_mlaa(33)).unwrap());
+    let read = |t: &wgpu::Texture| rtbake::runtime::gpu::read_texture(&g.device, &g.queue, t).unwrap();
+    let images = |p: &ThreePass, img: &[u8], inputs: &AaInputs| {
+        let out = p.run_with(&g.device, &g.queue, img, inputs).unwrap();
+        [read(p.edges()), read(p.weights()), out]
+    };
+    let colour = EdgeSettings { detector: EdgeDetector::Color, ..Default::default() };
+    let (w, h) = (301u32, 173u32);
+    let mask: Vec<u8> = (0..w * h).map(|i| if (i % w) < w / 2 { 255 } else { 0 }).collect();
+    let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
+    let cases: [(&str, Vec<u8>, EdgeSettings, bool); 4] = [
+        ("shapes", render_shapes(w, h, 1), EdgeSettings::default(), false),
+        ("moving scene", moving, EdgeSettings::default(), false),
+        ("colour edges", render_shapes(w, h, 1), colour, false),
+        ("masked", render_shapes(w, h, 1), EdgeSettings::default(), true),
+    ];
+    for (name, img, edges, masked) in &cases {
+        let inputs = AaInputs { depth: None, mask: masked.then_some(mask.as_slice()) };
+        let (smaa_options, mlaa_options) = (
+            SmaaOptions { edges: *edges, masked: *masked, ..Default::default() },
+            MlaaOptions { edges: *edges, masked: *masked },
+        );
+        let smaa = |s| Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &smaa_options, s).unwrap();
+        let mlaa = |s| Mlaa::with_shape(&g.device, &g.queue, (w, h), &map, &mlaa_options, s).unwrap();
+        let (sc, sf) = (smaa(PassShape::Compute), smaa(PassShape::Fragment));
+        assert_eq!((sc.shape(), sf.shape()), (PassShape::Compute, PassShape::Fragment));
+        let (mc, mf) = (mlaa(PassShape::Compute), mlaa(PassShape::Fragment));
+        for (pass, c, f) in [("SMAA", &*sc, &*sf), ("MLAA", &*mc, &*mf)] {
+            let (a, b) = (images(c, img, &inputs), images(f, img, &inputs));
+            assert!(b[1].iter().any(|v| *v > 0), "{pass} {name}: the scene must produce blending weights");
+            for (k, what) in ["edges", "weights", "output"].iter().enumerate() {
+                let differ = a[k].iter().zip(&b[k]).filter(|(x, y)| x != y).count();
+                assert_eq!(differ, 0, "{pass} {name}: {what} differ in {differ} bytes between compute and fragment");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_pass_shape_is_compute_or_fragment() {
+    use rtbake::runtime::aa::three_pass::PassShape;
+    assert_eq!(PassShape::parse("compute").unwrap(), PassShape::Compute);
+    assert_eq!(PassShape::parse("fragment").unwrap(), PassShape::Fragment);
+    let e = PassShape::parse("vertex").unwrap_err().to_string();
+    assert!(e.contains("RTBAKE_AA_PASSES") && e.contains("must be compute or fragment, got \"vertex\""), "{e}");
+}
+
+/// The compute shape's edge list at its extremes: a flat frame (no edge pixel: an empty indirect dispatch, zero
+/// weights, the input unchanged) and a 2048×2048 one-pixel checkerboard (every pixel an edge pixel: 65536 workgroups
+/// of 64, more than one dispatch row of 65535), against the fragment shape's bytes.
+#[test]
+fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
+    use rtbake::runtime::aa::three_pass::PassShape;
+    use rtbake::runtime::smaa::SmaaOptions;
+    let g = gpu();
+    let luts = baked_smaa();
+    let read = |t: &wgpu::Texture| rtbake::runtime::gpu::read_texture(&g.device, &g.queue, t).unwrap();
+    let run = |(w, h): (u32, u32), img: &[u8], shape| {
+        let pass = Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), shape).unwrap();
+        let out = pass.run(&g.device, &g.queue, img).unwrap();
+        (read(pass.weights()), out)
+    };
+    let flat = vec![90u8; 64 * 48 * 4];
+    let (weights, out) = run((64, 48), &flat, PassShape::Compute);
+    assert!(weights.iter().all(|v| *v == 0), "a flat frame has no blending weights");
+    assert_eq!(out, flat, "a flat frame leaves SMAA unchanged");
+    let n = 2048u32;
+    let board: Vec<u8> = (0..n * n)
+        .flat_map(|i| if (i % n + i / n).is_multiple_of(2) { [230, 230, 230, 255] } else { [20, 20, 20, 255] })
+        .collect();
+    let (wc, oc) = run((n, n), &board, PassShape::Compute);
+    let (wf, of) = run((n, n), &board, PassShape::Fragment);
+    assert!(wf.iter().any(|v| *v > 0), "the checkerboard must produce blending weights");
+    assert!(wc == wf, "weights differ in {} bytes", wc.iter().zip(&wf).filter(|(a, b)| a != b).count());
+    assert!(oc == of, "outputs differ in {} bytes", oc.iter().zip(&of).filter(|(a, b)| a != b).count());
+}

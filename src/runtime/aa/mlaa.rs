@@ -10,8 +10,8 @@
 
 use crate::aa::mlaa_area::MlaaVersion;
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{EdgeSettings, EdgeStage};
-use crate::runtime::aa::three_pass::ThreePass;
+use crate::runtime::aa::edges::EdgeSettings;
+use crate::runtime::aa::three_pass::{PassShape, PassSpec, ThreePass, COMPUTE_WGSL};
 use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
@@ -66,12 +66,17 @@ struct Params {
     cfg: [f32; 4],
 }
 
-const SHADER: &str = concat!(
-    include_str!("../fullscreen.wgsl"),
-    include_str!("srgb.wgsl"),
-    include_str!("morphological.wgsl"),
-    include_str!("mlaa.wgsl")
-);
+/// The MLAA shader: the full-screen triangle, the shared AA fetches, `mlaa.wgsl` and the compute entry points.
+static SHADER: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    concat!(
+        include_str!("../fullscreen.wgsl"),
+        include_str!("srgb.wgsl"),
+        include_str!("morphological.wgsl"),
+        include_str!("mlaa.wgsl")
+    )
+    .to_owned()
+        + COMPUTE_WGSL
+});
 
 /// MLAA for one frame size and area map. Create once, run per frame.
 pub struct Mlaa(ThreePass);
@@ -103,61 +108,33 @@ impl Mlaa {
         map: &MlaaAreaMap,
         options: &MlaaOptions,
     ) -> Result<Self, RuntimeError> {
+        Self::with_shape(device, queue, (width, height), map, options, PassShape::from_env()?)
+    }
+
+    /// As [`Self::with_options`] in the given [`PassShape`] (the benchmarks build both; same output bytes).
+    pub fn with_shape(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (width, height): (u32, u32),
+        map: &MlaaAreaMap,
+        options: &MlaaOptions,
+        shape: PassShape,
+    ) -> Result<Self, RuntimeError> {
         gpu::check_frame(device, width, height, 4)?;
-        use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, "mlaa colour", width, height, F::Rgba8Unorm);
-        let edges = gpu::texture(device, "mlaa edges", width, height, F::Rg8Unorm);
-        let weights = gpu::texture(device, "mlaa weights", width, height, F::Rgba8Unorm);
-        let output = gpu::texture(device, "mlaa output", width, height, F::Rgba8Unorm);
-        let area = gpu::texture(device, "mlaa area", 5 * map.n, 5 * map.n, F::Rg8Unorm);
+        let area = gpu::texture(device, "mlaa area", 5 * map.n, 5 * map.n, wgpu::TextureFormat::Rg8Unorm);
         gpu::upload(queue, &area, &map.bytes);
         let params = Params {
             rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
             cfg: [map.n as f32, map.search_steps() as f32, MLAA_THRESHOLD, 0.0],
         };
         let ubo = gpu::uniform_buffer(device, "mlaa params", bytemuck::bytes_of(&params));
-        let module = gpu::shader(device, "mlaa.wgsl", SHADER);
-        let pipes = [
-            gpu::fullscreen_pipeline(device, "mlaa edges", &module, "fs_edges", F::Rg8Unorm),
-            gpu::fullscreen_pipeline(device, "mlaa weights", &module, "fs_weights", F::Rgba8Unorm),
-            gpu::fullscreen_pipeline(device, "mlaa blend", &module, "fs_blend", F::Rgba8Unorm),
-        ];
-        let lin = gpu::linear_clamp_sampler(device);
-        let pnt = gpu::nearest_clamp_sampler(device);
-        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (cv, ev, wv, av) = (view(&color), view(&edges), view(&weights), view(&area));
+        let module = gpu::shader(device, "mlaa.wgsl", &SHADER);
+        let (lin, pnt) = (gpu::linear_clamp_sampler(device), gpu::nearest_clamp_sampler(device));
+        let av = area.create_view(&Default::default());
         use wgpu::BindingResource as R;
-        let groups = [
-            gpu::bind_group(
-                device,
-                "mlaa edges",
-                &pipes[0].get_bind_group_layout(0),
-                &[(0, ubo.as_entire_binding()), (1, R::TextureView(&cv))],
-            ),
-            gpu::bind_group(
-                device,
-                "mlaa weights",
-                &pipes[1].get_bind_group_layout(0),
-                &[
-                    (0, ubo.as_entire_binding()),
-                    (2, R::TextureView(&ev)),
-                    (3, R::TextureView(&av)),
-                    (6, R::Sampler(&lin)),
-                    (7, R::Sampler(&pnt)),
-                ],
-            ),
-            gpu::bind_group(
-                device,
-                "mlaa blend",
-                &pipes[2].get_bind_group_layout(0),
-                &[(0, ubo.as_entire_binding()), (1, R::TextureView(&cv)), (5, R::TextureView(&wv))],
-            ),
-        ];
-        let ov = view(&output);
-        let extra = EdgeStage::new(device, (width, height), (&cv, &ov), &options.edges, 0.0, options.masked)?;
-        let views = [ev, wv, ov];
-        let labels = ["mlaa edges", "mlaa weights", "mlaa blend"];
-        let name = "mlaa";
-        Ok(Self(ThreePass { width, height, color, edges, weights, output, views, pipes, groups, extra, labels, name }))
+        let weight_luts = vec![(3, R::TextureView(&av)), (6, R::Sampler(&lin)), (7, R::Sampler(&pnt))];
+        let spec = PassSpec { name: "mlaa", module: &module, ubo: &ubo, weight_luts };
+        let edges = (&options.edges, 0.0, options.masked);
+        Ok(Self(ThreePass::build(device, (width, height), spec, shape, edges)?))
     }
 }

@@ -25,13 +25,16 @@ struct Params {
 @group(0) @binding(7) var pnt: sampler;
 
 // Listing 9.1 (luminance variant): R = edge on the left, G = edge on top.
-@fragment
-fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+// The fragment entry points below and the compute ones of three_pass.wgsl call edges_px, weights_px, blend_px.
+fn edges_px(p: vec2<i32>) -> vec2<f32> {
     let l = luma_at(p);
     let delta = abs(vec2<f32>(l - luma_at(p + vec2<i32>(-1, 0)), l - luma_at(p + vec2<i32>(0, -1))));
-    let edges = step(vec2<f32>(P.cfg.z), delta);
-    return vec4<f32>(edges, 0.0, 0.0);
+    return step(vec2<f32>(P.cfg.z), delta);
+}
+
+@fragment
+fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(edges_px(vec2<i32>(floor(pos.xy))), 0.0, 0.0);
 }
 
 // Listing 9.3 and its three siblings: distance to the end of the line, two edgels per fetch.
@@ -91,9 +94,7 @@ fn area(d: vec2<f32>, e1: f32, e2: f32) -> vec2<f32> {
 }
 
 // Listing 9.2.
-@fragment
-fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let pix = pos.xy;
+fn weights_px(pix: vec2<f32>) -> vec4<f32> {
     var weights = vec4<f32>(0.0);
     let e = textureLoad(edges_tex, vec2<i32>(floor(pix)), 0).rg;
     if (e.y > 0.0) {
@@ -116,11 +117,14 @@ fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     return weights;
 }
 
+@fragment
+fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return weights_px(pos.xy);
+}
+
 // Listing 9.5: a = (own north, bottom pixel's g, own west, right pixel's a); each neighbour is blended in by the
 // bilinear fetch at an offset of a_k pixels, written out as a lerp; the result is averaged over the lines.
-@fragment
-fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+fn blend_px(p: vec2<i32>) -> vec4<f32> {
     let top_left = blend_at(p);
     let bottom = blend_at(p + vec2<i32>(0, 1)).g;
     let right = blend_at(p + vec2<i32>(1, 0)).a;
@@ -137,4 +141,9 @@ fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         return vec4<f32>(linear_to_srgb(color.rgb), color.a);
     }
     return textureLoad(color_tex, p, 0);
+}
+
+@fragment
+fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return blend_px(vec2<i32>(floor(pos.xy)));
 }

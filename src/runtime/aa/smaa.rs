@@ -10,8 +10,8 @@
 //! ([`crate::runtime::aa::edges`]).
 
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{EdgeSettings, EdgeStage, SMAA_LOCAL_CONTRAST_ADAPTATION};
-use crate::runtime::aa::three_pass::ThreePass;
+use crate::runtime::aa::edges::{EdgeSettings, SMAA_LOCAL_CONTRAST_ADAPTATION};
+use crate::runtime::aa::three_pass::{PassShape, PassSpec, ThreePass, COMPUTE_WGSL};
 use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
@@ -143,7 +143,7 @@ fn shader_source() -> &'static str {
             include_str!("srgb.wgsl"),
             include_str!("morphological.wgsl"),
             include_str!("smaa.wgsl")
-        )
+        ) + COMPUTE_WGSL
     });
     &SOURCE
 }
@@ -195,14 +195,22 @@ impl Smaa {
         luts: &SmaaTextures,
         options: &SmaaOptions,
     ) -> Result<Self, RuntimeError> {
+        Self::with_shape(device, queue, (width, height), luts, options, PassShape::from_env()?)
+    }
+
+    /// As [`Self::with_options`] in the given [`PassShape`] (the benchmarks build both; same output bytes).
+    pub fn with_shape(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (width, height): (u32, u32),
+        luts: &SmaaTextures,
+        options: &SmaaOptions,
+        shape: PassShape,
+    ) -> Result<Self, RuntimeError> {
         let subsample = options.subsample;
         gpu::check_frame(device, width, height, 4)?;
         subsample.validate()?;
         use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, "smaa colour", width, height, F::Rgba8Unorm);
-        let edges = gpu::texture(device, "smaa edges", width, height, F::Rg8Unorm);
-        let weights = gpu::texture(device, "smaa weights", width, height, F::Rgba8Unorm);
-        let output = gpu::texture(device, "smaa output", width, height, F::Rgba8Unorm);
         let area = gpu::texture(device, "smaa area", AREA_TEX_SIZE.0, AREA_TEX_SIZE.1, F::Rg8Unorm);
         let search = gpu::texture(device, "smaa search", SEARCH_TEX_SIZE.0, SEARCH_TEX_SIZE.1, F::R8Unorm);
         gpu::upload(queue, &area, &luts.area);
@@ -213,60 +221,14 @@ impl Smaa {
         };
         let ubo = gpu::uniform_buffer(device, "smaa params", bytemuck::bytes_of(&params));
         let module = gpu::shader(device, "smaa.wgsl", shader_source());
-        let pipe_edges = gpu::fullscreen_pipeline(device, "smaa edges", &module, "fs_edges", F::Rg8Unorm);
-        let pipe_weights = gpu::fullscreen_pipeline(device, "smaa weights", &module, "fs_weights", F::Rgba8Unorm);
-        let pipe_blend = gpu::fullscreen_pipeline(device, "smaa blend", &module, "fs_blend", F::Rgba8Unorm);
         let sampler = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (color_view, edges_view, weights_view, output_view) =
-            (view(&color), view(&edges), view(&weights), view(&output));
         let (area_view, search_view) = (view(&area), view(&search));
         use wgpu::BindingResource as R;
-        let bg_edges = gpu::bind_group(
-            device,
-            "smaa edges",
-            &pipe_edges.get_bind_group_layout(0),
-            &[(0, ubo.as_entire_binding()), (1, R::TextureView(&color_view))],
-        );
-        let bg_weights = gpu::bind_group(
-            device,
-            "smaa weights",
-            &pipe_weights.get_bind_group_layout(0),
-            &[
-                (0, ubo.as_entire_binding()),
-                (2, R::TextureView(&edges_view)),
-                (3, R::TextureView(&area_view)),
-                (4, R::TextureView(&search_view)),
-                (6, R::Sampler(&sampler)),
-            ],
-        );
-        let bg_blend = gpu::bind_group(
-            device,
-            "smaa blend",
-            &pipe_blend.get_bind_group_layout(0),
-            &[(0, ubo.as_entire_binding()), (1, R::TextureView(&color_view)), (5, R::TextureView(&weights_view))],
-        );
-        let extra = EdgeStage::new(
-            device,
-            (width, height),
-            (&color_view, &output_view),
-            &options.edges,
-            SMAA_LOCAL_CONTRAST_ADAPTATION,
-            options.masked,
-        )?;
-        Ok(Self(ThreePass {
-            width,
-            height,
-            color,
-            edges,
-            weights,
-            output,
-            views: [edges_view, weights_view, output_view],
-            pipes: [pipe_edges, pipe_weights, pipe_blend],
-            groups: [bg_edges, bg_weights, bg_blend],
-            extra,
-            labels: ["smaa edges", "smaa weights", "smaa blend"],
-            name: "smaa",
-        }))
+        let weight_luts =
+            vec![(3, R::TextureView(&area_view)), (4, R::TextureView(&search_view)), (6, R::Sampler(&sampler))];
+        let spec = PassSpec { name: "smaa", module: &module, ubo: &ubo, weight_luts };
+        let edges = (&options.edges, SMAA_LOCAL_CONTRAST_ADAPTATION, options.masked);
+        Ok(Self(ThreePass::build(device, (width, height), spec, shape, edges)?))
     }
 }

@@ -36,16 +36,15 @@ struct Params {
 // ---------------------------------------------------------------------------------------------------------
 // Pass 1: luma edge detection with local contrast adaptation. R = edge on the left, G = edge on top.
 
-@fragment
-fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+// The edges of texel `p`; the fragment entry point below and `cs_edges` (three_pass.wgsl) call it.
+fn edges_px(p: vec2<i32>) -> vec2<f32> {
     let l = luma_at(p);
     let l_left = luma_at(p + vec2<i32>(-1, 0));
     let l_top = luma_at(p + vec2<i32>(0, -1));
     let delta_lt = abs(vec2<f32>(l - l_left, l - l_top));
     var edges = step(vec2<f32>(THRESHOLD), delta_lt);
     if (edges.x + edges.y == 0.0) {
-        return vec4<f32>(0.0);
+        return vec2<f32>(0.0);
     }
     let l_right = luma_at(p + vec2<i32>(1, 0));
     let l_bottom = luma_at(p + vec2<i32>(0, 1));
@@ -56,7 +55,12 @@ fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let final_delta = max(max_delta.x, max_delta.y);
     // Local contrast adaptation: drop an edge when a neighbouring edge is LOCAL_CONTRAST_ADAPTATION times stronger.
     edges = edges * step(vec2<f32>(final_delta), LOCAL_CONTRAST_ADAPTATION * delta_lt);
-    return vec4<f32>(edges, 0.0, 0.0);
+    return edges;
+}
+
+@fragment
+fn fs_edges(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(edges_px(vec2<i32>(floor(pos.xy))), 0.0, 0.0);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -222,9 +226,8 @@ fn corner_factor(d: vec2<f32>) -> vec2<f32> {
     return (1.0 - CORNER_ROUNDING_NORM) * left_right / (left_right.x + left_right.y);
 }
 
-@fragment
-fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let pix = pos.xy;
+// The blending weights of the pixel centred at `pix` (pixel units); `fs_weights` and `cs_weights` call it.
+fn weights_px(pix: vec2<f32>) -> vec4<f32> {
     var weights = vec4<f32>(0.0);
     var e = textureLoad(edges_tex, vec2<i32>(floor(pix)), 0).rg;
     let span = 2.0 * MAX_SEARCH_STEPS;
@@ -279,13 +282,17 @@ fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     return weights;
 }
 
+@fragment
+fn fs_weights(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return weights_px(pos.xy);
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Pass 3: neighbourhood blending, in linear light (the colour image holds sRGB-encoded values; the texture is
 // Rgba8Unorm, so the shader decodes and re-encodes itself).
 
-@fragment
-fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+// The blended colour of texel `p`; `fs_blend` and `cs_blend` call it.
+fn blend_px(p: vec2<i32>) -> vec4<f32> {
     let here = blend_at(p);
     // x: right neighbour's left weight, y: bottom neighbour's top weight, z: own right, w: own top... as in SMAA:
     // a = (right.a, bottom.g, own.b, own.r).
@@ -311,4 +318,9 @@ fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     // Each term is the bilinear fetch of the reference shader at an offset of w.x (w.y) pixels, written out.
     let out = wn.x * mix(c, n0, w.x) + wn.y * mix(c, n1, w.y);
     return vec4<f32>(linear_to_srgb(out.rgb), out.a);
+}
+
+@fragment
+fn fs_blend(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return blend_px(vec2<i32>(floor(pos.xy)));
 }

@@ -1,12 +1,90 @@
-//! The three full-screen passes SMAA 1x and MLAA share (thesis ch. 9–10): edge detection (or the
-//! `EdgeStage` of another detector), blending weights, neighbourhood blending, then the optional mask; the
-//! frame's textures, its upload and read-back. [`crate::runtime::aa::smaa::Smaa`] and
-//! [`crate::runtime::aa::mlaa::Mlaa`] build the pipelines and bind groups and hand them over.
+//! The three passes SMAA 1x and MLAA share (thesis ch. 9–10): edge detection (or the `EdgeStage` of another
+//! detector), blending weights, neighbourhood blending, then the optional mask; the frame's textures, its upload
+//! and read-back. [`crate::runtime::aa::smaa::Smaa`] and [`crate::runtime::aa::mlaa::Mlaa`] hand over their shader
+//! module, uniform buffer and look-up tables (`PassSpec`); `ThreePass::build` makes the rest.
+//!
+//! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
+//! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
+//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace.
+//! Both call the same per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes
+//! (tested); the compute shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline
+//! spans (on an NVIDIA H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment`
+//! selects the fragment shape for the default constructors, so one benchmark binary measures both.
 
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{AaInputs, EdgeStage};
+use crate::runtime::aa::edges::{AaInputs, EdgeSettings, EdgeStage};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
+
+/// The compute entry points appended after `smaa.wgsl` or `mlaa.wgsl`.
+pub(crate) const COMPUTE_WGSL: &str = include_str!("three_pass.wgsl");
+
+/// Threads per workgroup side of the compute shape (`@workgroup_size(8, 8)` in `three_pass.wgsl`).
+const WORKGROUP: u32 = 8;
+
+/// The form the three passes take on the GPU; the output bytes are the same.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PassShape {
+    /// Compute passes: edges and blending over 8×8-thread workgroups, the weights on a list of the edge pixels.
+    #[default]
+    Compute,
+    /// Three full-screen fragment passes into render targets (the shape before the compute passes).
+    Fragment,
+}
+
+impl PassShape {
+    /// The environment variable [`Self::from_env`] reads.
+    pub const ENV: &'static str = "RTBAKE_AA_PASSES";
+
+    /// `compute` or `fragment`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Compute => "compute",
+            Self::Fragment => "fragment",
+        }
+    }
+
+    /// `compute` or `fragment`; anything else is refused naming [`Self::ENV`].
+    pub fn parse(value: &str) -> Result<Self, InvalidInput> {
+        [Self::Compute, Self::Fragment]
+            .into_iter()
+            .find(|s| s.name() == value)
+            .ok_or_else(|| InvalidInput::new(Self::ENV, format!("must be compute or fragment, got {value:?}")))
+    }
+
+    /// [`Self::ENV`] when set ([`Self::parse`]), else [`PassShape::Compute`].
+    pub fn from_env() -> Result<Self, InvalidInput> {
+        std::env::var(Self::ENV).map_or(Ok(Self::default()), |v| Self::parse(&v))
+    }
+}
+
+/// What a pass hands to [`ThreePass::build`]: a module holding `fs_edges`/`fs_weights`/`fs_blend` and the compute
+/// entry points of `three_pass.wgsl`, its uniform buffer (binding 0) and the weights pass's look-up textures and
+/// samplers.
+pub(crate) struct PassSpec<'a> {
+    /// `smaa` or `mlaa`: the labels' prefix.
+    pub name: &'static str,
+    pub module: &'a wgpu::ShaderModule,
+    pub ubo: &'a wgpu::Buffer,
+    pub weight_luts: Vec<(u32, wgpu::BindingResource<'a>)>,
+}
+
+/// The passes of one shape: pipelines and bind groups of edges, weights and blending.
+pub(crate) enum Passes {
+    /// Render targets: the edges, weights and output views.
+    Fragment { pipes: [wgpu::RenderPipeline; 3], groups: [wgpu::BindGroup; 3], views: [wgpu::TextureView; 3] },
+    /// Edges, edge list, dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
+    /// edges texture), the edge list (count first), the weights pass's indirect arguments and the edges view another
+    /// detector renders into.
+    Compute {
+        pipes: [wgpu::ComputePipeline; 5],
+        groups: [wgpu::BindGroup; 5],
+        edge_rows: wgpu::Buffer,
+        edge_list: wgpu::Buffer,
+        weights_args: wgpu::Buffer,
+        edges_view: wgpu::TextureView,
+    },
+}
 
 /// The resources of a three-pass morphological antialiasing frame; the passes deref to it.
 pub struct ThreePass {
@@ -16,14 +94,31 @@ pub struct ThreePass {
     pub(crate) edges: wgpu::Texture,
     pub(crate) weights: wgpu::Texture,
     pub(crate) output: wgpu::Texture,
-    /// Render targets of the edges, weights and blending passes.
-    pub(crate) views: [wgpu::TextureView; 3],
-    pub(crate) pipes: [wgpu::RenderPipeline; 3],
-    pub(crate) groups: [wgpu::BindGroup; 3],
+    pub(crate) passes: Passes,
     pub(crate) extra: EdgeStage,
-    /// Debug labels of the three passes and of the submission.
-    pub(crate) labels: [&'static str; 3],
     pub(crate) name: &'static str,
+}
+
+/// Bytes per row of the compute shape's edge buffer: 2 per pixel, rounded up to the 256 a buffer-to-texture copy
+/// needs (`edge_row_words` in `three_pass.wgsl`).
+fn edge_row_bytes(width: u32) -> u32 {
+    (2 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
+}
+
+/// A frame texture the passes write: a render target and, for the compute shape, a storage texture.
+fn frame_texture(device: &wgpu::Device, label: &str, (w, h): (u32, u32), shape: PassShape) -> wgpu::Texture {
+    use wgpu::TextureUsages as U;
+    let storage = if shape == PassShape::Compute { U::STORAGE_BINDING } else { U::empty() };
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: U::TEXTURE_BINDING | U::RENDER_ATTACHMENT | U::COPY_DST | U::COPY_SRC | storage,
+        view_formats: &[],
+    })
 }
 
 impl ThreePass {
@@ -58,14 +153,162 @@ impl ThreePass {
         Ok(())
     }
 
-    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
-        for (k, label) in self.labels.iter().enumerate() {
-            let slot = timer.map(|(t, first)| (t, first + k as u32));
-            if k == 0 && self.extra.encode_edges(enc, &self.views[0], slot) {
-                continue;
+    /// Creates the textures, pipelines and bind groups of one frame size and shape (`lca`: the local contrast
+    /// adaptation factor of another edge detector, 0 for none).
+    pub(crate) fn build(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+        spec: PassSpec<'_>,
+        shape: PassShape,
+        (edge_settings, lca, masked): (&EdgeSettings, f32, bool),
+    ) -> Result<Self, RuntimeError> {
+        let name = spec.name;
+        // The edge rows and the edge list are storage bindings, and the list packs x and y in 16 bits each; a frame
+        // beyond the device's limits or 65536 pixels a side takes the fragment shape (same bytes) rather than failing.
+        let (rows_bytes, list_bytes) =
+            (edge_row_bytes(width) as u64 * height as u64, 4 + 4 * width as u64 * height as u64);
+        let limits = device.limits();
+        let fits = rows_bytes.max(list_bytes) <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
+            && width.max(height) <= 1 << 16;
+        let shape = if fits { shape } else { PassShape::Fragment };
+        let label = |what: &str| format!("{name} {what}");
+        let size = (width, height);
+        let color = gpu::texture(device, &label("colour"), width, height, wgpu::TextureFormat::Rgba8Unorm);
+        let edges = gpu::texture(device, &label("edges"), width, height, wgpu::TextureFormat::Rg8Unorm);
+        let weights = frame_texture(device, &label("weights"), size, shape);
+        let output = frame_texture(device, &label("output"), size, shape);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (cv, ev, wv, ov) = (view(&color), view(&edges), view(&weights), view(&output));
+        use wgpu::BindingResource as R;
+        let ubo = || (0, spec.ubo.as_entire_binding());
+        let mut weights_entries = vec![ubo(), (2, R::TextureView(&ev))];
+        weights_entries.extend(spec.weight_luts.iter().cloned());
+        let entries = [
+            vec![ubo(), (1, R::TextureView(&cv))],
+            weights_entries,
+            vec![ubo(), (1, R::TextureView(&cv)), (5, R::TextureView(&wv))],
+        ];
+        let group = |stage: &str, layout: &wgpu::BindGroupLayout, entries: &[(u32, R<'_>)]| {
+            gpu::bind_group(device, &label(stage), layout, entries)
+        };
+        let extra = EdgeStage::new(device, size, (&cv, &ov), edge_settings, lca, masked)?;
+        let passes = match shape {
+            PassShape::Fragment => {
+                let pipes =
+                    [("edges", "fs_edges", true), ("weights", "fs_weights", false), ("blend", "fs_blend", false)].map(
+                        |(stage, entry, rg)| {
+                            let format =
+                                if rg { wgpu::TextureFormat::Rg8Unorm } else { wgpu::TextureFormat::Rgba8Unorm };
+                            gpu::fullscreen_pipeline(device, &label(stage), spec.module, entry, format)
+                        },
+                    );
+                let stages = ["edges", "weights", "blend"];
+                let groups = [0, 1, 2].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
+                Passes::Fragment { pipes, groups, views: [ev.clone(), wv.clone(), ov.clone()] }
             }
-            gpu::draw_fullscreen(enc, label, &self.pipes[k], &self.groups[k], &self.views[k], slot);
+            PassShape::Compute => {
+                let buffer = |what: &str, size: u64, usage: wgpu::BufferUsages| {
+                    let usage = usage | wgpu::BufferUsages::STORAGE;
+                    let desc =
+                        wgpu::BufferDescriptor { label: Some(&label(what)), size, usage, mapped_at_creation: false };
+                    device.create_buffer(&desc)
+                };
+                use wgpu::BufferUsages as B;
+                let edge_rows = buffer("edge rows", rows_bytes, B::COPY_SRC);
+                let edge_list = buffer("edge list", list_bytes, B::COPY_DST);
+                let weights_args = buffer("weights dispatch", 12, B::INDIRECT);
+                let [edges_entries, mut weights_entries, blend_entries] = entries;
+                let list = || (11, edge_list.as_entire_binding());
+                weights_entries.extend([(9, R::TextureView(&wv)), list()]);
+                let entries = [
+                    [edges_entries, vec![(8, edge_rows.as_entire_binding())]].concat(),
+                    vec![ubo(), (2, R::TextureView(&ev)), (9, R::TextureView(&wv)), list()],
+                    vec![list(), (12, weights_args.as_entire_binding())],
+                    weights_entries,
+                    [blend_entries, vec![(10, R::TextureView(&ov))]].concat(),
+                ];
+                let stages = ["cs_edges", "cs_edge_list", "cs_edge_args", "cs_weights_list", "cs_blend"];
+                let pipes = stages.map(|e| gpu::compute_pipeline(device, spec.module, e));
+                let groups = [0, 1, 2, 3, 4].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
+                Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view: ev.clone() }
+            }
+        };
+        Ok(Self { width, height, color, edges, weights, output, passes, extra, name })
+    }
+
+    /// The shape the passes were built in.
+    pub fn shape(&self) -> PassShape {
+        match self.passes {
+            Passes::Fragment { .. } => PassShape::Fragment,
+            Passes::Compute { .. } => PassShape::Compute,
+        }
+    }
+
+    /// Records the three passes; `timer` slots `first..first+3` receive their timestamps (in the compute shape the
+    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the edge
+    /// list, the dispatch arguments and the weights).
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+        let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
+        match &self.passes {
+            Passes::Fragment { pipes, groups, views } => {
+                for k in 0..3 {
+                    if k == 0 && self.extra.encode_edges(enc, &views[0], slot(0)) {
+                        continue;
+                    }
+                    let label = format!("{} {}", self.name, ["edges", "weights", "blend"][k]);
+                    gpu::draw_fullscreen(enc, &label, &pipes[k], &groups[k], &views[k], slot(k as u32));
+                }
+            }
+            Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view } => {
+                let (w, h) = (self.width, self.height);
+                // One compute pass of pipeline `k`: a grid of `groups_xy` workgroups, or the indirect arguments.
+                let dispatch = |enc: &mut wgpu::CommandEncoder, k: usize, groups_xy: Option<(u32, u32)>, writes| {
+                    let desc = wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: writes };
+                    let mut pass = enc.begin_compute_pass(&desc);
+                    pass.set_pipeline(&pipes[k]);
+                    pass.set_bind_group(0, &groups[k], &[]);
+                    match groups_xy {
+                        Some((x, y)) => pass.dispatch_workgroups(x, y, 1),
+                        None => pass.dispatch_workgroups_indirect(weights_args, 0),
+                    }
+                };
+                // The begin (or end) timestamp of slot `k` alone: a slot spanning several passes.
+                let half = |k: u32, begin: bool| {
+                    slot(k).map(|(t, i)| wgpu::ComputePassTimestampWrites {
+                        query_set: &t.query_set,
+                        beginning_of_pass_write_index: begin.then_some(2 * i),
+                        end_of_pass_write_index: (!begin).then_some(2 * i + 1),
+                    })
+                };
+                let grid = |threads_x: u32| Some((threads_x.div_ceil(WORKGROUP), h.div_ceil(WORKGROUP)));
+                enc.clear_buffer(edge_list, 0, Some(4));
+                if !self.extra.encode_edges(enc, edges_view, slot(0)) {
+                    dispatch(enc, 0, grid(w.div_ceil(2)), half(0, true));
+                    enc.copy_buffer_to_texture(
+                        wgpu::TexelCopyBufferInfo {
+                            buffer: edge_rows,
+                            layout: wgpu::TexelCopyBufferLayout {
+                                offset: 0,
+                                bytes_per_row: Some(edge_row_bytes(w)),
+                                rows_per_image: None,
+                            },
+                        },
+                        self.edges.as_image_copy(),
+                        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                    );
+                    // An empty pass closes the edges slot after the copy.
+                    if let Some(writes) = half(0, false) {
+                        drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("edges copied"),
+                            timestamp_writes: Some(writes),
+                        }));
+                    }
+                }
+                dispatch(enc, 1, grid(w), half(1, true));
+                dispatch(enc, 2, Some((1, 1)), None);
+                dispatch(enc, 3, None, half(1, false));
+                dispatch(enc, 4, grid(w), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
+            }
         }
         self.extra.encode_mask(enc);
     }
