@@ -467,8 +467,19 @@ fn type_mismatch(template: &Value, given: &Value, path: String) -> Option<String
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// `asset`'s default parameters and their typed form `P`, asserting that `P` writes them back unchanged (no
+    /// field lost or renamed between the embedded defaults and the struct the bake parses).
+    pub(crate) fn default_params_round_trip<P: serde::Serialize + serde::de::DeserializeOwned>(
+        asset: &Asset,
+    ) -> (Value, P) {
+        let v = (asset.default_params)();
+        let p: P = serde_json::from_value(v.clone()).unwrap();
+        assert_eq!(serde_json::to_value(&p).unwrap(), v, "{}", asset.name);
+        (v, p)
+    }
 
     #[test]
     fn the_default_bake_is_estimated_within_the_cli_time_budget() {

@@ -360,9 +360,7 @@ mod tests {
 
     #[test]
     fn default_params_round_trip_and_name_every_profile() {
-        let v = (assets()[0].default_params)();
-        let p: ProfilesParams = serde_json::from_value(v.clone()).unwrap();
-        assert_eq!(serde_json::to_value(&p).unwrap(), v);
+        let (_, p): (_, ProfilesParams) = crate::bake::tests::default_params_round_trip(&assets()[0]);
         let list = sources(&p).unwrap();
         assert_eq!(list.len(), 11 + 2 + 3 + 1);
         let three = list.iter().find(|s| s.0 == "layered/skin3_example").unwrap();

@@ -122,6 +122,18 @@ fn default_params() -> ReportParams {
     }
 }
 
+pub fn assets() -> Vec<Asset> {
+    vec![Asset {
+        name: "transport-report",
+        summary: "Monte Carlo transport vs the dipole (Jensen 2001 materials) and vs the multipole models of \
+                  physiological skins (spectral Monte Carlo reference, g = 0 and tissue-like g): total R and \
+                  r R(r) differences, table, summary and figures",
+        default_params: || serde_json::to_value(default_params()).expect("params serialise"),
+        bake,
+        time_estimate: Some(time_estimate),
+    }]
+}
+
 /// The seed of one case: FNV-1a (64-bit) of the case label, XOR the base seed. Deterministic, and different for
 /// every skin and g, so no two rows share a random stream.
 pub fn case_seed(base: u64, label: &str) -> u64 {
@@ -647,27 +659,13 @@ fn accuracy_panels(rows: &[Row]) -> [LinePlot; 2] {
     [panel(false), panel(true)]
 }
 
-pub fn assets() -> Vec<Asset> {
-    vec![Asset {
-        name: "transport-report",
-        summary: "Monte Carlo transport vs the dipole (Jensen 2001 materials) and vs the multipole models of \
-                  physiological skins (spectral Monte Carlo reference, g = 0 and tissue-like g): total R and \
-                  r R(r) differences, table, summary and figures",
-        default_params: || serde_json::to_value(default_params()).expect("params serialise"),
-        bake,
-        time_estimate: Some(time_estimate),
-    }]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn default_params_round_trip_and_bad_params_name_the_field() {
-        let v = (assets()[0].default_params)();
-        let p: ReportParams = serde_json::from_value(v.clone()).unwrap();
-        assert_eq!(serde_json::to_value(&p).unwrap(), v);
+        let (v, _): (_, ReportParams) = crate::bake::tests::default_params_round_trip(&assets()[0]);
         let expect = |field: &str, value: Value, name: &str| {
             let mut bad = v.clone();
             bad[field] = value;

@@ -17,7 +17,7 @@
 //!
 //! Prahl's table has a 2 nm step; values at other wavelengths are interpolated linearly between its rows.
 
-use super::data::{HEMOGLOBIN_EXTINCTION, HEMOGLOBIN_FIRST_NM, HEMOGLOBIN_STEP_NM};
+use super::data::{hemoglobin_extinction, HEMOGLOBIN_FIRST_NM, HEMOGLOBIN_STEP_NM};
 
 /// Hemoglobin concentration of whole blood used by Donner & Jensen 2006, g/L.
 pub const DEFAULT_HEMOGLOBIN_G_PER_L: f64 = 150.0;
@@ -54,14 +54,14 @@ pub fn dermis_sigma_s_prime_per_mm(lambda_nm: f64) -> f64 {
 pub fn hemoglobin_extinction_per_cm_per_molar(lambda_nm: f64) -> Option<[f64; 2]> {
     let first = HEMOGLOBIN_FIRST_NM as f64;
     let step = HEMOGLOBIN_STEP_NM as f64;
-    let last = first + step * (HEMOGLOBIN_EXTINCTION.len() - 1) as f64;
+    let last = first + step * (hemoglobin_extinction().len() - 1) as f64;
     if !(first..=last).contains(&lambda_nm) {
         return None;
     }
     let x = (lambda_nm - first) / step;
-    let i = (x.floor() as usize).min(HEMOGLOBIN_EXTINCTION.len() - 2);
+    let i = (x.floor() as usize).min(hemoglobin_extinction().len() - 2);
     let f = x - i as f64;
-    let (a, b) = (HEMOGLOBIN_EXTINCTION[i], HEMOGLOBIN_EXTINCTION[i + 1]);
+    let (a, b) = (hemoglobin_extinction()[i], hemoglobin_extinction()[i + 1]);
     Some([a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])])
 }
 
@@ -122,13 +122,13 @@ mod tests {
     #[test]
     fn interpolation_hits_table_rows_and_midpoints() {
         // 500 nm is row (500 − 250)/2 = 125; 501 nm is halfway to row 126.
-        let r = HEMOGLOBIN_EXTINCTION[125];
-        let s = HEMOGLOBIN_EXTINCTION[126];
+        let r = hemoglobin_extinction()[125];
+        let s = hemoglobin_extinction()[126];
         assert_eq!(hemoglobin_extinction_per_cm_per_molar(500.0).unwrap(), r);
         let mid = hemoglobin_extinction_per_cm_per_molar(501.0).unwrap();
         assert!((mid[0] - 0.5 * (r[0] + s[0])).abs() < 1e-9);
         assert!((mid[1] - 0.5 * (r[1] + s[1])).abs() < 1e-9);
-        assert_eq!(hemoglobin_extinction_per_cm_per_molar(1000.0).unwrap(), HEMOGLOBIN_EXTINCTION[375]);
+        assert_eq!(hemoglobin_extinction_per_cm_per_molar(1000.0).unwrap(), hemoglobin_extinction()[375]);
         assert!(hemoglobin_extinction_per_cm_per_molar(249.0).is_none());
         assert!(hemoglobin_extinction_per_cm_per_molar(1001.0).is_none());
     }

@@ -13,7 +13,7 @@
 //! The matrix is folded into the per-wavelength weights, so a spectrum maps to linear RGB with one dot product per
 //! channel. Under D65 a perfect white reflector maps to (1, 1, 1) within the 4-digit rounding of the matrix.
 
-use super::data::{CIE1931_2DEG_CMF, CIE_D65_SPD, CIE_FIRST_NM, CIE_LEN};
+use super::data::{cie1931_2deg_cmf, cie_d65_spd, CIE_FIRST_NM, CIE_LEN};
 use crate::error::InvalidInput;
 
 /// XYZ → linear sRGB (IEC 61966-2-1:1999, D65 white), rows R, G, B.
@@ -39,7 +39,7 @@ impl Illuminant {
     /// Relative spectral power at `lambda_nm` (an integer wavelength of the 380–780 nm, 1 nm table).
     fn spd(self, index: usize) -> f64 {
         match self {
-            Self::D65 => CIE_D65_SPD[index],
+            Self::D65 => cie_d65_spd()[index],
             Self::EqualEnergy => 1.0,
         }
     }
@@ -105,7 +105,7 @@ impl ColorWeights {
             .map(|i| {
                 let t = grid.table_index(i);
                 let s = illuminant.spd(t);
-                let c = CIE1931_2DEG_CMF[t];
+                let c = cie1931_2deg_cmf()[t];
                 [s * c[0], s * c[1], s * c[2]]
             })
             .collect();

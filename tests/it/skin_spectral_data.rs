@@ -1,45 +1,49 @@
-//! The embedded tables in `src/spectral/data.rs` equal the attributed source files in `$RTBAKE_DATA_DIR`
-//! (default `../shared/data` relative to the crate root). Without that folder the file comparison is reported as
-//! skipped (a failure under `RTBAKE_REQUIRE_REFERENCE=1`) and the published anchor values, which need nothing
-//! external, are still checked. Regenerate with `python3 scripts/gen_spectral_data.py`.
+//! The spectral tables embedded in `src/spectral/data/` are the attributed source files in `$RTBAKE_DATA_DIR`
+//! (default `../shared/data` relative to the crate root), byte for byte, and the parsed tables hold their values.
+//! Without that folder the file comparison is reported as skipped (a failure under `RTBAKE_REQUIRE_REFERENCE=1`)
+//! and the parse and the published anchor values, which need nothing external, are still checked.
 
-use rtbake::spectral::data::{CIE1931_2DEG_CMF, CIE_D65_SPD, HEMOGLOBIN_EXTINCTION};
+use rtbake::spectral::data::{
+    cie1931_2deg_cmf, cie_d65_spd, hemoglobin_extinction, CIE_CMF_FILE, CIE_D65_FILE, HEMOGLOBIN_FILE,
+};
 
-/// Numeric rows of a table (comment and header lines skipped), or `None` when the data folder is absent.
-fn rows(name: &str, sep: char) -> Option<Vec<Vec<f64>>> {
-    let path = crate::support::data_dir_for("embedded spectral tables vs their source files")?.join(name);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (set RTBAKE_DATA_DIR to the physical data tables)", path.display()));
-    Some(
-        text.lines()
-            .map(str::trim)
-            .filter(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with("nm"))
-            .map(|l| l.split(sep).map(|t| t.trim().parse::<f64>().unwrap()).collect())
-            .collect(),
-    )
+/// Numeric rows of a table's text (comment and header lines skipped), parsed here independently of the crate.
+fn rows(text: &str, sep: char) -> Vec<Vec<f64>> {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#') && !l.starts_with("nm"))
+        .map(|l| l.split(sep).map(|t| t.trim().parse::<f64>().unwrap()).collect())
+        .collect()
 }
 
 #[test]
-fn hemoglobin_table_matches_prahl_file() {
-    let Some(r) = rows("hemoglobin_molar_extinction_prahl.tsv", '\t') else { return };
-    assert_eq!(r.len(), HEMOGLOBIN_EXTINCTION.len());
-    for (i, (row, emb)) in r.iter().zip(HEMOGLOBIN_EXTINCTION.iter()).enumerate() {
+fn embedded_files_are_the_data_folders_files() {
+    let Some(dir) = crate::support::data_dir_for("embedded spectral tables vs their source files") else { return };
+    for (name, text) in [HEMOGLOBIN_FILE, CIE_CMF_FILE, CIE_D65_FILE] {
+        let source = std::fs::read_to_string(dir.join(name))
+            .unwrap_or_else(|e| panic!("{name}: {e} (set RTBAKE_DATA_DIR to the physical data tables)"));
+        assert!(source == text, "src/spectral/data/{name} differs from {}", dir.join(name).display());
+    }
+}
+
+#[test]
+fn hemoglobin_table_holds_the_prahl_rows() {
+    let r = rows(HEMOGLOBIN_FILE.1, '\t');
+    assert_eq!(r.len(), hemoglobin_extinction().len());
+    for (i, (row, emb)) in r.iter().zip(hemoglobin_extinction().iter()).enumerate() {
         assert_eq!(row[0], 250.0 + 2.0 * i as f64);
         assert_eq!([row[1], row[2]], *emb, "row {i}");
     }
 }
 
 #[test]
-fn cie_tables_match_files() {
-    let (Some(cmf), Some(d65)) = (rows("cie1931_2deg_cmf_380_780_1nm.csv", ','), rows("cie_d65_380_780_1nm.csv", ','))
-    else {
-        return;
-    };
+fn cie_tables_hold_the_cie_rows() {
+    let (cmf, d65) = (rows(CIE_CMF_FILE.1, ','), rows(CIE_D65_FILE.1, ','));
     assert_eq!((cmf.len(), d65.len()), (401, 401));
     for i in 0..401 {
-        assert_eq!(cmf[i][0], 380.0 + i as f64);
-        assert_eq!([cmf[i][1], cmf[i][2], cmf[i][3]], CIE1931_2DEG_CMF[i], "CMF row {i}");
-        assert_eq!(d65[i][1], CIE_D65_SPD[i], "D65 row {i}");
+        assert_eq!((cmf[i][0], d65[i][0]), (380.0 + i as f64, 380.0 + i as f64));
+        assert_eq!([cmf[i][1], cmf[i][2], cmf[i][3]], cie1931_2deg_cmf()[i], "CMF row {i}");
+        assert_eq!(d65[i][1], cie_d65_spd()[i], "D65 row {i}");
     }
 }
 
@@ -47,9 +51,9 @@ fn cie_tables_match_files() {
 /// and the Soret peak of oxy-hemoglobin at 414 nm (Prahl: ε = 524 280 cm⁻¹/M), the table's maximum.
 #[test]
 fn embedded_tables_hold_published_anchors() {
-    assert_eq!(CIE1931_2DEG_CMF[175][1], 1.0);
-    assert_eq!(CIE_D65_SPD[180], 100.0);
+    assert_eq!(cie1931_2deg_cmf()[175][1], 1.0);
+    assert_eq!(cie_d65_spd()[180], 100.0);
     let i414 = (414 - 250) / 2;
-    assert_eq!(HEMOGLOBIN_EXTINCTION[i414][0], 524280.0);
-    assert!(HEMOGLOBIN_EXTINCTION.iter().all(|e| e[0] <= 524280.0));
+    assert_eq!(hemoglobin_extinction()[i414][0], 524280.0);
+    assert!(hemoglobin_extinction().iter().all(|e| e[0] <= 524280.0));
 }
