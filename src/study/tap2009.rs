@@ -5,7 +5,7 @@
 //! The paper prints χ² and p only. The counts are the ones those χ² imply: χ² = (2c − 32)²/32 has the two roots
 //! c = 16 ± √(8χ²), and the larger one is taken because the paper reports that TS was chosen at or above chance in
 //! every comparison (§6, Fig. 8: "TS was chosen over SS Full slightly above chance"). E.g. 22 of 32 ↔ χ² 4.5.
-//! [`PUBLISHED`] keeps the printed χ² and p beside each count so the reproduction can be checked.
+//! [`published`] keeps the printed χ² and p beside each count so the reproduction can be checked.
 
 use super::PreferenceCount;
 
@@ -24,36 +24,40 @@ pub const RESPONSES_PER_COMPARISON: u64 = 32;
 /// Participants of the study (§5.2); each answered every comparison twice.
 pub const PARTICIPANTS: u64 = 16;
 
-const fn row(
-    configuration: &'static str,
-    shader: &'static str,
-    ts_chosen: u64,
-    chi2: f64,
-    p_value: f64,
-) -> PublishedRow {
-    PublishedRow { configuration, shader, ts_chosen, chi2, p_value }
-}
+/// Table II as printed, one comparison a row (`tap2009_table2.csv`: configuration, shader, TS chosen, χ², p), in
+/// the paper's order: configurations by distance and angle, shaders No SSS, SS Jittered, SS Full.
+pub const TABLE_II_CSV: &str = include_str!("tap2009_table2.csv");
 
-/// Table II, row by row (configuration) and column by column (No SSS, SS Jittered, SS Full).
-#[rustfmt::skip]
-pub const PUBLISHED: [PublishedRow; 36] = [
-    row("TS - Far - 0°", "No SSS", 29, 21.125, 0.000), row("TS - Far - 0°", "SS Jittered", 29, 21.125, 0.000), row("TS - Far - 0°", "SS Full", 21, 3.125, 0.077),
-    row("TS - Far - 60°", "No SSS", 31, 28.125, 0.000), row("TS - Far - 60°", "SS Jittered", 28, 18.0, 0.000), row("TS - Far - 60°", "SS Full", 21, 3.125, 0.077),
-    row("TS - Far - 110°", "No SSS", 30, 24.5, 0.000), row("TS - Far - 110°", "SS Jittered", 27, 15.125, 0.000), row("TS - Far - 110°", "SS Full", 17, 0.125, 0.724),
-    row("TS - Far - 150°", "No SSS", 32, 32.0, 0.000), row("TS - Far - 150°", "SS Jittered", 27, 15.125, 0.000), row("TS - Far - 150°", "SS Full", 16, 0.0, 1.0),
-    row("TS - Near - 0°", "No SSS", 32, 32.0, 0.000), row("TS - Near - 0°", "SS Jittered", 31, 28.125, 0.000), row("TS - Near - 0°", "SS Full", 16, 0.0, 1.0),
-    row("TS - Near - 60°", "No SSS", 32, 32.0, 0.000), row("TS - Near - 60°", "SS Jittered", 31, 28.125, 0.000), row("TS - Near - 60°", "SS Full", 17, 0.125, 0.724),
-    row("TS - Near - 110°", "No SSS", 30, 24.5, 0.000), row("TS - Near - 110°", "SS Jittered", 31, 28.125, 0.000), row("TS - Near - 110°", "SS Full", 19, 1.125, 0.289),
-    row("TS - Near - 150°", "No SSS", 32, 32.0, 0.000), row("TS - Near - 150°", "SS Jittered", 29, 21.125, 0.000), row("TS - Near - 150°", "SS Full", 17, 0.125, 0.724),
-    row("TS - Zoom - 0°", "No SSS", 31, 28.125, 0.000), row("TS - Zoom - 0°", "SS Jittered", 31, 28.125, 0.000), row("TS - Zoom - 0°", "SS Full", 18, 0.5, 0.480),
-    row("TS - Zoom - 60°", "No SSS", 31, 28.125, 0.000), row("TS - Zoom - 60°", "SS Jittered", 28, 18.0, 0.000), row("TS - Zoom - 60°", "SS Full", 20, 2.0, 0.157),
-    row("TS - Zoom - 110°", "No SSS", 32, 32.0, 0.000), row("TS - Zoom - 110°", "SS Jittered", 27, 15.125, 0.000), row("TS - Zoom - 110°", "SS Full", 22, 4.5, 0.034),
-    row("TS - Zoom - 150°", "No SSS", 32, 32.0, 0.000), row("TS - Zoom - 150°", "SS Jittered", 28, 18.0, 0.000), row("TS - Zoom - 150°", "SS Full", 18, 0.5, 0.480),
-];
+/// The 36 rows of [`TABLE_II_CSV`], parsed once. The file is compiled in, so a malformed row is a bug of the crate
+/// (a panic naming the line), caught by the tests.
+pub fn published() -> &'static [PublishedRow] {
+    static ROWS: std::sync::OnceLock<Vec<PublishedRow>> = std::sync::OnceLock::new();
+    ROWS.get_or_init(|| {
+        let rows: Vec<PublishedRow> = TABLE_II_CSV
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("configuration,"))
+            .map(|l| {
+                let f: Vec<&'static str> = l.split(',').collect();
+                let num = |i: usize| {
+                    f.get(i).and_then(|t| t.parse::<f64>().ok()).unwrap_or_else(|| panic!("tap2009_table2.csv: {l:?}"))
+                };
+                PublishedRow {
+                    configuration: f[0],
+                    shader: f[1],
+                    ts_chosen: num(2) as u64,
+                    chi2: num(3),
+                    p_value: num(4),
+                }
+            })
+            .collect();
+        assert_eq!(rows.len(), 36, "tap2009_table2.csv: Table II has 36 comparisons");
+        rows
+    })
+}
 
 /// The implied counts as the input of [`super::chi_square_2afc`]: comparison "TS vs SHADER", TS chosen of 32 responses.
 pub fn implied_counts() -> Vec<PreferenceCount> {
-    PUBLISHED
+    published()
         .iter()
         .map(|r| PreferenceCount {
             configuration: r.configuration.to_string(),
@@ -84,7 +88,7 @@ mod tests {
     fn reproduces_table_ii() {
         let counts = parse_counts_csv(&implied_counts_csv()).unwrap();
         assert_eq!(counts, implied_counts());
-        for (c, r) in counts.iter().zip(PUBLISHED.iter()) {
+        for (c, r) in counts.iter().zip(published().iter()) {
             let t = chi_square_2afc(c.chosen, c.total, 0.05).unwrap();
             assert_eq!(t.chi2, r.chi2, "{} {}", r.configuration, r.shader);
             assert!(

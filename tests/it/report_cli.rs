@@ -2,7 +2,7 @@
 //! same from a user's counts file, and bad counts files refused (exit 2, the line and column named, nothing written).
 
 use crate::support::rtbake;
-use rtbake::study::tap2009::PUBLISHED;
+use rtbake::study::tap2009::published;
 use serde_json::Value;
 
 /// The built-in implied counts reproduce every printed χ² exactly and every printed p to its 3 decimals; the
@@ -15,7 +15,7 @@ fn reproduces_tap2009_table_ii_from_the_implied_counts() {
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 36);
     let mut not_significant = 0;
-    for (r, p) in rows.iter().zip(PUBLISHED.iter()) {
+    for (r, p) in rows.iter().zip(published().iter()) {
         assert_eq!(r["chi2"].as_f64().unwrap(), p.chi2, "{r}");
         assert!((r["p_value"].as_f64().unwrap() - p.p_value).abs() <= 5e-4, "{r} vs printed p {}", p.p_value);
         not_significant += usize::from(!r["significant"].as_bool().unwrap());
