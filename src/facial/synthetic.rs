@@ -121,64 +121,30 @@ pub struct Expression {
 }
 
 /// Eight illustrative targets: six basic emotions and two global states (thesis §7.3: exercise, alcohol).
+/// Columns: name; perfusion change, global and per region (forehead, cheeks, nose, chin); local-contrast change,
+/// global and per region.
+#[rustfmt::skip]
 pub const EXPRESSIONS: [Expression; 8] = [
-    Expression {
-        name: "joy",
-        perfusion_global: 0.0,
-        perfusion: [0.0, 0.35, 0.10, 0.0],
-        contrast_global: 0.0,
-        contrast: [0.0, 0.2, 0.0, 0.0],
-    },
-    Expression {
-        name: "anger",
-        perfusion_global: 0.10,
-        perfusion: [0.30, 0.25, 0.20, 0.10],
-        contrast_global: 0.10,
-        contrast: [0.2, 0.0, 0.0, 0.0],
-    },
-    Expression {
-        name: "fear",
-        perfusion_global: -0.20,
-        perfusion: [-0.10, -0.15, -0.10, 0.0],
-        contrast_global: -0.25,
-        contrast: [0.0; 4],
-    },
-    Expression {
-        name: "disgust",
-        perfusion_global: 0.0,
-        perfusion: [-0.10, 0.0, 0.30, 0.05],
-        contrast_global: 0.0,
-        contrast: [0.0, 0.0, 0.3, 0.0],
-    },
-    Expression {
-        name: "sadness",
-        perfusion_global: -0.05,
-        perfusion: [0.0, -0.05, 0.15, 0.20],
-        contrast_global: -0.10,
-        contrast: [0.0; 4],
-    },
-    Expression {
-        name: "surprise",
-        perfusion_global: 0.0,
-        perfusion: [-0.20, 0.05, 0.0, 0.0],
-        contrast_global: 0.0,
-        contrast: [0.3, 0.0, 0.0, 0.0],
-    },
-    Expression {
-        name: "exercise",
-        perfusion_global: 0.25,
-        perfusion: [0.20, 0.40, 0.20, 0.20],
-        contrast_global: 0.10,
-        contrast: [0.0; 4],
-    },
-    Expression {
-        name: "alcohol",
-        perfusion_global: 0.15,
-        perfusion: [0.0, 0.50, 0.35, 0.0],
-        contrast_global: 0.0,
-        contrast: [0.0, 0.2, 0.0, 0.0],
-    },
+    row("joy",       0.0,   [0.0, 0.35, 0.10, 0.0],     0.0,   [0.0, 0.2, 0.0, 0.0]),
+    row("anger",     0.10,  [0.30, 0.25, 0.20, 0.10],   0.10,  [0.2, 0.0, 0.0, 0.0]),
+    row("fear",      -0.20, [-0.10, -0.15, -0.10, 0.0], -0.25, [0.0; 4]),
+    row("disgust",   0.0,   [-0.10, 0.0, 0.30, 0.05],   0.0,   [0.0, 0.0, 0.3, 0.0]),
+    row("sadness",   -0.05, [0.0, -0.05, 0.15, 0.20],   -0.10, [0.0; 4]),
+    row("surprise",  0.0,   [-0.20, 0.05, 0.0, 0.0],    0.0,   [0.3, 0.0, 0.0, 0.0]),
+    row("exercise",  0.25,  [0.20, 0.40, 0.20, 0.20],   0.10,  [0.0; 4]),
+    row("alcohol",   0.15,  [0.0, 0.50, 0.35, 0.0],     0.0,   [0.0, 0.2, 0.0, 0.0]),
 ];
+
+/// One row of [`EXPRESSIONS`].
+const fn row(
+    name: &'static str,
+    perfusion_global: f64,
+    perfusion: [f64; 4],
+    contrast_global: f64,
+    contrast: [f64; 4],
+) -> Expression {
+    Expression { name, perfusion_global, perfusion, contrast_global, contrast }
+}
 
 /// Looks an expression up by name.
 pub fn expression(name: &str) -> Option<&'static Expression> {
