@@ -41,7 +41,7 @@ use crate::runtime::skin::inputs::RigScaleBiasMaps;
 use crate::runtime::skin::lighting::{DemoAssets, SssMethod};
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS_PER_M};
-use crate::runtime::skin::shade_frame::render_geometry;
+use crate::runtime::skin::shade_frame::{render_geometry, shades_in_one_encoder};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
@@ -228,7 +228,7 @@ pub fn render_with<'g>(
     }
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let (geo, g, _) = geometry(gpu, &heads, s, passes, assets)?;
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, assets, shades_in_one_encoder(gpu))?;
     let coverage = g.coverage;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.

@@ -14,12 +14,15 @@
 //! thesis applies the global state factor g to the whole hemoglobin map after the blend, as
 //! [`crate::facial::hemoglobin_rig::evaluate`] does.
 //!
-//! One compute dispatch over flat f32 buffers (`skin/mesh_inputs.wgsl`, via `compute_chain`); the
-//! CPU twin is [`crate::runtime::skin::mesh_inputs_cpu`].
+//! One compute dispatch over flat f32 buffers (`skin/mesh_inputs.wgsl`, via `compute_chain`): on its own
+//! ([`hemoglobin_at_uv`], one submission and read-back), or recorded into a frame's command encoder with H written
+//! into the skin-inputs maps on the device (`record_into_skin_maps`, the screen-space frame of
+//! `shade_frame`). The CPU twin is [`crate::runtime::skin::mesh_inputs_cpu`].
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::gpu;
 use crate::runtime::loader::BakedRig;
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
 use crate::runtime::RuntimeError;
@@ -132,16 +135,17 @@ pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
     compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
-/// Per pixel of a `width`×`height` frame, (u, v, covered) → H (0 where not covered), on the GPU.
-pub fn hemoglobin_at_uv(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
+const SOURCE: &str =
+    concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl"));
+
+/// The pass's uniform block and its data buffers (uv and coverage per pixel, the rig's targets, H0), checked.
+fn pass_inputs(
     width: u32,
     height: u32,
     uv: &[[f32; 2]],
     covered: &[bool],
     maps: &RigAtUv<'_>,
-) -> Result<Vec<f32>, RuntimeError> {
+) -> Result<(compute_chain::MapParams, Vec<f32>, Vec<f32>), RuntimeError> {
     maps.validate()?;
     let n = (width * height) as usize;
     if uv.len() != n || covered.len() != n {
@@ -158,22 +162,88 @@ pub fn hemoglobin_at_uv(
     };
     let uvc: Vec<f32> = uv.iter().zip(covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
     let rig: Vec<f32> = maps.rig.targets.iter().flatten().flatten().copied().collect();
+    Ok((params, uvc, rig))
+}
+
+/// Per pixel of a `width`×`height` frame, (u, v, covered) → H (0 where not covered), on the GPU.
+pub fn hemoglobin_at_uv(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    width: u32,
+    height: u32,
+    uv: &[[f32; 2]],
+    covered: &[bool],
+    maps: &RigAtUv<'_>,
+) -> Result<Vec<f32>, RuntimeError> {
+    let (params, uvc, rig) = pass_inputs(width, height, uv, covered, maps)?;
     let out = compute_chain::run(
         device,
         queue,
         "mesh skin inputs",
-        concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl")),
+        SOURCE,
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),
             Buffer::Data(bytemuck::cast_slice(&rig)),
             Buffer::Data(bytemuck::cast_slice(&maps.h0.data)),
-            Buffer::Zeroed(4 * n as u64),
+            Buffer::Zeroed(4 * (width * height) as u64),
         ],
         &[Stage::new("main", compute_chain::groups_8x8(width, height))],
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())
+}
+
+/// Records the pass into `enc`, a frame's command encoder, with H written into the hemoglobin channel of
+/// `skin_maps` (the skin-inputs maps, `width`×`height` `Rgba32Float`, (Cm, H0, thickness mm, 0)), whose other
+/// channels are `texels` (row-major, one per pixel): no submission and no read-back of its own.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_into_skin_maps(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    width: u32,
+    height: u32,
+    uv: &[[f32; 2]],
+    covered: &[bool],
+    maps: &RigAtUv<'_>,
+    texels: &[[f32; 4]],
+    skin_maps: &wgpu::Texture,
+) -> Result<(), RuntimeError> {
+    let (params, uvc, rig) = pass_inputs(width, height, uv, covered, maps)?;
+    let n = (width * height) as usize;
+    if texels.len() != n || (skin_maps.width(), skin_maps.height()) != (width, height) {
+        return Err(InvalidInput::new("skin maps", format!("must be {width}x{height}")).into());
+    }
+    // The skin maps in a texture copy's padded rows.
+    let stride = (gpu::padded_row_bytes(skin_maps) / 16) as usize;
+    let mut padded = vec![[0.0f32; 4]; stride * height as usize];
+    for (row, src) in padded.chunks_exact_mut(stride).zip(texels.chunks_exact(width as usize)) {
+        row[..width as usize].copy_from_slice(src);
+    }
+    let what = "mesh skin inputs";
+    let data: [&[u8]; 3] =
+        [bytemuck::cast_slice(&uvc), bytemuck::cast_slice(&rig), bytemuck::cast_slice(&maps.h0.data)];
+    let sizes =
+        [data[0].len() as u64, data[1].len() as u64, data[2].len() as u64, 4 * n as u64, 16 * padded.len() as u64];
+    compute_chain::check_buffers(device, what, &sizes)?;
+    let mut bufs: Vec<wgpu::Buffer> =
+        data.iter().zip(&sizes).map(|(d, &b)| compute_chain::storage_buffer(device, what, b, Some(d))).collect();
+    bufs.push(compute_chain::storage_buffer(device, what, sizes[3], None));
+    bufs.push(compute_chain::storage_buffer(device, what, sizes[4], Some(bytemuck::cast_slice(&padded))));
+    let groups = compute_chain::groups_8x8(width, height);
+    let pack = Stage { entry: "into_skin_maps", groups, args: [stride as u32, 0, 0, 0] };
+    let bound: Vec<&wgpu::Buffer> = bufs.iter().collect();
+    compute_chain::record(
+        device,
+        enc,
+        what,
+        SOURCE,
+        bytemuck::bytes_of(&params),
+        &bound,
+        &[Stage::new("main", groups), pack],
+    );
+    gpu::encode_buffer_to_texture(enc, &bufs[4], 0, skin_maps);
+    Ok(())
 }
 
 #[cfg(test)]

@@ -19,9 +19,10 @@ use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::device::Gpu;
 use crate::runtime::gpu;
 use crate::runtime::skin::bloom::{self, BloomBuffers};
-use crate::runtime::skin::inputs::SkinInputs;
+use crate::runtime::skin::inputs::{maps_texels, SkinInputs};
 use crate::runtime::skin::lighting::{self, lit_geometry, subsurface_of, SssMethod};
 use crate::runtime::skin::lighting::{DemoAssets, Geometry, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
+use crate::runtime::skin::mesh_inputs::{self, RigAtUv};
 use crate::runtime::RuntimeError;
 
 thread_local! {
@@ -34,6 +35,13 @@ thread_local! {
 /// same either way.
 pub fn set_shading_in_one_encoder(on: bool) {
     SHADING_IN_ONE_ENCODER.with(|c| c.set(on));
+}
+
+/// Whether a frame rendered on `gpu` from this thread records its shading into one command encoder: on a device
+/// with [`set_shading_in_one_encoder`] on. Such a frame leaves the rig at uv to that encoder too
+/// ([`crate::runtime::skin::lighting::Geometry`]'s `rig_at_uv`).
+pub(crate) fn shades_in_one_encoder(gpu: Backend<'_>) -> bool {
+    gpu.is_gpu() && SHADING_IN_ONE_ENCODER.with(|c| c.get())
 }
 
 /// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
@@ -49,6 +57,9 @@ pub(crate) fn render_geometry(
     let parts = std::cell::Cell::new(Some((geo, background)));
     let take = || parts.take().expect("one backend runs");
     let per_pass = |(geo, background): (Geometry, Vec<u8>)| {
+        if geo.rig_at_uv.is_some() {
+            return Err(RuntimeError::Gpu("the rig at uv is left to a frame that is not shaded in one encoder".into()));
+        }
         let lit = lit_geometry(gpu, geo, assets)?;
         lighting::shade(gpu, lit, assets, method, background, None)
     };
@@ -107,7 +118,29 @@ pub(crate) fn shade(
         return Err(InvalidInput::new("background", format!("must be {w}x{h} RGBA8")).into());
     }
     let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
-    inputs.upload(queue, &geo.frame, &assets.rig_weights, assets.lights.back_view)?;
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin frame") });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    match (&geo.rig_at_uv, &assets.baked_rig) {
+        (Some(px), Some(r)) => {
+            // The rig's H at the mesh's uv goes into the skin-inputs maps on the device.
+            inputs.upload_except_maps(queue, &geo.frame, &assets.rig_weights, assets.lights.back_view)?;
+            let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose: &px.pose };
+            let texels = maps_texels(&geo.frame);
+            mesh_inputs::record_into_skin_maps(
+                device,
+                &mut enc,
+                w,
+                h,
+                &px.uv,
+                &geo.skin,
+                &maps,
+                &texels,
+                inputs.maps(),
+            )?;
+        }
+        (Some(_), None) => return Err(InvalidInput::new("hemoglobin rig", "the rig at uv needs a baked rig").into()),
+        (None, _) => inputs.upload(queue, &geo.frame, &assets.rig_weights, assets.lights.back_view)?,
+    }
     let blur = match sss {
         Some(m) => Some(SubsurfaceGpu::new(g, (w, h), m)?),
         None => None,
@@ -147,8 +180,6 @@ pub(crate) fn shade(
     let groups = compute_chain::groups_8x8(w, h);
     let stages = |names: &[&'static str]| names.iter().map(|e| Stage::new(e, groups)).collect::<Vec<_>>();
     let uniform = bytemuck::bytes_of(&params);
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     inputs.encode(&mut enc);
     gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
     gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row * h as u64);
