@@ -27,9 +27,12 @@
 //!    over a grey background.
 //!
 //! On a device the G-buffer and the shadow map are rasterised in one submission and read back together (the host
-//! computes thickness and the specular layer from them), and everything from the skin-inputs pass to the tone map
-//! is recorded into one command encoder and read back once, as the RGBA8 frame
-//! ([`crate::runtime::skin::shade_frame`]); the rig at uv is one more submission. Texture-space diffusion
+//! computes thickness and the specular layer from them), and everything from the rig at uv and the skin-inputs
+//! pass to the tone map is recorded into one command encoder and read back once, as the RGBA8 frame
+//! ([`crate::runtime::skin::shade_frame`]): 2 submissions and 2 read-backs a frame. The wrinkle pass (one more),
+//! the MSAA coverage blend (on the host, after the read-back) and the per-pass path
+//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off: the rig at uv and every shading pass
+//! submitted and read back on its own) are unchanged. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
 use crate::error::InvalidInput;

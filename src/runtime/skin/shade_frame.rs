@@ -1,5 +1,6 @@
-//! The shading of a skin frame resident on the GPU, as an engine records a frame: the skin-inputs pass, the lit
-//! diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
+//! The shading of a skin frame resident on the GPU, as an engine records a frame: the rig's hemoglobin at the
+//! mesh's uv when the frame leaves it here (`mesh_inputs::record_into_skin_maps`, writing H into the skin-inputs
+//! maps), the skin-inputs pass, the lit diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
 //! specular layer, bloom (thesis ch. 4) and the tone map are recorded into **one** command encoder, hand textures
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
