@@ -44,7 +44,7 @@ pub fn row_of_heads(mesh: &Mesh, heads: u32) -> Result<Mesh, InvalidInput> {
 
 /// The light camera of the shadow map: 1.5 m from the heads towards the back light (`back`, view space), looking at
 /// them.
-fn light_camera(cam: &Camera, back: [f32; 3]) -> Camera {
+pub(crate) fn light_camera(cam: &Camera, back: [f32; 3]) -> Camera {
     // View → world for directions: the transpose of the view rotation.
     let view = cam.view();
     let l = Vector3::from(back);

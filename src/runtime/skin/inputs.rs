@@ -277,6 +277,11 @@ impl SkinInputs {
         &self.maps
     }
 
+    /// The normals texture the pass reads, (normal, 0) per pixel, `Rgba32Float`.
+    pub(crate) fn normals(&self) -> &wgpu::Texture {
+        &self.normals
+    }
+
     /// [`SkinInputs::upload`] but for the maps texture, which the caller fills on the device.
     pub(crate) fn upload_except_maps(
         &mut self,
@@ -289,6 +294,19 @@ impl SkinInputs {
         if (frame.width, frame.height) != (self.width, self.height) {
             return Err(invalid("skin frame", format!("must be {}x{}", self.width, self.height)));
         }
+        self.upload_lights(queue, rig_weights, light_dir)?;
+        let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
+        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
+        Ok(())
+    }
+
+    /// The per-frame rig weights and light direction alone: the caller fills the maps and normals on the device.
+    pub(crate) fn upload_lights(
+        &mut self,
+        queue: &wgpu::Queue,
+        rig_weights: &[f32],
+        light_dir: [f32; 3],
+    ) -> Result<(), InvalidInput> {
         if rig_weights.len() != self.params.cfg[0] as usize {
             return Err(invalid(
                 "rig_weights",
@@ -302,8 +320,6 @@ impl SkinInputs {
         self.params.weights = w;
         self.params.light = [light_dir[0], light_dir[1], light_dir[2], 0.0];
         queue.write_buffer(&self.ubo, 0, bytemuck::bytes_of(&self.params));
-        let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
-        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
         Ok(())
     }
 

@@ -138,19 +138,13 @@ pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
 const SOURCE: &str =
     concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl"));
 
-/// The pass's uniform block and its data buffers (uv and coverage per pixel, the rig's targets, H0), checked.
-fn pass_inputs(
+/// The pass's uniform block and the rig's targets, checked.
+fn rig_inputs(
     width: u32,
     height: u32,
-    uv: &[[f32; 2]],
-    covered: &[bool],
     maps: &RigAtUv<'_>,
-) -> Result<(compute_chain::MapParams, Vec<f32>, Vec<f32>), RuntimeError> {
+) -> Result<(compute_chain::MapParams, Vec<f32>), RuntimeError> {
     maps.validate()?;
-    let n = (width * height) as usize;
-    if uv.len() != n || covered.len() != n {
-        return Err(InvalidInput::new("mesh uv", format!("needs {width}x{height} texture coordinates")).into());
-    }
     let mut w = [[0.0f32; 4]; 2];
     for (i, v) in maps.pose.weights.iter().enumerate() {
         w[i / 4][i % 4] = *v;
@@ -160,8 +154,24 @@ fn pass_inputs(
         cfg: [maps.h0.width as f32, maps.h0.height as f32, maps.rig.targets.len() as f32, maps.pose.global_scale],
         weights: w,
     };
-    let uvc: Vec<f32> = uv.iter().zip(covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
     let rig: Vec<f32> = maps.rig.targets.iter().flatten().flatten().copied().collect();
+    Ok((params, rig))
+}
+
+/// [`rig_inputs`] and the (u, v, covered, 0) per pixel the pass reads, checked.
+fn pass_inputs(
+    width: u32,
+    height: u32,
+    uv: &[[f32; 2]],
+    covered: &[bool],
+    maps: &RigAtUv<'_>,
+) -> Result<(compute_chain::MapParams, Vec<f32>, Vec<f32>), RuntimeError> {
+    let (params, rig) = rig_inputs(width, height, maps)?;
+    let n = (width * height) as usize;
+    if uv.len() != n || covered.len() != n {
+        return Err(InvalidInput::new("mesh uv", format!("needs {width}x{height} texture coordinates")).into());
+    }
+    let uvc: Vec<f32> = uv.iter().zip(covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
     Ok((params, uvc, rig))
 }
 
@@ -209,7 +219,7 @@ pub(crate) fn record_into_skin_maps(
     texels: &[[f32; 4]],
     skin_maps: &wgpu::Texture,
 ) -> Result<(), RuntimeError> {
-    let (params, uvc, rig) = pass_inputs(width, height, uv, covered, maps)?;
+    let (_, uvc, _) = pass_inputs(width, height, uv, covered, maps)?;
     let n = (width * height) as usize;
     if texels.len() != n || (skin_maps.width(), skin_maps.height()) != (width, height) {
         return Err(InvalidInput::new("skin maps", format!("must be {width}x{height}")).into());
@@ -221,28 +231,39 @@ pub(crate) fn record_into_skin_maps(
         row[..width as usize].copy_from_slice(src);
     }
     let what = "mesh skin inputs";
-    let data: [&[u8]; 3] =
-        [bytemuck::cast_slice(&uvc), bytemuck::cast_slice(&rig), bytemuck::cast_slice(&maps.h0.data)];
-    let sizes =
-        [data[0].len() as u64, data[1].len() as u64, data[2].len() as u64, 4 * n as u64, 16 * padded.len() as u64];
+    let uvc_buf = compute_chain::storage_buffer(device, what, 4 * uvc.len() as u64, Some(bytemuck::cast_slice(&uvc)));
+    let bytes = 16 * padded.len() as u64;
+    let maps_buf = compute_chain::storage_buffer(device, what, bytes, Some(bytemuck::cast_slice(&padded)));
+    record_into_skin_map_buffer(device, enc, (width, height), maps, &uvc_buf, &maps_buf, stride as u32)?;
+    gpu::encode_buffer_to_texture(enc, &maps_buf, 0, skin_maps);
+    Ok(())
+}
+
+/// Records the pass into `enc` over GPU buffers: (u, v, covered, 0) per pixel of the `size` frame in `uvc`, H
+/// written into the hemoglobin channel of `skin_maps` (vec4 texels, rows of `stride` texels).
+pub(crate) fn record_into_skin_map_buffer(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    (width, height): (u32, u32),
+    maps: &RigAtUv<'_>,
+    uvc: &wgpu::Buffer,
+    skin_maps: &wgpu::Buffer,
+    stride: u32,
+) -> Result<(), RuntimeError> {
+    let (params, rig) = rig_inputs(width, height, maps)?;
+    let what = "mesh skin inputs";
+    let h0: &[u8] = bytemuck::cast_slice(&maps.h0.data);
+    let n = width as u64 * height as u64;
+    let sizes = [uvc.size(), 4 * rig.len() as u64, h0.len() as u64, 4 * n, skin_maps.size()];
     compute_chain::check_buffers(device, what, &sizes)?;
-    let mut bufs: Vec<wgpu::Buffer> =
-        data.iter().zip(&sizes).map(|(d, &b)| compute_chain::storage_buffer(device, what, b, Some(d))).collect();
-    bufs.push(compute_chain::storage_buffer(device, what, sizes[3], None));
-    bufs.push(compute_chain::storage_buffer(device, what, sizes[4], Some(bytemuck::cast_slice(&padded))));
+    let rig_buf = compute_chain::storage_buffer(device, what, sizes[1], Some(bytemuck::cast_slice(&rig)));
+    let h0_buf = compute_chain::storage_buffer(device, what, sizes[2], Some(h0));
+    let hb = compute_chain::storage_buffer(device, what, sizes[3], None);
     let groups = compute_chain::groups_8x8(width, height);
-    let pack = Stage { entry: "into_skin_maps", groups, args: [stride as u32, 0, 0, 0] };
-    let bound: Vec<&wgpu::Buffer> = bufs.iter().collect();
-    compute_chain::record(
-        device,
-        enc,
-        what,
-        SOURCE,
-        bytemuck::bytes_of(&params),
-        &bound,
-        &[Stage::new("main", groups), pack],
-    );
-    gpu::encode_buffer_to_texture(enc, &bufs[4], 0, skin_maps);
+    let pack = Stage { entry: "into_skin_maps", groups, args: [stride, 0, 0, 0] };
+    let bound = [uvc, &rig_buf, &h0_buf, &hb, skin_maps];
+    let uniform = bytemuck::bytes_of(&params);
+    compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("main", groups), pack]);
     Ok(())
 }
 
