@@ -152,15 +152,26 @@ mod tests {
     }
 
     /// The device's per-pixel geometry against the host's (`heads::geometry`, from the same device G-buffer):
-    /// coverage and normals equal, depth to f32 rounding, thickness (Listing 5.1) within 0.01 mm on ≥ 99 % of the
-    /// covered pixels (a shadow-map texel may flip where f32 arithmetic differs), the specular layer within 1e-4
-    /// and the procedural H0 within 2e-4; the back light reaches part of the head (thickness under s_max).
+    /// coverage and normals equal, depth to f32 rounding, the specular layer within 1e-4, the hemoglobin (the
+    /// procedural H0, or the baked rig's at the mesh's uv written by the rig pass) within 2e-4, and thickness
+    /// (Listing 5.1) within 0.01 mm on ≥ 99 % of the pixels the back light reaches (thickness under s_max on the
+    /// host, 20 or more of them; a shadow-map texel may flip where f32 arithmetic differs).
     #[test]
     fn the_device_geometry_matches_the_hosts() {
         let g = crate::runtime::device::create_headless(&Default::default()).expect("an adapter (lavapipe)");
         let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/baked"));
-        let mut assets = DemoAssets::load(dir).unwrap();
-        assets.baked_rig = None;
+        let baked = DemoAssets::load(dir).unwrap();
+        assert!(baked.baked_rig.is_some(), "the committed bake has the example rig");
+        for with_rig in [false, true] {
+            let mut assets = baked.clone();
+            if !with_rig {
+                assets.baked_rig = None;
+            }
+            device_geometry_matches_the_hosts(&g, &assets);
+        }
+    }
+
+    fn device_geometry_matches_the_hosts(g: &crate::runtime::device::Gpu, assets: &DemoAssets) {
         let mesh = crate::mesh::head::default_head();
         let (w, h) = (320, 192);
         let s = SkinRenderSettings {
@@ -172,12 +183,26 @@ mod tests {
             melanin: 0.02,
             stretch: StretchPreset::Thesis,
         };
-        let (geo, _, _) = heads::geometry(Backend::Gpu(&g), &mesh, &s, &SkinPasses::none(), &assets, false).unwrap();
-        let job =
-            FrameGeometryJob { mesh: &mesh, camera: s.camera(), width: w, height: h, melanin: 0.02, rig_pose: None };
+        let (geo, _, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, &SkinPasses::none(), assets, false).unwrap();
+        let rig_pose = assets.baked_rig.as_ref().map(|r| RigPose::neutral(r.names.len()));
+        let job = FrameGeometryJob { mesh: &mesh, camera: s.camera(), width: w, height: h, melanin: 0.02, rig_pose };
         let mut enc = g.device.create_command_encoder(&Default::default());
-        let d = record(&g.device, &mut enc, &job, &assets).unwrap();
-        let r = read(&g, enc, &[&d.skin_maps, &d.normals, &d.texels, &d.depth]);
+        let d = record(&g.device, &mut enc, &job, assets).unwrap();
+        if let (Some(r), Some(pose)) = (&assets.baked_rig, &job.rig_pose) {
+            let maps = crate::runtime::skin::mesh_inputs::RigAtUv { rig: &r.rig, h0: &r.h0, pose };
+            let (uvc, sm, row) = (&d.uvc, &d.skin_maps, d.vec4_row);
+            crate::runtime::skin::mesh_inputs::record_into_skin_map_buffer(
+                &g.device,
+                &mut enc,
+                (w, h),
+                &maps,
+                uvc,
+                sm,
+                row,
+            )
+            .unwrap();
+        }
+        let r = read(g, enc, &[&d.skin_maps, &d.normals, &d.texels, &d.depth]);
         let (maps, normals, texels, depth) = (&r[0], &r[1], &r[2], &r[3]);
         let (row4, row1) = (4 * d.vec4_row as usize, padded_row(w, 4) as usize / 4);
         let (mut covered, mut thick_ok, mut lit_through) = (0, 0, 0);
@@ -192,7 +217,8 @@ mod tests {
             let dd = depth[y * row1 + x];
             assert!((dd - geo.depth[i]).abs() <= 1e-5 * geo.depth[i], "depth at {x},{y}: {dd} vs {}", geo.depth[i]);
             assert_eq!(m[0], geo.frame.melanin[i]);
-            assert!((m[1] - geo.frame.h0[i]).abs() <= 2e-4, "H0 at {x},{y}: {} vs {}", m[1], geo.frame.h0[i]);
+            let h0 = geo.frame.h0[i];
+            assert!((m[1] - h0).abs() <= 2e-4, "H at {x},{y} (rig {}): {} vs {h0}", job.rig_pose.is_some(), m[1]);
             let spec = geo.specular.as_ref().unwrap()[i];
             assert!((texels[8 * i + 7] - spec).abs() <= 1e-4 * spec.max(1.0), "specular at {x},{y}");
             if geo.skin[i] {
