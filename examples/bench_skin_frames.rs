@@ -9,8 +9,8 @@
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 7
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
-//! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the G-buffer read-back
-//! the host's geometry needs, the final read-back). Texture-space diffusion ("ts") has no one-encoder path yet: both
+//! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
+//! the per-pass path also the G-buffer read-back the host's geometry needs). Texture-space diffusion ("ts") has no one-encoder path yet: both
 //! columns run its per-pass path. Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
 
 use rtbake::mesh::head::default_head;

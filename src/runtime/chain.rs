@@ -285,6 +285,11 @@ impl SubsurfaceGpu {
         with_pass!(self, p => p.upload_depth(queue, depth))
     }
 
+    /// The linear depth the pass reads (`R32Float`).
+    pub(crate) fn depth(&self) -> &wgpu::Texture {
+        with_pass!(self, p => p.depth())
+    }
+
     /// Records the pass.
     pub(crate) fn encode(&self, enc: &mut wgpu::CommandEncoder) {
         with_pass!(self, p => p.encode(enc, None))

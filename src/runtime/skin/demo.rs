@@ -30,6 +30,7 @@ fn geometry(w: u32, h: u32, rig: Option<&loader::BakedRig>) -> Geometry {
         skin: vec![false; n],
         specular: None,
         albedo: None,
+        rig_at_uv: None,
     };
     let hf = h as f32;
     let aspect = w as f32 / hf;

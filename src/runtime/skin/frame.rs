@@ -26,22 +26,30 @@
 //!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
 //!    over a grey background.
 //!
-//! On a device the G-buffer and the shadow map are rasterised in one submission and read back together (the host
-//! computes thickness and the specular layer from them), and everything from the skin-inputs pass to the tone map
-//! is recorded into one command encoder and read back once, as the RGBA8 frame
-//! ([`crate::runtime::skin::shade_frame`]); the rig at uv is one more submission. Texture-space diffusion
+//! On a device the default frame (one sample, no wrinkle pass, no scan surface maps) is one command encoder,
+//! submitted once and read back once as the RGBA8 frame: the G-buffer and the shadow map are rasterised into it,
+//! thickness, the specular layer and the per-pixel skin inputs are computed from them on the device
+//! (`frame_geometry`, the GPU twin of steps 2–3), then the rig at uv and everything from the skin-inputs pass to
+//! the tone map ([`crate::runtime::skin::shade_frame`]). With `--msaa 4`, the wrinkle pass or a scan's surface
+//! maps, the G-buffer and shadow map are one submission read back for the host's geometry (steps 2–3 on the
+//! host; the wrinkle pass and the surface maps one more each), the MSAA coverage blend runs on the host after the
+//! read-back, and the shading with the rig at uv is one submission more. The per-pass path
+//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off) submits and reads back each pass on its
+//! own, for A/B comparison. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
+use crate::runtime::skin::frame_geometry::FrameGeometryJob;
 use crate::runtime::skin::heads::{blend_coverage, geometry, row_of_heads, BACKGROUND};
 use crate::runtime::skin::inputs::RigScaleBiasMaps;
 use crate::runtime::skin::lighting::{DemoAssets, SssMethod};
+use crate::runtime::skin::mesh_inputs::RigPose;
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS_PER_M};
-use crate::runtime::skin::shade_frame::render_geometry;
+use crate::runtime::skin::shade_frame::{render_geometry, render_on_device, shades_in_one_encoder};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
@@ -228,8 +236,7 @@ pub fn render_with<'g>(
     }
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let (geo, g, _) = geometry(gpu, &heads, s, passes, assets)?;
-    let coverage = g.coverage;
+    let original = assets;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
@@ -256,8 +263,24 @@ pub fn render_with<'g>(
         SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
     };
     let background = BACKGROUND.repeat((s.width * s.height) as usize);
+    let one_encoder = shades_in_one_encoder(gpu);
+    if one_encoder && passes.msaa == 1 && passes.wrinkles.is_none() && passes.surface_maps.is_none() {
+        // The geometry computed on the device in the shading's encoder: the G-buffer is never read back.
+        let rig_pose =
+            original.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
+        let job = FrameGeometryJob {
+            mesh: &heads,
+            camera: s.camera(),
+            width: s.width,
+            height: s.height,
+            melanin: s.melanin,
+            rig_pose,
+        };
+        return render_on_device(gpu, &job, &assets, method, background);
+    }
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, one_encoder)?;
     let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
-    blend_coverage(&mut frame, &coverage);
+    blend_coverage(&mut frame, &g.coverage);
     Ok(frame)
 }
 

@@ -10,7 +10,7 @@ use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
 use crate::runtime::sampler;
 use crate::runtime::skin::inputs::SkinFrame;
-use crate::runtime::skin::lighting::{key_light_view, DemoAssets, Geometry, KEY_LIGHT_INTENSITY};
+use crate::runtime::skin::lighting::{key_light_view, DemoAssets, Geometry, RigAtUvPixels, KEY_LIGHT_INTENSITY};
 use crate::runtime::skin::mesh_raster::{self, MeshGBuffer, RasterJob};
 use crate::runtime::skin::mesh_raster_cpu;
 use crate::runtime::skin::passes::SkinPasses;
@@ -44,7 +44,7 @@ pub fn row_of_heads(mesh: &Mesh, heads: u32) -> Result<Mesh, InvalidInput> {
 
 /// The light camera of the shadow map: 1.5 m from the heads towards the back light (`back`, view space), looking at
 /// them.
-fn light_camera(cam: &Camera, back: [f32; 3]) -> Camera {
+pub(crate) fn light_camera(cam: &Camera, back: [f32; 3]) -> Camera {
     // View → world for directions: the transpose of the view rotation.
     let view = cam.view();
     let l = Vector3::from(back);
@@ -154,13 +154,16 @@ pub fn specular_layer_lit(g: &MeshGBuffer, cam: &Camera, l: [f32; 3]) -> Vec<f32
 }
 
 /// The geometry of the heads' frame (see the module doc): skin inputs, view depth in metres, skin mask; the
-/// G-buffer it came from and the back light's shadow map.
+/// G-buffer it came from and the back light's shadow map. With `rig_in_frame_encoder` the baked rig's hemoglobin
+/// at the mesh's uv is left to the frame's command encoder ([`Geometry::rig_at_uv`], `frame.h0` 0); otherwise
+/// it is evaluated here, on `gpu` or its CPU twin.
 pub(crate) fn geometry(
     gpu: Backend<'_>,
     mesh: &Mesh,
     s: &SkinRenderSettings,
     passes: &SkinPasses,
     assets: &DemoAssets,
+    rig_in_frame_encoder: bool,
 ) -> Result<(Geometry, MeshGBuffer, ShadowMap), RuntimeError> {
     let cam = s.camera();
     let (w, h, msaa) = (s.width, s.height, passes.msaa);
@@ -217,30 +220,33 @@ pub(crate) fn geometry(
         thickness_mm: vec![assets.luts.s_max_mm; n],
         normals: vec![[0.0, 0.0, 1.0]; n],
     };
-    let hemoglobin = match &assets.baked_rig {
-        Some(r) => {
-            let neutral = crate::runtime::skin::mesh_inputs::RigPose::neutral(r.names.len());
-            let pose = passes.rig_pose.as_ref().unwrap_or(&neutral);
-            Some(crate::runtime::chain::hemoglobin_for_gbuffer(gpu, &g, r, pose)?)
+    let (mut hemoglobin, mut rig_at_uv) = (None, None);
+    if let Some(r) = &assets.baked_rig {
+        let neutral = crate::runtime::skin::mesh_inputs::RigPose::neutral(r.names.len());
+        let pose = passes.rig_pose.as_ref().unwrap_or(&neutral);
+        if rig_in_frame_encoder {
+            rig_at_uv = Some(RigAtUvPixels { uv: g.uv.clone(), pose: pose.clone() });
+        } else {
+            hemoglobin = Some(crate::runtime::chain::hemoglobin_for_gbuffer(gpu, &g, r, pose)?);
         }
-        None => None,
-    };
+    }
     let mut depth = vec![100.0f32; n];
     for i in 0..n {
         if !g.covered[i] {
             continue;
         }
         frame.melanin[i] = s.melanin;
-        frame.h0[i] = match &hemoglobin {
-            Some(hb) => hb[i],
-            None => 0.006 * ((g.uv[i][0] * 400.0).sin() * (g.uv[i][1] * 300.0).cos()),
+        frame.h0[i] = match (&hemoglobin, &rig_at_uv) {
+            (Some(hb), _) => hb[i],
+            (None, Some(_)) => 0.0,
+            (None, None) => 0.006 * ((g.uv[i][0] * 400.0).sin() * (g.uv[i][1] * 300.0).cos()),
         };
         frame.thickness_mm[i] = thickness[i].min(assets.luts.s_max_mm);
         frame.normals[i] = g.normal_view[i];
         depth[i] = g.depth_mm[i] / 1000.0 * WORLD_UNITS_PER_M;
     }
     let skin = g.covered.clone();
-    Ok((Geometry { frame, depth, skin, specular: Some(specular), albedo }, g, shadow))
+    Ok((Geometry { frame, depth, skin, specular: Some(specular), albedo, rig_at_uv }, g, shadow))
 }
 
 /// MSAA: partly covered pixels of `frame` blend the shaded skin with the background by their `coverage`, in linear

@@ -114,6 +114,11 @@ fn f16_bytes(v: impl Iterator<Item = f32>) -> Vec<u8> {
     bytemuck::cast_slice(&h).to_vec()
 }
 
+/// The maps texels of `frame`, (Cm, H0, thickness mm, 0) per pixel.
+pub(crate) fn maps_texels(frame: &SkinFrame) -> Vec<[f32; 4]> {
+    (0..frame.melanin.len()).map(|i| [frame.melanin[i], frame.h0[i], frame.thickness_mm[i], 0.0]).collect()
+}
+
 /// Skin inputs for one frame size, LUTs and rig.
 pub struct SkinInputs {
     width: u32,
@@ -261,10 +266,47 @@ impl SkinInputs {
         rig_weights: &[f32],
         light_dir: [f32; 3],
     ) -> Result<(), InvalidInput> {
+        self.upload_except_maps(queue, frame, rig_weights, light_dir)?;
+        gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps_texels(frame)));
+        Ok(())
+    }
+
+    /// The maps texture the pass reads, (Cm, H0, thickness mm, 0) per pixel, `Rgba32Float`: a frame that
+    /// computes H on the device writes it there ([`SkinInputs::upload_except_maps`]).
+    pub(crate) fn maps(&self) -> &wgpu::Texture {
+        &self.maps
+    }
+
+    /// The normals texture the pass reads, (normal, 0) per pixel, `Rgba32Float`.
+    pub(crate) fn normals(&self) -> &wgpu::Texture {
+        &self.normals
+    }
+
+    /// [`SkinInputs::upload`] but for the maps texture, which the caller fills on the device.
+    pub(crate) fn upload_except_maps(
+        &mut self,
+        queue: &wgpu::Queue,
+        frame: &SkinFrame,
+        rig_weights: &[f32],
+        light_dir: [f32; 3],
+    ) -> Result<(), InvalidInput> {
         frame.validate()?;
         if (frame.width, frame.height) != (self.width, self.height) {
             return Err(invalid("skin frame", format!("must be {}x{}", self.width, self.height)));
         }
+        self.upload_lights(queue, rig_weights, light_dir)?;
+        let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
+        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
+        Ok(())
+    }
+
+    /// The per-frame rig weights and light direction alone: the caller fills the maps and normals on the device.
+    pub(crate) fn upload_lights(
+        &mut self,
+        queue: &wgpu::Queue,
+        rig_weights: &[f32],
+        light_dir: [f32; 3],
+    ) -> Result<(), InvalidInput> {
         if rig_weights.len() != self.params.cfg[0] as usize {
             return Err(invalid(
                 "rig_weights",
@@ -278,11 +320,6 @@ impl SkinInputs {
         self.params.weights = w;
         self.params.light = [light_dir[0], light_dir[1], light_dir[2], 0.0];
         queue.write_buffer(&self.ubo, 0, bytemuck::bytes_of(&self.params));
-        let n = (self.width * self.height) as usize;
-        let maps: Vec<f32> = (0..n).flat_map(|i| [frame.melanin[i], frame.h0[i], frame.thickness_mm[i], 0.0]).collect();
-        let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
-        gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps));
-        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
         Ok(())
     }
 

@@ -249,6 +249,16 @@ pub(crate) struct Geometry {
     /// Linear albedo per pixel from a scan's albedo map ([`crate::runtime::skin::surface_maps`]), replacing the skin
     /// LUT's on skin pixels; None: the LUT's.
     pub(crate) albedo: Option<Vec<[f32; 3]>>,
+    /// The rig's hemoglobin at the mesh's uv left to the frame's command encoder
+    /// ([`crate::runtime::skin::shade_frame`]); None: `frame.h0` holds the hemoglobin already.
+    pub(crate) rig_at_uv: Option<RigAtUvPixels>,
+}
+
+/// What the rig at uv ([`crate::runtime::skin::mesh_inputs`]) needs beyond the baked rig: the mesh's texture
+/// coordinates per pixel (coverage is the frame's skin mask) and the pose.
+pub(crate) struct RigAtUvPixels {
+    pub(crate) uv: Vec<[f32; 2]>,
+    pub(crate) pose: crate::runtime::skin::mesh_inputs::RigPose,
 }
 
 /// Radiance scale of the key light (the diffuse layer's E = KEY_LIGHT_INTENSITY · N·L + ambient).

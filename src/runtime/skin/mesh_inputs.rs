@@ -14,12 +14,15 @@
 //! thesis applies the global state factor g to the whole hemoglobin map after the blend, as
 //! [`crate::facial::hemoglobin_rig::evaluate`] does.
 //!
-//! One compute dispatch over flat f32 buffers (`skin/mesh_inputs.wgsl`, via `compute_chain`); the
-//! CPU twin is [`crate::runtime::skin::mesh_inputs_cpu`].
+//! One compute dispatch over flat f32 buffers (`skin/mesh_inputs.wgsl`, via `compute_chain`): on its own
+//! ([`hemoglobin_at_uv`], one submission and read-back), or recorded into a frame's command encoder with H written
+//! into the skin-inputs maps on the device (`record_into_skin_maps`, the screen-space frame of
+//! `shade_frame`). The CPU twin is [`crate::runtime::skin::mesh_inputs_cpu`].
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::runtime::compute_chain::{self, Buffer, Stage};
+use crate::runtime::gpu;
 use crate::runtime::loader::BakedRig;
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, MAX_RIG_TARGETS};
 use crate::runtime::RuntimeError;
@@ -132,6 +135,46 @@ pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
     compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
+const SOURCE: &str =
+    concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl"));
+
+/// The pass's uniform block and the rig's targets, checked.
+fn rig_inputs(
+    width: u32,
+    height: u32,
+    maps: &RigAtUv<'_>,
+) -> Result<(compute_chain::MapParams, Vec<f32>), RuntimeError> {
+    maps.validate()?;
+    let mut w = [[0.0f32; 4]; 2];
+    for (i, v) in maps.pose.weights.iter().enumerate() {
+        w[i / 4][i % 4] = *v;
+    }
+    let params = compute_chain::MapParams {
+        size: [width as f32, height as f32, maps.rig.width as f32, maps.rig.height as f32],
+        cfg: [maps.h0.width as f32, maps.h0.height as f32, maps.rig.targets.len() as f32, maps.pose.global_scale],
+        weights: w,
+    };
+    let rig: Vec<f32> = maps.rig.targets.iter().flatten().flatten().copied().collect();
+    Ok((params, rig))
+}
+
+/// [`rig_inputs`] and the (u, v, covered, 0) per pixel the pass reads, checked.
+fn pass_inputs(
+    width: u32,
+    height: u32,
+    uv: &[[f32; 2]],
+    covered: &[bool],
+    maps: &RigAtUv<'_>,
+) -> Result<(compute_chain::MapParams, Vec<f32>, Vec<f32>), RuntimeError> {
+    let (params, rig) = rig_inputs(width, height, maps)?;
+    let n = (width * height) as usize;
+    if uv.len() != n || covered.len() != n {
+        return Err(InvalidInput::new("mesh uv", format!("needs {width}x{height} texture coordinates")).into());
+    }
+    let uvc: Vec<f32> = uv.iter().zip(covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
+    Ok((params, uvc, rig))
+}
+
 /// Per pixel of a `width`×`height` frame, (u, v, covered) → H (0 where not covered), on the GPU.
 pub fn hemoglobin_at_uv(
     device: &wgpu::Device,
@@ -142,38 +185,86 @@ pub fn hemoglobin_at_uv(
     covered: &[bool],
     maps: &RigAtUv<'_>,
 ) -> Result<Vec<f32>, RuntimeError> {
-    maps.validate()?;
-    let n = (width * height) as usize;
-    if uv.len() != n || covered.len() != n {
-        return Err(InvalidInput::new("mesh uv", format!("needs {width}x{height} texture coordinates")).into());
-    }
-    let mut w = [[0.0f32; 4]; 2];
-    for (i, v) in maps.pose.weights.iter().enumerate() {
-        w[i / 4][i % 4] = *v;
-    }
-    let params = compute_chain::MapParams {
-        size: [width as f32, height as f32, maps.rig.width as f32, maps.rig.height as f32],
-        cfg: [maps.h0.width as f32, maps.h0.height as f32, maps.rig.targets.len() as f32, maps.pose.global_scale],
-        weights: w,
-    };
-    let uvc: Vec<f32> = uv.iter().zip(covered).flat_map(|(t, &c)| [t[0], t[1], c as u8 as f32, 0.0]).collect();
-    let rig: Vec<f32> = maps.rig.targets.iter().flatten().flatten().copied().collect();
+    let (params, uvc, rig) = pass_inputs(width, height, uv, covered, maps)?;
     let out = compute_chain::run(
         device,
         queue,
         "mesh skin inputs",
-        concat!(include_str!("pixel_frame.wgsl"), include_str!("bilinear_taps.wgsl"), include_str!("mesh_inputs.wgsl")),
+        SOURCE,
         bytemuck::bytes_of(&params),
         &[
             Buffer::Data(bytemuck::cast_slice(&uvc)),
             Buffer::Data(bytemuck::cast_slice(&rig)),
             Buffer::Data(bytemuck::cast_slice(&maps.h0.data)),
-            Buffer::Zeroed(4 * n as u64),
+            Buffer::Zeroed(4 * (width * height) as u64),
         ],
         &[Stage::new("main", compute_chain::groups_8x8(width, height))],
         3,
     )?;
     Ok(bytemuck::cast_slice(&out).to_vec())
+}
+
+/// Records the pass into `enc`, a frame's command encoder, with H written into the hemoglobin channel of
+/// `skin_maps` (the skin-inputs maps, `width`×`height` `Rgba32Float`, (Cm, H0, thickness mm, 0)), whose other
+/// channels are `texels` (row-major, one per pixel): no submission and no read-back of its own.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_into_skin_maps(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    width: u32,
+    height: u32,
+    uv: &[[f32; 2]],
+    covered: &[bool],
+    maps: &RigAtUv<'_>,
+    texels: &[[f32; 4]],
+    skin_maps: &wgpu::Texture,
+) -> Result<(), RuntimeError> {
+    let (_, uvc, _) = pass_inputs(width, height, uv, covered, maps)?;
+    let n = (width * height) as usize;
+    if texels.len() != n || (skin_maps.width(), skin_maps.height()) != (width, height) {
+        return Err(InvalidInput::new("skin maps", format!("must be {width}x{height}")).into());
+    }
+    // The skin maps in a texture copy's padded rows.
+    let stride = (gpu::padded_row_bytes(skin_maps) / 16) as usize;
+    let mut padded = vec![[0.0f32; 4]; stride * height as usize];
+    for (row, src) in padded.chunks_exact_mut(stride).zip(texels.chunks_exact(width as usize)) {
+        row[..width as usize].copy_from_slice(src);
+    }
+    let what = "mesh skin inputs";
+    let uvc_buf = compute_chain::storage_buffer(device, what, 4 * uvc.len() as u64, Some(bytemuck::cast_slice(&uvc)));
+    let bytes = 16 * padded.len() as u64;
+    let maps_buf = compute_chain::storage_buffer(device, what, bytes, Some(bytemuck::cast_slice(&padded)));
+    record_into_skin_map_buffer(device, enc, (width, height), maps, &uvc_buf, &maps_buf, stride as u32)?;
+    gpu::encode_buffer_to_texture(enc, &maps_buf, 0, skin_maps);
+    Ok(())
+}
+
+/// Records the pass into `enc` over GPU buffers: (u, v, covered, 0) per pixel of the `size` frame in `uvc`, H
+/// written into the hemoglobin channel of `skin_maps` (vec4 texels, rows of `stride` texels).
+pub(crate) fn record_into_skin_map_buffer(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    (width, height): (u32, u32),
+    maps: &RigAtUv<'_>,
+    uvc: &wgpu::Buffer,
+    skin_maps: &wgpu::Buffer,
+    stride: u32,
+) -> Result<(), RuntimeError> {
+    let (params, rig) = rig_inputs(width, height, maps)?;
+    let what = "mesh skin inputs";
+    let h0: &[u8] = bytemuck::cast_slice(&maps.h0.data);
+    let n = width as u64 * height as u64;
+    let sizes = [uvc.size(), 4 * rig.len() as u64, h0.len() as u64, 4 * n, skin_maps.size()];
+    compute_chain::check_buffers(device, what, &sizes)?;
+    let rig_buf = compute_chain::storage_buffer(device, what, sizes[1], Some(bytemuck::cast_slice(&rig)));
+    let h0_buf = compute_chain::storage_buffer(device, what, sizes[2], Some(h0));
+    let hb = compute_chain::storage_buffer(device, what, sizes[3], None);
+    let groups = compute_chain::groups_8x8(width, height);
+    let pack = Stage { entry: "into_skin_maps", groups, args: [stride, 0, 0, 0] };
+    let bound = [uvc, &rig_buf, &h0_buf, &hb, skin_maps];
+    let uniform = bytemuck::bytes_of(&params);
+    compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("main", groups), pack]);
+    Ok(())
 }
 
 #[cfg(test)]

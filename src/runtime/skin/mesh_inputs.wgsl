@@ -8,12 +8,17 @@ struct Params {
     // H0 width, height, targets, global scale g
     cfg: vec4<f32>,
     weights: array<vec4<f32>, 2>,
+    // per dispatch (compute_chain's stage arguments): `into_skin_maps`' row stride in texels, 0, 0, 0
+    stage: vec4<u32>,
 };
 
 // (scale, bias) per texel, target-major, rows top first
 @group(0) @binding(2) var<storage, read_write> rig: array<vec2<f32>>;
 @group(0) @binding(3) var<storage, read_write> h0: array<f32>;
 @group(0) @binding(4) var<storage, read_write> hb: array<f32>;
+// Bound only where the frame's shading records this pass (`record_into_skin_maps`): the skin-inputs maps
+// (Cm, H0, thickness mm, 0) per texel, rows of `p.stage.x` texels (a texture copy's padded rows).
+@group(0) @binding(5) var<storage, read_write> skin_maps: array<vec4<f32>>;
 
 // Prepended by the host module: `p` (binding 0, this `Params`), `uvc` and the entry point `main`, which calls
 // `covered` and `uncovered` below per pixel (pixel_frame.wgsl); `Taps`, `taps`, `tap_index` and `bilerp*`
@@ -47,4 +52,13 @@ fn covered(i: u32, uv: vec2<f32>) {
     }
     let th = taps(uv.x, uv.y, p.cfg.x, p.cfg.y);
     hb[i] = p.cfg.w * (bias + h0_at(th) * scale); // eq. 7.6
+}
+
+// After `main`: H into the skin-inputs maps' hemoglobin channel, which the skin-inputs pass reads with a neutral rig.
+@compute @workgroup_size(8, 8, 1)
+fn into_skin_maps(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= u32(p.size.x) || id.y >= u32(p.size.y)) {
+        return;
+    }
+    skin_maps[id.y * p.stage.x + id.x].y = hb[id.y * u32(p.size.x) + id.x];
 }

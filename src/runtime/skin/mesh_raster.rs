@@ -169,7 +169,7 @@ pub fn rasterise_jobs(
 
 /// Records the G-buffer pass of `job` into `enc`; returns its three targets (normal + depth, uv + coverage,
 /// tangent; resolved when multisampled).
-fn record(
+pub(crate) fn record(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
     job: &RasterJob<'_>,

@@ -14,6 +14,7 @@ pub mod bloom;
 pub mod bloom_cpu;
 pub mod demo;
 pub mod frame;
+mod frame_geometry;
 pub mod heads;
 pub mod inputs;
 pub mod inputs_cpu;

@@ -1,5 +1,7 @@
-//! The shading of a skin frame resident on the GPU, as an engine records a frame: the skin-inputs pass, the lit
-//! diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
+//! The shading of a skin frame resident on the GPU, as an engine records a frame: for the default `run skin` frame
+//! the G-buffer, the shadow map and the geometry computed from them (`frame_geometry`), the rig's hemoglobin at the
+//! mesh's uv when the frame leaves it here (`mesh_inputs::record_into_skin_maps`, writing H into the skin-inputs
+//! maps), the skin-inputs pass, the lit diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
 //! specular layer, bloom (thesis ch. 4) and the tone map are recorded into **one** command encoder, hand textures
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
@@ -19,9 +21,11 @@ use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::device::Gpu;
 use crate::runtime::gpu;
 use crate::runtime::skin::bloom::{self, BloomBuffers};
-use crate::runtime::skin::inputs::SkinInputs;
+use crate::runtime::skin::frame_geometry::{self, FrameGeometryJob};
+use crate::runtime::skin::inputs::{maps_texels, SkinInputs};
 use crate::runtime::skin::lighting::{self, lit_geometry, subsurface_of, SssMethod};
 use crate::runtime::skin::lighting::{DemoAssets, Geometry, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
+use crate::runtime::skin::mesh_inputs::{self, RigAtUv};
 use crate::runtime::RuntimeError;
 
 thread_local! {
@@ -34,6 +38,13 @@ thread_local! {
 /// same either way.
 pub fn set_shading_in_one_encoder(on: bool) {
     SHADING_IN_ONE_ENCODER.with(|c| c.set(on));
+}
+
+/// Whether a frame rendered on `gpu` from this thread records its shading into one command encoder: on a device
+/// with [`set_shading_in_one_encoder`] on. Such a frame leaves the rig at uv to that encoder too
+/// ([`crate::runtime::skin::lighting::Geometry`]'s `rig_at_uv`).
+pub(crate) fn shades_in_one_encoder(gpu: Backend<'_>) -> bool {
+    gpu.is_gpu() && SHADING_IN_ONE_ENCODER.with(|c| c.get())
 }
 
 /// The shaded frame of `geo` over `background` (RGBA8 sRGB of the frame's size): the lit diffuse layer through
@@ -49,6 +60,9 @@ pub(crate) fn render_geometry(
     let parts = std::cell::Cell::new(Some((geo, background)));
     let take = || parts.take().expect("one backend runs");
     let per_pass = |(geo, background): (Geometry, Vec<u8>)| {
+        if geo.rig_at_uv.is_some() {
+            return Err(RuntimeError::Gpu("the rig at uv is left to a frame that is not shaded in one encoder".into()));
+        }
         let lit = lit_geometry(gpu, geo, assets)?;
         lighting::shade(gpu, lit, assets, method, background, None)
     };
@@ -59,9 +73,25 @@ pub(crate) fn render_geometry(
                 return per_pass(take());
             }
             let (geo, background) = take();
-            shade(g, &geo, assets, subsurface_of(assets, method)?.as_ref(), background)
+            shade(g, FrameSource::Host(&geo), assets, subsurface_of(assets, method)?.as_ref(), background)
         },
         || per_pass(take()),
+    )
+}
+
+/// The shaded frame of `job` (see [`render_geometry`]) with its geometry rasterised and computed on the device in
+/// the shading's own command encoder ([`FrameSource::Device`]): one submission, one read-back. Only for a frame
+/// that [`shades_in_one_encoder`]; the CPU twins take the host's [`Geometry`].
+pub(crate) fn render_on_device(
+    gpu: Backend<'_>,
+    job: &FrameGeometryJob<'_>,
+    assets: &DemoAssets,
+    method: Option<SssMethod>,
+    background: Vec<u8>,
+) -> Result<Image<u8>, RuntimeError> {
+    gpu.run(
+        |g| shade(g, FrameSource::Device(job), assets, subsurface_of(assets, method)?.as_ref(), background),
+        || Err(RuntimeError::Gpu("a frame whose geometry is computed on the device needs a device".into())),
     )
 }
 
@@ -91,43 +121,100 @@ fn geometry_texels(geo: &Geometry) -> Vec<f32> {
     out
 }
 
-/// The frame of `geo` shaded through `sss` (None: no SSS pass) over `background` (RGBA8 sRGB of the frame's size),
-/// with `assets`' tables, lights, post-scatter switch and bloom: one submission, one read-back (the RGBA8 frame).
+/// Where a frame's geometry comes from: the host's [`Geometry`] (the reference, and the path for MSAA, wrinkles and
+/// a scan's surface maps), or the device's, rasterised and computed in the frame's own command encoder
+/// (`frame_geometry`: no G-buffer read-back).
+pub(crate) enum FrameSource<'a> {
+    Host(&'a Geometry),
+    Device(&'a FrameGeometryJob<'a>),
+}
+
+/// The frame of `source` shaded through `sss` (None: no SSS pass) over `background` (RGBA8 sRGB of the frame's
+/// size), with `assets`' tables, lights, post-scatter switch and bloom: one submission, one read-back (the RGBA8
+/// frame).
 pub(crate) fn shade(
     g: &Gpu,
-    geo: &Geometry,
+    source: FrameSource<'_>,
     assets: &DemoAssets,
     sss: Option<&Subsurface>,
     background: Vec<u8>,
 ) -> Result<Image<u8>, RuntimeError> {
     let (device, queue) = (&g.device, &g.queue);
-    let (w, h) = (geo.frame.width, geo.frame.height);
+    let has_albedo = matches!(&source, FrameSource::Host(geo) if geo.albedo.is_some());
+    let (w, h) = match &source {
+        FrameSource::Host(geo) => (geo.frame.width, geo.frame.height),
+        FrameSource::Device(job) => (job.width, job.height),
+    };
     let n = w as u64 * h as u64;
     if background.len() as u64 != 4 * n {
         return Err(InvalidInput::new("background", format!("must be {w}x{h} RGBA8")).into());
     }
+    let what = "skin frame";
     let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
-    inputs.upload(queue, &geo.frame, &assets.rig_weights, assets.lights.back_view)?;
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let blur = match sss {
         Some(m) => Some(SubsurfaceGpu::new(g, (w, h), m)?),
         None => None,
     };
-    if let Some(b) = &blur {
-        b.upload_depth(queue, &geo.depth)?;
-    }
+    let (light, weights) = (assets.lights.back_view, &assets.rig_weights);
+    let geo_buf = match source {
+        FrameSource::Host(geo) => {
+            match (&geo.rig_at_uv, &assets.baked_rig) {
+                (Some(px), Some(r)) => {
+                    // The rig's H at the mesh's uv goes into the skin-inputs maps on the device.
+                    inputs.upload_except_maps(queue, &geo.frame, weights, light)?;
+                    let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose: &px.pose };
+                    let texels = maps_texels(&geo.frame);
+                    let target = inputs.maps();
+                    mesh_inputs::record_into_skin_maps(
+                        device, &mut enc, w, h, &px.uv, &geo.skin, &maps, &texels, target,
+                    )?;
+                }
+                (Some(_), None) => {
+                    return Err(InvalidInput::new("hemoglobin rig", "the rig at uv needs a baked rig").into())
+                }
+                (None, _) => inputs.upload(queue, &geo.frame, weights, light)?,
+            }
+            if let Some(b) = &blur {
+                b.upload_depth(queue, &geo.depth)?;
+            }
+            let texels = geometry_texels(geo);
+            compute_chain::storage_buffer(device, what, 32 * n, Some(bytemuck::cast_slice(&texels)))
+        }
+        FrameSource::Device(job) => {
+            let d = frame_geometry::record(device, &mut enc, job, assets)?;
+            inputs.upload_lights(queue, weights, light)?;
+            if let (Some(pose), Some(r)) = (&job.rig_pose, &assets.baked_rig) {
+                let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose };
+                mesh_inputs::record_into_skin_map_buffer(
+                    device,
+                    &mut enc,
+                    (w, h),
+                    &maps,
+                    &d.uvc,
+                    &d.skin_maps,
+                    d.vec4_row,
+                )?;
+            }
+            gpu::encode_buffer_to_texture(&mut enc, &d.skin_maps, 0, inputs.maps());
+            gpu::encode_buffer_to_texture(&mut enc, &d.normals, 0, inputs.normals());
+            if let Some(b) = &blur {
+                gpu::encode_buffer_to_texture(&mut enc, &d.depth, 0, b.depth());
+            }
+            d.texels
+        }
+    };
     let bloom_buffers = match &assets.bloom {
         Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
         None => None,
     };
     // Half-float images (the skin-inputs targets, the SSS frame) share one padded row: all are w×h Rgba16Float.
     let row = gpu::padded_row_bytes(inputs.albedo()) as u64;
-    let what = "skin frame";
     let sizes = [2 * row * h as u64, 32 * n, 16 * n, row * h as u64, 16 * n, 16, 4 * n];
     compute_chain::check_buffers(device, what, &sizes)?;
-    let texels = geometry_texels(geo);
     let make = |k: usize, data: Option<&[u8]>| compute_chain::storage_buffer(device, what, sizes[k], data);
     let skin16 = make(0, None);
-    let geo_buf = make(1, Some(bytemuck::cast_slice(&texels)));
     let diffuse = make(2, None);
     let sss16 = make(3, None);
     let rgba = make(6, Some(&background));
@@ -140,15 +227,13 @@ pub(crate) fn shade(
     let flag = |b: bool| if b { 1.0 } else { 0.0 };
     let params = Params {
         size: [w as f32, h as f32, (row / 4) as f32, flag(assets.post_scatter_albedo)],
-        key: [key[0], key[1], key[2], flag(geo.albedo.is_some())],
+        key: [key[0], key[1], key[2], flag(has_albedo)],
         cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, flag(bloom_buffers.is_some()), flag(blur.is_some())],
     };
     let bound = [&skin16, &geo_buf, &diffuse, &sss16, &hdr, &bloomed, &rgba];
     let groups = compute_chain::groups_8x8(w, h);
     let stages = |names: &[&'static str]| names.iter().map(|e| Stage::new(e, groups)).collect::<Vec<_>>();
     let uniform = bytemuck::bytes_of(&params);
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     inputs.encode(&mut enc);
     gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
     gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row * h as u64);

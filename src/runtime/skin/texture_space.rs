@@ -184,7 +184,7 @@ pub fn render_with<'g>(
     s.validate()?;
     ts.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let (geo, g, shadow) = heads::geometry(gpu, &heads, s, passes, assets)?;
+    let (geo, g, shadow) = heads::geometry(gpu, &heads, s, passes, assets, false)?;
     // As `skin_render::render_with`: a neutral rig (scale 1, bias 0), post-scatter texturing (the maps hold
     // irradiance; each pixel's albedo multiplies what it gathers, thesis §7.6) and the passes' bloom.
     let mut assets = assets.clone();
@@ -288,7 +288,8 @@ pub fn render_with<'g>(
         if st.shaded_texels == 0 {
             continue;
         }
-        let texels = Geometry { frame, depth: vec![1.0; n], skin: shaded, specular: None, albedo: None };
+        let texels =
+            Geometry { frame, depth: vec![1.0; n], skin: shaded, specular: None, albedo: None, rig_at_uv: None };
         let irr = lit_geometry(gpu, texels, &assets)?.diffuse;
         let irr: Vec<[f32; 4]> = irr.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let uvs: Vec<[f32; 2]> = pixels.iter().map(|&i| g.uv[i]).collect();

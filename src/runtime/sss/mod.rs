@@ -129,6 +129,11 @@ impl<B: SssBlur> SssPass<B> {
         self.inputs.upload(queue, color, depth)
     }
 
+    /// The linear depth the pass reads (`R32Float`): a frame that computes it on the device copies it there.
+    pub(crate) fn depth(&self) -> &wgpu::Texture {
+        &self.inputs.depth
+    }
+
     /// Uploads the linear depth alone (top row first): the irradiance comes from an earlier pass of the same
     /// command encoder, copied into [`SssPass::input`].
     pub fn upload_depth(&self, queue: &wgpu::Queue, depth: &[f32]) -> Result<(), InvalidInput> {
