@@ -54,9 +54,12 @@ fn main() {
         stretch: Default::default(),
     };
     let cam = s.camera();
+    let tangents = rtbake::mesh::tangents::vertex_tangents(&head);
     let raster = |samples| match g {
         Some(d) => {
-            rtbake::runtime::mesh_raster::rasterise_samples(&d.device, &d.queue, &head, &cam, w, h, samples).unwrap()
+            use rtbake::runtime::mesh_raster::{rasterise_jobs, RasterJob};
+            let job = RasterJob { mesh: &head, tangents: &tangents, camera: &cam, width: w, height: h, samples };
+            rasterise_jobs(&d.device, &d.queue, &[job]).unwrap().remove(0)
         }
         None => rtbake::runtime::cpu::mesh_raster::rasterise_samples(&head, &cam, w, h, samples).unwrap(),
     };

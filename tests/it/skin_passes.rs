@@ -216,15 +216,17 @@ fn bloom_conserves_energy_spreads_a_bright_pixel_monotonically_and_gpu_matches_c
 #[test]
 fn msaa_4x_gpu_matches_cpu_and_its_coverage_is_closer_to_16x_supersampling_than_1x() {
     use rtbake::runtime::cpu::mesh_raster::rasterise_samples;
+    use rtbake::runtime::mesh_raster::{rasterise_jobs, RasterJob};
     let g = gpu();
     let mesh = default_head();
     let cam = Camera::facing(0.6).unwrap();
     let (w, h) = (160usize, 90usize);
     let one = rasterise_samples(&mesh, &cam, w as u32, h as u32, 1).unwrap();
     let four = rasterise_samples(&mesh, &cam, w as u32, h as u32, 4).unwrap();
-    let four_gpu =
-        rtbake::runtime::mesh_raster::rasterise_samples(&g.device, &g.queue, &mesh, &cam, w as u32, h as u32, 4)
-            .unwrap();
+    let tangents = rtbake::mesh::tangents::vertex_tangents(&mesh);
+    let job =
+        RasterJob { mesh: &mesh, tangents: &tangents, camera: &cam, width: w as u32, height: h as u32, samples: 4 };
+    let four_gpu = rasterise_jobs(&g.device, &g.queue, &[job]).unwrap().remove(0);
     let same = four.coverage.iter().zip(&four_gpu.coverage).filter(|(a, b)| a == b).count();
     assert!(same as f64 >= 0.99 * (w * h) as f64, "coverage: {same} of {} pixels agree", w * h);
     let both: Vec<usize> = (0..w * h).filter(|&i| four.coverage[i] == 1.0 && four_gpu.coverage[i] == 1.0).collect();

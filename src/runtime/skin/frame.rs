@@ -14,7 +14,7 @@
 //!    With [`SkinPasses::wrinkles`], the wrinkle pass of Listing 8.1 ([`crate::runtime::skin::wrinkles`]) replaces the
 //!    G-buffer's normals before any lighting.
 //!    With `--msaa 4` ([`SkinPasses::msaa`]) the G-buffer is rasterised with 4 samples per pixel
-//!    ([`crate::runtime::skin::mesh_raster::rasterise_samples`]) and partly covered pixels are blended with the background by
+//!    ([`crate::runtime::skin::mesh_raster::RasterJob::samples`]) and partly covered pixels are blended with the background by
 //!    their coverage after shading (the shadow map stays at 1 sample).
 //! 4. The demo's shading in the thesis' order: Lambert key light; the SSS pass of `shader` (none, separable or
 //!    the screen-space sum of Gaussians) on the diffuse irradiance, view depth in head-sized world units

@@ -155,6 +155,15 @@ fn data_texture(
     })
 }
 
+/// Where [`SkinInputs::upload`] takes the maps texture (Cm, H0, thickness) from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapsFrom {
+    /// The frame's own values, uploaded from the host.
+    Frame,
+    /// Written on the device by the caller's pass (the rig at the mesh's uv), not uploaded.
+    Device,
+}
+
 impl SkinInputs {
     pub fn new(
         device: &wgpu::Device,
@@ -258,21 +267,8 @@ impl SkinInputs {
         &self.transmitted
     }
 
-    /// Uploads a frame and the per-frame rig weights and light direction (unit, towards the light).
-    pub fn upload(
-        &mut self,
-        queue: &wgpu::Queue,
-        frame: &SkinFrame,
-        rig_weights: &[f32],
-        light_dir: [f32; 3],
-    ) -> Result<(), InvalidInput> {
-        self.upload_except_maps(queue, frame, rig_weights, light_dir)?;
-        gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps_texels(frame)));
-        Ok(())
-    }
-
     /// The maps texture the pass reads, (Cm, H0, thickness mm, 0) per pixel, `Rgba32Float`: a frame that
-    /// computes H on the device writes it there ([`SkinInputs::upload_except_maps`]).
+    /// computes H on the device writes it there ([`MapsFrom::Device`]).
     pub(crate) fn maps(&self) -> &wgpu::Texture {
         &self.maps
     }
@@ -282,13 +278,16 @@ impl SkinInputs {
         &self.normals
     }
 
-    /// [`SkinInputs::upload`] but for the maps texture, which the caller fills on the device.
-    pub(crate) fn upload_except_maps(
+    /// Uploads a frame and the per-frame rig weights and light direction (unit, towards the light); the maps
+    /// texture from the frame with [`MapsFrom::Frame`], or left to the caller to fill on the device
+    /// ([`MapsFrom::Device`]).
+    pub fn upload(
         &mut self,
         queue: &wgpu::Queue,
         frame: &SkinFrame,
         rig_weights: &[f32],
         light_dir: [f32; 3],
+        maps: MapsFrom,
     ) -> Result<(), InvalidInput> {
         frame.validate()?;
         if (frame.width, frame.height) != (self.width, self.height) {
@@ -297,6 +296,9 @@ impl SkinInputs {
         self.upload_lights(queue, rig_weights, light_dir)?;
         let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
         gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
+        if maps == MapsFrom::Frame {
+            gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps_texels(frame)));
+        }
         Ok(())
     }
 
@@ -358,7 +360,7 @@ impl SkinInputs {
         rig_weights: &[f32],
         light_dir: [f32; 3],
     ) -> Result<(Vec<f32>, Vec<f32>), RuntimeError> {
-        self.upload(queue, frame, rig_weights, light_dir)?;
+        self.upload(queue, frame, rig_weights, light_dir, MapsFrom::Frame)?;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin") });
         self.encode(&mut enc);
         // One submission, both targets read back with one wait.

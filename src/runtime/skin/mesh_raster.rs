@@ -6,7 +6,7 @@
 //! screen-space passes, texture-space diffusion and the wrinkle pass need. Its CPU twin is [`crate::runtime::skin::mesh_raster_cpu`]; both return a
 //! [`MeshGBuffer`].
 //!
-//! MSAA ([`rasterise_samples`] with 4 samples, `run skin --msaa 4`): multisampled targets and depth buffer, the
+//! MSAA ([`RasterJob::samples`] 4, `run skin --msaa 4`): multisampled targets and depth buffer, the
 //! fragment shaded once per pixel at its centre and stored in the samples it covers, the hardware resolve averaging
 //! the samples; uncovered samples hold zeros, so the resolved coverage flag is the covered fraction and the
 //! attributes divided by it are the mean over the covered samples (the normal renormalised). 4× needs
@@ -92,7 +92,9 @@ pub(crate) fn check_raster_inputs(mesh: &Mesh, tangents: &[[f32; 4]], samples: u
     check_samples(samples)
 }
 
-/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU.
+/// Renders `mesh` seen by `camera` into a `width`×`height` G-buffer on the GPU, one sample per pixel, with the
+/// mesh's own vertex tangents ([`crate::mesh::tangents::vertex_tangents`]); [`rasterise_jobs`] takes MSAA, the
+/// caller's tangents (e.g. MikkTSpace's for a normal-mapped scan) and several G-buffers in one submission.
 pub fn rasterise(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -101,42 +103,13 @@ pub fn rasterise(
     width: u32,
     height: u32,
 ) -> Result<MeshGBuffer, RuntimeError> {
-    rasterise_samples(device, queue, mesh, camera, width, height, 1)
-}
-
-/// [`rasterise`] with `samples` (1 or 4) samples per pixel (see the module doc).
-pub fn rasterise_samples(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    mesh: &Mesh,
-    camera: &Camera,
-    width: u32,
-    height: u32,
-    samples: u32,
-) -> Result<MeshGBuffer, RuntimeError> {
     let tangents = crate::mesh::tangents::vertex_tangents(mesh);
-    rasterise_with_tangents(device, queue, mesh, &tangents, camera, width, height, samples)
-}
-
-/// [`rasterise_samples`] with the caller's per-vertex `tangents` (unit xyz, handedness w; one per vertex of
-/// `mesh`), e.g. MikkTSpace's for a normal-mapped scan ([`crate::mesh::tangents::mikktspace_tangents`]).
-#[allow(clippy::too_many_arguments)]
-pub fn rasterise_with_tangents(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    mesh: &Mesh,
-    tangents: &[[f32; 4]],
-    camera: &Camera,
-    width: u32,
-    height: u32,
-    samples: u32,
-) -> Result<MeshGBuffer, RuntimeError> {
-    let job = RasterJob { mesh, tangents, camera, width, height, samples };
+    let job = RasterJob { mesh, tangents: &tangents, camera, width, height, samples: 1 };
     Ok(rasterise_jobs(device, queue, &[job])?.remove(0))
 }
 
 /// One G-buffer to rasterise: `mesh` with its per-vertex `tangents` seen by `camera`, `width`×`height`, `samples`
-/// per pixel (the arguments of [`rasterise_with_tangents`]).
+/// per pixel (1, or 4 for MSAA: see the module doc).
 pub struct RasterJob<'a> {
     pub mesh: &'a Mesh,
     pub tangents: &'a [[f32; 4]],

@@ -24,7 +24,7 @@ pub struct SkinPasses {
     pub wrinkles: Option<Wrinkles>,
     /// Bloom; None: off.
     pub bloom: Option<BloomParams>,
-    /// Samples per pixel of the G-buffer raster, 1 or 4 (MSAA, [`crate::runtime::skin::mesh_raster::rasterise_samples`]).
+    /// Samples per pixel of the G-buffer raster, 1 or 4 (MSAA, [`crate::runtime::skin::mesh_raster::RasterJob::samples`]).
     pub msaa: u32,
     /// A scanned head's albedo and tangent-space normal map at the mesh's uv
     /// ([`crate::runtime::skin::surface_maps`]); None: the skin LUT's albedo and the mesh's normals.

@@ -22,7 +22,7 @@ use crate::runtime::device::Gpu;
 use crate::runtime::gpu;
 use crate::runtime::skin::bloom::{self, BloomBuffers};
 use crate::runtime::skin::frame_geometry::{self, FrameGeometryJob};
-use crate::runtime::skin::inputs::{maps_texels, SkinInputs};
+use crate::runtime::skin::inputs::{maps_texels, MapsFrom, SkinInputs};
 use crate::runtime::skin::lighting::{self, lit_geometry, subsurface_of, SssMethod};
 use crate::runtime::skin::lighting::{DemoAssets, Geometry, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
 use crate::runtime::skin::mesh_inputs::{self, RigAtUv};
@@ -163,7 +163,7 @@ pub(crate) fn shade(
             match (&geo.rig_at_uv, &assets.baked_rig) {
                 (Some(px), Some(r)) => {
                     // The rig's H at the mesh's uv goes into the skin-inputs maps on the device.
-                    inputs.upload_except_maps(queue, &geo.frame, weights, light)?;
+                    inputs.upload(queue, &geo.frame, weights, light, MapsFrom::Device)?;
                     let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose: &px.pose };
                     let texels = maps_texels(&geo.frame);
                     let target = inputs.maps();
@@ -174,7 +174,7 @@ pub(crate) fn shade(
                 (Some(_), None) => {
                     return Err(InvalidInput::new("hemoglobin rig", "the rig at uv needs a baked rig").into())
                 }
-                (None, _) => inputs.upload(queue, &geo.frame, weights, light)?,
+                (None, _) => inputs.upload(queue, &geo.frame, weights, light, MapsFrom::Frame)?,
             }
             if let Some(b) = &blur {
                 b.upload_depth(queue, &geo.depth)?;
