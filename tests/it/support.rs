@@ -68,7 +68,7 @@ pub fn skip_missing(what: &str, path: &std::path::Path, env_var: &str) {
         "SKIPPED{}: {what} — {} not found ({}; set {env_var}; see README \"Tests and ../shared\")",
         test_name(),
         path.display(),
-        origin_of(path)
+        origin_of(path, env_var)
     );
     if external_inputs_required() {
         panic!("{msg}, but RTBAKE_REQUIRE_REFERENCE=1");
@@ -83,17 +83,19 @@ pub fn test_name() -> String {
     std::thread::current().name().filter(|n| *n != "main").map(|n| format!(" [{n}]")).unwrap_or_default()
 }
 
-/// Where a missing external input comes from, by its place under `../shared`.
-fn origin_of(path: &std::path::Path) -> &'static str {
+/// Where a missing external input comes from: the data tables by the variable that overrides their folder
+/// (whatever path it names), the reference files by their place under `../shared/reference`.
+fn origin_of(path: &std::path::Path, env_var: &str) -> &'static str {
     let p = path.to_string_lossy();
+    if env_var == "RTBAKE_DATA_DIR" {
+        return "the physical data tables of ../shared/data (spectra, absorption coefficients)";
+    }
     if p.contains("consumers/bevy_anti_alias") {
         "Bevy's SMAA LUTs, from the bevy_anti_alias 0.20.1 crate on crates.io"
     } else if p.contains("consumers/separable-sss") {
         "SeparableSSS.h of github.com/iryoku/separable-sss"
     } else if p.contains("heads/") {
         "the Lee Perry-Smith head scan as distributed with the three.js examples"
-    } else if p.ends_with("data") || p.contains("shared/data") {
-        "the physical data tables of ../shared/data (spectra, absorption coefficients)"
     } else {
         "the upstream SMAA (github.com/iryoku/smaa) and Jimenez MLAA textures of ../shared/reference, not \
          redistributed in a clone"
