@@ -13,7 +13,7 @@ for f in LeePerrySmith.glb color.jpg normal.jpg; do
 done
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-target/debug/rtbake --json run tap-grid --separable --mesh "$heads/LeePerrySmith.glb" --mesh-units auto \
+target/debug/rtbake --json run tap-grid --separable --mesh "$heads/LeePerrySmith.glb" --mesh-units auto --uv-origin bottom-left \
     --albedo "$heads/color.jpg" --normal-map "$heads/normal.jpg" --width 640 --height 360 --out "$out/grid" \
     > "$out/grid.json"
 python3 - "$out" <<'PY'

@@ -5,7 +5,7 @@ use crate::cli::{usage, usage_msg, Ctx};
 use rtbake::facial::wrinkles::GreenConvention;
 use rtbake::io::{self, atomic::write_atomic};
 use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits, TapDistance};
-use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh};
+use rtbake::mesh::{gltf::parse_gltf, head::default_head, obj::parse_obj, Mesh, UvOrigin};
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::mesh_skin_inputs::RigPose;
 use rtbake::runtime::skin::lighting::{SceneLights, TransmittanceMode};
@@ -101,7 +101,7 @@ pub struct SkinArgs {
     #[arg(long, value_enum, default_value = "bounds")]
     mesh_origin: MeshOriginArg,
     /// Stretch parameters of --shader ss-full: tap2009 (α = 11, β = 800, no clamp of the depth derivative, TAP
-    /// 2009 §4; the default, closest to TS on the scanned head), thesis (the bake's α, β, γ) — both stated for a
+    /// 2009 §4; the default: TAP's SS Full ≈ TS was found with it), thesis (the bake's α, β, γ) — both stated for a
     /// 20° field of view and scaled to the camera's — or physical (α from the camera: each Gaussian at its width
     /// in mm, as TS and SS Jittered).
     #[arg(long, value_enum, default_value = "tap2009")]
@@ -180,6 +180,19 @@ pub struct MapArgs {
     /// directx (+y down the texture).
     #[arg(long, value_enum, default_value = "opengl")]
     normal_green: GreenArg,
+    /// Where v = 0 of --mesh's texture coordinates lies in --albedo/--normal-map: format (the format's own
+    /// convention: glTF top-left, OBJ bottom-left), top-left or bottom-left. The three.js distribution of the
+    /// Lee Perry-Smith scan is a glTF with bottom-left texture coordinates (three.js loads its maps with flipY):
+    /// read as glTF, its lips land on the chin and its eyebrows on the neck.
+    #[arg(long, value_enum, default_value = "format")]
+    pub(crate) uv_origin: UvOriginArg,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum UvOriginArg {
+    Format,
+    TopLeft,
+    BottomLeft,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -270,9 +283,10 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
     Ok(p)
 }
 
-/// Reads and validates `--mesh` (exit 2 naming the file and the defect), then puts it in metres (`units`) with
-/// its bounding-box centre at the origin unless `origin` is authored.
-pub fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow::Result<Mesh> {
+/// Reads and validates `--mesh` (exit 2 naming the file and the defect), re-reads its texture coordinates with
+/// `uv_origin` (`--uv-origin`), then puts it in metres (`units`) with its bounding-box centre at the origin unless
+/// `origin` is authored.
+pub fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg, uv_origin: UvOriginArg) -> anyhow::Result<Mesh> {
     let name = format!("--mesh {}", path.display());
     let meta = std::fs::metadata(path).map_err(|e| usage_msg(format!("{name}: {e}")))?;
     if meta.len() > MAX_MESH_FILE_BYTES {
@@ -293,7 +307,14 @@ pub fn load_mesh(path: &Path, units: MeshUnits, origin: MeshOriginArg) -> anyhow
         Some("obj") => parse_obj(&name, &bytes, 1000.0),
         _ => return Err(usage_msg(format!("{name}: unknown extension; accepted .gltf, .glb, .obj"))),
     };
-    let mesh = mesh.map_err(usage)?;
+    // The parsers read each format's own convention into this crate's top-left one.
+    let parsed_as = UvOrigin::of_format(ext.as_deref() != Some("obj"));
+    let file_origin = match uv_origin {
+        UvOriginArg::Format => parsed_as,
+        UvOriginArg::TopLeft => UvOrigin::TopLeft,
+        UvOriginArg::BottomLeft => UvOrigin::BottomLeft,
+    };
+    let mesh = mesh.map_err(usage)?.with_uv_origin(parsed_as, file_origin);
     let origin = match origin {
         MeshOriginArg::Bounds => MeshOrigin::Head,
         MeshOriginArg::Authored => MeshOrigin::Authored,
@@ -394,7 +415,7 @@ pub fn run(ctx: &Ctx, a: SkinArgs) -> anyhow::Result<()> {
         rtbake::runtime::demo::time_estimate_seconds(a.width, a.height, a.common.cpu) + 0.5,
     )?;
     let mesh = match &a.mesh {
-        Some(p) => load_mesh(p, units, a.mesh_origin)?,
+        Some(p) => load_mesh(p, units, a.mesh_origin, a.maps.uv_origin)?,
         None => default_head(),
     };
     let head_height_m = head_height_units(&mesh) * mesh.mm_per_unit / 1000.0;

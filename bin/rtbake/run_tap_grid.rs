@@ -93,7 +93,7 @@ pub fn run(ctx: &Ctx, a: TapGridArgs) -> anyhow::Result<()> {
         time,
     )?;
     let mesh = match &a.mesh {
-        Some(p) => load_mesh(p, units, a.mesh_origin)?,
+        Some(p) => load_mesh(p, units, a.mesh_origin, a.maps.uv_origin)?,
         None => default_head(),
     };
     settings.head_height_m = head_height_units(&mesh) * mesh.mm_per_unit / 1000.0;

@@ -10,6 +10,9 @@
 //! - [`obj`], [`gltf`]: Wavefront OBJ (`tobj`) and glTF 2.0 (`gltf`) parsed from bytes; the caller reads the files.
 //!
 //! Positions are in mesh units with [`Mesh::mm_per_unit`] saying what one unit is (glTF: metres, 1000 mm).
+//! Texture coordinates follow one convention, v = 0 at the top row of the image; [`UvOrigin`] says where a file's
+//! own v = 0 lies, since files do not always follow their format's convention (the three.js distribution of the
+//! Lee Perry-Smith scan is a glTF whose v = 0 is the bottom row of its maps, as three.js loads them with `flipY`).
 
 pub mod camera;
 pub mod framing;
@@ -24,6 +27,26 @@ use crate::error::InvalidInput;
 pub const MAX_TRIANGLES: usize = 8 << 20;
 /// Most vertices a mesh may have.
 pub const MAX_VERTICES: usize = 8 << 20;
+
+/// Where v = 0 of a file's texture coordinates lies in its texture images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UvOrigin {
+    /// v = 0 is the image's top row: glTF 2.0's convention (and D3D's, wgpu's, this crate's).
+    TopLeft,
+    /// v = 0 is the image's bottom row: OpenGL's and Wavefront OBJ's convention.
+    BottomLeft,
+}
+
+impl UvOrigin {
+    /// The convention a file format states: glTF top-left, OBJ bottom-left.
+    pub fn of_format(gltf: bool) -> UvOrigin {
+        if gltf {
+            UvOrigin::TopLeft
+        } else {
+            UvOrigin::BottomLeft
+        }
+    }
+}
 
 /// An indexed triangle mesh with one normal and one UV per vertex (counter-clockwise front faces).
 #[derive(Clone, Debug, PartialEq)]
@@ -149,6 +172,17 @@ impl Mesh {
         Ok(Mesh { positions, normals: unit_normals, uvs, indices, mm_per_unit })
     }
 
+    /// The mesh with its texture coordinates re-read as if its file put v = 0 at `file_origin` rather than at
+    /// `parsed_as` (the convention it was parsed with): v becomes 1 − v where the two differ, nothing else changes.
+    pub fn with_uv_origin(mut self, parsed_as: UvOrigin, file_origin: UvOrigin) -> Mesh {
+        if parsed_as != file_origin {
+            for uv in &mut self.uvs {
+                uv[1] = 1.0 - uv[1];
+            }
+        }
+        self
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
@@ -193,6 +227,20 @@ mod tests {
         let m = Mesh::new("quad", p, n, uv, i, 1000.0).unwrap();
         assert_eq!(m.normals[0], [0.0, 0.0, 1.0]);
         assert!((m.area() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_bottom_left_file_origin_mirrors_v_and_only_v() {
+        let (p, n, uv, i) = quad();
+        let m = Mesh::new("quad", p, n, uv, i, 1000.0).unwrap();
+        let same = m.clone().with_uv_origin(UvOrigin::TopLeft, UvOrigin::TopLeft);
+        assert_eq!(same, m);
+        let flipped = m.clone().with_uv_origin(UvOrigin::TopLeft, UvOrigin::BottomLeft);
+        assert_eq!(flipped.uvs, vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+        assert_eq!((flipped.positions.clone(), flipped.indices.clone()), (m.positions.clone(), m.indices.clone()));
+        assert_eq!(flipped.with_uv_origin(UvOrigin::BottomLeft, UvOrigin::TopLeft), m);
+        assert_eq!(UvOrigin::of_format(true), UvOrigin::TopLeft);
+        assert_eq!(UvOrigin::of_format(false), UvOrigin::BottomLeft);
     }
 
     #[test]

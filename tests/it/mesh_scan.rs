@@ -74,6 +74,65 @@ fn the_scans_maps_decode_and_a_colour_picture_is_no_normal_map() {
     assert!(e.message.contains("is not a tangent-space normal map"), "{e}");
 }
 
+/// The scan's texture coordinates put v = 0 at the bottom row of its maps (three.js, whose copy this is, loads
+/// them with `flipY`), not at the top as glTF states: read as glTF, the crown samples the neck's rows of color.jpg
+/// and the lips (its reddest texels) land on the chin; with the bottom-left origin (`--uv-origin bottom-left`) the
+/// crown samples the scalp's top rows and the lips lie a mouth's distance below the nose tip.
+#[test]
+fn the_scans_texture_coordinates_have_their_origin_at_the_bottom_left() {
+    use rtbake::mesh::UvOrigin;
+    let Some(glb) = reference_file("heads/lee-perry-smith/LeePerrySmith.glb", WHAT) else { return };
+    let Some(color) = reference_file("heads/lee-perry-smith/color.jpg", WHAT) else { return };
+    let bytes = std::fs::read(&glb).unwrap();
+    let parsed = parse_gltf("LeePerrySmith.glb", &bytes, &no_files).unwrap();
+    let auto = MeshUnits::parse("--mesh-units", "auto").unwrap();
+    let as_gltf = frame_in_metres(&parsed, auto, "--mesh-units").unwrap();
+    let fixed = as_gltf.clone().with_uv_origin(UvOrigin::TopLeft, UvOrigin::BottomLeft);
+    let top = Bounds::of(&as_gltf).max[1];
+    let crown_v = |m: &rtbake::mesh::Mesh| {
+        let v: Vec<f32> =
+            m.positions.iter().zip(&m.uvs).filter(|(p, _)| p[1] > top - 0.02).map(|(_, t)| t[1]).collect();
+        v.iter().sum::<f32>() / v.len() as f32
+    };
+    assert!(crown_v(&as_gltf) > 0.8, "{}", crown_v(&as_gltf));
+    assert!(crown_v(&fixed) < 0.2, "{}", crown_v(&fixed));
+    // The lips: the 1 % of the albedo's middle third (the face; the corners hold dark red discs) with the highest
+    // linear red-to-green ratio, their mean uv.
+    let albedo = albedo_linear("--albedo", &rgb8(&color)).unwrap();
+    let w = albedo.width as usize;
+    let middle = |i: usize| (w / 3..2 * w / 3).contains(&(i % w)) && (w / 3..2 * w / 3).contains(&(i / w));
+    let mut red: Vec<(f32, usize)> = albedo
+        .data
+        .chunks_exact(3)
+        .enumerate()
+        .filter(|(i, _)| middle(*i))
+        .map(|(i, c)| (c[0] / (c[1] + 1e-3), i))
+        .collect();
+    red.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let lips = &red[..red.len() / 100];
+    let mean_uv = lips.iter().fold([0.0f32; 2], |a, &(_, i)| {
+        let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+        [a[0] + x / w as f32 / lips.len() as f32, a[1] + y / w as f32 / lips.len() as f32]
+    });
+    // Mesh points there: the vertices within 0.01 in uv of the lips' mean, in front (the face looks +z).
+    let nose = as_gltf.positions.iter().copied().max_by(|a, b| a[2].total_cmp(&b[2])).unwrap();
+    let lips_y = |m: &rtbake::mesh::Mesh| {
+        let near: Vec<f32> = m
+            .positions
+            .iter()
+            .zip(&m.uvs)
+            .filter(|(p, t)| p[2] > nose[2] - 0.05 && (t[0] - mean_uv[0]).hypot(t[1] - mean_uv[1]) < 0.01)
+            .map(|(p, _)| p[1])
+            .collect();
+        assert!(!near.is_empty(), "no vertex at the lips' uv {mean_uv:?}");
+        near.iter().sum::<f32>() / near.len() as f32
+    };
+    let (wrong, right) = (nose[1] - lips_y(&as_gltf), nose[1] - lips_y(&fixed));
+    // A head 230 mm tall: the mouth 15-45 mm below the nose tip (the scan: 34 mm; read as glTF, 58 mm).
+    assert!(right > 0.015 && right < 0.045, "the lips {right} m below the nose tip");
+    assert!(wrong > 0.05, "read as glTF, the lips {wrong} m below the nose tip");
+}
+
 /// Share of pixels of an RGBA frame that differ from the background (the top-left pixel).
 fn coverage(path: &std::path::Path) -> (f64, Vec<u8>) {
     let img = image::open(path).unwrap().to_rgba8();
@@ -146,6 +205,7 @@ fn run_skin_refuses_bad_units_and_distances() {
         (vec!["--mesh-units", "cm"], "--mesh only"),
         (vec!["--distance", "close"], "zoom, near, far"),
         (vec!["--distance", "0.1"], "--distance"),
+        (vec!["--mesh", head, "--uv-origin", "top"], "format, top-left, bottom-left"),
     ] {
         let mut a = vec!["run", "skin", "--cpu", "--width", "64", "--height", "48", "--output", out.to_str().unwrap()];
         a.extend_from_slice(&args);

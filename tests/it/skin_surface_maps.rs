@@ -327,6 +327,7 @@ fn the_scan_renders_with_its_maps_on_both_paths() {
     let frame = |shader: &str, cpu: bool| {
         let out = t.path().join(format!("{shader}{cpu}.png"));
         let mut a = vec!["run", "skin", "--mesh", glb.to_str().unwrap(), "--mesh-units", "auto", "--distance", "near"];
+        a.extend_from_slice(&["--uv-origin", "bottom-left"]);
         a.extend_from_slice(&["--albedo", color.to_str().unwrap(), "--normal-map", normal.to_str().unwrap()]);
         a.extend_from_slice(&["--shader", shader, "--bloom", "off", "--width", "192", "--height", "108"]);
         a.extend_from_slice(&["--ts-map-size", "512", "--output", out.to_str().unwrap()]);

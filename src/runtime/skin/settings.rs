@@ -35,9 +35,10 @@ pub enum StretchPreset {
     /// The bake's fit parameters (the thesis' α = 31.5, β = 800, γ = 0.001 unless the bake says otherwise).
     Thesis,
     /// TAP 2009 §4: "empirically fixed values of α = 11 and β = 800", with no clamp of the depth derivative (its
-    /// field of view taken as the thesis' 20°). The default: on the Lee Perry-Smith scan with its maps (TAP's
-    /// 12 conditions, 640×360, 30° camera) it is the preset closest to TS — mean RMSE 0.0061 against 0.0063
-    /// (physical) and 0.0065 (thesis) — as TAP's finding (SS Full ≈ TS) was made with it.
+    /// field of view taken as the thesis' 20°). The default, as TAP's finding (SS Full ≈ TS) was made with it.
+    /// On the Lee Perry-Smith scan with its maps (TAP's 12 conditions, 640×360, 30° camera) no preset is closest
+    /// to TS everywhere: mean RMSE 0.0067 (this), 0.0064 ([`StretchPreset::Thesis`], closer at zoom),
+    /// 0.0069 ([`StretchPreset::Physical`]); this one is closer at far and in two of the four near conditions.
     #[default]
     Tap2009,
     /// α from the camera, so that every Gaussian of the fit has its physical width in mm at the pixel's depth, as
