@@ -264,7 +264,7 @@ pub fn render_with<'g>(
     };
     let background = BACKGROUND.repeat((s.width * s.height) as usize);
     let one_encoder = shades_in_one_encoder(gpu);
-    if one_encoder && passes.msaa == 1 && passes.wrinkles.is_none() && passes.surface_maps.is_none() {
+    if one_encoder {
         // The geometry computed on the device in the shading's encoder: the G-buffer is never read back.
         let rig_pose =
             original.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
@@ -275,6 +275,9 @@ pub fn render_with<'g>(
             height: s.height,
             melanin: s.melanin,
             rig_pose,
+            msaa: passes.msaa,
+            surface_maps: passes.surface_maps.as_ref(),
+            wrinkles: passes.wrinkles.as_ref(),
         };
         return render_on_device(gpu, &job, &assets, method, background);
     }
