@@ -165,7 +165,7 @@ fn surface_maps_wrinkles_and_msaa_frames_submit_once_and_agree_with_the_cpu_twin
     let head = default_head();
     let wrinkles = rtbake::runtime::skin_passes::Wrinkles {
         maps: rtbake::runtime::wrinkle_pass::WrinkleMaps::load(&baked_dir()).unwrap(),
-        zone_weights: rtbake::runtime::wrinkle_pass::parse_wrinkle_weights("joy=1,surprise=1").unwrap(),
+        zone_weights: rtbake::runtime::wrinkle_pass::parse_wrinkle_weights("joy=1,surprise=1,anger=1").unwrap(),
     };
     let maps = SkinPasses { surface_maps: Some(synthetic_surface_maps()), ..SkinPasses::default() };
     let wrinkled = SkinPasses { wrinkles: Some(wrinkles), ..SkinPasses::default() };
@@ -174,7 +174,7 @@ fn surface_maps_wrinkles_and_msaa_frames_submit_once_and_agree_with_the_cpu_twin
     let cases = [("surface maps", maps), ("wrinkles", wrinkled), ("msaa 4", msaa), ("all three", all)];
     for shader in [SkinShader::Separable, SkinShader::SsFull] {
         let s = small_frame(shader, StretchPreset::Tap2009);
-        let plain = render_with(None, &head, &s, &SkinPasses::default(), &assets).unwrap().data;
+        let plain = render_with(Some(&g), &head, &s, &SkinPasses::default(), &assets).unwrap().data;
         for (name, passes) in &cases {
             let case = format!("{shader:?}, {name}");
             let (counts, frame) = counted_frame(&g, &head, &s, passes, &assets);
@@ -192,9 +192,11 @@ fn surface_maps_wrinkles_and_msaa_frames_submit_once_and_agree_with_the_cpu_twin
                 let f = close_fraction(&frame, other);
                 assert!(f >= 0.99, "{case}: {:.2} % of channels within 2/255 of {what}", 100.0 * f);
             }
-            // The passes change the frame (so the device ran them).
+            // The passes change the device's frame (so the device ran them): the maps and MSAA's edges many
+            // pixels, the wrinkles those of their zones.
             let changed = frame.chunks(4).zip(plain.chunks(4)).filter(|(a, b)| a != b).count();
-            assert!(changed >= 50, "{case}: {changed} pixels changed");
+            eprintln!("{case}: {changed} pixels changed");
+            assert!(changed >= 100, "{case}: {changed} pixels changed");
         }
     }
 }
