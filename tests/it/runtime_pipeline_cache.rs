@@ -260,6 +260,7 @@ fn the_scanned_heads_frame_with_its_maps_is_one_submission() {
         let per_pass = render_with(Some(&g), &mesh, &s, &passes, &assets);
         set_shading_in_one_encoder(true);
         let f = close_fraction(&frame, &per_pass.unwrap().data);
+        eprintln!("the scan, msaa {msaa}: {:.2} % of channels within 2/255 of the per-pass frame", 100.0 * f);
         assert!(f >= 0.99, "msaa {msaa}: {:.2} % of channels within 2/255 of the per-pass frame", 100.0 * f);
         let skin = frame.chunks(4).filter(|p| p[..3] != [46, 48, 52]).count();
         assert!(skin * 5 > frame.len() / 4, "msaa {msaa}: the head covers {skin} pixels");
