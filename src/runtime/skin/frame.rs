@@ -26,15 +26,15 @@
 //!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
 //!    over a grey background.
 //!
-//! On a device the default frame (one sample, no wrinkle pass, no scan surface maps) is one command encoder,
-//! submitted once and read back once as the RGBA8 frame: the G-buffer and the shadow map are rasterised into it,
-//! thickness, the specular layer and the per-pixel skin inputs are computed from them on the device
-//! (`frame_geometry`, the GPU twin of steps 2–3), then the rig at uv and everything from the skin-inputs pass to
-//! the tone map ([`crate::runtime::skin::shade_frame`]). With `--msaa 4`, the wrinkle pass or a scan's surface
-//! maps, the G-buffer and shadow map are one submission read back for the host's geometry (steps 2–3 on the
-//! host; the wrinkle pass and the surface maps one more each), the MSAA coverage blend runs on the host after the
-//! read-back, and the shading with the rig at uv is one submission more. The per-pass path
-//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off) submits and reads back each pass on its
+//! On a device every screen-space frame is one command encoder, submitted once and read back once as the RGBA8
+//! frame: the G-buffer and the shadow map are rasterised into it, a scan's surface maps and the wrinkle pass
+//! replace the normals there, thickness, the specular layer and the per-pixel skin inputs are computed from them
+//! on the device (`frame_geometry`, the GPU twin of steps 2–3; with `--msaa 4` from the resolved G-buffer divided
+//! by its coverage), then the rig at uv and everything from the skin-inputs pass to the tone map, and with MSAA the
+//! coverage blend ([`crate::runtime::skin::shade_frame`]). The host's geometry (steps 2–3 on the host, the wrinkle
+//! pass and the surface maps one submission each, the coverage blend after the read-back) is the CPU twin's
+//! reference and the per-pass path
+//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off), which submits and reads back each pass on its
 //! own, for A/B comparison. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
@@ -281,7 +281,8 @@ pub fn render_with<'g>(
         };
         return render_on_device(gpu, &job, &assets, method, background);
     }
-    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, one_encoder)?;
+    // The CPU twin, or the per-pass path on a device: the rig at uv evaluated with the geometry.
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, false)?;
     let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
     blend_coverage(&mut frame, &g.coverage);
     Ok(frame)

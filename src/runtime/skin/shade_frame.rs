@@ -1,8 +1,9 @@
-//! The shading of a skin frame resident on the GPU, as an engine records a frame: for the default `run skin` frame
-//! the G-buffer, the shadow map and the geometry computed from them (`frame_geometry`), the rig's hemoglobin at the
+//! The shading of a skin frame resident on the GPU, as an engine records a frame: for a screen-space `run skin`
+//! frame the G-buffer, the shadow map and the geometry computed from them (`frame_geometry`, with a scan's surface
+//! maps, the wrinkle pass and MSAA), the rig's hemoglobin at the
 //! mesh's uv when the frame leaves it here (`mesh_inputs::record_into_skin_maps`, writing H into the skin-inputs
 //! maps), the skin-inputs pass, the lit diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
-//! specular layer, bloom (thesis ch. 4) and the tone map are recorded into **one** command encoder, hand textures
+//! specular layer, bloom (thesis ch. 4), the tone map and, with MSAA, the coverage blend are recorded into **one** command encoder, hand textures
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
@@ -122,9 +123,9 @@ fn geometry_texels(geo: &Geometry) -> Vec<f32> {
     out
 }
 
-/// Where a frame's geometry comes from: the host's [`Geometry`] (the reference, and the path for MSAA, wrinkles and
-/// a scan's surface maps), or the device's, rasterised and computed in the frame's own command encoder
-/// (`frame_geometry`: no G-buffer read-back).
+/// Where a frame's geometry comes from: the host's [`Geometry`] (the reference), or the device's, rasterised and
+/// computed in the frame's own command encoder (`frame_geometry`, with a scan's surface maps, the wrinkle pass and
+/// MSAA: no G-buffer read-back).
 pub(crate) enum FrameSource<'a> {
     Host(&'a Geometry),
     Device(&'a FrameGeometryJob<'a>),
