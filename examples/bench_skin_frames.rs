@@ -129,11 +129,9 @@ fn main() {
     let mut rows: Vec<(String, Mesh, f32, SkinShader, SkinPasses)> =
         shaders.iter().map(|(n, sh)| (n.to_string(), default_head(), 0.6, *sh, plain.clone())).collect();
     if let Some((mesh, distance, maps)) = scan() {
-        println!(
-            "scan: {} triangles at {distance:.3} m (TAP's near), maps: {maps_desc}",
-            mesh.triangle_count(),
-            maps_desc = format!("albedo {}, normal map {}", maps.albedo.is_some(), maps.normal.is_some())
-        );
+        let (a, n) = (maps.albedo.is_some(), maps.normal.is_some());
+        let t = mesh.triangle_count();
+        println!("scan: {t} triangles at {distance:.3} m (TAP's near), maps: albedo {a}, normal map {n}");
         let mapped = SkinPasses { surface_maps: Some(maps), ..plain.clone() };
         for (n, sh) in &shaders[..4] {
             rows.push((format!("scan {n}"), mesh.clone(), distance, *sh, mapped.clone()));

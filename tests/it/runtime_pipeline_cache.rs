@@ -114,7 +114,7 @@ fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_f
 /// map of ripples (unit vectors tilted up to ±0.35), 48² and 40² texels.
 fn synthetic_surface_maps() -> rtbake::runtime::skin::surface_maps::SurfaceMaps {
     use rtbake::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
-    let checker = |i: u32| ((i % 48) / 4 + (i / 48) / 4) % 2 == 0;
+    let checker = |i: u32| ((i % 48) / 4 + (i / 48) / 4).is_multiple_of(2);
     let albedo = (0..48 * 48).map(|i| if checker(i) { [0.55, 0.38, 0.3, 0.0] } else { [0.3, 0.15, 0.1, 0.0] });
     let ripple = (0..40 * 40u32).map(|i| {
         let (x, y) = ((i % 40) as f32, (i / 40) as f32);
