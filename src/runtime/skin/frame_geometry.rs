@@ -255,12 +255,14 @@ mod tests {
     }
 
     /// The device geometry with a scan's surface maps, the wrinkle pass, and both (the surface maps first, as the
-    /// host runs them) recorded into the frame's encoder against the host's geometry from the same rasteriser and
-    /// the same passes run one submission each: the same checks as without them, the albedo map's texels equal,
+    /// host runs them), and 4× MSAA alone and with both, recorded into the frame's encoder against the host's
+    /// geometry from the same rasteriser and the same passes run one submission each: the same checks as without
+    /// them (with MSAA the normals within 1e-5: the device divides the resolved G-buffer by its coverage in its own
+    /// f32 arithmetic), the coverage equal, the albedo map's texels equal (within 1e-5 with MSAA),
     /// and the normals bent by the passes (by the bump map on most covered pixels, by the wrinkles in their zones;
     /// none without passes), so the passes did run on the device.
     #[test]
-    fn the_device_geometry_with_surface_maps_and_wrinkles_matches_the_hosts() {
+    fn the_device_geometry_with_surface_maps_wrinkles_and_msaa_matches_the_hosts() {
         use crate::runtime::skin::passes::Wrinkles;
         use crate::runtime::skin::wrinkles::{parse_wrinkle_weights, WrinkleMaps};
         let (_one_at_a_time, g) = device();
@@ -273,7 +275,9 @@ mod tests {
         let mapped = SkinPasses { surface_maps: Some(synthetic_maps()), ..SkinPasses::none() };
         let wrinkled = SkinPasses { wrinkles: Some(wrinkles), ..SkinPasses::none() };
         let both = SkinPasses { surface_maps: mapped.surface_maps.clone(), ..wrinkled.clone() };
-        for passes in [mapped, wrinkled, both] {
+        let msaa = SkinPasses { msaa: 4, ..SkinPasses::none() };
+        let all = SkinPasses { msaa: 4, ..both.clone() };
+        for passes in [mapped, wrinkled, both, msaa, all] {
             device_geometry_matches_the_hosts(&g, &assets, &passes);
         }
     }
@@ -290,9 +294,10 @@ mod tests {
             melanin: 0.02,
             stretch: StretchPreset::Thesis,
         };
-        let (geo, _, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, passes, assets, false).unwrap();
-        // The normals without the passes, to see that they bend them.
-        let (plain, _, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, &SkinPasses::none(), assets, false).unwrap();
+        let (geo, gbuf, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, passes, assets, false).unwrap();
+        // The normals without the passes on the normals, to see that they bend them.
+        let unbent = SkinPasses { msaa: passes.msaa, ..SkinPasses::none() };
+        let (plain, _, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, &unbent, assets, false).unwrap();
         let rig_pose = assets.baked_rig.as_ref().map(|r| RigPose::neutral(r.names.len()));
         let job = FrameGeometryJob {
             mesh: &mesh,
@@ -301,7 +306,7 @@ mod tests {
             height: h,
             melanin: 0.02,
             rig_pose,
-            msaa: 1,
+            msaa: passes.msaa,
             surface_maps: passes.surface_maps.as_ref(),
             wrinkles: passes.wrinkles.as_ref(),
         };
@@ -321,8 +326,11 @@ mod tests {
             )
             .unwrap();
         }
-        let r = read(g, enc, &[&d.skin_maps, &d.normals, &d.texels, &d.depth]);
-        let (maps, normals, texels, depth) = (&r[0], &r[1], &r[2], &r[3]);
+        let r = read(g, enc, &[&d.skin_maps, &d.normals, &d.texels, &d.depth, &d.uvc]);
+        let (maps, normals, texels, depth, uvc) = (&r[0], &r[1], &r[2], &r[3], &r[4]);
+        // Exact with one sample (the same f16 texels, the same passes); MSAA divides by the coverage on each side.
+        let tol = if passes.msaa > 1 { 1e-5 } else { 0.0 };
+        let near = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol);
         let (row4, row1) = (4 * d.vec4_row as usize, padded_row(w, 4) as usize / 4);
         let (mut covered, mut thick_ok, mut lit_through, mut bent) = (0, 0, 0, 0);
         let s_max = assets.luts.s_max_mm;
@@ -331,10 +339,15 @@ mod tests {
             let m = &maps[y * row4 + 4 * x..y * row4 + 4 * x + 4];
             assert_eq!(texels[8 * i + 3] == 1.0, geo.skin[i], "coverage at {x},{y}");
             let nv = &normals[y * row4 + 4 * x..y * row4 + 4 * x + 3];
-            assert_eq!(nv, geo.frame.normals[i].as_slice(), "normal at {x},{y}");
+            assert!(
+                near(nv, geo.frame.normals[i].as_slice()),
+                "normal at {x},{y}: {nv:?} vs {:?}",
+                geo.frame.normals[i]
+            );
+            assert_eq!(uvc[4 * i + 3], gbuf.coverage[i], "coverage at {x},{y}");
             assert_eq!(&texels[8 * i..8 * i + 3], nv);
             let albedo = geo.albedo.as_ref().map_or([0.0; 3], |a| a[i]);
-            assert_eq!(&texels[8 * i + 4..8 * i + 7], albedo.as_slice(), "albedo at {x},{y}");
+            assert!(near(&texels[8 * i + 4..8 * i + 7], albedo.as_slice()), "albedo at {x},{y}");
             let n0 = plain.frame.normals[i];
             // Turned by more than about 2.5° (the G-buffer's normals are f16, not exactly unit).
             let len = |v: &[f32]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
