@@ -87,7 +87,8 @@ pub(crate) fn largest_fitting(width: u32, height: u32, fits: impl Fn(u32, u32) -
 /// `--bloom off`, `--ts-map-size`, `--cpu`: the CPU twins have no such limit). Each pass's footprint comes from the
 /// function beside it: the G-buffer ([`mesh_raster::GBUFFER_BYTES_PER_TEXEL`], the largest per-pixel image, as
 /// the SSS passes' textures are smaller), the rig at uv ([`mesh_inputs::largest_buffer_bytes`]), the wrinkle pass
-/// ([`wrinkles::largest_buffer_bytes`]), the texture-space gather ([`texture_space::gather_buffer_bytes`]), bloom ([`bloom::largest_buffer_bytes`]) and the texture-space irradiance
+/// ([`wrinkles::largest_buffer_bytes`]) and, for it or a scan's surface maps, the G-buffer's three targets copied
+/// for them on the device, the texture-space gather ([`texture_space::gather_buffer_bytes`]), bloom ([`bloom::largest_buffer_bytes`]) and the texture-space irradiance
 /// map ([`texture_space::map_buffer_bytes`]).
 ///
 /// [`mesh_raster::GBUFFER_BYTES_PER_TEXEL`]: crate::runtime::skin::mesh_raster::GBUFFER_BYTES_PER_TEXEL
@@ -117,6 +118,11 @@ pub fn check_frame_fits(
     }
     if passes.wrinkles.is_some() {
         per_pixel.push(("the wrinkle pass (`wrinkles`)", wrinkles::largest_buffer_bytes, ""));
+    }
+    if passes.wrinkles.is_some() || passes.surface_maps.is_some() {
+        // On a device the two read the G-buffer's three targets, copied into one buffer with padded rows.
+        let copy: fn(u32, u32) -> u64 = |w, h| 3 * readback_bytes(w, h, 8);
+        per_pixel.push(("the G-buffer copy of the surface-map and wrinkle passes", copy, ""));
     }
     if matches!(s.shader, SkinShader::Ts(_)) {
         // A head covering every pixel gathers one RGBA f32 per pixel.
@@ -344,6 +350,24 @@ mod limits_tests {
         // Without bloom the same frame fits; so does the suggested one with bloom.
         assert_eq!(check_frame_fits(&l, &s, &SkinPasses::none()), Ok(()));
         assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, w, h), &SkinPasses::default()), Ok(()));
+    }
+
+    #[test]
+    fn a_mapped_frame_whose_g_buffer_copy_is_over_the_storage_limit_is_refused() {
+        use crate::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
+        let l = limits();
+        let map = SurfaceMap { width: 2, height: 2, texels: vec![[0.0, 0.0, 1.0, 0.0]; 4] };
+        let mapped =
+            SkinPasses { surface_maps: Some(SurfaceMaps { albedo: None, normal: Some(map) }), ..SkinPasses::none() };
+        // 3 targets × 8 bytes × 2880×1620 = 111974400 bytes fit in 128 MiB; 3840×2160 (199065600) does not.
+        assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, 2880, 1620), &mapped), Ok(()));
+        let s = settings(SkinShader::Separable, 3840, 2160);
+        assert_eq!(check_frame_fits(&l, &s, &SkinPasses::none()), Ok(()));
+        let err = check_frame_fits(&l, &s, &mapped).unwrap_err();
+        assert_eq!(err.param, "width/height");
+        assert!(err.message.contains("G-buffer copy") && err.message.contains("199065600"), "{err}");
+        let (w, h) = suggested(&err.message);
+        assert!(3 * crate::runtime::device::readback_bytes(w, h, 8) <= 1 << 27, "{w}x{h}");
     }
 
     #[test]
