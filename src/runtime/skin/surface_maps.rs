@@ -16,7 +16,8 @@
 //! LUT's albedo in [`crate::runtime::skin::lighting`]; the mapped normal replaces the G-buffer's before any lighting
 //! (key light, transmittance's E, specular). Without a normal map the normal is the G-buffer's bit for bit.
 //!
-//! One compute dispatch over flat f32 buffers (`skin/surface_maps.wgsl`); CPU twin
+//! One compute dispatch over flat f32 buffers (`skin/surface_maps.wgsl`), submitted on its own over a host G-buffer
+//! ([`surface_pixels`]) or recorded into a frame's command encoder over the device's (`record`); CPU twin
 //! [`crate::runtime::skin::surface_maps_cpu`].
 
 use crate::error::InvalidInput;

@@ -16,7 +16,9 @@
 //! normal is N bit for bit (`n_ts = (0, 0, 1)` exactly), so the frame does not change.
 //!
 //! The wrinkled normal replaces the G-buffer's before lighting: the Lambert key light, transmittance's E and the
-//! specular layer all see it. One compute dispatch over flat f32 buffers (`skin/wrinkles.wgsl`); CPU twin
+//! specular layer all see it. One compute dispatch over flat f32 buffers (`skin/wrinkles.wgsl`), submitted on its own
+//! over a host G-buffer ([`wrinkled_normals`]) or recorded into a frame's command encoder over the device's
+//! (`record`); CPU twin
 //! [`crate::runtime::skin::wrinkles_cpu`].
 
 use crate::baked_layout::path;
