@@ -127,7 +127,9 @@ pub(crate) fn record(
         if per_pixel_frame { 16 * n } else { 16 },
     ];
     compute_chain::check_buffers(device, what, &sizes)?;
+    // Bindings 1..=8 of frame_geometry.wgsl: view_g, shadow_g, uvc, skin_maps, normals, geo, depth, nrm.
     let bufs: Vec<wgpu::Buffer> = sizes.iter().map(|&b| compute_chain::storage_buffer(device, what, b, None)).collect();
+    let (uvc, normals, texels, nrm) = (&bufs[2], &bufs[4], &bufs[5], &bufs[7]);
     for (k, target) in view.iter().take(view_targets as usize).enumerate() {
         gpu::encode_texture_to_buffer(enc, target, &bufs[0], k as u64 * view_row * h as u64);
     }
@@ -155,15 +157,16 @@ pub(crate) fn record(
     if per_pixel_frame {
         compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("unpack", groups)]);
         // (u, v, covered, coverage), the normal and (in the normals buffer until `main` writes it) the tangent.
-        let frame = [&bufs[2], &bufs[7], &bufs[4]];
+        let frame = [uvc, nrm, normals];
         if let Some(maps) = job.surface_maps {
-            surface_maps::record(device, enc, (w, h), frame, maps, &bufs[5])?;
+            // Per pixel (normal, 0), (albedo, 0) into the lit layer's texels, where `main` reads the albedo.
+            surface_maps::record(device, enc, (w, h), frame, maps, texels)?;
             compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("take_normals", groups)]);
         }
         if let Some(wr) = job.wrinkles {
             let out = compute_chain::storage_buffer(device, what, 16 * n, None);
             wrinkles::record(device, enc, (w, h), frame, &wr.maps, &wr.zone_weights, &out)?;
-            enc.copy_buffer_to_buffer(&out, 0, &bufs[7], 0, 16 * n);
+            enc.copy_buffer_to_buffer(&out, 0, nrm, 0, 16 * n);
         }
     }
     compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("main", groups)]);
