@@ -6,7 +6,13 @@
 //! device, and the median of frames 2..=N of each, their ratio and the queue submissions and host read-backs of a
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
-//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom]]   # 1280 720 7
+//!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom] [mesh=SCAN.glb
+//!         albedo=ALBEDO.jpg normal=NORMAL.jpg]]   # 1280 720 7
+//!
+//! With `mesh=` (a glTF or OBJ head, framed as `run skin --mesh-units auto --distance near` frames it) and its maps
+//! (`albedo=`, `normal=`: sRGB albedo, OpenGL-green tangent-space normal map), the scanned head's frame follows:
+//! each screen-space shader with the maps, and separable SSS with the maps and `--msaa 4` — e.g. the Lee Perry-Smith
+//! scan of `../shared/reference/heads/lee-perry-smith/` (CC BY 3.0).
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
 //! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
@@ -14,6 +20,7 @@
 //! columns run its per-pass path. Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
 
 use rtbake::mesh::head::default_head;
+use rtbake::mesh::Mesh;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, Gpu};
 use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
@@ -28,14 +35,57 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// One frame on `g` through the one-encoder path or not: wall ms, submissions, read-backs.
-fn frame(g: &Gpu, one_encoder: bool, s: &SkinRenderSettings, passes: &SkinPasses, assets: &DemoAssets) -> [f64; 3] {
+/// One frame of `head` on `g` through the one-encoder path or not: wall ms, submissions, read-backs.
+fn frame(
+    g: &Gpu,
+    one_encoder: bool,
+    head: &Mesh,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> [f64; 3] {
     set_shading_in_one_encoder(one_encoder);
-    let head = default_head();
     let (sub, read, t) = (submissions_on_this_thread(), read_backs_on_this_thread(), Instant::now());
-    render_with(Some(g), &head, s, passes, assets).expect("render");
+    render_with(Some(g), head, s, passes, assets).expect("render");
     let ms = t.elapsed().as_secs_f64() * 1e3;
     [ms, (submissions_on_this_thread() - sub) as f64, (read_backs_on_this_thread() - read) as f64]
+}
+
+/// The value of the `NAME=VALUE` argument `name`.
+fn arg(name: &str) -> Option<String> {
+    std::env::args().skip(1).find_map(|a| a.strip_prefix(&format!("{name}=")).map(str::to_string))
+}
+
+/// The scanned head of `mesh=` framed as `run skin --mesh-units auto` frames it, the camera distance of TAP's
+/// "near" for it, and its maps (`albedo=`, `normal=`).
+fn scan() -> Option<(Mesh, f32, rtbake::runtime::skin::surface_maps::SurfaceMaps)> {
+    use rtbake::mesh::framing::{head_height_units, to_metres, MeshOrigin, MeshUnits, TapDistance};
+    let path = PathBuf::from(arg("mesh")?);
+    let bytes = std::fs::read(&path).expect("mesh= readable");
+    let dir = path.parent().map(PathBuf::from).unwrap_or_default();
+    let mesh = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+        rtbake::mesh::obj::parse_obj("mesh", &bytes, 1000.0)
+    } else {
+        rtbake::mesh::gltf::parse_gltf("mesh", &bytes, &|uri: &str| {
+            std::fs::read(dir.join(uri)).map_err(|e| e.to_string())
+        })
+    }
+    .expect("a valid mesh");
+    let units = MeshUnits::parse("mesh_units", "auto").expect("auto");
+    let mesh = to_metres(&mesh, units, MeshOrigin::Head, "mesh_units").expect("a framable head");
+    let height_m = head_height_units(&mesh) * mesh.mm_per_unit / 1000.0;
+    let distance = TapDistance::parse("near").expect("near").camera_distance_m(height_m);
+    let picture = |name: &str| {
+        arg(name).map(|p| {
+            let bytes = std::fs::read(&p).expect("map readable");
+            rtbake::io::picture::decode_u8(name, &p, &bytes).expect("a PNG or JPEG map")
+        })
+    };
+    let (albedo, normal) = (picture("albedo"), picture("normal"));
+    let green = rtbake::facial::wrinkles::GreenConvention::OpenGl;
+    let maps = rtbake::runtime::skin::surface_maps::SurfaceMaps::from_pictures(albedo.as_ref(), normal.as_ref(), green)
+        .expect("valid maps");
+    Some((mesh, distance, maps))
 }
 
 fn main() {
@@ -67,28 +117,44 @@ fn main() {
         "per-pass s/r",
         "one-enc s/r"
     );
-    for (name, shader) in [
+    let plain = if bloom { SkinPasses::default() } else { SkinPasses::none() };
+    let shaders = [
         ("none", SkinShader::None),
         ("ss-jittered", SkinShader::SsJittered),
         ("ss-full", SkinShader::SsFull),
         ("separable", SkinShader::Separable),
         ("ts", SkinShader::Ts(TsSettings::default())),
-    ] {
+    ];
+    // (row, head, camera distance m, shader, passes)
+    let mut rows: Vec<(String, Mesh, f32, SkinShader, SkinPasses)> =
+        shaders.iter().map(|(n, sh)| (n.to_string(), default_head(), 0.6, *sh, plain.clone())).collect();
+    if let Some((mesh, distance, maps)) = scan() {
+        let (a, n) = (maps.albedo.is_some(), maps.normal.is_some());
+        let t = mesh.triangle_count();
+        println!("scan: {t} triangles at {distance:.3} m (TAP's near), maps: albedo {a}, normal map {n}");
+        let mapped = SkinPasses { surface_maps: Some(maps), ..plain.clone() };
+        for (n, sh) in &shaders[..4] {
+            rows.push((format!("scan {n}"), mesh.clone(), distance, *sh, mapped.clone()));
+        }
+        let msaa = SkinPasses { msaa: 4, ..mapped };
+        rows.push(("scan sep 4x".to_string(), mesh, distance, SkinShader::Separable, msaa));
+    }
+    for (name, head, distance_m, shader, passes) in &rows {
+        let (shader, distance_m) = (*shader, *distance_m);
         let s = SkinRenderSettings {
             shader,
             heads: 1,
-            distance_m: 0.6,
+            distance_m,
             width,
             height,
             melanin: 0.02,
             stretch: Default::default(),
         };
-        let passes = if bloom { SkinPasses::default() } else { SkinPasses::none() };
-        let first = [false, true].map(|one| frame(&device(), one, &s, &passes, &assets)[0]);
+        let first = [false, true].map(|one| frame(&device(), one, head, &s, passes, &assets)[0]);
         let (mut per_pass, mut one_enc) = (Vec::new(), Vec::new());
         for _ in 0..frames {
-            per_pass.push(frame(&g, false, &s, &passes, &assets));
-            one_enc.push(frame(&g, true, &s, &passes, &assets));
+            per_pass.push(frame(&g, false, head, &s, passes, &assets));
+            one_enc.push(frame(&g, true, head, &s, passes, &assets));
         }
         let ms = |v: &[[f64; 3]]| median(v[1..].iter().map(|f| f[0]).collect());
         let (p, o) = (ms(&per_pass), ms(&one_enc));

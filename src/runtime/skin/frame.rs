@@ -26,15 +26,15 @@
 //!    HDR frame before tone mapping ([`SkinPasses::bloom`], ch. 4; the demo has none); tone-mapped and encoded
 //!    over a grey background.
 //!
-//! On a device the default frame (one sample, no wrinkle pass, no scan surface maps) is one command encoder,
-//! submitted once and read back once as the RGBA8 frame: the G-buffer and the shadow map are rasterised into it,
-//! thickness, the specular layer and the per-pixel skin inputs are computed from them on the device
-//! (`frame_geometry`, the GPU twin of steps 2–3), then the rig at uv and everything from the skin-inputs pass to
-//! the tone map ([`crate::runtime::skin::shade_frame`]). With `--msaa 4`, the wrinkle pass or a scan's surface
-//! maps, the G-buffer and shadow map are one submission read back for the host's geometry (steps 2–3 on the
-//! host; the wrinkle pass and the surface maps one more each), the MSAA coverage blend runs on the host after the
-//! read-back, and the shading with the rig at uv is one submission more. The per-pass path
-//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off) submits and reads back each pass on its
+//! On a device every screen-space frame is one command encoder, submitted once and read back once as the RGBA8
+//! frame: the G-buffer and the shadow map are rasterised into it, a scan's surface maps and the wrinkle pass
+//! replace the normals there, thickness, the specular layer and the per-pixel skin inputs are computed from them
+//! on the device (`frame_geometry`, the GPU twin of steps 2–3; with `--msaa 4` from the resolved G-buffer divided
+//! by its coverage), then the rig at uv and everything from the skin-inputs pass to the tone map, and with MSAA the
+//! coverage blend ([`crate::runtime::skin::shade_frame`]). The host's geometry (steps 2–3 on the host, the wrinkle
+//! pass and the surface maps one submission each, the coverage blend after the read-back) is the CPU twin's
+//! reference and the per-pass path
+//! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off), which submits and reads back each pass on its
 //! own, for A/B comparison. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
 
@@ -87,7 +87,8 @@ pub(crate) fn largest_fitting(width: u32, height: u32, fits: impl Fn(u32, u32) -
 /// `--bloom off`, `--ts-map-size`, `--cpu`: the CPU twins have no such limit). Each pass's footprint comes from the
 /// function beside it: the G-buffer ([`mesh_raster::GBUFFER_BYTES_PER_TEXEL`], the largest per-pixel image, as
 /// the SSS passes' textures are smaller), the rig at uv ([`mesh_inputs::largest_buffer_bytes`]), the wrinkle pass
-/// ([`wrinkles::largest_buffer_bytes`]), the texture-space gather ([`texture_space::gather_buffer_bytes`]), bloom ([`bloom::largest_buffer_bytes`]) and the texture-space irradiance
+/// ([`wrinkles::largest_buffer_bytes`]) and, for it or a scan's surface maps, the G-buffer's three targets copied
+/// for them on the device, the texture-space gather ([`texture_space::gather_buffer_bytes`]), bloom ([`bloom::largest_buffer_bytes`]) and the texture-space irradiance
 /// map ([`texture_space::map_buffer_bytes`]).
 ///
 /// [`mesh_raster::GBUFFER_BYTES_PER_TEXEL`]: crate::runtime::skin::mesh_raster::GBUFFER_BYTES_PER_TEXEL
@@ -117,6 +118,11 @@ pub fn check_frame_fits(
     }
     if passes.wrinkles.is_some() {
         per_pixel.push(("the wrinkle pass (`wrinkles`)", wrinkles::largest_buffer_bytes, ""));
+    }
+    if passes.wrinkles.is_some() || passes.surface_maps.is_some() {
+        // On a device the two read the G-buffer's three targets, copied into one buffer with padded rows.
+        let copy: fn(u32, u32) -> u64 = |w, h| 3 * readback_bytes(w, h, 8);
+        per_pixel.push(("the G-buffer copy of the surface-map and wrinkle passes", copy, ""));
     }
     if matches!(s.shader, SkinShader::Ts(_)) {
         // A head covering every pixel gathers one RGBA f32 per pixel.
@@ -264,7 +270,7 @@ pub fn render_with<'g>(
     };
     let background = BACKGROUND.repeat((s.width * s.height) as usize);
     let one_encoder = shades_in_one_encoder(gpu);
-    if one_encoder && passes.msaa == 1 && passes.wrinkles.is_none() && passes.surface_maps.is_none() {
+    if one_encoder {
         // The geometry computed on the device in the shading's encoder: the G-buffer is never read back.
         let rig_pose =
             original.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
@@ -275,10 +281,14 @@ pub fn render_with<'g>(
             height: s.height,
             melanin: s.melanin,
             rig_pose,
+            msaa: passes.msaa,
+            surface_maps: passes.surface_maps.as_ref(),
+            wrinkles: passes.wrinkles.as_ref(),
         };
         return render_on_device(gpu, &job, &assets, method, background);
     }
-    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, one_encoder)?;
+    // The CPU twin, or the per-pass path on a device: the rig at uv evaluated with the geometry.
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, false)?;
     let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
     blend_coverage(&mut frame, &g.coverage);
     Ok(frame)
@@ -340,6 +350,24 @@ mod limits_tests {
         // Without bloom the same frame fits; so does the suggested one with bloom.
         assert_eq!(check_frame_fits(&l, &s, &SkinPasses::none()), Ok(()));
         assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, w, h), &SkinPasses::default()), Ok(()));
+    }
+
+    #[test]
+    fn a_mapped_frame_whose_g_buffer_copy_is_over_the_storage_limit_is_refused() {
+        use crate::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
+        let l = limits();
+        let map = SurfaceMap { width: 2, height: 2, texels: vec![[0.0, 0.0, 1.0, 0.0]; 4] };
+        let mapped =
+            SkinPasses { surface_maps: Some(SurfaceMaps { albedo: None, normal: Some(map) }), ..SkinPasses::none() };
+        // 3 targets × 8 bytes × 2880×1620 = 111974400 bytes fit in 128 MiB; 3840×2160 (199065600) does not.
+        assert_eq!(check_frame_fits(&l, &settings(SkinShader::Separable, 2880, 1620), &mapped), Ok(()));
+        let s = settings(SkinShader::Separable, 3840, 2160);
+        assert_eq!(check_frame_fits(&l, &s, &SkinPasses::none()), Ok(()));
+        let err = check_frame_fits(&l, &s, &mapped).unwrap_err();
+        assert_eq!(err.param, "width/height");
+        assert!(err.message.contains("G-buffer copy") && err.message.contains("199065600"), "{err}");
+        let (w, h) = suggested(&err.message);
+        assert!(3 * crate::runtime::device::readback_bytes(w, h, 8) <= 1 << 27, "{w}x{h}");
     }
 
     #[test]

@@ -1,8 +1,9 @@
-//! The shading of a skin frame resident on the GPU, as an engine records a frame: for the default `run skin` frame
-//! the G-buffer, the shadow map and the geometry computed from them (`frame_geometry`), the rig's hemoglobin at the
+//! The shading of a skin frame resident on the GPU, as an engine records a frame: for a screen-space `run skin`
+//! frame the G-buffer, the shadow map and the geometry computed from them (`frame_geometry`, with a scan's surface
+//! maps, the wrinkle pass and MSAA), the rig's hemoglobin at the
 //! mesh's uv when the frame leaves it here (`mesh_inputs::record_into_skin_maps`, writing H into the skin-inputs
 //! maps), the skin-inputs pass, the lit diffuse layer, the SSS pass of the shader, the composite with post-scatter albedo (thesis §7.6) and the unblurred
-//! specular layer, bloom (thesis ch. 4) and the tone map are recorded into **one** command encoder, hand textures
+//! specular layer, bloom (thesis ch. 4), the tone map and, with MSAA, the coverage blend are recorded into **one** command encoder, hand textures
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
@@ -103,6 +104,7 @@ struct Params {
     size: [f32; 4],
     key: [f32; 4],
     cfg: [f32; 4],
+    cover: [f32; 4],
 }
 
 /// Per pixel of `geo` the two vec4 `shade_frame.wgsl` reads: (view-space normal, skin 1/0), (albedo map, specular).
@@ -121,9 +123,9 @@ fn geometry_texels(geo: &Geometry) -> Vec<f32> {
     out
 }
 
-/// Where a frame's geometry comes from: the host's [`Geometry`] (the reference, and the path for MSAA, wrinkles and
-/// a scan's surface maps), or the device's, rasterised and computed in the frame's own command encoder
-/// (`frame_geometry`: no G-buffer read-back).
+/// Where a frame's geometry comes from: the host's [`Geometry`] (the reference), or the device's, rasterised and
+/// computed in the frame's own command encoder (`frame_geometry`, with a scan's surface maps, the wrinkle pass and
+/// MSAA: no G-buffer read-back).
 pub(crate) enum FrameSource<'a> {
     Host(&'a Geometry),
     Device(&'a FrameGeometryJob<'a>),
@@ -140,7 +142,12 @@ pub(crate) fn shade(
     background: Vec<u8>,
 ) -> Result<Image<u8>, RuntimeError> {
     let (device, queue) = (&g.device, &g.queue);
-    let has_albedo = matches!(&source, FrameSource::Host(geo) if geo.albedo.is_some());
+    let has_albedo = match &source {
+        FrameSource::Host(geo) => geo.albedo.is_some(),
+        FrameSource::Device(job) => job.has_albedo_map(),
+    };
+    // With MSAA on the device, partly covered pixels are blended with the background after the tone map.
+    let blend_coverage = matches!(&source, FrameSource::Device(job) if job.msaa > 1);
     let (w, h) = match &source {
         FrameSource::Host(geo) => (geo.frame.width, geo.frame.height),
         FrameSource::Device(job) => (job.width, job.height),
@@ -158,7 +165,7 @@ pub(crate) fn shade(
         None => None,
     };
     let (light, weights) = (assets.lights.back_view, &assets.rig_weights);
-    let geo_buf = match source {
+    let (geo_buf, coverage) = match source {
         FrameSource::Host(geo) => {
             match (&geo.rig_at_uv, &assets.baked_rig) {
                 (Some(px), Some(r)) => {
@@ -180,7 +187,9 @@ pub(crate) fn shade(
                 b.upload_depth(queue, &geo.depth)?;
             }
             let texels = geometry_texels(geo);
-            compute_chain::storage_buffer(device, what, 32 * n, Some(bytemuck::cast_slice(&texels)))
+            let texels = compute_chain::storage_buffer(device, what, 32 * n, Some(bytemuck::cast_slice(&texels)));
+            // The host blends its coverage after the read-back (`heads::blend_coverage`): nothing to bind.
+            (texels, compute_chain::storage_buffer(device, what, 16, None))
         }
         FrameSource::Device(job) => {
             let d = frame_geometry::record(device, &mut enc, job, assets)?;
@@ -202,7 +211,7 @@ pub(crate) fn shade(
             if let Some(b) = &blur {
                 gpu::encode_buffer_to_texture(&mut enc, &d.depth, 0, b.depth());
             }
-            d.texels
+            (d.texels, d.uvc)
         }
     };
     let bloom_buffers = match &assets.bloom {
@@ -229,8 +238,12 @@ pub(crate) fn shade(
         size: [w as f32, h as f32, (row / 4) as f32, flag(assets.post_scatter_albedo)],
         key: [key[0], key[1], key[2], flag(has_albedo)],
         cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, flag(bloom_buffers.is_some()), flag(blur.is_some())],
+        cover: {
+            let bg = crate::runtime::skin::heads::BACKGROUND.map(|c| c as f32 / 255.0);
+            [bg[0], bg[1], bg[2], flag(blend_coverage)]
+        },
     };
-    let bound = [&skin16, &geo_buf, &diffuse, &sss16, &hdr, &bloomed, &rgba];
+    let bound = [&skin16, &geo_buf, &diffuse, &sss16, &hdr, &bloomed, &rgba, &coverage];
     let groups = compute_chain::groups_8x8(w, h);
     let stages = |names: &[&'static str]| names.iter().map(|e| Stage::new(e, groups)).collect::<Vec<_>>();
     let uniform = bytemuck::bytes_of(&params);
@@ -250,7 +263,8 @@ pub(crate) fn shade(
     if let (Some(p), Some(b)) = (&assets.bloom, &bloom_buffers) {
         bloom::record(device, &mut enc, w, h, p, b);
     }
-    compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["tonemap"]));
+    let last: &[&str] = if blend_coverage { &["tonemap", "coverage"] } else { &["tonemap"] };
+    compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(last));
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: rgba.size(),

@@ -2,7 +2,8 @@
 // lit (the diffuse layer from the skin-inputs pass, lighting.rs `lit_geometry`), pack (that layer as the SSS pass's
 // Rgba16Float input, rows padded for a buffer-to-texture copy), composite (post-scatter albedo and the unblurred
 // specular layer, the background's linear radiance for bloom, lighting.rs `composite`) and tonemap (1 - e^-L on the
-// luminance, sRGB encode, the bloomed background re-encoded). Prepended: aa/srgb.wgsl (the sRGB transfer
+// luminance, sRGB encode, the bloomed background re-encoded) and, with MSAA, coverage (partly covered pixels blended
+// with the background in linear light, heads.rs `blend_coverage`). Prepended: aa/srgb.wgsl (the sRGB transfer
 // functions, LUMA). CPU twin: lighting.rs, the same f32 arithmetic in the same order.
 
 struct Params {
@@ -12,6 +13,8 @@ struct Params {
     key: vec4<f32>,
     // key-light intensity, back-light intensity, bloom (1) or not, SSS pass (1) or not
     cfg: vec4<f32>,
+    // the background colour (sRGB-encoded, 0..1), coverage blend (1) or not (0)
+    cover: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
@@ -30,6 +33,8 @@ struct Params {
 @group(0) @binding(6) var<storage, read_write> bloomed: array<vec4<f32>>;
 // The background in, the frame out: RGBA8 (sRGB-encoded) packed little-endian.
 @group(0) @binding(7) var<storage, read_write> rgba: array<u32>;
+// Per pixel (u, v, covered, coverage) of the device's G-buffer, when the coverage blend runs.
+@group(0) @binding(8) var<storage, read_write> cover: array<vec4<f32>>;
 
 // The pixel of this invocation, or false outside the frame.
 fn pixel(id: vec3<u32>) -> vec2<u32> {
@@ -145,4 +150,23 @@ fn tonemap(@builtin(global_invocation_id) id: vec3<u32>) {
     let scale = select(0.0, (1.0 - exp(-l)) / l, l > 0.0);
     let c = unorm8(linear_to_srgb(min(v * scale, vec3<f32>(1.0))));
     rgba[i] = c.x | (c.y << 8u) | (c.z << 16u) | 0xff000000u;
+}
+
+// MSAA: the tone-mapped skin of a partly covered pixel blended with the background by its coverage, in linear light.
+@compute @workgroup_size(8, 8, 1)
+fn coverage(@builtin(global_invocation_id) id: vec3<u32>) {
+    let px = pixel(id);
+    if (px.y == 0u) {
+        return;
+    }
+    let i = px.x;
+    let c = cover[i].w;
+    if (c <= 0.0 || c >= 1.0) {
+        return;
+    }
+    let old = rgba[i];
+    let skin = srgb_to_linear(unpack4x8unorm(old).xyz);
+    let bg = srgb_to_linear(p.cover.xyz);
+    let v = unorm8(linear_to_srgb(c * skin + (1.0 - c) * bg));
+    rgba[i] = v.x | (v.y << 8u) | (v.z << 16u) | (old & 0xff000000u);
 }

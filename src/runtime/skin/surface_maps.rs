@@ -16,7 +16,8 @@
 //! LUT's albedo in [`crate::runtime::skin::lighting`]; the mapped normal replaces the G-buffer's before any lighting
 //! (key light, transmittance's E, specular). Without a normal map the normal is the G-buffer's bit for bit.
 //!
-//! One compute dispatch over flat f32 buffers (`skin/surface_maps.wgsl`); CPU twin
+//! One compute dispatch over flat f32 buffers (`skin/surface_maps.wgsl`), submitted on its own over a host G-buffer
+//! ([`surface_pixels`]) or recorded into a frame's command encoder over the device's (`record`); CPU twin
 //! [`crate::runtime::skin::surface_maps_cpu`].
 
 use crate::error::InvalidInput;
@@ -129,19 +130,22 @@ struct Params {
     normal: [f32; 4],
 }
 
-/// The pass on the GPU (see the module doc).
-pub fn surface_pixels(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    g: &MeshGBuffer,
-    maps: &SurfaceMaps,
-) -> Result<SurfacedPixels, RuntimeError> {
-    let flat = SurfaceMap { width: 1, height: 1, texels: vec![[0.0, 0.0, 1.0, 0.0]] };
-    let a = maps.albedo.as_ref().unwrap_or(&flat);
-    let nm = maps.normal.as_ref().unwrap_or(&flat);
-    maps.check_fits(device.limits().max_storage_buffer_binding_size)?;
+/// The stand-in the pass binds for an absent map: one texel, (0, 0, 1).
+fn flat_map() -> SurfaceMap {
+    SurfaceMap { width: 1, height: 1, texels: vec![[0.0, 0.0, 1.0, 0.0]] }
+}
+
+/// The uniform block of a `width`×`height` frame and the two maps the pass binds (`flat` for an absent one).
+fn pass_inputs<'a>(
+    width: u32,
+    height: u32,
+    maps: &'a SurfaceMaps,
+    flat: &'a SurfaceMap,
+) -> (Params, &'a SurfaceMap, &'a SurfaceMap) {
+    let a = maps.albedo.as_ref().unwrap_or(flat);
+    let nm = maps.normal.as_ref().unwrap_or(flat);
     let params = Params {
-        size: [g.width as f32, g.height as f32, a.width as f32, a.height as f32],
+        size: [width as f32, height as f32, a.width as f32, a.height as f32],
         normal: [
             nm.width as f32,
             nm.height as f32,
@@ -149,11 +153,24 @@ pub fn surface_pixels(
             maps.normal.is_some() as u8 as f32,
         ],
     };
+    (params, a, nm)
+}
+
+/// The pass on the GPU (see the module doc).
+pub fn surface_pixels(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    g: &MeshGBuffer,
+    maps: &SurfaceMaps,
+) -> Result<SurfacedPixels, RuntimeError> {
+    maps.check_fits(device.limits().max_storage_buffer_binding_size)?;
+    let flat = flat_map();
+    let (params, a, nm) = pass_inputs(g.width, g.height, maps, &flat);
     let out = view_frame::run(
         device,
         queue,
         "surface maps",
-        include_str!("surface_maps.wgsl"),
+        SOURCE,
         bytemuck::bytes_of(&params),
         g,
         [Buffer::Data(bytemuck::cast_slice(&a.texels)), Buffer::Data(bytemuck::cast_slice(&nm.texels))],
@@ -163,4 +180,26 @@ pub fn surface_pixels(
     let normals = f.chunks_exact(8).map(|c| [c[0], c[1], c[2]]).collect();
     let albedo = maps.albedo.as_ref().map(|_| f.chunks_exact(8).map(|c| [c[4], c[5], c[6]]).collect());
     Ok(SurfacedPixels { normals, albedo })
+}
+
+const SOURCE: &str = include_str!("surface_maps.wgsl");
+
+/// Records the pass into a frame's command encoder over the device's per-pixel `frame` of a `size` frame
+/// ((u, v, covered, coverage), view normal, view tangent: [`view_frame::record`]), writing per pixel (mapped
+/// normal, 0), (linear albedo, 0) into `out` (2 vec4 of f32 per pixel): the maps are uploaded, nothing is read
+/// back.
+pub(crate) fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    size: (u32, u32),
+    frame: [&wgpu::Buffer; 3],
+    maps: &SurfaceMaps,
+    out: &wgpu::Buffer,
+) -> Result<(), RuntimeError> {
+    maps.check_fits(device.limits().max_storage_buffer_binding_size)?;
+    let flat = flat_map();
+    let (params, a, nm) = pass_inputs(size.0, size.1, maps, &flat);
+    let params = bytemuck::bytes_of(&params);
+    let maps = [bytemuck::cast_slice(&a.texels), bytemuck::cast_slice(&nm.texels)];
+    view_frame::record(device, enc, "surface maps", SOURCE, params, size, frame, maps, out)
 }

@@ -1,7 +1,9 @@
 //! The G-buffer as the view-frame compute passes read it ([`super::surface_maps`], [`super::wrinkles`]): a pass's
 //! shader is `pixel_frame.wgsl`, `view_frame.wgsl` and `bilinear_taps.wgsl` ahead of its own WGSL (entry `main`,
 //! 8 × 8 workgroups over the frame); bindings 1–3 are the G-buffer's (u, v, covered, 0), (view normal, 0) and view
-//! tangent per pixel, bindings 4 and 5 the pass's own maps, binding 6 its output.
+//! tangent per pixel, bindings 4 and 5 the pass's own maps, binding 6 its output. [`run`] uploads a host G-buffer
+//! and reads the output back; [`record`] records the pass into a frame's command encoder over the G-buffer the
+//! device already holds (`frame_geometry`), with no submission and no read-back.
 
 use crate::runtime::compute_chain::{self, Buffer, Stage};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
@@ -39,4 +41,28 @@ pub(crate) fn run(
         &[Stage::new("main", compute_chain::groups_8x8(g.width, g.height))],
         5,
     )
+}
+
+/// Records the view-frame pass `what` (`pass_wgsl`) into `enc` over the device's per-pixel `frame` buffers of a
+/// `width`×`height` frame ((u, v, covered, coverage), (view normal, 0), view tangent: one vec4 of f32 each per
+/// pixel) with the uniform block `params` and the pass's two `maps` (uploaded here), writing `out`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    what: &str,
+    pass_wgsl: &str,
+    params: &[u8],
+    (width, height): (u32, u32),
+    frame: [&wgpu::Buffer; 3],
+    maps: [&[u8]; 2],
+    out: &wgpu::Buffer,
+) -> Result<(), RuntimeError> {
+    let sizes = [frame[0].size(), frame[1].size(), frame[2].size(), maps[0].len() as u64, maps[1].len() as u64];
+    compute_chain::check_buffers(device, what, &sizes)?;
+    let [a, b] = maps.map(|m| compute_chain::storage_buffer(device, what, m.len() as u64, Some(m)));
+    let bound = [frame[0], frame[1], frame[2], &a, &b, out];
+    let stages = [Stage::new("main", compute_chain::groups_8x8(width, height))];
+    compute_chain::record(device, enc, what, &[PRELUDES, pass_wgsl].concat(), params, &bound, &stages);
+    Ok(())
 }

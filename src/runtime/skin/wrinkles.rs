@@ -16,7 +16,9 @@
 //! normal is N bit for bit (`n_ts = (0, 0, 1)` exactly), so the frame does not change.
 //!
 //! The wrinkled normal replaces the G-buffer's before lighting: the Lambert key light, transmittance's E and the
-//! specular layer all see it. One compute dispatch over flat f32 buffers (`skin/wrinkles.wgsl`); CPU twin
+//! specular layer all see it. One compute dispatch over flat f32 buffers (`skin/wrinkles.wgsl`), submitted on its own
+//! over a host G-buffer ([`wrinkled_normals`]) or recorded into a frame's command encoder over the device's
+//! (`record`); CPU twin
 //! [`crate::runtime::skin::wrinkles_cpu`].
 
 use crate::baked_layout::path;
@@ -139,6 +141,23 @@ pub fn largest_buffer_bytes(width: u32, height: u32) -> u64 {
     compute_chain::vec4_per_pixel_bytes(width, height)
 }
 
+const SOURCE: &str = include_str!("wrinkles.wgsl");
+
+/// The uniform block of a `width`×`height` frame with `maps` and `weights`, and the masks as one flat buffer.
+fn pass_inputs(
+    width: u32,
+    height: u32,
+    maps: &WrinkleMaps,
+    weights: &[f32; 8],
+) -> (compute_chain::MapParams, Vec<f32>) {
+    let params = compute_chain::MapParams {
+        size: [width as f32, height as f32, maps.pd_size.0 as f32, maps.pd_size.1 as f32],
+        cfg: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
+        weights: [[weights[0], weights[1], weights[2], weights[3]], [weights[4], weights[5], weights[6], weights[7]]],
+    };
+    (params, maps.masks.iter().flatten().flatten().copied().collect())
+}
+
 /// The wrinkled view-space normals of `g` (uncovered pixels keep theirs), on the GPU.
 pub fn wrinkled_normals(
     device: &wgpu::Device,
@@ -148,17 +167,12 @@ pub fn wrinkled_normals(
     weights: &[f32; 8],
 ) -> Result<Vec<[f32; 3]>, RuntimeError> {
     maps.validate()?;
-    let params = compute_chain::MapParams {
-        size: [g.width as f32, g.height as f32, maps.pd_size.0 as f32, maps.pd_size.1 as f32],
-        cfg: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
-        weights: [[weights[0], weights[1], weights[2], weights[3]], [weights[4], weights[5], weights[6], weights[7]]],
-    };
-    let masks: Vec<f32> = maps.masks.iter().flatten().flatten().copied().collect();
+    let (params, masks) = pass_inputs(g.width, g.height, maps, weights);
     let out = view_frame::run(
         device,
         queue,
         "wrinkle pass",
-        include_str!("wrinkles.wgsl"),
+        SOURCE,
         bytemuck::bytes_of(&params),
         g,
         [Buffer::Data(bytemuck::cast_slice(&maps.pd)), Buffer::Data(bytemuck::cast_slice(&masks))],
@@ -166,6 +180,24 @@ pub fn wrinkled_normals(
     )?;
     let f: &[f32] = bytemuck::cast_slice(&out);
     Ok(f.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+/// Records the pass into a frame's command encoder over the device's per-pixel `frame` of a `size` frame
+/// ((u, v, covered, coverage), view normal, view tangent: [`view_frame::record`]), writing (wrinkled normal, 0)
+/// per pixel into `out`: the maps are uploaded, nothing is read back.
+pub(crate) fn record(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    size: (u32, u32),
+    frame: [&wgpu::Buffer; 3],
+    maps: &WrinkleMaps,
+    weights: &[f32; 8],
+    out: &wgpu::Buffer,
+) -> Result<(), RuntimeError> {
+    maps.validate()?;
+    let (params, masks) = pass_inputs(size.0, size.1, maps, weights);
+    let bytes = [bytemuck::cast_slice(&maps.pd), bytemuck::cast_slice(&masks)];
+    view_frame::record(device, enc, "wrinkle pass", SOURCE, bytemuck::bytes_of(&params), size, frame, bytes, out)
 }
 
 #[cfg(test)]
