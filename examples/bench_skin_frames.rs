@@ -7,12 +7,13 @@
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom] [mesh=SCAN.glb
-//!         albedo=ALBEDO.jpg normal=NORMAL.jpg]]   # 1280 720 7
+//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]]]   # 1280 720 7
 //!
 //! With `mesh=` (a glTF or OBJ head, framed as `run skin --mesh-units auto --distance near` frames it) and its maps
 //! (`albedo=`, `normal=`: sRGB albedo, OpenGL-green tangent-space normal map), the scanned head's frame follows:
 //! each screen-space shader with the maps, and separable SSS with the maps and `--msaa 4` — e.g. the Lee Perry-Smith
-//! scan of `../shared/reference/heads/lee-perry-smith/` (CC BY 3.0).
+//! scan of `../shared/reference/heads/lee-perry-smith/` (CC BY 3.0; its texture coordinates need
+//! `uv-origin=bottom-left`, as `run skin` needs `--uv-origin bottom-left`).
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
 //! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
@@ -71,6 +72,11 @@ fn scan() -> Option<(Mesh, f32, rtbake::runtime::skin::surface_maps::SurfaceMaps
         })
     }
     .expect("a valid mesh");
+    // uv-origin=bottom-left for the three.js copy of the Lee Perry-Smith scan (as `run skin --uv-origin`).
+    let mesh = match arg("uv-origin").as_deref() {
+        Some("bottom-left") => mesh.with_uv_origin(rtbake::mesh::UvOrigin::TopLeft, rtbake::mesh::UvOrigin::BottomLeft),
+        _ => mesh,
+    };
     let units = MeshUnits::parse("mesh_units", "auto").expect("auto");
     let mesh = to_metres(&mesh, units, MeshOrigin::Head, "mesh_units").expect("a framable head");
     let height_m = head_height_units(&mesh) * mesh.mm_per_unit / 1000.0;

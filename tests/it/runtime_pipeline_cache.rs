@@ -239,7 +239,9 @@ fn the_scanned_heads_frame_with_its_maps_is_one_submission() {
     let mesh = rtbake::mesh::gltf::parse_gltf("scan", &read(&glb), &|uri: &str| {
         std::fs::read(dir.join(uri)).map_err(|e| e.to_string())
     })
-    .unwrap();
+    .unwrap()
+    // The scan's maps are bottom-left (`run skin --uv-origin bottom-left`).
+    .with_uv_origin(rtbake::mesh::UvOrigin::TopLeft, rtbake::mesh::UvOrigin::BottomLeft);
     use rtbake::mesh::framing::{to_metres, MeshOrigin, MeshUnits};
     let mesh =
         to_metres(&mesh, MeshUnits::parse("mesh_units", "auto").unwrap(), MeshOrigin::Head, "mesh_units").unwrap();
