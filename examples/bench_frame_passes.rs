@@ -37,7 +37,7 @@ fn span_holds(label: &str) -> &'static str {
         "frame geometry: main" => "G-buffer + shadow-map raster, texture-to-buffer copies",
         "skin frame: lit" => "skin-inputs render pass, copies",
         "skin frame: composite" => "SSS passes, copies",
-        _ => "copies and passes outside compute chains",
+        _ => "whatever lies between the two chain recordings (barriers, copies)",
     }
 }
 
@@ -70,6 +70,10 @@ fn main() {
          {frames} frames after one warm-up",
         head.triangle_count()
     );
+    println!(
+        "bytes moved: each storage buffer a pass reads and each it writes counted whole, once (bloom's levels share \
+         one buffer and the frame geometry samples a shadow map: for them an upper bound, time/bound a lower bound)"
+    );
     let names = ["none", "separable", "ss-full", "ss-jittered", "ts"];
     let ts = SkinShader::Ts(TsSettings::default());
     let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered, ts];
@@ -100,7 +104,7 @@ fn main() {
             println!("  no compute-chain pass recorded (this shader's frame does not go through compute chains)");
             continue;
         }
-        println!("  {:<44} {:>10} {:>10} {:>10} {:>10}", "pass", "GPU ms", "MB moved", "bound ms", "time/bound");
+        println!("  {:<52} {:>10} {:>10} {:>10} {:>10}", "pass", "GPU ms", "MB moved", "bound ms", "time/bound");
         let (mut chain_ms, mut chain_bytes, mut all_ms) = (0.0, 0u64, 0.0);
         for (k, p) in first.iter().enumerate() {
             let ms = timed.then(|| median(profiles.iter().map(|f| f[k].gpu_ms.unwrap_or(f64::NAN)).collect()));
@@ -108,7 +112,7 @@ fn main() {
             all_ms += ms.unwrap_or(0.0);
             match (p.span, p.bytes) {
                 (true, _) => {
-                    println!("  {:<44} {cell:>10}  span: {}", p.label, span_holds(&p.label));
+                    println!("  {:<52} {cell:>10}  span: {}", p.label, span_holds(&p.label));
                 }
                 (false, Some(b)) => {
                     let bound = bound_ms(b);
@@ -116,14 +120,14 @@ fn main() {
                     chain_bytes += b;
                     let ratio = ms.map(|m| m / bound);
                     println!(
-                        "  {:<44} {cell:>10} {:>10.2} {bound:>10.4} {:>10}{}",
+                        "  {:<52} {cell:>10} {:>10.2} {bound:>10.4} {:>10}{}",
                         p.label,
                         b as f64 * 1e-6,
                         ratio.map_or("-".to_string(), |r| format!("{r:.1}")),
                         if ratio.is_some_and(|r| r > 4.0) { "  OVER 4x" } else { "" }
                     );
                 }
-                (false, None) => println!("  {:<44} {cell:>10}  (bytes unknown: module not analysed)", p.label),
+                (false, None) => println!("  {:<52} {cell:>10}  (bytes unknown: module not analysed)", p.label),
             }
         }
         let bound = bound_ms(chain_bytes);
