@@ -6,8 +6,8 @@
 #   scripts/gpu_bench.sh BIN_DIR [WIDTHxHEIGHT]      # default 1920x1080
 #
 # On a GPU machine, from the repository root (the exact command; release build of the examples, then the run):
-#   cargo build --release --example bench_runtime --example bench_smaa_modes && \
-#     scripts/gpu_bench.sh target/release/examples 1920x1080 2>&1 | tee gpu_bench.log
+#   cargo build --release --example bench_runtime --example bench_smaa_modes --example bench_skin_frames \
+#     --example bench_frame_passes && scripts/gpu_bench.sh target/release/examples 1920x1080 2>&1 | tee gpu_bench.log
 #
 # SMAA 1x and MLAA are measured in both shapes in one run: bench_runtime times the fragment passes (before) and the
 # compute passes (after, the default) side by side, each pass beside its bytes-moved bound, and prints the speed-up;
@@ -45,4 +45,9 @@ if [[ -x $bin/bench_skin_frames ]]; then
   # run skin's whole frame per shader, the runtime's caches off (as before them) and on; absent from older trees.
   echo "== bench_skin_frames ${size/x/ } 5"
   "$bin/bench_skin_frames" ${size/x/ } 5 2>/dev/null
+fi
+if [[ -x $bin/bench_frame_passes ]]; then
+  # every pass of run skin's frame per shader, GPU ms beside its bytes-moved bound; absent from older trees.
+  echo "== bench_frame_passes ${size/x/ } 7"
+  "$bin/bench_frame_passes" ${size/x/ } 7 2>/dev/null
 fi

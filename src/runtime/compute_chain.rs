@@ -175,13 +175,95 @@ pub(crate) fn record(
     let mut group_entries = vec![(0, wgpu::BindingResource::Buffer(binding))];
     group_entries.extend(buffers.iter().enumerate().map(|(i, b)| (i as u32 + 1, b.as_entire_binding())));
     let group = gpu::bind_group(device, what, &bgl, &group_entries);
+    // Per-pass profiling (off by default: one thread-local check).
+    let profile = gpu::profile_timer(device, stages.len() as u32);
     for (k, (p, s)) in pipelines.iter().zip(stages).enumerate() {
-        let mut pass =
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.entry), timestamp_writes: None });
+        let timestamp_writes = profile.as_ref().and_then(|t| t.as_ref()).map(|t| t.compute_pass_writes(k as u32));
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(s.entry), timestamp_writes });
         pass.set_pipeline(p);
         pass.set_bind_group(0, &group, &[(k * stride) as u32]);
         pass.dispatch_workgroups(s.groups[0], s.groups[1], s.groups[2]);
     }
+    if let Some(timer) = profile {
+        let sizes: Vec<u64> = buffers.iter().map(|b| b.size()).collect();
+        let passes = stages
+            .iter()
+            .map(|s| {
+                let repeated = stages.iter().filter(|o| o.entry == s.entry).count() > 1;
+                let label = match repeated {
+                    true => format!("{what}: {} {}", s.entry, s.args[0]),
+                    false => format!("{what}: {}", s.entry),
+                };
+                (label, pass_bytes(source, s.entry, &sizes))
+            })
+            .collect();
+        gpu::profile_passes(timer, passes);
+    }
+}
+
+/// Which storage buffers (bindings 1..=N, as indices 0..N) an entry point of a chain's module reads and writes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct BufferUse {
+    pub read: Vec<usize>,
+    pub written: Vec<usize>,
+}
+
+/// The buffers `entry` of the WGSL `source` reads and writes, by naga's static analysis of the module (what the
+/// entry point and every function it calls may load or store; `arrayLength` is neither): None when the module
+/// does not parse or has no such entry point. Analyses are kept per module source.
+pub(crate) fn buffer_use(source: &str, entry: &str) -> Option<BufferUse> {
+    type Uses = Option<std::sync::Arc<std::collections::HashMap<String, BufferUse>>>;
+    static ANALYSED: std::sync::LazyLock<std::sync::Mutex<std::collections::HashMap<String, Uses>>> =
+        std::sync::LazyLock::new(Default::default);
+    let mut seen = ANALYSED.lock().unwrap_or_else(|e| e.into_inner());
+    let uses = seen.entry(source.to_string()).or_insert_with(|| analyse(source).map(std::sync::Arc::new));
+    uses.as_ref()?.get(entry).cloned()
+}
+
+/// Per entry point of `source`, the storage buffers of group 0 (binding b ≥ 1 → index b − 1) it reads and writes.
+fn analyse(source: &str) -> Option<std::collections::HashMap<String, BufferUse>> {
+    use wgpu::naga;
+    let module = naga::front::wgsl::parse_str(source).ok()?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .ok()?;
+    let storage: Vec<_> = module
+        .global_variables
+        .iter()
+        .filter(|(_, v)| matches!(v.space, naga::AddressSpace::Storage { .. }))
+        .filter_map(|(h, v)| v.binding.as_ref().filter(|b| b.group == 0 && b.binding >= 1).map(|b| (h, b.binding)))
+        .collect();
+    let mut out = std::collections::HashMap::new();
+    for (i, ep) in module.entry_points.iter().enumerate() {
+        let f = info.get_entry_point(i);
+        let mut u = BufferUse::default();
+        for &(h, binding) in &storage {
+            let index = binding as usize - 1;
+            if f[h].contains(naga::valid::GlobalUse::READ) {
+                u.read.push(index);
+            }
+            if f[h].contains(naga::valid::GlobalUse::WRITE) {
+                u.written.push(index);
+            }
+        }
+        u.read.sort_unstable();
+        u.written.sort_unstable();
+        out.insert(ep.name.clone(), u);
+    }
+    Some(out)
+}
+
+/// The bytes a dispatch of `entry` must move over storage buffers of `sizes` bytes (binding order), the figure
+/// its bytes-moved bound divides by the copy bandwidth: every buffer it reads counts its whole size once, every
+/// buffer it writes counts its whole size once (a buffer both read and written counts twice), whatever the
+/// number of times a texel is touched; the uniform block is left out. A dispatch over part of a buffer (a pyramid
+/// level in a buffer of all levels, a shadow map sampled where the frame needs it) is counted whole, so for such a
+/// pass the figure is an upper bound of its traffic and its time/bound a lower bound. None when the module
+/// cannot be analysed ([`buffer_use`]).
+pub(crate) fn pass_bytes(source: &str, entry: &str, sizes: &[u64]) -> Option<u64> {
+    let u = buffer_use(source, entry)?;
+    let size = |i: &usize| sizes.get(*i).copied().unwrap_or(0);
+    Some(u.read.iter().map(size).sum::<u64>() + u.written.iter().map(size).sum::<u64>())
 }
 
 /// The chain's layout (uniform at 0, `buffers` read-write storage buffers at 1..=N) and one pipeline per entry.
@@ -239,4 +321,86 @@ fn chain_pipelines(
         })
         .collect();
     (bgl, pipelines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::runtime::device::{create_headless, DeviceOptions};
+
+    /// A chain of three entry points over three vec4 buffers: `copy` reads a, writes b; `scale` reads and writes
+    /// b; `sum` reads a and b through a helper function and writes c, and asks a's length (a query, not a read).
+    const CHAIN: &str = "
+        struct P { size: vec4<f32>, stage: vec4<u32> }
+        @group(0) @binding(0) var<uniform> p: P;
+        @group(0) @binding(1) var<storage, read_write> a: array<vec4<f32>>;
+        @group(0) @binding(2) var<storage, read_write> b: array<vec4<f32>>;
+        @group(0) @binding(3) var<storage, read_write> c: array<vec4<f32>>;
+        fn both(i: u32) -> vec4<f32> { return a[i] + b[i]; }
+        @compute @workgroup_size(8, 8, 1)
+        fn copy(@builtin(global_invocation_id) id: vec3<u32>) {
+            let i = id.y * u32(p.size.x) + id.x;
+            b[i] = a[i];
+        }
+        @compute @workgroup_size(8, 8, 1)
+        fn scale(@builtin(global_invocation_id) id: vec3<u32>) {
+            let i = id.y * u32(p.size.x) + id.x;
+            b[i] = 2.0 * b[i];
+        }
+        @compute @workgroup_size(8, 8, 1)
+        fn sum(@builtin(global_invocation_id) id: vec3<u32>) {
+            let i = id.y * u32(p.size.x) + id.x;
+            if (i < arrayLength(&a)) { c[i] = both(i); }
+        }
+    ";
+
+    #[test]
+    fn the_buffers_an_entry_point_reads_and_writes_come_from_the_module() {
+        let u = |read: &[usize], written: &[usize]| BufferUse { read: read.to_vec(), written: written.to_vec() };
+        assert_eq!(buffer_use(CHAIN, "copy"), Some(u(&[0], &[1])));
+        assert_eq!(buffer_use(CHAIN, "scale"), Some(u(&[1], &[1])));
+        assert_eq!(buffer_use(CHAIN, "sum"), Some(u(&[0, 1], &[2])));
+        assert_eq!(buffer_use(CHAIN, "missing"), None);
+        assert_eq!(buffer_use("not wgsl", "copy"), None);
+    }
+
+    /// A 64×32 frame through the chain with profiling on: the bytes of each pass by hand (a, b, c of 16 bytes per
+    /// pixel: copy reads a and writes b, scale reads and writes b, sum reads a and b and writes c), the labels in
+    /// recording order, the chain's result unchanged, and GPU times where the device has timestamps.
+    #[test]
+    fn a_profiled_chain_reports_each_pass_with_its_hand_counted_bytes() {
+        let g = create_headless(&DeviceOptions { timestamps: true }).expect("an adapter");
+        let (w, h) = (64u32, 32u32);
+        let frame = vec4_per_pixel_bytes(w, h);
+        assert_eq!(frame, 32768);
+        let a: Vec<f32> = (0..4 * w * h).map(|i| i as f32).collect();
+        let uniform: [f32; 4] = [w as f32, h as f32, 0.0, 0.0];
+        let groups = groups_8x8(w, h);
+        let stages = [Stage::new("copy", groups), Stage::new("scale", groups), Stage::new("sum", groups)];
+        let buffers = [Buffer::Data(bytemuck::cast_slice(&a)), Buffer::Zeroed(frame), Buffer::Zeroed(frame)];
+        let run_chain =
+            || run(&g.device, &g.queue, "test chain", CHAIN, bytemuck::bytes_of(&uniform), &buffers, &stages, 2);
+        let plain = run_chain().unwrap();
+        gpu::set_pass_profiling(true);
+        let profiled = run_chain().unwrap();
+        let passes = gpu::take_pass_profile(&g.device, &g.queue).unwrap();
+        gpu::set_pass_profiling(false);
+        assert_eq!(plain, profiled, "profiling changed the chain's result");
+        let c: &[f32] = bytemuck::cast_slice(&plain);
+        assert_eq!(&c[..8], &[0.0, 3.0, 6.0, 9.0, 12.0, 15.0, 18.0, 21.0]);
+        let got: Vec<(&str, Option<u64>, bool)> = passes.iter().map(|p| (p.label.as_str(), p.bytes, p.span)).collect();
+        let expected = vec![
+            ("test chain: copy", Some(2 * frame), false),
+            ("test chain: scale", Some(2 * frame), false),
+            ("test chain: sum", Some(3 * frame), false),
+        ];
+        assert_eq!(got, expected);
+        for p in &passes {
+            assert_eq!(p.gpu_ms.is_some(), g.timestamps, "{p:?}");
+            assert!(p.gpu_ms.is_none_or(|ms| ms.is_finite() && ms >= 0.0), "{p:?}");
+        }
+        // Off: nothing is recorded.
+        run_chain().unwrap();
+        assert!(gpu::take_pass_profile(&g.device, &g.queue).unwrap().is_empty());
+    }
 }

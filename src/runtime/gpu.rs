@@ -681,3 +681,140 @@ pub fn copy_bandwidth(device: &wgpu::Device, queue: &wgpu::Queue, timestamps: bo
         by_timestamps: by_gpu,
     }
 }
+
+/// Per-pass GPU profiling of the compute chains a frame records ([`crate::runtime::compute_chain::record`]), off by
+/// default. On (for the calling thread, [`set_pass_profiling`]), every compute pass a chain records gets begin/end
+/// timestamps (where the device has `TIMESTAMP_QUERY`), its label and the bytes it must move; [`profile_mark`]
+/// stamps a point in an encoder (the start of a frame) so that the work before the next chain pass — render passes,
+/// copies, passes recorded outside compute chains — is timed as one span. [`take_pass_profile`] resolves them after
+/// the frame's submission. Off, a chain checks one thread-local flag and records what it always did.
+struct PassProfile {
+    /// Chain recordings and marks in recording order.
+    recorded: Vec<Recorded>,
+}
+
+/// A profiled chain recording or a mark: its timer (None without timestamps) and per slot its label and bytes
+/// moved (one slot, bytes None, for a mark).
+struct Recorded {
+    timer: Option<GpuTimer>,
+    passes: Vec<(String, Option<u64>)>,
+    mark: bool,
+}
+
+thread_local! {
+    static PASS_PROFILE: std::cell::RefCell<Option<PassProfile>> = const { std::cell::RefCell::new(None) };
+}
+
+/// One timed piece of a profiled frame, in recording order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTime {
+    /// A chain pass: `"<chain>: <entry point>"` (plus the stage's first argument, a pyramid level, where the chain
+    /// dispatches the entry point more than once). A span: `"<from> → <to>"`, the points it lies between.
+    pub label: String,
+    /// GPU milliseconds between the pass's (span's) begin and end timestamps; None where the device has no
+    /// timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Bytes the pass must move ([`crate::runtime::compute_chain`]'s rule); None for a span, whose work is not a
+    /// chain's.
+    pub bytes: Option<u64>,
+    /// Whether this is a span (the work between two timed points) rather than a chain pass.
+    pub span: bool,
+}
+
+/// Turns per-pass profiling on or off for frames recorded on the calling thread. On starts an empty profile
+/// (dropping one not taken); off drops it.
+pub fn set_pass_profiling(on: bool) {
+    PASS_PROFILE.with(|p| *p.borrow_mut() = on.then(|| PassProfile { recorded: Vec::new() }));
+}
+
+/// Whether per-pass profiling is on for the calling thread.
+pub fn pass_profiling() -> bool {
+    PASS_PROFILE.with(|p| p.borrow().is_some())
+}
+
+/// A timer of `slots` passes for a profiled recording on `device`: None when profiling is off, the device has no
+/// timestamp queries or there is nothing to time (`Some(None)`: profiling on, no timestamps).
+pub(crate) fn profile_timer(device: &wgpu::Device, slots: u32) -> Option<Option<GpuTimer>> {
+    if !pass_profiling() {
+        return None;
+    }
+    let timed = slots > 0 && device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    Some(timed.then(|| GpuTimer::new(device, slots)))
+}
+
+/// Adds a profiled recording: `timer`'s slots are the passes named in `passes` (label, bytes moved).
+pub(crate) fn profile_passes(timer: Option<GpuTimer>, passes: Vec<(String, Option<u64>)>) {
+    PASS_PROFILE.with(|p| {
+        if let Some(p) = p.borrow_mut().as_mut() {
+            p.recorded.push(Recorded { timer, passes, mark: false });
+        }
+    });
+}
+
+/// When profiling is on, stamps the current point of `enc` as `label` (an empty compute pass with timestamps):
+/// the work recorded between it and the next chain pass comes back as one span. Nothing when off.
+pub fn profile_mark(device: &wgpu::Device, enc: &mut wgpu::CommandEncoder, label: &str) {
+    let Some(timer) = profile_timer(device, 1) else { return };
+    if let Some(t) = &timer {
+        let timestamp_writes = Some(t.compute_pass_writes(0));
+        drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes }));
+    }
+    PASS_PROFILE.with(|p| {
+        if let Some(p) = p.borrow_mut().as_mut() {
+            p.recorded.push(Recorded { timer, passes: vec![(label.to_string(), None)], mark: true });
+        }
+    });
+}
+
+/// The passes profiled on the calling thread since profiling was turned on or last taken, in recording order, with
+/// the spans between them (call after the frame's submission; one more submission resolves the timestamps).
+/// Profiling stays on with an empty profile. After a mark (the start of a frame recorded into one encoder), the
+/// GPU time from the mark to the next chain pass is a span, and so is the time from the end of one chain recording
+/// to the beginning of the next; chains recorded before any mark (each in its own submission, say) have no spans
+/// between them, as idle time between submissions would count in them.
+pub fn take_pass_profile(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<PassTime>, RuntimeError> {
+    let recorded = PASS_PROFILE.with(|p| p.borrow_mut().as_mut().map(|p| std::mem::take(&mut p.recorded)));
+    let recorded = recorded.unwrap_or_default();
+    let timed = recorded.iter().any(|r| r.timer.is_some());
+    let mut ticks = Vec::new();
+    if timed {
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pass profile") });
+        for t in recorded.iter().filter_map(|r| r.timer.as_ref()) {
+            t.resolve(&mut enc);
+        }
+        submit(queue, enc.finish());
+        for r in &recorded {
+            ticks.push(match &r.timer {
+                Some(t) => Some(bytemuck::cast_slice::<u8, u64>(&map_read(device, &t.readback)?).to_vec()),
+                None => None,
+            });
+        }
+    } else {
+        ticks.resize(recorded.len(), None);
+    }
+    let ns = queue.get_timestamp_period() as f64;
+    let ms = |from: u64, to: u64| to.wrapping_sub(from) as i64 as f64 * ns * 1e-6;
+    let mut out = Vec::new();
+    // The last timed point (ticks, label): a mark's beginning or a chain's last end.
+    let mut last: Option<(Option<u64>, String)> = None;
+    let mut after_mark = false;
+    for (Recorded { passes, mark, .. }, t) in recorded.iter().zip(&ticks) {
+        if *mark {
+            last = Some((t.as_ref().map(|t| t[0]), passes[0].0.clone()));
+            after_mark = true;
+            continue;
+        }
+        if let (true, Some((from, from_label)), Some((to, _))) = (after_mark, &last, passes.first()) {
+            let gpu_ms = from.zip(t.as_ref()).map(|(from, t)| ms(from, t[0]));
+            out.push(PassTime { label: format!("{from_label} → {to}"), gpu_ms, bytes: None, span: true });
+        }
+        for (k, (label, bytes)) in passes.iter().enumerate() {
+            let gpu_ms = t.as_ref().map(|t| ms(t[2 * k], t[2 * k + 1]));
+            out.push(PassTime { label: label.clone(), gpu_ms, bytes: *bytes, span: false });
+        }
+        if let Some((label, _)) = passes.last() {
+            last = Some((t.as_ref().map(|t| t[2 * passes.len() - 1]), label.clone()));
+        }
+    }
+    Ok(out)
+}

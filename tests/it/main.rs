@@ -66,6 +66,7 @@ mod runtime_limits_precheck;
 mod runtime_loader;
 mod runtime_loader_tables;
 mod runtime_mlaa;
+mod runtime_pass_profile;
 mod runtime_pipeline_cache;
 mod runtime_shader_includes;
 mod runtime_skin_inputs;

@@ -159,6 +159,7 @@ pub(crate) fn shade(
     let what = "skin frame";
     let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
     let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+    gpu::profile_mark(device, &mut enc, "frame start");
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let blur = match sss {
         Some(m) => Some(SubsurfaceGpu::new(g, (w, h), m)?),
