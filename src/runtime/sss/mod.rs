@@ -3,18 +3,25 @@
 //! - [`separable`] (`separable.wgsl`, [`separable_cpu`]): separable SSS, Jimenez et al., CGF 2015 (thesis ch. 6);
 //!   [`separable_tiled`] (`separable_tiled.wgsl`) is the same pass as compute over workgroup-memory line tiles;
 //! - [`gaussian`] (`gaussian.wgsl`, [`gaussian_cpu`]): the screen-space sum of Gaussians, TAP 2009 (thesis ch. 4);
-//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel.
+//!   [`gaussian_tiled`] (`gaussian_tiled.wgsl`) is the same chain as compute over workgroup-memory line tiles;
+//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel
+//!   (fragment or compute, the same per-pixel function).
+//!
+//! [`SssShape`] picks the form of each pass: compute (the default on GPUs) or the full-screen fragment passes they
+//! replace (`RTBAKE_SSS_PASSES=fragment`, so one benchmark binary measures both).
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
 //!
 //! Shared by the four: [`SssPass`] (the input frame, the output and upload / encode / run; each module's `new`
 //! builds its blur), the camera scale [`dist_to_window`], the blur bind group and frame checks of `SssInputs`, the
-//! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches) and `separable_params.wgsl` (the uniform block
-//! of both separable forms), and `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
+//! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches), `separable_params.wgsl` (the uniform block
+//! of both separable forms) and `gaussian_params.wgsl` (the uniform block and stretch of both Gaussian forms), and
+//! `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
 
 mod blur_cpu;
 pub mod gaussian;
 pub mod gaussian_cpu;
+pub mod gaussian_tiled;
 pub mod importance;
 pub mod importance_cpu;
 pub mod separable;
@@ -32,6 +39,54 @@ use crate::runtime::RuntimeError;
 /// `(H/2) · dist_to_window / (z · mm_per_world_unit)`.
 pub fn dist_to_window(fovy_deg: f32) -> f32 {
     1.0 / (0.5 * fovy_deg.to_radians()).tan()
+}
+
+/// The form a screen-space SSS pass takes on the GPU: the same arithmetic and the same CPU twin either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SssShape {
+    /// Compute passes: the separable and Gaussian blurs over workgroup-memory line tiles, the importance-sampled
+    /// gather over 8×8-thread workgroups. On an NVIDIA H100/H200 a full-screen fragment pass reaches only the
+    /// TPCs its graphics pipeline spans, a compute pass every SM.
+    #[default]
+    Compute,
+    /// Full-screen fragment passes into render targets (the shape before the compute passes).
+    Fragment,
+}
+
+impl SssShape {
+    /// The environment variable [`Self::from_env`] reads.
+    pub const ENV: &'static str = "RTBAKE_SSS_PASSES";
+
+    /// `compute` or `fragment`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Compute => "compute",
+            Self::Fragment => "fragment",
+        }
+    }
+
+    /// `compute` or `fragment`; anything else is refused naming [`Self::ENV`].
+    pub fn parse(value: &str) -> Result<Self, InvalidInput> {
+        [Self::Compute, Self::Fragment]
+            .into_iter()
+            .find(|s| s.name() == value)
+            .ok_or_else(|| InvalidInput::new(Self::ENV, format!("must be compute or fragment, got {value:?}")))
+    }
+
+    /// [`Self::ENV`] when set ([`Self::parse`]), else [`SssShape::Compute`].
+    pub fn from_env() -> Result<Self, InvalidInput> {
+        std::env::var(Self::ENV).map_or(Ok(Self::default()), |v| Self::parse(&v))
+    }
+
+    /// The shape for an adapter: [`Self::ENV`] when set, else the fragment passes on a software rasteriser (where
+    /// workgroup barriers are emulated and the tiles are slower; same arithmetic, same twin), compute on a GPU.
+    pub fn for_adapter(software: bool) -> Result<Self, InvalidInput> {
+        match std::env::var(Self::ENV) {
+            Ok(v) => Self::parse(&v),
+            Err(_) if software => Ok(Self::Fragment),
+            Err(_) => Ok(Self::Compute),
+        }
+    }
 }
 
 /// The vertical field of view every pass accepts: 1° to 179°.
