@@ -160,3 +160,17 @@ fn pass_through_and_energy(k: SssKernel, variant: Variant) {
         }
     }
 }
+
+#[test]
+fn the_sss_pass_shape_is_compute_or_fragment() {
+    use rtbake::runtime::sss::SssShape;
+    assert_eq!(SssShape::parse("compute").unwrap(), SssShape::Compute);
+    assert_eq!(SssShape::parse("fragment").unwrap(), SssShape::Fragment);
+    let e = SssShape::parse("tiled").unwrap_err().to_string();
+    assert!(e.contains("RTBAKE_SSS_PASSES") && e.contains("must be compute or fragment, got \"tiled\""), "{e}");
+    // Without the variable: the fragment passes on a software rasteriser, compute on a GPU.
+    if std::env::var_os(SssShape::ENV).is_none() {
+        assert_eq!(SssShape::for_adapter(true).unwrap(), SssShape::Fragment);
+        assert_eq!(SssShape::for_adapter(false).unwrap(), SssShape::Compute);
+    }
+}
