@@ -185,7 +185,7 @@ fn sss_shapes(
         let name = format!("sum-of-Gaussians SSS (deon6) {w}x{h}, {}", shape.name());
         print_sum(&name, &pp, wall, "thesis 3.07 ms @1080p GTX 580");
         let names: Vec<String> = (0..n).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
-        let per_px = |i: u32| match (shape, i % 2 == 0) {
+        let per_px = |i: u32| match (shape, i.is_multiple_of(2)) {
             (SssShape::Fragment, true) => 28,
             (SssShape::Fragment, false) => 44,
             (SssShape::Compute, true) => 20,

@@ -155,8 +155,8 @@ pub type GaussianSss = SssPass<GaussianChain>;
 /// The passes of [`GaussianSss`]: per Gaussian after the first, a horizontal and a blended vertical pass, in one of
 /// the two [`SssShape`]s.
 pub enum GaussianChain {
-    Fragment(FragmentChain),
-    Compute(TiledChain),
+    Fragment(Box<FragmentChain>),
+    Compute(Box<TiledChain>),
 }
 
 /// The fragment form of [`GaussianChain`]: render targets RT1, RT2 and RTF, the vertical pass blending into RTF.
@@ -202,11 +202,11 @@ impl GaussianSss {
         let (output, blur) = match shape {
             SssShape::Fragment => {
                 let chain = FragmentChain::new(device, &inputs, (width, height), ubos, blurs);
-                (chain.rtf.clone(), GaussianChain::Fragment(chain))
+                (chain.rtf.clone(), GaussianChain::Fragment(Box::new(chain)))
             }
             SssShape::Compute => {
                 let chain = TiledChain::new(device, &inputs, (width, height), ubos)?;
-                (chain.output().clone(), GaussianChain::Compute(chain))
+                (chain.output().clone(), GaussianChain::Compute(Box::new(chain)))
             }
         };
         Ok(SssPass { inputs, output, blur })

@@ -56,7 +56,7 @@ impl TiledChain {
         let (lh, lv) = (pipes[0].get_bind_group_layout(0), pipes[1].get_bind_group_layout(0));
         let m = ubos.len();
         // The running sum ping-pongs so that the last vertical pass writes the output.
-        let sum_out = |k: usize| if (m - 1 - k) % 2 == 0 { &outv } else { &sumv };
+        let sum_out = |k: usize| if (m - 1 - k).is_multiple_of(2) { &outv } else { &sumv };
         use wgpu::BindingResource as R;
         let steps = ubos
             .iter()
@@ -106,13 +106,13 @@ impl TiledChain {
             enc.copy_texture_to_texture(whole(&self.input), whole(&self.output), self.input.size());
         }
         for (k, groups) in self.steps.iter().enumerate() {
-            for j in 0..2 {
+            for (j, (pipe, group)) in self.pipes.iter().zip(groups).enumerate() {
                 let slot = (2 * k + j) as u32;
                 let timestamp_writes = timer.map(|(t, first)| t.compute_pass_writes(first + slot));
                 let mut pass =
                     enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("gsss"), timestamp_writes });
-                pass.set_pipeline(&self.pipes[j]);
-                pass.set_bind_group(0, &groups[j], &[]);
+                pass.set_pipeline(pipe);
+                pass.set_bind_group(0, group, &[]);
                 let [x, y, z] = self.dispatch[j];
                 pass.dispatch_workgroups(x, y, z);
             }
