@@ -18,7 +18,7 @@
 //!     cargo build --release --example bench_runtime --example bench_smaa_modes && \
 //!         scripts/gpu_bench.sh target/release/examples 1920x1080
 //!
-//! The SSS passes likewise (`rtbake::runtime::sss::SssShape`): separable (two fragment passes, then the two compute
+//! The SSS passes likewise (`rtbake::runtime::sss::PassShape`): separable (two fragment passes, then the two compute
 //! passes over line tiles), the sum of Gaussians (d'Eon's six: ten fragment passes after two copies, then ten compute
 //! passes over line tiles with the blend folded in) and the importance-sampled pass (TAP's SS Jittered, 13 taps: one
 //! fragment pass, then one compute pass), each pass beside its bound and a line per method with both.
@@ -43,7 +43,6 @@ use rtbake::runtime::scene::render_shapes;
 use rtbake::runtime::separable_sss::{SeparableSss, SssParams};
 use rtbake::runtime::smaa::{Smaa, SmaaOptions, SubsampleIndices};
 use rtbake::runtime::sss::separable_tiled::SeparableSssTiled;
-use rtbake::runtime::sss::SssShape;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -140,7 +139,7 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures,
 }
 
 /// The SSS passes on a lit sphere filling the frame height (alpha 1 on skin), each in the fragment shape (full-screen
-/// fragment passes, before) and the compute shape (after; `rtbake::runtime::sss::SssShape`), each pass beside its
+/// fragment passes, before) and the compute shape (after; `rtbake::runtime::sss::PassShape`), each pass beside its
 /// bytes-moved bound, then per method the speed-up and time/bound of both.
 fn sss_shapes(
     g: &rtbake::runtime::device::Gpu,
@@ -154,14 +153,14 @@ fn sss_shapes(
     let mut totals = Vec::new();
     // Separable, each pass: RGBA16F colour and R32F depth in, RGBA16F out (both shapes).
     let bytes = [20 * px, 20 * px];
-    for shape in [SssShape::Fragment, SssShape::Compute] {
+    for shape in [PassShape::Fragment, PassShape::Compute] {
         let (pp, wall) = match shape {
-            SssShape::Fragment => {
+            PassShape::Fragment => {
                 let sss = SeparableSss::new(&g.device, w, h, kernel, &SssParams::default()).unwrap();
                 sss.upload(&g.queue, &color, &depth).unwrap();
                 time_passes(g, 2, &|e, t| sss.encode(e, t))
             }
-            SssShape::Compute => {
+            PassShape::Compute => {
                 let sss = SeparableSssTiled::new(&g.device, w, h, kernel, &SssParams::default()).unwrap();
                 sss.upload(&g.queue, &color, &depth).unwrap();
                 time_passes(g, 2, &|e, t| sss.encode(e, t))
@@ -177,7 +176,7 @@ fn sss_shapes(
     // horizontal passes of 28 B/px (source, depth, matte in; RT2 out) and vertical ones of 44 (RT2, depth, matte in;
     // RT1 out; RTF blended, read and written). Compute: no copies, horizontal 20, vertical 36, the last 28.
     let params = fit.params.for_viewport_height(h);
-    for shape in [SssShape::Fragment, SssShape::Compute] {
+    for shape in [PassShape::Fragment, PassShape::Compute] {
         let gs = GaussianSss::with_shape(&g.device, (w, h), &fit.blurs, &params, shape).unwrap();
         gs.upload(&g.queue, &color, &depth).unwrap();
         let n = gs.passes();
@@ -186,21 +185,21 @@ fn sss_shapes(
         print_sum(&name, &pp, wall, "thesis 3.07 ms @1080p GTX 580");
         let names: Vec<String> = (0..n).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
         let per_px = |i: u32| match (shape, i.is_multiple_of(2)) {
-            (SssShape::Fragment, true) => 28,
-            (SssShape::Fragment, false) => 44,
-            (SssShape::Compute, true) => 20,
-            (SssShape::Compute, false) if i + 1 == n => 28,
-            (SssShape::Compute, false) => 36,
+            (PassShape::Fragment, true) => 28,
+            (PassShape::Fragment, false) => 44,
+            (PassShape::Compute, true) => 20,
+            (PassShape::Compute, false) if i + 1 == n => 28,
+            (PassShape::Compute, false) => 36,
         };
         let bytes: Vec<u64> = (0..n).map(|i| per_px(i) * px).collect();
         print_bounds(&names.iter().map(String::as_str).collect::<Vec<_>>(), &pp, wall, &bytes, bw);
-        let copies = if shape == SssShape::Fragment { 32 * px } else { 0 };
+        let copies = if shape == PassShape::Fragment { 32 * px } else { 0 };
         totals.push(("sum-of-Gaussians SSS", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>() + copies));
     }
     // Importance-sampled, TAP's SS Jittered (13 taps): RGBA16F colour and R32F depth in, RGBA16F out.
     let samples = rtbake::runtime::skin::frame::jittered_samples().unwrap();
     let bytes = [20 * px];
-    for shape in [SssShape::Fragment, SssShape::Compute] {
+    for shape in [PassShape::Fragment, PassShape::Compute] {
         let params = ImportanceSssParams::default();
         let is = ImportanceSss::with_shape(&g.device, (w, h), &samples, &params, shape).unwrap();
         is.upload(&g.queue, &color, &depth).unwrap();

@@ -24,7 +24,7 @@ use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSss, GaussianSssParam
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
 use crate::runtime::sss::separable::{SeparableSss, SssKernel, SssParams};
 use crate::runtime::sss::separable_tiled::SeparableSssTiled;
-use crate::runtime::sss::{gaussian_cpu, importance_cpu, separable_cpu, SssShape};
+use crate::runtime::sss::{self, gaussian_cpu, importance_cpu, separable_cpu, PassShape};
 use crate::runtime::transport::mc_gpu::TransportGpu;
 use crate::runtime::RuntimeError;
 
@@ -250,9 +250,9 @@ impl SubsurfaceGpu {
         let d = &g.device;
         // Compute passes on GPUs; the fragment passes on software adapters, where workgroup barriers are emulated
         // and the tiles are slower (same arithmetic, same twin); `RTBAKE_SSS_PASSES` overrides either.
-        let shape = SssShape::for_adapter(g.is_software())?;
+        let shape = sss::shape_for_adapter(g.is_software())?;
         Ok(match method {
-            Subsurface::Separable { kernel, params } if shape == SssShape::Fragment => {
+            Subsurface::Separable { kernel, params } if shape == PassShape::Fragment => {
                 Self::Separable(SeparableSss::new(d, w, h, kernel, params)?)
             }
             Subsurface::Separable { kernel, params } => Self::Tiled(SeparableSssTiled::new(d, w, h, kernel, params)?),

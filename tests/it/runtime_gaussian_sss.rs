@@ -5,7 +5,7 @@ use crate::support::*;
 use rtbake::diffusion::sum_of_gaussians::{deon4, deon6, SumOfGaussians};
 use rtbake::runtime::cpu::gaussian_sss::gaussian_sss;
 use rtbake::runtime::gaussian_sss::{GaussianBlurs, GaussianSss, GaussianSssParams};
-use rtbake::runtime::sss::SssShape;
+use rtbake::runtime::sss::PassShape;
 
 /// Two striped discs (skin, alpha 1): one near (depth ≈ 2), one far (depth ≈ 20, where the narrow Gaussians
 /// are skipped by eq. 4.6), on a background (alpha 0).
@@ -62,7 +62,7 @@ fn gaussian_sss_gpu_matches_cpu() {
     let blurs = GaussianBlurs::from_sum_of_gaussians(&deon6()).unwrap();
     let p = GaussianSssParams::default();
     let cpu = gaussian_sss(&color, &depth, w, h, &blurs, &p);
-    for shape in [SssShape::Fragment, SssShape::Compute] {
+    for shape in [PassShape::Fragment, PassShape::Compute] {
         let pass = GaussianSss::with_shape(&g.device, (w, h), &blurs, &p, shape).unwrap();
         assert_eq!((pass.shape(), pass.passes()), (shape, 10));
         let out = pass.run(&g.device, &g.queue, &color, &depth).unwrap();
@@ -122,7 +122,7 @@ fn compute_chain_matches_cpu_across_tile_seams_and_beyond_the_apron() {
             let pass = GaussianSss::with_shape(&g.device, (w, h), &blurs, &p, shape).unwrap();
             pass.run(&g.device, &g.queue, &color, &depth).unwrap()
         };
-        let (compute, fragment) = (run(SssShape::Compute), run(SssShape::Fragment));
+        let (compute, fragment) = (run(PassShape::Compute), run(PassShape::Fragment));
         let diff = |out: &[f32]| out.iter().zip(&cpu).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
         let (dc, df) = (diff(&compute), diff(&fragment));
         let n = fit.variances_mm2.len();
@@ -154,14 +154,14 @@ fn lod_skip_and_matte_leave_pixels_untouched_and_energy_is_kept() {
     let (color, _) = scene(w, h);
     let blurs = GaussianBlurs::from_sum_of_gaussians(&deon6()).unwrap();
     let p = GaussianSssParams::default();
-    for shape in [SssShape::Fragment, SssShape::Compute] {
+    for shape in [PassShape::Fragment, PassShape::Compute] {
         lod_skip_and_matte(&g, shape, &color, (w, h), &blurs, &p);
     }
 }
 
 fn lod_skip_and_matte(
     g: &rtbake::runtime::device::Gpu,
-    shape: SssShape,
+    shape: PassShape,
     color: &[f32],
     (w, h): (u32, u32),
     blurs: &GaussianBlurs,

@@ -7,7 +7,7 @@ use rtbake::diffusion::burley::{RgbBurley, ShapeFit};
 use rtbake::runtime::chain::{self, Subsurface};
 use rtbake::runtime::cpu::importance_sss::importance_sss;
 use rtbake::runtime::importance_sss::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
-use rtbake::runtime::sss::SssShape;
+use rtbake::runtime::sss::PassShape;
 use rtbake::sss_sampling::compare::{BURLEY_SKIN_ALBEDO, BURLEY_SKIN_MFP_MM};
 use rtbake::sss_sampling::{ImportanceKernel, SampledProfile};
 
@@ -136,7 +136,7 @@ fn importance_sss_compute_and_fragment_write_the_same_bytes() {
             let pass = ImportanceSss::with_shape(&g.device, (w, h), &samples, &p, shape).unwrap();
             pass.run(&g.device, &g.queue, &color, &depth).unwrap()
         };
-        let (compute, fragment) = (run(SssShape::Compute), run(SssShape::Fragment));
+        let (compute, fragment) = (run(PassShape::Compute), run(PassShape::Fragment));
         let differ = compute.iter().zip(&fragment).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
         assert_eq!(differ, 0, "N = {}: {differ} samples differ", samples.offsets_mm.len());
         let changed = compute.iter().zip(&color).filter(|(a, b)| (*a - *b).abs() > 1e-2).count();

@@ -8,7 +8,7 @@
 //! Textures: diffuse `Rgba16Float` (linear, alpha = local SSS level, 0 = not skin), depth `R32Float` (linear,
 //! loaded, never filtered), RT1/RT2/RTF `Rgba16Float`. CPU twin [`crate::runtime::sss::gaussian_cpu`].
 //!
-//! Two shapes ([`SssShape`]): the full-screen fragment passes of Listing 4.1 (below) or compute passes over
+//! Two shapes ([`PassShape`]): the full-screen fragment passes of Listing 4.1 (below) or compute passes over
 //! workgroup-memory line tiles ([`crate::runtime::sss::gaussian_tiled`]), which also fold the blend into the
 //! vertical pass and read the input in place of the copies the fragment form starts with.
 
@@ -16,7 +16,7 @@ use crate::diffusion::sum_of_gaussians::SumOfGaussians;
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::gaussian_tiled::TiledChain;
-use crate::runtime::sss::{SssBlur, SssInputs, SssPass, SssShape};
+use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
 /// The blurs derived from a sum-of-Gaussians fit.
@@ -153,7 +153,7 @@ const SHADER: &str = concat!(
 pub type GaussianSss = SssPass<GaussianChain>;
 
 /// The passes of [`GaussianSss`]: per Gaussian after the first, a horizontal and a blended vertical pass, in one of
-/// the two [`SssShape`]s.
+/// the two [`PassShape`]s.
 pub enum GaussianChain {
     Fragment(Box<FragmentChain>),
     Compute(Box<TiledChain>),
@@ -176,7 +176,7 @@ pub struct FragmentChain {
 }
 
 impl GaussianSss {
-    /// The chain in the shape [`SssShape::from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
+    /// The chain in the shape [`shape_from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
     pub fn new(
         device: &wgpu::Device,
         width: u32,
@@ -184,7 +184,7 @@ impl GaussianSss {
         blurs: &GaussianBlurs,
         params: &GaussianSssParams,
     ) -> Result<Self, RuntimeError> {
-        Self::with_shape(device, (width, height), blurs, params, SssShape::from_env()?)
+        Self::with_shape(device, (width, height), blurs, params, shape_from_env(PassShape::Compute)?)
     }
 
     /// As [`Self::new`] in the given shape (the benchmarks build both; the same CPU twin).
@@ -193,18 +193,18 @@ impl GaussianSss {
         (width, height): (u32, u32),
         blurs: &GaussianBlurs,
         params: &GaussianSssParams,
-        shape: SssShape,
+        shape: PassShape,
     ) -> Result<Self, RuntimeError> {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
         let inputs = SssInputs::new(device, "gsss", width, height);
         let ubos = Params::buffers(device, (width, height), (blurs, params));
         let (output, blur) = match shape {
-            SssShape::Fragment => {
+            PassShape::Fragment => {
                 let chain = FragmentChain::new(device, &inputs, (width, height), ubos, blurs);
                 (chain.rtf.clone(), GaussianChain::Fragment(Box::new(chain)))
             }
-            SssShape::Compute => {
+            PassShape::Compute => {
                 let chain = TiledChain::new(device, &inputs, (width, height), ubos)?;
                 (chain.output().clone(), GaussianChain::Compute(Box::new(chain)))
             }
@@ -221,10 +221,10 @@ impl GaussianSss {
     }
 
     /// The shape the chain was built in.
-    pub fn shape(&self) -> SssShape {
+    pub fn shape(&self) -> PassShape {
         match self.blur {
-            GaussianChain::Fragment(_) => SssShape::Fragment,
-            GaussianChain::Compute(_) => SssShape::Compute,
+            GaussianChain::Fragment(_) => PassShape::Fragment,
+            GaussianChain::Compute(_) => PassShape::Compute,
         }
     }
 }

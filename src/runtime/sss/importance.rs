@@ -2,7 +2,7 @@
 //! ([`crate::sss_sampling::disk`]; the sampling of Unity HDRP's diffusion profiles, Golubev 2018) on a linear HDR
 //! irradiance image (`Rgba16Float`, alpha = per-pixel strength, 0 = not skin: passes through) with a linear depth
 //! image (`R32Float`). Resources created once in [`ImportanceSss::new`]; CPU twin
-//! [`crate::runtime::sss::importance_cpu`]. A fragment pass or a compute pass ([`SssShape`]), both calling the
+//! [`crate::runtime::sss::importance_cpu`]. A fragment pass or a compute pass ([`PassShape`]), both calling the
 //! shader's one per-pixel function through the same sampler: the same bytes. Not tiled: the samples spread over a
 //! disk out to the kernel's widest sample at the pixel's depth (TAP's SS Jittered: 13 taps out to red's wide
 //! ring; a Burley kernel: out to its 0.999 radius), in every direction, so a 2-D workgroup tile would load an apron
@@ -25,7 +25,7 @@
 
 use crate::error::{check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
-use crate::runtime::sss::{SssBlur, SssInputs, SssPass, SssShape};
+use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 use crate::sss_sampling::ImportanceKernel;
 
@@ -118,7 +118,7 @@ const SHADER: &str =
 /// Importance-sampled SSS for one frame size and kernel.
 pub type ImportanceSss = SssPass<ImportanceBlur>;
 
-/// The one pass of [`ImportanceSss`], in either [`SssShape`] (the same per-pixel function, the same bytes).
+/// The one pass of [`ImportanceSss`], in either [`PassShape`] (the same per-pixel function, the same bytes).
 pub enum ImportanceBlur {
     /// A full-screen fragment pass into the output (a render target).
     Fragment { pipe: wgpu::RenderPipeline, group: wgpu::BindGroup, target: wgpu::TextureView },
@@ -130,7 +130,7 @@ pub enum ImportanceBlur {
 const WORKGROUP: u32 = 8;
 
 impl ImportanceSss {
-    /// The pass in the shape [`SssShape::from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
+    /// The pass in the shape [`shape_from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
     pub fn new(
         device: &wgpu::Device,
         width: u32,
@@ -138,7 +138,7 @@ impl ImportanceSss {
         samples: &ImportanceSamples,
         params: &ImportanceSssParams,
     ) -> Result<Self, RuntimeError> {
-        Self::with_shape(device, (width, height), samples, params, SssShape::from_env()?)
+        Self::with_shape(device, (width, height), samples, params, shape_from_env(PassShape::Compute)?)
     }
 
     /// As [`Self::new`] in the given shape (the benchmarks build both; the same output bytes).
@@ -147,7 +147,7 @@ impl ImportanceSss {
         (width, height): (u32, u32),
         samples: &ImportanceSamples,
         params: &ImportanceSssParams,
-        shape: SssShape,
+        shape: PassShape,
     ) -> Result<Self, RuntimeError> {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
@@ -171,14 +171,14 @@ impl ImportanceSss {
         let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
         let cv = inputs.color.create_view(&Default::default());
         let (output, blur) = match shape {
-            SssShape::Fragment => {
+            PassShape::Fragment => {
                 let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
                 let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
                 let group = inputs.blur_group(device, "isss", &pipe.get_bind_group_layout(0), (&ubo, &cv), &[]);
                 let target = output.create_view(&Default::default());
                 (output, ImportanceBlur::Fragment { pipe, group, target })
             }
-            SssShape::Compute => {
+            PassShape::Compute => {
                 let output = gpu::storage_texture(device, "isss output", width, height, F::Rgba16Float);
                 let pipe = gpu::compute_pipeline(device, &module, "cs_blur");
                 let ov = output.create_view(&Default::default());

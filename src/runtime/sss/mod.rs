@@ -7,8 +7,8 @@
 //! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel
 //!   (fragment or compute, the same per-pixel function).
 //!
-//! [`SssShape`] picks the form of each pass: compute (the default on GPUs) or the full-screen fragment passes they
-//! replace (`RTBAKE_SSS_PASSES=fragment`, so one benchmark binary measures both).
+//! A [`PassShape`] picks the form of each pass: compute (the default on GPUs) or the full-screen fragment passes they
+//! replace ([`SHAPE_ENV`] `RTBAKE_SSS_PASSES=fragment`, so one benchmark binary measures both).
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
 //!
@@ -41,52 +41,30 @@ pub fn dist_to_window(fovy_deg: f32) -> f32 {
     1.0 / (0.5 * fovy_deg.to_radians()).tan()
 }
 
-/// The form a screen-space SSS pass takes on the GPU: the same arithmetic and the same CPU twin either way.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum SssShape {
-    /// Compute passes: the separable and Gaussian blurs over workgroup-memory line tiles, the importance-sampled
-    /// gather over 8×8-thread workgroups. On an NVIDIA H100/H200 a full-screen fragment pass reaches only the
-    /// TPCs its graphics pipeline spans, a compute pass every SM.
-    #[default]
-    Compute,
-    /// Full-screen fragment passes into render targets (the shape before the compute passes).
-    Fragment,
+/// The form of a screen-space SSS pass on the GPU, the one type of the AA passes: [`PassShape::Compute`] (the
+/// separable and Gaussian blurs over workgroup-memory line tiles, the importance-sampled gather over 8×8-thread
+/// workgroups) or [`PassShape::Fragment`] (the full-screen fragment passes they replace); the same arithmetic and the
+/// same CPU twin either way. On an NVIDIA H100/H200 a fragment pass reaches only the TPCs its graphics pipeline
+/// spans, a compute pass every SM.
+pub use crate::runtime::aa::three_pass::PassShape;
+
+/// The environment variable that picks the SSS passes' [`PassShape`] (`compute` or `fragment`).
+pub const SHAPE_ENV: &str = "RTBAKE_SSS_PASSES";
+
+/// The SSS passes' shape: [`SHAPE_ENV`] when set (anything but `compute` or `fragment` is refused naming it), else
+/// `default`.
+pub fn shape_from_env(default: PassShape) -> Result<PassShape, InvalidInput> {
+    match std::env::var(SHAPE_ENV) {
+        Ok(v) => PassShape::parse(&v)
+            .map_err(|_| InvalidInput::new(SHAPE_ENV, format!("must be compute or fragment, got {v:?}"))),
+        Err(_) => Ok(default),
+    }
 }
 
-impl SssShape {
-    /// The environment variable [`Self::from_env`] reads.
-    pub const ENV: &'static str = "RTBAKE_SSS_PASSES";
-
-    /// `compute` or `fragment`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Compute => "compute",
-            Self::Fragment => "fragment",
-        }
-    }
-
-    /// `compute` or `fragment`; anything else is refused naming [`Self::ENV`].
-    pub fn parse(value: &str) -> Result<Self, InvalidInput> {
-        [Self::Compute, Self::Fragment]
-            .into_iter()
-            .find(|s| s.name() == value)
-            .ok_or_else(|| InvalidInput::new(Self::ENV, format!("must be compute or fragment, got {value:?}")))
-    }
-
-    /// [`Self::ENV`] when set ([`Self::parse`]), else [`SssShape::Compute`].
-    pub fn from_env() -> Result<Self, InvalidInput> {
-        std::env::var(Self::ENV).map_or(Ok(Self::default()), |v| Self::parse(&v))
-    }
-
-    /// The shape for an adapter: [`Self::ENV`] when set, else the fragment passes on a software rasteriser (where
-    /// workgroup barriers are emulated and the tiles are slower; same arithmetic, same twin), compute on a GPU.
-    pub fn for_adapter(software: bool) -> Result<Self, InvalidInput> {
-        match std::env::var(Self::ENV) {
-            Ok(v) => Self::parse(&v),
-            Err(_) if software => Ok(Self::Fragment),
-            Err(_) => Ok(Self::Compute),
-        }
-    }
+/// The shape for an adapter: [`SHAPE_ENV`] when set, else the fragment passes on a software rasteriser (where
+/// workgroup barriers are emulated and the tiles are slower; same arithmetic, same twin), compute on a GPU.
+pub fn shape_for_adapter(software: bool) -> Result<PassShape, InvalidInput> {
+    shape_from_env(if software { PassShape::Fragment } else { PassShape::Compute })
 }
 
 /// The vertical field of view every pass accepts: 1° to 179°.
