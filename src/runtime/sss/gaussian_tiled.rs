@@ -18,7 +18,8 @@ use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::SssInputs;
 use crate::runtime::RuntimeError;
 
-const SHADER: &str = concat!(include_str!("gaussian_params.wgsl"), include_str!("gaussian_tiled.wgsl"));
+const SHADER: &str =
+    concat!(include_str!("gaussian_params.wgsl"), include_str!("line_tile.wgsl"), include_str!("gaussian_tiled.wgsl"));
 /// Texels a workgroup blurs along its line (the shader's `SEGMENT`).
 const SEGMENT: u32 = 128;
 

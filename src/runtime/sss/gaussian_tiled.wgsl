@@ -14,35 +14,21 @@
 // (matte or eq. 4.6) copies: RT2 = source, RT1 = RT2, sum_out = sum_in, as the fragment form leaves it untouched.
 // The matte is the source's alpha (RT1 and RT2 carry the input's alpha unchanged), so the input is not read again.
 //
-// Prepended by the host module: Params, P, src_tex, stretch_width and W (gaussian_params.wgsl).
+// Prepended by the host module: Params, P, src_tex, stretch_width and W (gaussian_params.wgsl); depth_tex, out_tex,
+// SEGMENT, APRON, SLOTS, tile_color and line_texel (line_tile.wgsl).
 
-@group(0) @binding(2) var depth_tex: texture_2d<f32>;
-@group(0) @binding(3) var out_tex: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(4) var sum_in: texture_2d<f32>;
 @group(0) @binding(5) var sum_out: texture_storage_2d<rgba16float, write>;
 
-const SEGMENT: i32 = 128;
-const APRON: i32 = 64;
-const SLOTS: i32 = 256; // SEGMENT + 2 · APRON
-
-var<workgroup> tile: array<vec4<f32>, 256>;
 var<workgroup> tile_depth: array<f32, 128>;
-
-// The texel at position `along` of line `line` of the pass's axis.
-fn texel(along: i32, line: i32, horizontal: bool) -> vec2<i32> {
-    if (horizontal) {
-        return vec2<i32>(along, line);
-    }
-    return vec2<i32>(line, along);
-}
 
 // Colour of texel `a` (already clamped to the line) from the tile, or the source beyond it.
 fn fetch(a: i32, start: i32, line: i32, horizontal: bool) -> vec3<f32> {
     let k = a - start;
     if (k >= 0 && k < SLOTS) {
-        return tile[k].rgb;
+        return tile_color[k].rgb;
     }
-    return textureLoad(src_tex, texel(a, line, horizontal), 0).rgb;
+    return textureLoad(src_tex, line_texel(a, line, horizontal), 0).rgb;
 }
 
 // One pixel of a 1-D pass: where it is, the source there and, unless `skipped`, the blurred colour (source alpha).
@@ -63,13 +49,13 @@ fn blur_line(lid: u32, wid: vec2<u32>) -> Pixel {
     let line = i32(wid.y);
     let start = i32(wid.x) * SEGMENT - APRON;
     for (var k = i32(lid); k < SLOTS; k = k + SEGMENT) {
-        tile[k] = textureLoad(src_tex, texel(clamp(start + k, 0, len - 1), line, horizontal), 0);
+        tile_color[k] = textureLoad(src_tex, line_texel(clamp(start + k, 0, len - 1), line, horizontal), 0);
     }
     let along = i32(wid.x) * SEGMENT + i32(lid);
-    tile_depth[lid] = textureLoad(depth_tex, texel(clamp(along, 0, len - 1), line, horizontal), 0).r;
+    tile_depth[lid] = textureLoad(depth_tex, line_texel(clamp(along, 0, len - 1), line, horizontal), 0).r;
     workgroupBarrier();
-    let p = texel(along, line, horizontal);
-    let centre = tile[APRON + i32(lid)];
+    let p = line_texel(along, line, horizontal);
+    let centre = tile_color[APRON + i32(lid)];
     var px = Pixel(p, along < len, true, centre, centre);
     if (!px.inside) {
         return px;

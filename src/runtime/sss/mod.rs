@@ -15,8 +15,8 @@
 //! Shared by the four: [`SssPass`] (the input frame, the output and upload / encode / run; each module's `new`
 //! builds its blur), the camera scale [`dist_to_window`], the blur bind group and frame checks of `SssInputs`, the
 //! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches), `separable_params.wgsl` (the uniform block
-//! of both separable forms) and `gaussian_params.wgsl` (the uniform block and stretch of both Gaussian forms), and
-//! `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
+//! of both separable forms) and `gaussian_params.wgsl` (the uniform block and stretch of both Gaussian forms), `line_tile.wgsl` (the
+//! workgroup line tile of both tiled forms), and `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
 
 mod blur_cpu;
 pub mod gaussian;
