@@ -18,6 +18,11 @@
 //!     cargo build --release --example bench_runtime --example bench_smaa_modes && \
 //!         scripts/gpu_bench.sh target/release/examples 1920x1080
 //!
+//! The SSS passes likewise (`rtbake::runtime::sss::PassShape`): separable (two fragment passes, then the two compute
+//! passes over line tiles), the sum of Gaussians (d'Eon's six: ten fragment passes after two copies, then ten compute
+//! passes over line tiles with the blend folded in) and the importance-sampled pass (TAP's SS Jittered, 13 taps: one
+//! fragment pass, then one compute pass), each pass beside its bound and a line per method with both.
+//!
 //! GPU passes are timed with timestamp queries when the adapter supports them, else by wall time of
 //! submit + wait (which includes driver overhead). The adapter is printed first: figures from a software
 //! rasteriser (lavapipe/llvmpipe) are CPU figures, not GPU figures. Thesis anchors: SMAA 1x 1.02 ms at 1080p
@@ -30,6 +35,7 @@ use rtbake::runtime::cpu::{self, FilterPrecision, Tex8};
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gaussian_sss::GaussianSss;
 use rtbake::runtime::gpu::GpuTimer;
+use rtbake::runtime::importance_sss::{ImportanceSss, ImportanceSssParams};
 use rtbake::runtime::loader;
 use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
 use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
@@ -124,34 +130,102 @@ fn gpu_passes(dir: &std::path::Path, luts: &rtbake::runtime::smaa::SmaaTextures,
          scene's textured frame (rtbake::runtime::moving_scene, edges almost everywhere)"
     );
     for &(w, h) in sizes {
-        let px = w as u64 * h as u64;
         let img = render_shapes(w, h, 1);
         aa_shapes(&g, luts, &map, (w, h), &img, "shapes", bw);
         let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
         aa_shapes(&g, luts, &map, (w, h), &moving, "moving scene", bw);
-        // SSS inputs: a lit sphere filling the frame height, alpha 1 on skin.
-        let (color, depth) = sss_frame(w, h);
-        let sss = SeparableSss::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
-        sss.upload(&g.queue, &color, &depth).unwrap();
-        let (pp, wall) = time_passes(&g, 2, &|e, t| sss.encode(e, t));
-        print_sum(&format!("separable SSS 17 taps, fragment {w}x{h}"), &pp, wall, "thesis 1.05 ms @1080p GTX 580");
-        // Each pass: RGBA16F colour and R32F depth in, RGBA16F out.
-        print_bounds(&["horizontal", "vertical"], &pp, wall, &[20 * px, 20 * px], bw);
-        let tiled = SeparableSssTiled::new(&g.device, w, h, &kernel.kernel, &SssParams::default()).unwrap();
-        tiled.upload(&g.queue, &color, &depth).unwrap();
-        let (pp, wall) = time_passes(&g, 2, &|e, t| tiled.encode(e, t));
-        print_sum(&format!("separable SSS 17 taps, compute line tiles {w}x{h}"), &pp, wall, "goal 0.2 ms @1080p");
-        print_bounds(&["horizontal", "vertical"], &pp, wall, &[20 * px, 20 * px], bw);
-        let gs = GaussianSss::new(&g.device, w, h, &fit.blurs, &fit.params).unwrap();
+        sss_shapes(&g, &kernel.kernel, &fit, (w, h), bw);
+    }
+}
+
+/// The SSS passes on a lit sphere filling the frame height (alpha 1 on skin), each in the fragment shape (full-screen
+/// fragment passes, before) and the compute shape (after; `rtbake::runtime::sss::PassShape`), each pass beside its
+/// bytes-moved bound, then per method the speed-up and time/bound of both.
+fn sss_shapes(
+    g: &rtbake::runtime::device::Gpu,
+    kernel: &rtbake::runtime::separable_sss::SssKernel,
+    fit: &loader::BakedGaussians,
+    (w, h): (u32, u32),
+    bw: f64,
+) {
+    let px = w as u64 * h as u64;
+    let (color, depth) = sss_frame(w, h);
+    let mut totals = Vec::new();
+    // Separable, each pass: RGBA16F colour and R32F depth in, RGBA16F out (both shapes).
+    let bytes = [20 * px, 20 * px];
+    for shape in [PassShape::Fragment, PassShape::Compute] {
+        let (pp, wall) = match shape {
+            PassShape::Fragment => {
+                let sss = SeparableSss::new(&g.device, w, h, kernel, &SssParams::default()).unwrap();
+                sss.upload(&g.queue, &color, &depth).unwrap();
+                time_passes(g, 2, &|e, t| sss.encode(e, t))
+            }
+            PassShape::Compute => {
+                let sss = SeparableSssTiled::new(&g.device, w, h, kernel, &SssParams::default()).unwrap();
+                sss.upload(&g.queue, &color, &depth).unwrap();
+                time_passes(g, 2, &|e, t| sss.encode(e, t))
+            }
+        };
+        let name = format!("separable SSS 17 taps {w}x{h}, {}", shape.name());
+        print_sum(&name, &pp, wall, "thesis 1.05 ms @1080p GTX 580; goal 0.2 ms @1080p H100");
+        print_bounds(&["horizontal", "vertical"], &pp, wall, &bytes, bw);
+        totals.push(("separable SSS 17 taps", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>()));
+    }
+    // Sum of Gaussians (d'Eon's six, α scaled to the viewport as `run skin` does; bytes per pass in
+    // `rtbake::runtime::sss::gaussian_tiled`'s docs). Fragment: the two copies of the input (32 B/px, untimed) before
+    // horizontal passes of 28 B/px (source, depth, matte in; RT2 out) and vertical ones of 44 (RT2, depth, matte in;
+    // RT1 out; RTF blended, read and written). Compute: no copies, horizontal 20, vertical 36, the last 28.
+    let params = fit.params.for_viewport_height(h);
+    for shape in [PassShape::Fragment, PassShape::Compute] {
+        let gs = GaussianSss::with_shape(&g.device, (w, h), &fit.blurs, &params, shape).unwrap();
         gs.upload(&g.queue, &color, &depth).unwrap();
-        let (pp, wall) = time_passes(&g, gs.passes(), &|e, t| gs.encode(e, t));
-        print_sum(&format!("sum-of-Gaussians SSS (deon6) {w}x{h}"), &pp, wall, "thesis 3.07 ms @1080p GTX 580");
-        // Horizontal: RGBA16F source, R32F depth and RGBA16F matte in, RGBA16F out; vertical: the same in, RGBA16F
-        // out and the blended RGBA16F sum read and written.
-        let names: Vec<String> =
-            (0..gs.passes()).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
-        let bytes: Vec<u64> = (0..gs.passes()).map(|i| if i % 2 == 0 { 28 * px } else { 44 * px }).collect();
+        let n = gs.passes();
+        let (pp, wall) = time_passes(g, n, &|e, t| gs.encode(e, t));
+        let name = format!("sum-of-Gaussians SSS (deon6) {w}x{h}, {}", shape.name());
+        print_sum(&name, &pp, wall, "thesis 3.07 ms @1080p GTX 580");
+        let names: Vec<String> = (0..n).map(|i| format!("{}{}", ["h", "v"][i as usize % 2], i / 2 + 1)).collect();
+        let per_px = |i: u32| match (shape, i.is_multiple_of(2)) {
+            (PassShape::Fragment, true) => 28,
+            (PassShape::Fragment, false) => 44,
+            (PassShape::Compute, true) => 20,
+            (PassShape::Compute, false) if i + 1 == n => 28,
+            (PassShape::Compute, false) => 36,
+        };
+        let bytes: Vec<u64> = (0..n).map(|i| per_px(i) * px).collect();
         print_bounds(&names.iter().map(String::as_str).collect::<Vec<_>>(), &pp, wall, &bytes, bw);
+        let copies = if shape == PassShape::Fragment { 32 * px } else { 0 };
+        totals.push(("sum-of-Gaussians SSS", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>() + copies));
+    }
+    // Importance-sampled, TAP's SS Jittered (13 taps): RGBA16F colour and R32F depth in, RGBA16F out.
+    let samples = rtbake::runtime::skin::frame::jittered_samples().unwrap();
+    let bytes = [20 * px];
+    for shape in [PassShape::Fragment, PassShape::Compute] {
+        let params = ImportanceSssParams::default();
+        let is = ImportanceSss::with_shape(&g.device, (w, h), &samples, &params, shape).unwrap();
+        is.upload(&g.queue, &color, &depth).unwrap();
+        let (pp, wall) = time_passes(g, 1, &|e, t| is.encode(e, t));
+        print_sum(&format!("importance-sampled SSS (SS Jittered, 13 taps) {w}x{h}, {}", shape.name()), &pp, wall, "");
+        print_bounds(&["gather"], &pp, wall, &bytes, bw);
+        totals.push(("importance-sampled SSS (SS Jittered)", total_ms(&pp, wall), wall, bytes[0]));
+    }
+    // Software adapters do not time compute passes faithfully (their timestamps miss the work): there the speed-up
+    // and time/bound are taken from the wall times of submit + wait, which include the driver's overhead.
+    let bound = |b: u64| b as f64 / bw * 1e3;
+    let by = if g.is_software() { "wall time (software adapter)" } else { "GPU time" };
+    for pair in totals.chunks(2) {
+        let ((pass, old, old_wall, old_b), (_, new, new_wall, new_b)) = (pair[0], pair[1]);
+        let (old, new) = if g.is_software() { (old_wall, new_wall) } else { (old, new) };
+        println!(
+            "{pass} {w}x{h} by {by}: fragment {old:.3} ms -> compute {new:.3} ms ({:.2}x); bound {:.4} -> {:.4} ms \
+             ({:.0} -> {:.0} B/px), time/bound {:.1} -> {:.1}",
+            old / new,
+            bound(old_b),
+            bound(new_b),
+            old_b as f64 / px as f64,
+            new_b as f64 / px as f64,
+            old / bound(old_b),
+            new / bound(new_b),
+        );
     }
 }
 

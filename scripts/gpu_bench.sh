@@ -13,6 +13,9 @@
 # compute passes (after, the default) side by side, each pass beside its bytes-moved bound, and prints the speed-up;
 # bench_smaa_modes runs once per shape (RTBAKE_AA_PASSES=fragment, then compute). The per-shape byte identity is
 # a test: `cargo test --test it runtime_smaa::compute_and_fragment` (run it on the GPU too).
+# The SSS passes likewise: bench_runtime times separable, sum of Gaussians and SS Jittered as fragment passes (before)
+# and compute passes (after) side by side, each pass beside its bound (RTBAKE_SSS_PASSES=fragment|compute picks the
+# shape elsewhere). Their GPU-vs-CPU tests: `cargo test --test it -- runtime_gaussian_sss runtime_importance_sss`.
 #
 # BIN_DIR holds release builds of the examples (`cargo build --release --example bench_runtime --example
 # bench_smaa_modes` puts them in target/release/examples). The same command runs binaries built from an older tree

@@ -24,7 +24,7 @@ use crate::runtime::sss::gaussian::{GaussianBlurs, GaussianSss, GaussianSssParam
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
 use crate::runtime::sss::separable::{SeparableSss, SssKernel, SssParams};
 use crate::runtime::sss::separable_tiled::SeparableSssTiled;
-use crate::runtime::sss::{gaussian_cpu, importance_cpu, separable_cpu};
+use crate::runtime::sss::{self, gaussian_cpu, importance_cpu, separable_cpu, PassShape};
 use crate::runtime::transport::mc_gpu::TransportGpu;
 use crate::runtime::RuntimeError;
 
@@ -248,19 +248,24 @@ impl SubsurfaceGpu {
     /// The pass of `method` for a `w`×`h` frame on `g`.
     pub(crate) fn new(g: &Gpu, (w, h): (u32, u32), method: &Subsurface) -> Result<Self, RuntimeError> {
         let d = &g.device;
+        // Compute passes on GPUs; the fragment passes on software adapters, where workgroup barriers are emulated
+        // and the tiles are slower (same arithmetic, same twin); `RTBAKE_SSS_PASSES` overrides either.
+        let shape = sss::shape_for_adapter(g.is_software())?;
         Ok(match method {
-            // The compute pass over workgroup-memory line tiles on GPUs; the fragment pass on software adapters,
-            // where workgroup barriers are emulated and the tiles are slower (same arithmetic, same twin).
-            Subsurface::Separable { kernel, params } if g.is_software() => {
+            Subsurface::Separable { kernel, params } if shape == PassShape::Fragment => {
                 Self::Separable(SeparableSss::new(d, w, h, kernel, params)?)
             }
             Subsurface::Separable { kernel, params } => Self::Tiled(SeparableSssTiled::new(d, w, h, kernel, params)?),
             // The α·h/720 viewport scaling of eq. 4.1, the same for both backends.
-            Subsurface::Gaussians { blurs, params } => {
-                Self::Gaussians(Box::new(GaussianSss::new(d, w, h, blurs, &params.for_viewport_height(h))?))
-            }
+            Subsurface::Gaussians { blurs, params } => Self::Gaussians(Box::new(GaussianSss::with_shape(
+                d,
+                (w, h),
+                blurs,
+                &params.for_viewport_height(h),
+                shape,
+            )?)),
             Subsurface::Importance { samples, params } => {
-                Self::Importance(ImportanceSss::new(d, w, h, samples, params)?)
+                Self::Importance(ImportanceSss::with_shape(d, (w, h), samples, params, shape)?)
             }
         })
     }

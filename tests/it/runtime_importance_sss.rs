@@ -1,11 +1,13 @@
 //! Importance-sampled SSS: GPU vs CPU reference (a power-of-two-free and an odd size), the matte (non-skin pixels
-//! pass through), energy conservation on a constant image, and the chain's GPU/CPU choice.
+//! pass through), energy conservation on a constant image, the chain's GPU/CPU choice, and the compute and fragment
+//! shapes writing the same bytes.
 
 use crate::support::*;
 use rtbake::diffusion::burley::{RgbBurley, ShapeFit};
 use rtbake::runtime::chain::{self, Subsurface};
 use rtbake::runtime::cpu::importance_sss::importance_sss;
 use rtbake::runtime::importance_sss::{ImportanceSamples, ImportanceSss, ImportanceSssParams};
+use rtbake::runtime::sss::PassShape;
 use rtbake::sss_sampling::compare::{BURLEY_SKIN_ALBEDO, BURLEY_SKIN_MFP_MM};
 use rtbake::sss_sampling::{ImportanceKernel, SampledProfile};
 
@@ -117,4 +119,27 @@ fn importance_sss_through_the_chain_and_bad_input() {
     let empty = ImportanceSamples { offsets_mm: vec![], weights: vec![], cutoff_mm: 1.0 };
     let e = ImportanceSss::new(&g.device, w, h, &empty, &params).err().unwrap().to_string();
     assert!(e.contains("samples") && e.contains("1..=1024"), "{e}");
+}
+
+/// The compute shape (8×8-pixel workgroups) and the fragment pass call one per-pixel function through the same
+/// sampler: the same bytes, at a size no multiple of the workgroup, with follow-surface across the sphere's edge,
+/// and TAP's 13 jittered taps (SS Jittered) as well as a Burley kernel.
+#[test]
+fn importance_sss_compute_and_fragment_write_the_same_bytes() {
+    let g = gpu();
+    let (w, h) = (131, 97);
+    let (color, depth) = scene(w, h);
+    let jittered = rtbake::runtime::skin::frame::jittered_samples().unwrap();
+    for samples in [jittered, burley_samples(40)] {
+        let p = ImportanceSssParams::default();
+        let run = |shape| {
+            let pass = ImportanceSss::with_shape(&g.device, (w, h), &samples, &p, shape).unwrap();
+            pass.run(&g.device, &g.queue, &color, &depth).unwrap()
+        };
+        let (compute, fragment) = (run(PassShape::Compute), run(PassShape::Fragment));
+        let differ = compute.iter().zip(&fragment).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+        assert_eq!(differ, 0, "N = {}: {differ} samples differ", samples.offsets_mm.len());
+        let changed = compute.iter().zip(&color).filter(|(a, b)| (*a - *b).abs() > 1e-2).count();
+        assert!(changed > 1000, "SSS must blur the stripes ({changed} samples changed)");
+    }
 }

@@ -160,3 +160,60 @@ fn pass_through_and_energy(k: SssKernel, variant: Variant) {
         }
     }
 }
+
+#[test]
+fn the_sss_pass_shape_comes_from_rtbake_sss_passes() {
+    use rtbake::runtime::sss::{shape_for_adapter, PassShape, SHAPE_ENV};
+    assert_eq!(SHAPE_ENV, "RTBAKE_SSS_PASSES");
+    // Without the variable: the fragment passes on a software rasteriser, compute on a GPU. (The variable is read,
+    // never set here: tests share one process.)
+    match std::env::var(SHAPE_ENV).ok().as_deref() {
+        None => {
+            assert_eq!(shape_for_adapter(true).unwrap(), PassShape::Fragment);
+            assert_eq!(shape_for_adapter(false).unwrap(), PassShape::Compute);
+        }
+        Some(v) => match PassShape::parse(v) {
+            Ok(shape) => assert_eq!(shape_for_adapter(true).unwrap(), shape),
+            Err(_) => {
+                let e = shape_for_adapter(false).unwrap_err().to_string();
+                assert!(e.contains("RTBAKE_SSS_PASSES") && e.contains("must be compute or fragment"), "{e}");
+            }
+        },
+    }
+}
+
+/// `run sss` on the adapter with `RTBAKE_SSS_PASSES` naming no shape: exit 2 naming the variable and its values,
+/// nothing written; `compute` and `fragment` both run (the sum of Gaussians, whose two shapes differ most).
+#[test]
+fn run_sss_refuses_an_unknown_pass_shape() {
+    use rtbake::image_buf::Image;
+    let t = tempfile::tempdir().unwrap();
+    let (w, h) = (40u32, 24u32);
+    let (color, depth) = scene(w, h);
+    let enc = |img: &Image<f32>| rtbake::io::exr::encode(img, rtbake::io::exr::ExrPrecision::F32).unwrap();
+    let (cp, dp, op) = (t.path().join("c.exr"), t.path().join("d.exr"), t.path().join("o.exr"));
+    std::fs::write(&cp, enc(&Image::from_vec(w, h, 4, color))).unwrap();
+    std::fs::write(&dp, enc(&Image::from_vec(w, h, 1, depth))).unwrap();
+    let baked = baked_dir();
+    let run = |shape: &str| {
+        let _ = std::fs::remove_file(&op);
+        let mut args = vec!["run", "sss", "--method", "gaussians", "--color", cp.to_str().unwrap()];
+        args.extend(["--depth", dp.to_str().unwrap(), "--output", op.to_str().unwrap()]);
+        args.extend(["--baked-dir", baked.to_str().unwrap()]);
+        std::process::Command::new(env!("CARGO_BIN_EXE_rtbake"))
+            .args(&args)
+            .env("RTBAKE_SSS_PASSES", shape)
+            .output()
+            .unwrap()
+    };
+    let o = run("tiled");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("RTBAKE_SSS_PASSES") && err.contains("must be compute or fragment, got \"tiled\""), "{err}");
+    assert!(!op.exists(), "nothing may be written");
+    for shape in ["compute", "fragment"] {
+        let o = run(shape);
+        assert!(o.status.success(), "{shape}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(op.exists());
+    }
+}

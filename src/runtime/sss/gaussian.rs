@@ -7,11 +7,16 @@
 //!
 //! Textures: diffuse `Rgba16Float` (linear, alpha = local SSS level, 0 = not skin), depth `R32Float` (linear,
 //! loaded, never filtered), RT1/RT2/RTF `Rgba16Float`. CPU twin [`crate::runtime::sss::gaussian_cpu`].
+//!
+//! Two shapes ([`PassShape`]): the full-screen fragment passes of Listing 4.1 (below) or compute passes over
+//! workgroup-memory line tiles ([`crate::runtime::sss::gaussian_tiled`]), which also fold the blend into the
+//! vertical pass and read the input in place of the copies the fragment form starts with.
 
 use crate::diffusion::sum_of_gaussians::SumOfGaussians;
 use crate::error::{check_non_negative, check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
-use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
+use crate::runtime::sss::gaussian_tiled::TiledChain;
+use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
 /// The blurs derived from a sum-of-Gaussians fit.
@@ -95,16 +100,67 @@ struct Params {
     rt: [f32; 4],
     stretch: [f32; 4],
     blur: [f32; 4],
+    blend: [f32; 4],
 }
 
-const SHADER: &str =
-    concat!(include_str!("../fullscreen.wgsl"), include_str!("frame.wgsl"), include_str!("gaussian.wgsl"));
+impl Params {
+    /// The uniform block (`gaussian_params.wgsl`) of Gaussian `i`'s pass in direction `dir` over a `width`×`height`
+    /// frame; `write_rt1` tells the compute form's vertical pass to write RT1 (all but the last Gaussian).
+    fn new(
+        (width, height): (u32, u32),
+        (blurs, params): (&GaussianBlurs, &GaussianSssParams),
+        i: usize,
+        dir: [f32; 2],
+        write_rt1: bool,
+    ) -> Self {
+        let [r, g, b] = blurs.blend[i];
+        Params {
+            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+            stretch: [params.alpha, params.beta, params.gamma, params.lod_factor],
+            blur: [blurs.incremental_sigma_mm[i], blurs.sigma_mm[i], dir[0], dir[1]],
+            blend: [r, g, b, if write_rt1 { 1.0 } else { 0.0 }],
+        }
+    }
+
+    /// The horizontal and vertical uniform buffers of every Gaussian after the first.
+    fn buffers(
+        device: &wgpu::Device,
+        size: (u32, u32),
+        fit: (&GaussianBlurs, &GaussianSssParams),
+    ) -> Vec<[wgpu::Buffer; 2]> {
+        let n = fit.0.sigma_mm.len();
+        let buffer = |label, block: Params| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block));
+        (1..n)
+            .map(|i| {
+                let last = i + 1 == n;
+                [
+                    buffer("gsss h", Self::new(size, fit, i, [1.0, 0.0], !last)),
+                    buffer("gsss v", Self::new(size, fit, i, [0.0, 1.0], !last)),
+                ]
+            })
+            .collect()
+    }
+}
+
+const SHADER: &str = concat!(
+    include_str!("gaussian_params.wgsl"),
+    include_str!("../fullscreen.wgsl"),
+    include_str!("frame.wgsl"),
+    include_str!("gaussian.wgsl")
+);
 
 /// Screen-space sum-of-Gaussians SSS for one frame size and fit.
 pub type GaussianSss = SssPass<GaussianChain>;
 
-/// The passes of [`GaussianSss`]: per Gaussian after the first, a horizontal and a blended vertical pass.
-pub struct GaussianChain {
+/// The passes of [`GaussianSss`]: per Gaussian after the first, a horizontal and a blended vertical pass, in one of
+/// the two [`PassShape`]s.
+pub enum GaussianChain {
+    Fragment(Box<FragmentChain>),
+    Compute(Box<TiledChain>),
+}
+
+/// The fragment form of [`GaussianChain`]: render targets RT1, RT2 and RTF, the vertical pass blending into RTF.
+pub struct FragmentChain {
     width: u32,
     height: u32,
     input: wgpu::Texture,
@@ -120,6 +176,7 @@ pub struct GaussianChain {
 }
 
 impl GaussianSss {
+    /// The chain in the shape [`shape_from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
     pub fn new(
         device: &wgpu::Device,
         width: u32,
@@ -127,10 +184,60 @@ impl GaussianSss {
         blurs: &GaussianBlurs,
         params: &GaussianSssParams,
     ) -> Result<Self, RuntimeError> {
+        Self::with_shape(device, (width, height), blurs, params, shape_from_env(PassShape::Compute)?)
+    }
+
+    /// As [`Self::new`] in the given shape (the benchmarks build both; the same CPU twin).
+    pub fn with_shape(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+        blurs: &GaussianBlurs,
+        params: &GaussianSssParams,
+        shape: PassShape,
+    ) -> Result<Self, RuntimeError> {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
-        use wgpu::TextureFormat as F;
         let inputs = SssInputs::new(device, "gsss", width, height);
+        let ubos = Params::buffers(device, (width, height), (blurs, params));
+        let (output, blur) = match shape {
+            PassShape::Fragment => {
+                let chain = FragmentChain::new(device, &inputs, (width, height), ubos, blurs);
+                (chain.rtf.clone(), GaussianChain::Fragment(Box::new(chain)))
+            }
+            PassShape::Compute => {
+                let chain = TiledChain::new(device, &inputs, (width, height), ubos)?;
+                (chain.output().clone(), GaussianChain::Compute(Box::new(chain)))
+            }
+        };
+        Ok(SssPass { inputs, output, blur })
+    }
+
+    /// Number of passes [`Self::encode`] records (two per Gaussian after the first).
+    pub fn passes(&self) -> u32 {
+        2 * match &self.blur {
+            GaussianChain::Fragment(c) => c.steps.len(),
+            GaussianChain::Compute(c) => c.steps(),
+        } as u32
+    }
+
+    /// The shape the chain was built in.
+    pub fn shape(&self) -> PassShape {
+        match self.blur {
+            GaussianChain::Fragment(_) => PassShape::Fragment,
+            GaussianChain::Compute(_) => PassShape::Compute,
+        }
+    }
+}
+
+impl FragmentChain {
+    fn new(
+        device: &wgpu::Device,
+        inputs: &SssInputs,
+        (width, height): (u32, u32),
+        ubos: Vec<[wgpu::Buffer; 2]>,
+        blurs: &GaussianBlurs,
+    ) -> Self {
+        use wgpu::TextureFormat as F;
         let rt1 = gpu::texture(device, "gsss rt1", width, height, F::Rgba16Float);
         let rt2 = gpu::texture(device, "gsss rt2", width, height, F::Rgba16Float);
         let rtf = gpu::texture(device, "gsss rtf", width, height, F::Rgba16Float);
@@ -160,44 +267,31 @@ impl GaussianSss {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (iv, rt1_view, rt2_view, rtf_view) = (view(&inputs.color), view(&rt1), view(&rt2), view(&rtf));
         let (lh, lv) = (pipe_h.get_bind_group_layout(0), pipe_v.get_bind_group_layout(0));
-        let mut steps = Vec::new();
-        for i in 1..blurs.sigma_mm.len() {
-            let mk = |dir: [f32; 2]| Params {
-                rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
-                stretch: [params.alpha, params.beta, params.gamma, params.lod_factor],
-                blur: [blurs.incremental_sigma_mm[i], blurs.sigma_mm[i], dir[0], dir[1]],
-            };
-            let uh = gpu::uniform_buffer(device, "gsss h", bytemuck::bytes_of(&mk([1.0, 0.0])));
-            let uv = gpu::uniform_buffer(device, "gsss v", bytemuck::bytes_of(&mk([0.0, 1.0])));
-            let gh = inputs.blur_group(device, "gsss h", &lh, (&uh, &rt1_view), &[(3, &iv)]);
-            let gv = inputs.blur_group(device, "gsss v", &lv, (&uv, &rt2_view), &[(3, &iv)]);
-            steps.push((gh, gv, blurs.blend[i]));
-        }
+        let steps = ubos
+            .iter()
+            .zip(&blurs.blend[1..])
+            .map(|([uh, uv], w)| {
+                let gh = inputs.blur_group(device, "gsss h", &lh, (uh, &rt1_view), &[(3, &iv)]);
+                let gv = inputs.blur_group(device, "gsss v", &lv, (uv, &rt2_view), &[(3, &iv)]);
+                (gh, gv, *w)
+            })
+            .collect();
         let input = inputs.color.clone();
-        let chain = GaussianChain {
-            width,
-            height,
-            input,
-            rt1,
-            rtf: rtf.clone(),
-            rt1_view,
-            rt2_view,
-            rtf_view,
-            pipe_h,
-            pipe_v,
-            steps,
-        };
-        Ok(SssPass { inputs, output: rtf, blur: chain })
-    }
-
-    /// Number of passes [`Self::encode`] records (two per Gaussian after the first).
-    pub fn passes(&self) -> u32 {
-        2 * self.blur.steps.len() as u32
+        FragmentChain { width, height, input, rt1, rtf, rt1_view, rt2_view, rtf_view, pipe_h, pipe_v, steps }
     }
 }
 
 impl SssBlur for GaussianChain {
     /// Records the whole chain; pass k (0-based, H and V alternating) uses timer slot `first + k`.
+    fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
+        match self {
+            Self::Fragment(c) => c.encode(enc, timer),
+            Self::Compute(c) => c.encode(enc, timer),
+        }
+    }
+}
+
+impl FragmentChain {
     fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let full = wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 };
         let whole = |t| wgpu::TexelCopyTextureInfo {

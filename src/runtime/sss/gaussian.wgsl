@@ -9,19 +9,9 @@
 // exact half-pixel rule; the thesis ships 0.5). A skipped pixel is left untouched by the vertical pass (the
 // thesis uses the depth test); the horizontal pass copies it so RT2 never holds stale texels.
 //
-// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl); depth_tex, lin, depth_load (frame.wgsl).
+// Prepended by the host module: Params, P, src_tex, stretch_width and W (gaussian_params.wgsl); vs_fullscreen
+// (../fullscreen.wgsl); depth_tex, lin, depth_load (frame.wgsl).
 
-struct Params {
-    // (1/width, 1/height, width, height)
-    rt: vec4<f32>,
-    // x: α (sssLevel), y: β (correction), z: γ (maxdd), w: lod factor
-    stretch: vec4<f32>,
-    // x: std dev of the incremental blur sqrt(vᵢ − vᵢ₋₁) (mm), y: sqrt(vᵢ) (mm), zw: direction
-    blur: vec4<f32>,
-}
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var src_tex: texture_2d<f32>;
 @group(0) @binding(3) var matte_tex: texture_2d<f32>;
 
 struct VOut {
@@ -40,17 +30,13 @@ fn stretch_step(p: vec2<i32>) -> vec2<f32> {
     let d = depth_load(p);
     let a = textureLoad(matte_tex, p, 0).a;
     let dir = vec2<i32>(P.blur.zw);
-    // eq. 4.6 (depth LOD) and the matte.
-    if (a == 0.0 || d >= P.stretch.w * P.blur.y * P.stretch.x) {
+    let w = stretch_width(d, depth_derivative(p, dir), a);
+    if (w < 0.0) {
         return vec2<f32>(-1.0, 0.0);
     }
-    let s = P.stretch.x / (d + P.stretch.y * min(abs(depth_derivative(p, dir)), P.stretch.z)); // eq. 4.1/4.2
-    let s_local = s * a; // eq. 4.3/4.4
-    let final_width = s_local * P.blur.x * P.rt.xy * P.blur.zw;
+    let final_width = w * P.rt.xy * P.blur.zw;
     return final_width;
 }
-
-const W: array<f32, 7> = array<f32, 7>(0.006, 0.061, 0.242, 0.382, 0.242, 0.061, 0.006);
 
 fn blur(p: vec2<i32>, pos: vec2<f32>, final_width: vec2<f32>) -> vec4<f32> {
     var offset = pos * P.rt.xy - final_width;

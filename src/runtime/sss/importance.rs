@@ -2,7 +2,11 @@
 //! ([`crate::sss_sampling::disk`]; the sampling of Unity HDRP's diffusion profiles, Golubev 2018) on a linear HDR
 //! irradiance image (`Rgba16Float`, alpha = per-pixel strength, 0 = not skin: passes through) with a linear depth
 //! image (`R32Float`). Resources created once in [`ImportanceSss::new`]; CPU twin
-//! [`crate::runtime::sss::importance_cpu`].
+//! [`crate::runtime::sss::importance_cpu`]. A fragment pass or a compute pass ([`PassShape`]), both calling the
+//! shader's one per-pixel function through the same sampler: the same bytes. Not tiled: the samples spread over a
+//! disk out to the kernel's widest sample at the pixel's depth (TAP's SS Jittered: 13 taps out to red's wide
+//! ring; a Burley kernel: out to its 0.999 radius), in every direction, so a 2-D workgroup tile would load an apron
+//! many times its own area for each pixel's 13–1024 scattered fetches; the texture cache serves them instead. Bytes per pixel, each texel once: colour 8 and depth 4 in, 8 out.
 //!
 //! **Scale.** Depth is in world units; a world unit is `mm_per_world_unit` mm (default 125, the separable fit's
 //! scale: a head 1 unit tall). A pinhole camera with vertical field of view FOVy maps a length L (world units) at
@@ -21,7 +25,7 @@
 
 use crate::error::{check_positive, InvalidInput};
 use crate::runtime::gpu::{self, GpuTimer};
-use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
+use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 use crate::sss_sampling::ImportanceKernel;
 
@@ -114,14 +118,19 @@ const SHADER: &str =
 /// Importance-sampled SSS for one frame size and kernel.
 pub type ImportanceSss = SssPass<ImportanceBlur>;
 
-/// The one fragment pass of [`ImportanceSss`].
-pub struct ImportanceBlur {
-    pipe: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    target: wgpu::TextureView,
+/// The one pass of [`ImportanceSss`], in either [`PassShape`] (the same per-pixel function, the same bytes).
+pub enum ImportanceBlur {
+    /// A full-screen fragment pass into the output (a render target).
+    Fragment { pipe: wgpu::RenderPipeline, group: wgpu::BindGroup, target: wgpu::TextureView },
+    /// A compute pass over 8×8-pixel workgroups into the output (a storage texture).
+    Compute { pipe: wgpu::ComputePipeline, group: wgpu::BindGroup, groups: [u32; 2] },
 }
 
+/// Pixels per workgroup side of the compute shape (`cs_blur`'s `@workgroup_size(8, 8)`).
+const WORKGROUP: u32 = 8;
+
 impl ImportanceSss {
+    /// The pass in the shape [`shape_from_env`] names (compute unless `RTBAKE_SSS_PASSES=fragment`).
     pub fn new(
         device: &wgpu::Device,
         width: u32,
@@ -129,14 +138,23 @@ impl ImportanceSss {
         samples: &ImportanceSamples,
         params: &ImportanceSssParams,
     ) -> Result<Self, RuntimeError> {
+        Self::with_shape(device, (width, height), samples, params, shape_from_env(PassShape::Compute)?)
+    }
+
+    /// As [`Self::new`] in the given shape (the benchmarks build both; the same output bytes).
+    pub fn with_shape(
+        device: &wgpu::Device,
+        (width, height): (u32, u32),
+        samples: &ImportanceSamples,
+        params: &ImportanceSssParams,
+        shape: PassShape,
+    ) -> Result<Self, RuntimeError> {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
         samples.validate()?;
         use wgpu::TextureFormat as F;
         let inputs = SssInputs::new(device, "isss", width, height);
-        let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
         let module = gpu::shader(device, "importance_sss.wgsl", SHADER);
-        let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
         let mut p: Params = bytemuck::Zeroable::zeroed();
         let n = samples.offsets_mm.len();
         for i in 0..n {
@@ -152,15 +170,41 @@ impl ImportanceSss {
         ];
         let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
         let cv = inputs.color.create_view(&Default::default());
-        let group = inputs.blur_group(device, "isss", &pipe.get_bind_group_layout(0), (&ubo, &cv), &[]);
-        let target = output.create_view(&Default::default());
-        Ok(SssPass { inputs, output, blur: ImportanceBlur { pipe, group, target } })
+        let (output, blur) = match shape {
+            PassShape::Fragment => {
+                let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
+                let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
+                let group = inputs.blur_group(device, "isss", &pipe.get_bind_group_layout(0), (&ubo, &cv), &[]);
+                let target = output.create_view(&Default::default());
+                (output, ImportanceBlur::Fragment { pipe, group, target })
+            }
+            PassShape::Compute => {
+                let output = gpu::storage_texture(device, "isss output", width, height, F::Rgba16Float);
+                let pipe = gpu::compute_pipeline(device, &module, "cs_blur");
+                let ov = output.create_view(&Default::default());
+                let layout = pipe.get_bind_group_layout(0);
+                let group = inputs.blur_group(device, "isss", &layout, (&ubo, &cv), &[(3, &ov)]);
+                let groups = [width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP)];
+                (output, ImportanceBlur::Compute { pipe, group, groups })
+            }
+        };
+        Ok(SssPass { inputs, output, blur })
     }
 }
 
 impl SssBlur for ImportanceBlur {
     /// Records the pass.
     fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
-        gpu::draw_fullscreen(enc, "isss", &self.pipe, &self.group, &self.target, timer);
+        match self {
+            Self::Fragment { pipe, group, target } => gpu::draw_fullscreen(enc, "isss", pipe, group, target, timer),
+            Self::Compute { pipe, group, groups } => {
+                let timestamp_writes = timer.map(|(t, i)| t.compute_pass_writes(i));
+                let mut pass =
+                    enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("isss"), timestamp_writes });
+                pass.set_pipeline(pipe);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(groups[0], groups[1], 1);
+            }
+        }
     }
 }

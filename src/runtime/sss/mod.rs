@@ -3,18 +3,25 @@
 //! - [`separable`] (`separable.wgsl`, [`separable_cpu`]): separable SSS, Jimenez et al., CGF 2015 (thesis ch. 6);
 //!   [`separable_tiled`] (`separable_tiled.wgsl`) is the same pass as compute over workgroup-memory line tiles;
 //! - [`gaussian`] (`gaussian.wgsl`, [`gaussian_cpu`]): the screen-space sum of Gaussians, TAP 2009 (thesis ch. 4);
-//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel.
+//!   [`gaussian_tiled`] (`gaussian_tiled.wgsl`) is the same chain as compute over workgroup-memory line tiles;
+//! - [`importance`] (`importance.wgsl`, [`importance_cpu`]): one pass over an importance-sampled disk kernel
+//!   (fragment or compute, the same per-pixel function).
+//!
+//! A [`PassShape`] picks the form of each pass: compute (the default on GPUs) or the full-screen fragment passes they
+//! replace ([`SHAPE_ENV`] `RTBAKE_SSS_PASSES=fragment`, so one benchmark binary measures both).
 //!
 //! Texture-space diffusion renders whole heads and lives with the skin frame ([`super::skin::texture_space`]).
 //!
 //! Shared by the four: [`SssPass`] (the input frame, the output and upload / encode / run; each module's `new`
 //! builds its blur), the camera scale [`dist_to_window`], the blur bind group and frame checks of `SssInputs`, the
-//! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches) and `separable_params.wgsl` (the uniform block
-//! of both separable forms), and `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
+//! WGSL preludes `frame.wgsl` (depth binding, sampler, depth fetches), `separable_params.wgsl` (the uniform block
+//! of both separable forms) and `gaussian_params.wgsl` (the uniform block and stretch of both Gaussian forms), `line_tile.wgsl` (the
+//! workgroup line tile of both tiled forms), and `blur_cpu` (the frame loop and tap of the one-kernel CPU twins).
 
 mod blur_cpu;
 pub mod gaussian;
 pub mod gaussian_cpu;
+pub mod gaussian_tiled;
 pub mod importance;
 pub mod importance_cpu;
 pub mod separable;
@@ -32,6 +39,32 @@ use crate::runtime::RuntimeError;
 /// `(H/2) · dist_to_window / (z · mm_per_world_unit)`.
 pub fn dist_to_window(fovy_deg: f32) -> f32 {
     1.0 / (0.5 * fovy_deg.to_radians()).tan()
+}
+
+/// The form of a screen-space SSS pass on the GPU, the one type of the AA passes: [`PassShape::Compute`] (the
+/// separable and Gaussian blurs over workgroup-memory line tiles, the importance-sampled gather over 8×8-thread
+/// workgroups) or [`PassShape::Fragment`] (the full-screen fragment passes they replace); the same arithmetic and the
+/// same CPU twin either way. On an NVIDIA H100/H200 a fragment pass reaches only the TPCs its graphics pipeline
+/// spans, a compute pass every SM.
+pub use crate::runtime::aa::three_pass::PassShape;
+
+/// The environment variable that picks the SSS passes' [`PassShape`] (`compute` or `fragment`).
+pub const SHAPE_ENV: &str = "RTBAKE_SSS_PASSES";
+
+/// The SSS passes' shape: [`SHAPE_ENV`] when set (anything but `compute` or `fragment` is refused naming it), else
+/// `default`.
+pub fn shape_from_env(default: PassShape) -> Result<PassShape, InvalidInput> {
+    match std::env::var(SHAPE_ENV) {
+        Ok(v) => PassShape::parse(&v)
+            .map_err(|_| InvalidInput::new(SHAPE_ENV, format!("must be compute or fragment, got {v:?}"))),
+        Err(_) => Ok(default),
+    }
+}
+
+/// The shape for an adapter: [`SHAPE_ENV`] when set, else the fragment passes on a software rasteriser (where
+/// workgroup barriers are emulated and the tiles are slower; same arithmetic, same twin), compute on a GPU.
+pub fn shape_for_adapter(software: bool) -> Result<PassShape, InvalidInput> {
+    shape_from_env(if software { PassShape::Fragment } else { PassShape::Compute })
 }
 
 /// The vertical field of view every pass accepts: 1° to 179°.

@@ -12,7 +12,11 @@ use crate::runtime::sss::separable::{sealed, SeparableForm};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
 
-const SHADER: &str = concat!(include_str!("separable_params.wgsl"), include_str!("separable_tiled.wgsl"));
+const SHADER: &str = concat!(
+    include_str!("separable_params.wgsl"),
+    include_str!("line_tile.wgsl"),
+    include_str!("separable_tiled.wgsl")
+);
 /// Texels a workgroup blurs along its line (the shader's `SEGMENT`).
 const SEGMENT: u32 = 128;
 

@@ -7,24 +7,14 @@
 // Along the pass's axis a tap lands at a texel centre's row or column exactly, so its bilinear fetch is the 1-D
 // lerp of two neighbours (clamp to edge), written out in f32 for colour and depth alike.
 //
-// Prepended by the host module: Params, P and color_tex (separable_params.wgsl).
+// Prepended by the host module: Params, P and color_tex (separable_params.wgsl); depth_tex, out_tex, SEGMENT, APRON,
+// SLOTS, tile_color and line_texel (line_tile.wgsl).
 
-@group(0) @binding(2) var depth_tex: texture_2d<f32>;
-@group(0) @binding(3) var out_tex: texture_storage_2d<rgba16float, write>;
-
-const SEGMENT: i32 = 128;
-const APRON: i32 = 64;
-const SLOTS: i32 = 256; // SEGMENT + 2 · APRON
-
-var<workgroup> tile_color: array<vec4<f32>, 256>;
 var<workgroup> tile_depth: array<f32, 256>;
 
 // The texel at position `along` of line `line` of the pass's axis.
 fn texel(along: i32, line: i32) -> vec2<i32> {
-    if (P.dir.x > 0.5) {
-        return vec2<i32>(along, line);
-    }
-    return vec2<i32>(line, along);
+    return line_texel(along, line, P.dir.x > 0.5);
 }
 
 struct Fetch {
