@@ -69,6 +69,7 @@ mod runtime_mlaa;
 mod runtime_pipeline_cache;
 mod runtime_shader_includes;
 mod runtime_skin_inputs;
+mod runtime_ts_frame;
 mod runtime_smaa;
 mod runtime_sss;
 mod separable_cli;

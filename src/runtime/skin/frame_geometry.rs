@@ -39,6 +39,8 @@ pub(crate) struct DeviceGeometry {
     pub(crate) texels: wgpu::Buffer,
     pub(crate) depth: wgpu::Buffer,
     pub(crate) vec4_row: u32,
+    /// The back light's shadow map as copied from its G-buffer (texture-space diffusion's texels read it).
+    pub(crate) shadow: wgpu::Buffer,
 }
 
 #[repr(C)]
@@ -112,6 +114,7 @@ pub(crate) fn record(
     let bound: Vec<&wgpu::Buffer> = bufs.iter().collect();
     let stages = [Stage::new("main", compute_chain::groups_8x8(w, h))];
     compute_chain::record(device, enc, what, SOURCE, bytemuck::bytes_of(&params), &bound, &stages);
+    let shadow = bufs[1].clone();
     let mut it = bufs.into_iter().skip(2);
     let mut next = || it.next().expect("seven buffers");
     Ok(DeviceGeometry {
@@ -121,6 +124,7 @@ pub(crate) fn record(
         texels: next(),
         depth: next(),
         vec4_row: vec4_row / 16,
+        shadow,
     })
 }
 

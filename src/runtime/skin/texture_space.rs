@@ -35,7 +35,10 @@ use crate::runtime::gpu;
 use crate::runtime::skin::heads::{self, row_of_heads};
 use crate::runtime::skin::inputs::{RigScaleBiasMaps, SkinFrame};
 use crate::runtime::skin::lighting::{composite, lit_geometry, DemoAssets, Geometry};
+use crate::runtime::skin::mesh_inputs::RigPose;
 use crate::runtime::skin::passes::SkinPasses;
+use crate::runtime::skin::shade_frame::shades_in_one_encoder;
+use crate::runtime::skin::texture_space_frame;
 use crate::runtime::skin::settings::{SkinRenderSettings, HEAD_SPACING_M};
 pub use crate::runtime::skin::settings::{TsSettings, DEFAULT_MAP_SIZE, MAX_MAP_SIZE, MIN_MAP_SIZE};
 use crate::runtime::skin::surface_maps_cpu::{self, mapped_normal};
@@ -60,7 +63,7 @@ type KeptUvMap = ((u64, u32), Arc<UvMap>);
 const UV_MAPS_KEPT: usize = 8;
 
 /// A 64-bit hash of everything [`rasterise_uv`] reads of `mesh`.
-fn mesh_key(mesh: &Mesh) -> u64 {
+pub(crate) fn mesh_key(mesh: &Mesh) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     let bits =
         |v: &[f32], h: &mut std::collections::hash_map::DefaultHasher| v.iter().for_each(|x| x.to_bits().hash(h));
@@ -184,14 +187,17 @@ pub fn render_with<'g>(
     s.validate()?;
     ts.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
+    let one_encoder = passes.msaa == 1 && passes.wrinkles.is_none() && passes.surface_maps.is_none();
+    if let (Backend::Gpu(g), true) = (gpu, one_encoder && shades_in_one_encoder(gpu)) {
+        if g.device.limits().max_storage_buffers_per_shader_stage >= texture_space_frame::FRAME_BUFFERS {
+            let rig_pose =
+                assets.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
+            let frame_assets = frame_assets(assets, passes);
+            return texture_space_frame::render(g, mesh, mesh_key(mesh), &heads, s, ts, rig_pose, &frame_assets);
+        }
+    }
     let (geo, g, shadow) = heads::geometry(gpu, &heads, s, passes, assets, false)?;
-    // As `skin_render::render_with`: a neutral rig (scale 1, bias 0), post-scatter texturing (the maps hold
-    // irradiance; each pixel's albedo multiplies what it gathers, thesis §7.6) and the passes' bloom.
-    let mut assets = assets.clone();
-    assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
-    assets.rig_weights = vec![1.0];
-    assets.post_scatter_albedo = true;
-    assets.bloom = passes.bloom;
+    let assets = frame_assets(assets, passes);
     let lit = lit_geometry(gpu, geo, &assets)?;
     let cam = s.camera();
     let (w, h) = (s.width, s.height);
@@ -318,6 +324,18 @@ pub fn render_with<'g>(
     Ok((img, stats))
 }
 
+/// The tables of a texture-space frame, as `skin_render::render_with`'s: a neutral rig (scale 1, bias 0),
+/// post-scatter texturing (the maps hold irradiance; each pixel's albedo multiplies what it gathers, thesis §7.6) and
+/// the passes' bloom.
+fn frame_assets(assets: &DemoAssets, passes: &SkinPasses) -> DemoAssets {
+    let mut assets = assets.clone();
+    assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
+    assets.rig_weights = vec![1.0];
+    assets.post_scatter_albedo = true;
+    assets.bloom = passes.bloom;
+    assets
+}
+
 /// eq. 3.1's d_ref for a frame `height_px` tall with a vertical field of view `fov_y_deg`: the distance (m) at which
 /// one pixel covers four texels of `map` along the coarser texel direction, max(stretch_u, stretch_v), of the median
 /// texel; closer than d_ref the map keeps its full size. (Two texels per pixel changed the image at 2 m by more
@@ -375,6 +393,56 @@ impl TextureSpaceDiffusion {
         Ok(Self { blur, gather })
     }
 
+    /// Records the chained u/v blurs of the irradiance map in `chain` (premultiplied RGBA f32, `size`×`size`,
+    /// alpha 0 = not shaded) into `enc`, ping-ponging with `temp`, and adds each Gaussian's result weighted by
+    /// `weights` to `sum` (zero at the start): no submission, no read-back.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn record_blurs(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        [chain, temp, sum]: [&wgpu::Buffer; 3],
+        stretch: &wgpu::Buffer,
+        size: u32,
+        incremental_sigma_mm: &[f32],
+        weights: &[[f32; 3]],
+    ) {
+        let groups = size.div_ceil(8);
+        let layout = self.blur.get_bind_group_layout(0);
+        for (sigma, w) in incremental_sigma_mm.iter().zip(weights) {
+            for (dir, src, dst) in [(0u32, chain, temp), (1, temp, chain)] {
+                let p = BlurParams {
+                    size,
+                    dir,
+                    accumulate: dir,
+                    pad0: 0,
+                    sigma_mm: [*sigma, 0.0, 0.0, 0.0],
+                    weight: [w[0], w[1], w[2], 0.0],
+                };
+                let ubuf = gpu::uniform_buffer(device, "ts blur", bytemuck::bytes_of(&p));
+                let bind = gpu::bind_group(
+                    device,
+                    "ts blur",
+                    &layout,
+                    &[
+                        (0, ubuf.as_entire_binding()),
+                        (1, src.as_entire_binding()),
+                        (2, dst.as_entire_binding()),
+                        (3, stretch.as_entire_binding()),
+                        (4, sum.as_entire_binding()),
+                    ],
+                );
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("ts blur"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.blur);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(groups, groups, 1);
+            }
+        }
+    }
+
     /// The chained blurs of `irradiance` (premultiplied RGBA, `size`×`size`, alpha 0 = not shaded), their sum
     /// weighted by `weights`, sampled at `uvs`: (rgb, 1) per uv, zeros where no shaded texel is in reach. Same
     /// results as [`crate::runtime::skin::texture_space_cpu::blur_sum`] then [`crate::runtime::skin::texture_space_cpu::gather`].
@@ -410,41 +478,8 @@ impl TextureSpaceDiffusion {
         let b = storage("ts temp", &vec![0u8; map_bytes as usize]);
         let acc = storage("ts sum", &vec![0u8; map_bytes as usize]);
         let stretch = storage("ts stretch", bytemuck::cast_slice(stretch_mm_per_texel));
-        let groups = size.div_ceil(8);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ts") });
-        let layout = self.blur.get_bind_group_layout(0);
-        for (sigma, w) in incremental_sigma_mm.iter().zip(weights) {
-            for (dir, src, dst) in [(0u32, &a, &b), (1, &b, &a)] {
-                let p = BlurParams {
-                    size,
-                    dir,
-                    accumulate: dir,
-                    pad0: 0,
-                    sigma_mm: [*sigma, 0.0, 0.0, 0.0],
-                    weight: [w[0], w[1], w[2], 0.0],
-                };
-                let ubuf = gpu::uniform_buffer(device, "ts blur", bytemuck::bytes_of(&p));
-                let bind = gpu::bind_group(
-                    device,
-                    "ts blur",
-                    &layout,
-                    &[
-                        (0, ubuf.as_entire_binding()),
-                        (1, src.as_entire_binding()),
-                        (2, dst.as_entire_binding()),
-                        (3, stretch.as_entire_binding()),
-                        (4, acc.as_entire_binding()),
-                    ],
-                );
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("ts blur"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.blur);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups(groups, groups, 1);
-            }
-        }
+        self.record_blurs(device, &mut enc, [&a, &b, &acc], &stretch, size, incremental_sigma_mm, weights);
         let count = uvs.len() as u32;
         // A head with no visible pixel still has its maps blurred (as d'Eon's shader); its uv list is padded to one
         // entry because wgpu refuses empty bindings.
