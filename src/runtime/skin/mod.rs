@@ -31,7 +31,6 @@ pub mod surface_maps_cpu;
 pub mod tap_grid;
 pub mod texture_space;
 pub mod texture_space_cpu;
-mod texture_space_frame;
 mod view_frame;
 pub mod wrinkles;
 pub mod wrinkles_cpu;

@@ -1,5 +1,5 @@
 // Texture-space diffusion recorded into the frame's command encoder (runtime/skin/texture_space.rs
-// `render_in_one_encoder`; d'Eon et al. 2007, thesis ch. 3). Two entry points around the skin-inputs pass, the lit
+// `one_encoder::render`; d'Eon et al. 2007, thesis ch. 3). Two entry points around the skin-inputs pass, the lit
 // stage (shade_frame.wgsl) and the blurs (texture_space.wgsl) of one head:
 // - `texels`: each texel of the head's irradiance map as those passes read it: its view-space normal and the
 //   thickness the back light crosses to reach its surface point (Listing 5.1, the shadow map of the frame's
