@@ -2,7 +2,8 @@
 //! G-buffer and shadow map, the irradiance maps lit on the device from the UV map cached per mesh, the 12 chained
 //! blurs per head, the gather at each pixel's uv, the specular layer, bloom, the tone map) is recorded into one
 //! command encoder and read back once; it agrees with the CPU twin and with the per-pass GPU path, and the
-//! per-head counts of texels and pixels come back with the frame and match the per-pass path's.
+//! per-head counts of texels and pixels come back with the frame and match the per-pass path's. The procedural
+//! demo (`run demo`) shades in one submission too.
 
 use crate::support::{baked_dir, gpu};
 use rtbake::mesh::head::default_head;
@@ -99,5 +100,33 @@ fn a_texture_space_frame_submits_once_and_reads_back_only_the_final_frame() {
         let (d_one, d_none) = (distance(&one.data), distance(&none.data));
         eprintln!("{case}: per pass {sub_p} submissions / {read_p} read-backs; Σ|Δ| to the per-pass frame {d_one}, no SSS {d_none}; {one_stats:?}");
         assert!(2 * d_one < d_none, "{case}: Σ|Δ| {d_one} to the per-pass frame, the frame without SSS {d_none}");
+    }
+}
+
+/// The procedural demo's shading (skin inputs, lit layer, SSS, composite, tone map) on a device is one submission
+/// and one read-back, the per-pass path one each for the skin-inputs pass and the SSS pass; the frame agrees with
+/// the CPU twin and with the per-pass path as `run skin`'s frames do.
+#[test]
+fn the_procedural_demo_shades_in_one_submission() {
+    use rtbake::runtime::demo::{render, SssMethod};
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    for method in [SssMethod::Separable, SssMethod::Gaussians] {
+        let case = format!("demo, {method:?}");
+        render(Some(&g), 192, 108, &assets, method, None).unwrap();
+        let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
+        let one = render(Some(&g), 192, 108, &assets, method, None).unwrap();
+        let (sub, read) = (submissions_on_this_thread() - sub, read_backs_on_this_thread() - read);
+        assert_eq!((sub, read), (1, 1), "{case}: {sub} submissions, {read} read-backs");
+        set_shading_in_one_encoder(false);
+        let (sub_p, read_p) = (submissions_on_this_thread(), read_backs_on_this_thread());
+        let per_pass = render(Some(&g), 192, 108, &assets, method, None);
+        let (sub_p, read_p) = (submissions_on_this_thread() - sub_p, read_backs_on_this_thread() - read_p);
+        set_shading_in_one_encoder(true);
+        eprintln!("{case}: per pass {sub_p} submissions / {read_p} read-backs");
+        assert_eq!((sub_p, read_p), (2, 2), "{case}: per pass");
+        let cpu = render(None, 192, 108, &assets, method, None).unwrap();
+        assert_close(&one.data, &cpu.data, &format!("{case}: the CPU twin"));
+        assert_close(&one.data, &per_pass.unwrap().data, &format!("{case}: the per-pass GPU frame"));
     }
 }
