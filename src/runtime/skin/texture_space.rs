@@ -643,6 +643,23 @@ mod one_encoder {
         })
     }
 
+    /// Records the skin-inputs pass of `inputs` over the maps (Cm, H0, thickness) and normals in `maps_normals`
+    /// (padded rows, copied into its textures) and copies its albedo and transmitted light into `out` (two
+    /// Rgba16Float images, padded rows).
+    fn record_skin_inputs(
+        enc: &mut wgpu::CommandEncoder,
+        inputs: &SkinInputs,
+        [maps, normals]: [&wgpu::Buffer; 2],
+        out: &wgpu::Buffer,
+    ) {
+        gpu::encode_buffer_to_texture(enc, maps, 0, inputs.maps());
+        gpu::encode_buffer_to_texture(enc, normals, 0, inputs.normals());
+        inputs.encode(enc);
+        let image_bytes = gpu::padded_row_bytes(inputs.albedo()) as u64 * inputs.albedo().height() as u64;
+        gpu::encode_texture_to_buffer(enc, inputs.albedo(), out, 0);
+        gpu::encode_texture_to_buffer(enc, inputs.transmitted(), out, image_bytes);
+    }
+
     /// The per-frame buffers of one irradiance-map size (heads of the same size reuse them, one after the other).
     struct MapBuffers {
         inputs: SkinInputs,
@@ -738,9 +755,6 @@ mod one_encoder {
                 d.vec4_row,
             )?;
         }
-        gpu::encode_buffer_to_texture(&mut enc, &d.skin_maps, 0, inputs.maps());
-        gpu::encode_buffer_to_texture(&mut enc, &d.normals, 0, inputs.normals());
-        inputs.encode(&mut enc);
         let row16 = gpu::padded_row_bytes(inputs.albedo()) as u64;
         let bloom_buffers = match &assets.bloom {
             Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
@@ -757,8 +771,7 @@ mod one_encoder {
             Some(b) => (b.0[0].clone(), b.0[3].clone()),
             None => (storage_buffer(device, what, sizes[1], None), unused()),
         };
-        gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
-        gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row16 * h as u64);
+        record_skin_inputs(&mut enc, &inputs, [&d.skin_maps, &d.normals], &skin16);
         let key = assets.lights.key_view;
         let bloom_on = bloom_buffers.is_some() as u8 as f32;
         let shade_params = |width: u32, height: u32, row16: u64| ShadeParams {
@@ -801,8 +814,8 @@ mod one_encoder {
             let distance_m = nearest_corner_distance(cam.eye, lo_k, hi_k) * mmu / 1000.0;
             let size = if ts.depth_sized { depth_sized_map(ts.map_size, d_ref_m, distance_m) } else { ts.map_size };
             stats.heads.push(TsHeadStats { map_size: size, distance_m, ..Default::default() });
-            if !maps.contains_key(&size) {
-                maps.insert(size, MapBuffers::new(g, mesh, mesh_key, size, assets)?);
+            if let std::collections::hash_map::Entry::Vacant(e) = maps.entry(size) {
+                e.insert(MapBuffers::new(g, mesh, mesh_key, size, assets)?);
             }
             let m = &maps[&size];
             let params = FrameParams {
@@ -820,36 +833,19 @@ mod one_encoder {
             };
             let bound =
                 [&m.uv_map, &d.shadow, &m.maps, &m.normals, &m.geo, &counts, &d.uvc, &d.depth, &m.sum, &diffuse];
-            let stage = |entry, groups| [Stage { entry, groups, args: [k, 0, 0, 0] }];
             let uniform = bytemuck::bytes_of(&params);
-            compute_chain::record(
-                device,
-                &mut enc,
-                what,
-                FRAME_SOURCE,
-                uniform,
-                &bound,
-                &stage("texels", groups_8x8(size, size)),
-            );
-            gpu::encode_buffer_to_texture(&mut enc, &m.maps, 0, m.inputs.maps());
-            gpu::encode_buffer_to_texture(&mut enc, &m.normals, 0, m.inputs.normals());
-            m.inputs.encode(&mut enc);
-            gpu::encode_texture_to_buffer(&mut enc, m.inputs.albedo(), &m.skin16, 0);
-            gpu::encode_texture_to_buffer(&mut enc, m.inputs.transmitted(), &m.skin16, m.row16 * size as u64);
+            let record_stage = |enc: &mut wgpu::CommandEncoder, entry, groups| {
+                let stages = [Stage { entry, groups, args: [k, 0, 0, 0] }];
+                compute_chain::record(device, enc, what, FRAME_SOURCE, uniform, &bound, &stages);
+            };
+            record_stage(&mut enc, "texels", groups_8x8(size, size));
+            record_skin_inputs(&mut enc, &m.inputs, [&m.maps, &m.normals], &m.skin16);
             let [a, b, c, e] = &texel_unused;
             let texel_bound = [&m.skin16, &m.geo, &m.chain, a, b, c, e];
             shade(&mut enc, &shade_params(size, size, m.row16), &texel_bound, "lit", groups_8x8(size, size));
             enc.clear_buffer(&m.sum, 0, None);
             blurs.record_blurs(device, &mut enc, [&m.chain, &m.temp, &m.sum], &m.stretch, size, sigmas, &weights);
-            compute_chain::record(
-                device,
-                &mut enc,
-                what,
-                FRAME_SOURCE,
-                uniform,
-                &bound,
-                &stage("gather", groups_8x8(w, h)),
-            );
+            record_stage(&mut enc, "gather", groups_8x8(w, h));
         }
         // 3. Composite, bloom, tone map; the frame and the counts read back together.
         shade(&mut enc, &screen, &frame_bound, "composite", groups_8x8(w, h));
