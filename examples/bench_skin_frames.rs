@@ -17,8 +17,8 @@
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
 //! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
-//! the per-pass path also the G-buffer read-back the host's geometry needs). Texture-space diffusion ("ts") has no one-encoder path yet: both
-//! columns run its per-pass path. Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
+//! the per-pass path also the G-buffer read-back the host's geometry needs). Texture-space diffusion ("ts") has a one-encoder path too
+//! (its irradiance maps lit, blurred and gathered on the device; one read-back of the frame and its texel counts). Tables come from the committed bake (`baked/`, or $RTBAKE_BAKED_DIR).
 
 use rtbake::mesh::head::default_head;
 use rtbake::mesh::Mesh;

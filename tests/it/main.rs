@@ -72,6 +72,7 @@ mod runtime_shader_includes;
 mod runtime_skin_inputs;
 mod runtime_smaa;
 mod runtime_sss;
+mod runtime_ts_frame;
 mod separable_cli;
 mod separable_fit;
 mod separable_kernel;

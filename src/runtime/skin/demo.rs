@@ -9,7 +9,8 @@ use crate::runtime::backend::Backend;
 use crate::runtime::chain::Antialiasing;
 use crate::runtime::loader;
 use crate::runtime::skin::inputs::SkinFrame;
-use crate::runtime::skin::lighting::{lit_geometry, shade, DemoAssets, Geometry, Lit, SssMethod};
+use crate::runtime::skin::lighting::{lit_geometry, DemoAssets, Geometry, Lit, SssMethod};
+use crate::runtime::skin::shade_frame::render_geometry;
 use crate::runtime::RuntimeError;
 
 /// Spheres as (centre x, centre y in units of the frame height, radius, depth of the centre).
@@ -96,7 +97,10 @@ pub fn sss_inputs<'g>(
     Ok(SssInputs { width: w, height: h, irradiance_rgba: diffuse, depth: geo.depth })
 }
 
-/// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased.
+/// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased. On a device the shading
+/// (skin inputs, lit layer, SSS, composite, tone map) is recorded into one command encoder and read back once
+/// ([`crate::runtime::skin::shade_frame`], or each pass on its own with its `set_shading_in_one_encoder` off); the
+/// antialiasing runs on that frame after it, with its own submissions.
 pub fn render<'g>(
     gpu: impl Into<Backend<'g>>,
     w: u32,
@@ -106,8 +110,14 @@ pub fn render<'g>(
     aa: Option<&Antialiasing>,
 ) -> Result<Image<u8>, RuntimeError> {
     let gpu: Backend = gpu.into();
-    let lit = lit(gpu, w, h, assets)?;
-    shade(gpu, lit, assets, Some(method), crate::runtime::aa::scene::render_shapes(w, h, 1), aa)
+    crate::error::check_size("width/height", w as u64, h as u64)?;
+    let geo = geometry(w, h, assets.baked_rig.as_ref());
+    let background = crate::runtime::aa::scene::render_shapes(w, h, 1);
+    let frame = render_geometry(gpu, geo, assets, Some(method), background)?;
+    match aa {
+        Some(aa) => crate::runtime::chain::antialias(gpu, &frame, aa),
+        None => Ok(frame),
+    }
 }
 
 /// Bytes per pixel of the demo frame's largest GPU image: the skin-inputs pass reads back albedo and T(s)·E as

@@ -36,7 +36,7 @@
 //! reference and the per-pass path
 //! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off), which submits and reads back each pass on its
 //! own, for A/B comparison. Texture-space diffusion
-//! ([`crate::runtime::skin::texture_space`]) runs its passes one submission each.
+//! ([`crate::runtime::skin::texture_space`]) is one submission and one read-back under the same conditions.
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;

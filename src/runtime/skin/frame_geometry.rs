@@ -63,6 +63,8 @@ pub(crate) struct DeviceGeometry {
     pub(crate) texels: wgpu::Buffer,
     pub(crate) depth: wgpu::Buffer,
     pub(crate) vec4_row: u32,
+    /// The back light's shadow map as copied from its G-buffer (texture-space diffusion's texels read it).
+    pub(crate) shadow: wgpu::Buffer,
 }
 
 #[repr(C)]
@@ -170,6 +172,7 @@ pub(crate) fn record(
         }
     }
     compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("main", groups)]);
+    let shadow = bufs[1].clone();
     let mut it = bufs.into_iter().skip(2);
     let mut next = || it.next().expect("eight buffers");
     Ok(DeviceGeometry {
@@ -179,6 +182,7 @@ pub(crate) fn record(
         texels: next(),
         depth: next(),
         vec4_row: vec4_row / 16,
+        shadow,
     })
 }
 
