@@ -18,12 +18,16 @@
 //!   strength 0.4.
 //! - **Matte / stencil masking**: pixels whose mask byte is below 128 leave the pass exactly as they came in; the
 //!   passes run everywhere, so pixels inside the matte still blend with their neighbours outside it (a fourth,
-//!   untimed full-screen pass selects per pixel).
+//!   untimed pass selects per pixel).
+//!
+//! Every detector and the mask exist as fragment passes and as compute passes (the two `PassShape`s of
+//! [`crate::runtime::aa::three_pass`]), both calling the same per-pixel WGSL functions: the same bytes.
 //!
 //! The luma detector without predication stays the passes' own (`fs_edges` of `smaa.wgsl` / `mlaa.wgsl`), so
 //! default runs are unchanged.
 
 use crate::error::{check_range, InvalidInput};
+use crate::runtime::aa::three_pass::{dispatch, frame_texture, grid, PassShape, ShapedPass};
 use crate::runtime::gpu;
 
 /// SMAA's luma / colour threshold (SMAA.hlsl `SMAA_THRESHOLD`, preset HIGH; MLAA's listings use the same 0.1).
@@ -185,29 +189,43 @@ struct Params {
     pred: [f32; 4],
 }
 
-const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("srgb.wgsl"), include_str!("edges.wgsl"));
+const SHADER: &str = concat!(
+    include_str!("../fullscreen.wgsl"),
+    include_str!("srgb.wgsl"),
+    include_str!("edges.wgsl"),
+    include_str!("edge_rows.wgsl")
+);
 
-/// The GPU side of this module for one pass: the depth and mask textures, the edge pipeline replacing the pass's
-/// luma detector (unless plain luma) and the mask composite (when masked).
+/// Where [`EdgeStage::encode_edges`] writes: the fragment shape's edges target (with the timer slot of the edges
+/// pass) or the compute shape's edge rows (with the beginning timestamp of the edges slot).
+pub(crate) enum EdgeOut<'a> {
+    Render(&'a wgpu::TextureView, Option<(&'a gpu::GpuTimer, u32)>),
+    Rows(Option<wgpu::ComputePassTimestampWrites<'a>>),
+}
+
+/// The GPU side of this module for one pass: the depth and mask textures, the edge pass replacing the pass's
+/// luma detector (unless plain luma) and the mask composite (when masked), as fragment or compute passes (the
+/// frame's [`PassShape`]; same bytes).
 pub(crate) struct EdgeStage {
     settings: EdgeSettings,
     size: (u32, u32),
     depth: Option<wgpu::Texture>,
     mask: Option<wgpu::Texture>,
-    edges: Option<(wgpu::RenderPipeline, wgpu::BindGroup)>,
-    composite: Option<(wgpu::RenderPipeline, wgpu::BindGroup, wgpu::Texture, wgpu::TextureView)>,
+    edges: Option<ShapedPass>,
+    composite: Option<(ShapedPass, wgpu::Texture, wgpu::TextureView)>,
 }
 
 impl EdgeStage {
     /// `color` is the pass's input view, `aa_output` its blended output; `lca` the local contrast adaptation
-    /// factor (0: none, MLAA).
+    /// factor (0: none, MLAA). `edge_rows`: the compute shape's edge buffer (`edge_rows.wgsl`), which the compute
+    /// edge pass writes and [`ThreePass`](super::three_pass::ThreePass) copies into the edges texture; `None`
+    /// for the fragment shape, whose edge pass renders into the edges texture.
     pub(crate) fn new(
         device: &wgpu::Device,
         (width, height): (u32, u32),
         (color, aa_output): (&wgpu::TextureView, &wgpu::TextureView),
-        settings: &EdgeSettings,
-        lca: f32,
-        masked: bool,
+        (settings, lca, masked): (&EdgeSettings, f32, bool),
+        edge_rows: Option<&wgpu::Buffer>,
     ) -> Result<Self, InvalidInput> {
         settings.validate()?;
         use wgpu::TextureFormat as F;
@@ -224,15 +242,15 @@ impl EdgeStage {
         let module = needs_module.then(|| gpu::shader(device, "smaa_edges.wgsl", SHADER));
         let ubo = gpu::uniform_buffer(device, "aa edge params", bytemuck::bytes_of(&params));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let prefix = if edge_rows.is_some() { "cs" } else { "fs" };
         use wgpu::BindingResource as R;
         let edges = match (&module, settings.is_plain_luma()) {
             (Some(module), false) => {
                 let entry = match (settings.detector, settings.predication.is_some()) {
-                    (EdgeDetector::Depth, _) => "fs_edges_depth",
-                    (_, true) => "fs_edges_color_predicated",
-                    (_, false) => "fs_edges_color",
+                    (EdgeDetector::Depth, _) => "edges_depth",
+                    (_, true) => "edges_color_predicated",
+                    (_, false) => "edges_color",
                 };
-                let pipe = gpu::fullscreen_pipeline(device, entry, module, entry, F::Rg8Unorm);
                 let dv = depth.as_ref().map(view);
                 let mut entries = vec![(0, ubo.as_entire_binding())];
                 if settings.detector != EdgeDetector::Depth {
@@ -241,24 +259,25 @@ impl EdgeStage {
                 if let Some(dv) = &dv {
                     entries.push((2, R::TextureView(dv)));
                 }
-                let bg = gpu::bind_group(device, entry, &pipe.get_bind_group_layout(0), &entries);
-                Some((pipe, bg))
+                if let Some(rows) = edge_rows {
+                    entries.push((8, rows.as_entire_binding()));
+                }
+                Some(ShapedPass::new(device, module, &format!("{prefix}_{entry}"), F::Rg8Unorm, &entries))
             }
             _ => None,
         };
         let composite = match (&module, &mask) {
             (Some(module), Some(mask)) => {
-                let out = gpu::texture(device, "aa masked output", width, height, F::Rgba8Unorm);
-                let pipe = gpu::fullscreen_pipeline(device, "aa mask", module, "fs_mask", F::Rgba8Unorm);
-                let mv = view(mask);
-                let bg = gpu::bind_group(
-                    device,
-                    "aa mask",
-                    &pipe.get_bind_group_layout(0),
-                    &[(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))],
-                );
-                let ov = view(&out);
-                Some((pipe, bg, out, ov))
+                let shape = if edge_rows.is_some() { PassShape::Compute } else { PassShape::Fragment };
+                let out = frame_texture(device, "aa masked output", (width, height), shape);
+                let (mv, ov) = (view(mask), view(&out));
+                let mut entries =
+                    vec![(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))];
+                if edge_rows.is_some() {
+                    entries.extend([(0, ubo.as_entire_binding()), (5, R::TextureView(&ov))]);
+                }
+                let pass = ShapedPass::new(device, module, &format!("{prefix}_mask"), F::Rgba8Unorm, &entries);
+                Some((pass, out, ov))
             }
             _ => None,
         };
@@ -278,32 +297,39 @@ impl EdgeStage {
         Ok(())
     }
 
-    /// Records the edge pass into `target` and returns true, or returns false when the pass's own luma detector
-    /// is to run.
-    pub(crate) fn encode_edges(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        slot: Option<(&gpu::GpuTimer, u32)>,
-    ) -> bool {
-        match &self.edges {
-            Some((pipe, bg)) => {
-                gpu::draw_fullscreen(enc, "aa edges", pipe, bg, target, slot);
-                true
+    /// Records the edge pass into `out` and returns true, or returns false when the pass's own luma detector is to
+    /// run. The compute shape writes the edge rows (two pixels per thread); its caller copies them into the edges
+    /// texture.
+    pub(crate) fn encode_edges(&self, enc: &mut wgpu::CommandEncoder, out: EdgeOut<'_>) -> bool {
+        let (w, h) = self.size;
+        match (&self.edges, out) {
+            (Some(ShapedPass::Draw(pipe, bg)), EdgeOut::Render(target, slot)) => {
+                gpu::draw_fullscreen(enc, "aa edges", pipe, bg, target, slot)
             }
-            None => false,
+            (Some(ShapedPass::Dispatch(pipe, bg)), EdgeOut::Rows(writes)) => {
+                dispatch(enc, "aa edges", pipe, bg, grid(w.div_ceil(2), h), writes)
+            }
+            (None, _) => return false,
+            _ => unreachable!("the edge stage is built in the frame's shape"),
         }
+        true
     }
 
     /// Records the mask composite (nothing when unmasked).
     pub(crate) fn encode_mask(&self, enc: &mut wgpu::CommandEncoder) {
-        if let Some((pipe, bg, _, view)) = &self.composite {
-            gpu::draw_fullscreen(enc, "aa mask", pipe, bg, view, None);
+        if let Some((pass, _, view)) = &self.composite {
+            pass.encode(enc, "aa mask", view, self.size, None);
         }
+    }
+
+    /// Render passes this stage records (the edge detector and the mask in the fragment shape).
+    pub(crate) fn render_passes(&self) -> u32 {
+        let mask = self.composite.as_ref().map(|c| &c.0);
+        self.edges.iter().chain(mask).map(ShapedPass::render_passes).sum()
     }
 
     /// The masked output, when masked.
     pub(crate) fn masked_output(&self) -> Option<&wgpu::Texture> {
-        self.composite.as_ref().map(|c| &c.2)
+        self.composite.as_ref().map(|c| &c.1)
     }
 }
