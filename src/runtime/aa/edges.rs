@@ -203,6 +203,15 @@ pub(crate) enum EdgeOut<'a> {
     Rows(Option<wgpu::ComputePassTimestampWrites<'a>>),
 }
 
+/// What the compute shape's edge pass writes (`edge_rows.wgsl`): the edge rows
+/// [`ThreePass`](super::three_pass::ThreePass) copies into the edges texture, the list of edge pixels the weights
+/// pass runs on (count first) and the weights texture it zeroes.
+pub(crate) struct EdgeOutputs<'a> {
+    pub rows: &'a wgpu::Buffer,
+    pub list: &'a wgpu::Buffer,
+    pub weights: &'a wgpu::TextureView,
+}
+
 /// The GPU side of this module for one pass: the depth and mask textures, the edge pass replacing the pass's
 /// luma detector (unless plain luma) and the mask composite (when masked), as fragment or compute passes (the
 /// frame's [`PassShape`]; same bytes).
@@ -217,15 +226,14 @@ pub(crate) struct EdgeStage {
 
 impl EdgeStage {
     /// `color` is the pass's input view, `aa_output` its blended output; `lca` the local contrast adaptation
-    /// factor (0: none, MLAA). `edge_rows`: the compute shape's edge buffer (`edge_rows.wgsl`), which the compute
-    /// edge pass writes and [`ThreePass`](super::three_pass::ThreePass) copies into the edges texture; `None`
-    /// for the fragment shape, whose edge pass renders into the edges texture.
+    /// factor (0: none, MLAA). `compute`: what the compute shape's edge pass writes; `None` for the fragment
+    /// shape, whose edge pass renders into the edges texture.
     pub(crate) fn new(
         device: &wgpu::Device,
         (width, height): (u32, u32),
         (color, aa_output): (&wgpu::TextureView, &wgpu::TextureView),
         (settings, lca, masked): (&EdgeSettings, f32, bool),
-        edge_rows: Option<&wgpu::Buffer>,
+        compute: Option<EdgeOutputs<'_>>,
     ) -> Result<Self, InvalidInput> {
         settings.validate()?;
         use wgpu::TextureFormat as F;
@@ -242,7 +250,7 @@ impl EdgeStage {
         let module = needs_module.then(|| gpu::shader(device, "smaa_edges.wgsl", SHADER));
         let ubo = gpu::uniform_buffer(device, "aa edge params", bytemuck::bytes_of(&params));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let prefix = if edge_rows.is_some() { "cs" } else { "fs" };
+        let prefix = if compute.is_some() { "cs" } else { "fs" };
         use wgpu::BindingResource as R;
         let edges = match (&module, settings.is_plain_luma()) {
             (Some(module), false) => {
@@ -259,8 +267,9 @@ impl EdgeStage {
                 if let Some(dv) = &dv {
                     entries.push((2, R::TextureView(dv)));
                 }
-                if let Some(rows) = edge_rows {
-                    entries.push((8, rows.as_entire_binding()));
+                if let Some(out) = &compute {
+                    let rows = (8, out.rows.as_entire_binding());
+                    entries.extend([rows, (9, R::TextureView(out.weights)), (11, out.list.as_entire_binding())]);
                 }
                 Some(ShapedPass::new(device, module, &format!("{prefix}_{entry}"), F::Rg8Unorm, &entries))
             }
@@ -268,12 +277,12 @@ impl EdgeStage {
         };
         let composite = match (&module, &mask) {
             (Some(module), Some(mask)) => {
-                let shape = if edge_rows.is_some() { PassShape::Compute } else { PassShape::Fragment };
+                let shape = if compute.is_some() { PassShape::Compute } else { PassShape::Fragment };
                 let out = frame_texture(device, "aa masked output", (width, height), shape);
                 let (mv, ov) = (view(mask), view(&out));
                 let mut entries =
                     vec![(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))];
-                if edge_rows.is_some() {
+                if compute.is_some() {
                     entries.extend([(0, ubo.as_entire_binding()), (5, R::TextureView(&ov))]);
                 }
                 let pass = ShapedPass::new(device, module, &format!("{prefix}_mask"), F::Rgba8Unorm, &entries);

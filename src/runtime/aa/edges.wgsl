@@ -9,7 +9,8 @@
 //
 // Each detector is a per-pixel function (`*_px`) called by a fragment entry point (`fs_*`, the fragment shape of
 // three_pass.rs) and a compute one (`cs_*`, its compute shape: two pixels per thread into the edge rows of
-// edge_rows.wgsl, the mask over 8×8 workgroups into a storage texture), so both shapes write the same bytes.
+// edge_rows.wgsl, which also zeroes the weights and lists the edge pixels; the mask over 8×8 workgroups into a
+// storage texture), so both shapes write the same bytes.
 //
 // Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl); appended: edge_rows.wgsl.
 
@@ -124,27 +125,21 @@ fn fs_mask(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
 }
 
 @compute @workgroup_size(8, 8)
-fn cs_edges_color(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (edge_pair_in_frame(id.xy)) {
-        let p = edge_pair_origin(id.xy);
-        store_edge_pair(id.xy, color_edges_px(p), color_edges_px(p + vec2<i32>(1, 0)));
-    }
+fn cs_edges_color(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, color_edges_px(p), color_edges_px(p + vec2<i32>(1, 0)));
 }
 
 @compute @workgroup_size(8, 8)
-fn cs_edges_color_predicated(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (edge_pair_in_frame(id.xy)) {
-        let p = edge_pair_origin(id.xy);
-        store_edge_pair(id.xy, color_edges_predicated_px(p), color_edges_predicated_px(p + vec2<i32>(1, 0)));
-    }
+fn cs_edges_color_predicated(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, color_edges_predicated_px(p), color_edges_predicated_px(p + vec2<i32>(1, 0)));
 }
 
 @compute @workgroup_size(8, 8)
-fn cs_edges_depth(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (edge_pair_in_frame(id.xy)) {
-        let p = edge_pair_origin(id.xy);
-        store_edge_pair(id.xy, depth_edges_px(p), depth_edges_px(p + vec2<i32>(1, 0)));
-    }
+fn cs_edges_depth(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, depth_edges_px(p), depth_edges_px(p + vec2<i32>(1, 0)));
 }
 
 @compute @workgroup_size(8, 8)

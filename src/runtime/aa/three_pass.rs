@@ -12,7 +12,7 @@
 //! selects the fragment shape for the default constructors, so one benchmark binary measures both.
 
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{AaInputs, EdgeOut, EdgeSettings, EdgeStage};
+use crate::runtime::aa::edges::{AaInputs, EdgeOut, EdgeOutputs, EdgeSettings, EdgeStage};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
 
@@ -81,8 +81,8 @@ pub(crate) enum Passes {
     /// edges texture; another detector's compute pass writes it too), the edge list (count first) and the weights
     /// pass's indirect arguments.
     Compute {
-        pipes: [wgpu::ComputePipeline; 5],
-        groups: [wgpu::BindGroup; 5],
+        pipes: [wgpu::ComputePipeline; 4],
+        groups: [wgpu::BindGroup; 4],
         edge_rows: wgpu::Buffer,
         edge_list: wgpu::Buffer,
         weights_args: wgpu::Buffer,
@@ -272,10 +272,15 @@ impl ThreePass {
             let desc = wgpu::BufferDescriptor { label: Some(&label(what)), size, usage, mapped_at_creation: false };
             device.create_buffer(&desc)
         };
-        let edge_rows =
-            (shape == PassShape::Compute).then(|| buffer("edge rows", rows_bytes, wgpu::BufferUsages::COPY_SRC));
-        let extra = EdgeStage::new(device, size, (&cv, &ov), (edge_settings, lca, masked), edge_rows.as_ref())?;
-        let passes = match edge_rows {
+        use wgpu::BufferUsages as B;
+        // The compute shape's edge rows, edge list and indirect arguments of the weights pass.
+        let buffers = (shape == PassShape::Compute).then(|| {
+            let rows = buffer("edge rows", rows_bytes, B::COPY_SRC);
+            (rows, buffer("edge list", list_bytes, B::COPY_DST), buffer("weights dispatch", 12, B::INDIRECT))
+        });
+        let outputs = buffers.as_ref().map(|(rows, list, _)| EdgeOutputs { rows, list, weights: &wv });
+        let extra = EdgeStage::new(device, size, (&cv, &ov), (edge_settings, lca, masked), outputs)?;
+        let passes = match buffers {
             None => {
                 let pipes =
                     [("edges", "fs_edges", true), ("weights", "fs_weights", false), ("blend", "fs_blend", false)].map(
@@ -289,23 +294,20 @@ impl ThreePass {
                 let groups = [0, 1, 2].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
                 Passes::Fragment { pipes, groups, views: [ev.clone(), wv.clone(), ov.clone()] }
             }
-            Some(edge_rows) => {
-                use wgpu::BufferUsages as B;
-                let edge_list = buffer("edge list", list_bytes, B::COPY_DST);
-                let weights_args = buffer("weights dispatch", 12, B::INDIRECT);
+            Some((edge_rows, edge_list, weights_args)) => {
                 let [edges_entries, mut weights_entries, blend_entries] = entries;
                 let list = || (11, edge_list.as_entire_binding());
-                weights_entries.extend([(9, R::TextureView(&wv)), list()]);
+                let weights_out = || (9, R::TextureView(&wv));
+                weights_entries.extend([weights_out(), list()]);
                 let entries = [
-                    [edges_entries, vec![(8, edge_rows.as_entire_binding())]].concat(),
-                    vec![ubo(), (2, R::TextureView(&ev)), (9, R::TextureView(&wv)), list()],
+                    [edges_entries, vec![(8, edge_rows.as_entire_binding()), weights_out(), list()]].concat(),
                     vec![list(), (12, weights_args.as_entire_binding())],
                     weights_entries,
                     [blend_entries, vec![(10, R::TextureView(&ov))]].concat(),
                 ];
-                let stages = ["cs_edges", "cs_edge_list", "cs_edge_args", "cs_weights_list", "cs_blend"];
+                let stages = ["cs_edges", "cs_edge_args", "cs_weights_list", "cs_blend"];
                 let pipes = stages.map(|e| gpu::compute_pipeline(device, spec.module, e));
-                let groups = [0, 1, 2, 3, 4].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
+                let groups = [0, 1, 2, 3].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
                 Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args }
             }
         };
@@ -381,16 +383,15 @@ impl ThreePass {
                         timestamp_writes: Some(writes),
                     }));
                 }
-                run(enc, 1, grid(w, h), half(1, true));
-                run(enc, 2, (1, 1), None);
+                run(enc, 1, (1, 1), half(1, true));
                 {
                     let desc = wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: half(1, false) };
                     let mut pass = enc.begin_compute_pass(&desc);
-                    pass.set_pipeline(&pipes[3]);
-                    pass.set_bind_group(0, &groups[3], &[]);
+                    pass.set_pipeline(&pipes[2]);
+                    pass.set_bind_group(0, &groups[2], &[]);
                     pass.dispatch_workgroups_indirect(weights_args, 0);
                 }
-                run(enc, 4, grid(w, h), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
+                run(enc, 3, grid(w, h), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
             }
         }
         self.extra.encode_mask(enc);

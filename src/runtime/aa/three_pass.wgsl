@@ -7,64 +7,25 @@
 // Why compute: on GPUs whose graphics pipeline reaches only part of the chip (NVIDIA H100/H200: two TPCs of the
 // whole GPU run pixel shaders), a full-screen fragment pass runs on a few SMs, a compute pass on all of them.
 //
-// Edges: two pixels per thread into the edge rows of edge_rows.wgsl (prepended with this file).
+// Edges: two pixels per thread into the edge rows of edge_rows.wgsl (prepended with this file), which also zeroes
+// the weights and lists the edge pixels for the weights pass.
 
-@group(0) @binding(9) var weights_out: texture_storage_2d<rgba8unorm, write>;
 @group(0) @binding(10) var color_out: texture_storage_2d<rgba8unorm, write>;
 
 @compute @workgroup_size(8, 8)
-fn cs_edges(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (edge_pair_in_frame(id.xy)) {
-        let p = edge_pair_origin(id.xy);
-        store_edge_pair(id.xy, edges_px(p), edges_px(p + vec2<i32>(1, 0)));
-    }
+fn cs_edges(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, edges_px(p), edges_px(p + vec2<i32>(1, 0)));
 }
 
-// Weights on edge pixels only (the compute form of the stencil SMAA's weights pass runs under, thesis §9.3): a list
-// pass writes zero weights everywhere and appends each edge pixel to `edge_list` (one global atomic per workgroup),
-// one thread turns the count into the indirect dispatch, and `cs_weights_list` runs `weights_px` on the listed pixels,
-// packed 64 to a workgroup. Pixels without an edge have zero weights in both shapes (`weights_px` returns 0 there).
-struct EdgeList {
-    count: atomic<u32>,
-    // x | y << 16 of each edge pixel, in no particular order (each pixel writes only its own weights).
-    pixels: array<u32>,
-}
-
-@group(0) @binding(11) var<storage, read_write> edge_list: EdgeList;
+// Weights on the edge pixels the edges pass listed (edge_rows.wgsl): one thread turns the count into the indirect
+// dispatch, and `cs_weights_list` runs `weights_px` on the listed pixels, packed 64 to a workgroup, so no lane waits
+// on a pixel without an edge.
 @group(0) @binding(12) var<storage, read_write> weights_args: array<u32, 3>;
 
 // Threads per workgroup of `cs_weights_list`, and the most workgroups one dispatch dimension takes.
 const LIST_GROUP: u32 = 64u;
 const MAX_GROUPS_X: u32 = 65535u;
-
-var<workgroup> group_count: atomic<u32>;
-var<workgroup> group_base: u32;
-
-@compute @workgroup_size(8, 8)
-fn cs_edge_list(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    var is_edge = false;
-    if (all(id.xy < vec2<u32>(P.rt.zw))) {
-        let e = textureLoad(edges_tex, vec2<i32>(id.xy), 0).rg;
-        is_edge = e.x > 0.0 || e.y > 0.0;
-        textureStore(weights_out, id.xy, vec4<f32>(0.0));
-    }
-    if (li == 0u) {
-        atomicStore(&group_count, 0u);
-    }
-    workgroupBarrier();
-    var slot = 0u;
-    if (is_edge) {
-        slot = atomicAdd(&group_count, 1u);
-    }
-    workgroupBarrier();
-    if (li == 0u) {
-        group_base = atomicAdd(&edge_list.count, atomicLoad(&group_count));
-    }
-    workgroupBarrier();
-    if (is_edge) {
-        edge_list.pixels[group_base + slot] = id.x | (id.y << 16u);
-    }
-}
 
 @compute @workgroup_size(1)
 fn cs_edge_args() {
