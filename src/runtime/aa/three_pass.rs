@@ -4,8 +4,9 @@
 //! module, uniform buffer and look-up tables (`PassSpec`); `ThreePass::build` makes the rest.
 //!
 //! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
-//! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
-//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace.
+//! 8×8-thread workgroups, which also zero the weights and list the edge pixels (`edge_rows.wgsl`), then the weights on
+//! the listed pixels only, dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment
+//! passes they replace. The other edge detectors and the mask (`EdgeStage`) take the same shape.
 //! Both call the same per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes
 //! (tested); the compute shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline
 //! spans (on an NVIDIA H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment`
@@ -77,7 +78,7 @@ pub(crate) struct PassSpec<'a> {
 pub(crate) enum Passes {
     /// Render targets: the edges, weights and output views.
     Fragment { pipes: [wgpu::RenderPipeline; 3], groups: [wgpu::BindGroup; 3], views: [wgpu::TextureView; 3] },
-    /// Edges, edge list, dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
+    /// Edges (which list the edge pixels), dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
     /// edges texture; another detector's compute pass writes it too), the edge list (count first) and the weights
     /// pass's indirect arguments.
     Compute {
@@ -333,8 +334,8 @@ impl ThreePass {
     }
 
     /// Records the three passes; `timer` slots `first..first+3` receive their timestamps (in the compute shape the
-    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the edge
-    /// list, the dispatch arguments and the weights).
+    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the
+    /// dispatch arguments and the weights).
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
         match &self.passes {
