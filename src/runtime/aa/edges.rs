@@ -17,17 +17,17 @@
 //!   `T' = scale · T · (1 − strength · [|D − D_n| ≥ T_pred])`; SMAA's defaults: `T_pred` 0.01, scale 2.0,
 //!   strength 0.4.
 //! - **Matte / stencil masking**: pixels whose mask byte is below 128 leave the pass exactly as they came in; the
-//!   passes run everywhere, so pixels inside the matte still blend with their neighbours outside it (a fourth,
-//!   untimed pass selects per pixel).
+//!   passes run everywhere, so pixels inside the matte still blend with their neighbours outside it (the fragment
+//!   shape selects per pixel in a fourth, untimed pass; the compute shape in its blending pass).
 //!
-//! Every detector and the mask exist as fragment passes and as compute passes (the two `PassShape`s of
+//! Every detector exists as a fragment pass and as a compute pass (the two `PassShape`s of
 //! [`crate::runtime::aa::three_pass`]), both calling the same per-pixel WGSL functions: the same bytes.
 //!
 //! The luma detector without predication stays the passes' own (`fs_edges` of `smaa.wgsl` / `mlaa.wgsl`), so
 //! default runs are unchanged.
 
 use crate::error::{check_range, InvalidInput};
-use crate::runtime::aa::three_pass::{dispatch, frame_texture, grid, PassShape, ShapedPass};
+use crate::runtime::aa::three_pass::{dispatch, grid, ShapedPass};
 use crate::runtime::gpu;
 
 /// SMAA's luma / colour threshold (SMAA.hlsl `SMAA_THRESHOLD`, preset HIGH; MLAA's listings use the same 0.1).
@@ -213,8 +213,8 @@ pub(crate) struct EdgeOutputs<'a> {
 }
 
 /// The GPU side of this module for one pass: the depth and mask textures, the edge pass replacing the pass's
-/// luma detector (unless plain luma) and the mask composite (when masked), as fragment or compute passes (the
-/// frame's [`PassShape`]; same bytes).
+/// luma detector (unless plain luma) and, in the fragment shape, the mask composite (when masked); the edge pass as a
+/// fragment or compute pass (the frame's [`PassShape`](super::three_pass::PassShape); same bytes).
 pub(crate) struct EdgeStage {
     settings: EdgeSettings,
     size: (u32, u32),
@@ -275,17 +275,13 @@ impl EdgeStage {
             }
             _ => None,
         };
-        let composite = match (&module, &mask) {
-            (Some(module), Some(mask)) => {
-                let shape = if compute.is_some() { PassShape::Compute } else { PassShape::Fragment };
-                let out = frame_texture(device, "aa masked output", (width, height), shape);
+        // The compute shape blends and masks in one pass (`cs_blend_masked` of three_pass.wgsl, [`Self::mask`]).
+        let composite = match (&module, &mask, &compute) {
+            (Some(module), Some(mask), None) => {
+                let out = gpu::texture(device, "aa masked output", width, height, F::Rgba8Unorm);
                 let (mv, ov) = (view(mask), view(&out));
-                let mut entries =
-                    vec![(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))];
-                if compute.is_some() {
-                    entries.extend([(0, ubo.as_entire_binding()), (5, R::TextureView(&ov))]);
-                }
-                let pass = ShapedPass::new(device, module, &format!("{prefix}_mask"), F::Rgba8Unorm, &entries);
+                let entries = [(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))];
+                let pass = ShapedPass::new(device, module, "fs_mask", F::Rgba8Unorm, &entries);
                 Some((pass, out, ov))
             }
             _ => None,
@@ -337,7 +333,12 @@ impl EdgeStage {
         self.edges.iter().chain(mask).map(ShapedPass::render_passes).sum()
     }
 
-    /// The masked output, when masked.
+    /// The mask texture, when masked (the compute shape's blending pass reads it).
+    pub(crate) fn mask(&self) -> Option<&wgpu::Texture> {
+        self.mask.as_ref()
+    }
+
+    /// The fragment shape's masked output, when masked (the compute shape masks in its blending pass).
     pub(crate) fn masked_output(&self) -> Option<&wgpu::Texture> {
         self.composite.as_ref().map(|c| &c.1)
     }

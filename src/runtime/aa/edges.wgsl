@@ -9,8 +9,9 @@
 //
 // Each detector is a per-pixel function (`*_px`) called by a fragment entry point (`fs_*`, the fragment shape of
 // three_pass.rs) and a compute one (`cs_*`, its compute shape: two pixels per thread into the edge rows of
-// edge_rows.wgsl, which also zeroes the weights and lists the edge pixels; the mask over 8×8 workgroups into a
-// storage texture), so both shapes write the same bytes.
+// edge_rows.wgsl, which also zeroes the weights and lists the edge pixels), so both shapes write the same bytes.
+// The compute shape masks in its blending pass (`cs_blend_masked` of three_pass.wgsl, the same selection as
+// `mask_px`).
 //
 // Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl); appended: edge_rows.wgsl.
 
@@ -28,7 +29,6 @@ struct Params {
 @group(0) @binding(2) var depth_tex: texture_2d<f32>;
 @group(0) @binding(3) var aa_tex: texture_2d<f32>;
 @group(0) @binding(4) var mask_tex: texture_2d<f32>;
-@group(0) @binding(5) var mask_out: texture_storage_2d<rgba8unorm, write>;
 
 fn clamp_px(p: vec2<i32>) -> vec2<i32> {
     return clamp(p, vec2<i32>(0, 0), vec2<i32>(P.rt.zw) - vec2<i32>(1, 1));
@@ -140,11 +140,4 @@ fn cs_edges_color_predicated(@builtin(global_invocation_id) id: vec3<u32>, @buil
 fn cs_edges_depth(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let p = edge_pair_origin(id.xy);
     emit_edge_pair(id.xy, li, depth_edges_px(p), depth_edges_px(p + vec2<i32>(1, 0)));
-}
-
-@compute @workgroup_size(8, 8)
-fn cs_mask(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (all(id.xy < vec2<u32>(P.rt.zw))) {
-        textureStore(mask_out, id.xy, mask_px(vec2<i32>(id.xy)));
-    }
 }

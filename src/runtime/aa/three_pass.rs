@@ -296,6 +296,8 @@ impl ThreePass {
                 Passes::Fragment { pipes, groups, views: [ev.clone(), wv.clone(), ov.clone()] }
             }
             Some((edge_rows, edge_list, weights_args)) => {
+                let mask_view = extra.mask().map(|t| t.create_view(&Default::default()));
+                let mask_entry: Vec<_> = mask_view.iter().map(|v| (13, R::TextureView(v))).collect();
                 let [edges_entries, mut weights_entries, blend_entries] = entries;
                 let list = || (11, edge_list.as_entire_binding());
                 let weights_out = || (9, R::TextureView(&wv));
@@ -304,9 +306,10 @@ impl ThreePass {
                     [edges_entries, vec![(8, edge_rows.as_entire_binding()), weights_out(), list()]].concat(),
                     vec![list(), (12, weights_args.as_entire_binding())],
                     weights_entries,
-                    [blend_entries, vec![(10, R::TextureView(&ov))]].concat(),
+                    [blend_entries, vec![(10, R::TextureView(&ov))], mask_entry].concat(),
                 ];
-                let stages = ["cs_edges", "cs_edge_args", "cs_weights_list", "cs_blend"];
+                let blend = if masked { "cs_blend_masked" } else { "cs_blend" };
+                let stages = ["cs_edges", "cs_edge_args", "cs_weights_list", blend];
                 let pipes = stages.map(|e| gpu::compute_pipeline(device, spec.module, e));
                 let groups = [0, 1, 2, 3].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
                 Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args }

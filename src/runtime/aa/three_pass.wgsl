@@ -57,3 +57,20 @@ fn cs_blend(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     textureStore(color_out, id.xy, blend_px(vec2<i32>(id.xy)));
 }
+
+// Blending and the matte / stencil in one pass (edges.wgsl's `mask_px` after `cs_blend`, without the blended image's
+// round trip through memory): inside the mask (≥ 128/255) the blended pixel, outside the input pixel unchanged.
+@group(0) @binding(13) var mask_tex: texture_2d<f32>;
+
+@compute @workgroup_size(8, 8)
+fn cs_blend_masked(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id.xy >= vec2<u32>(P.rt.zw))) {
+        return;
+    }
+    let p = vec2<i32>(id.xy);
+    var c = textureLoad(color_tex, p, 0);
+    if (textureLoad(mask_tex, p, 0).r >= 0.5) {
+        c = blend_px(p);
+    }
+    textureStore(color_out, id.xy, c);
+}
