@@ -9,8 +9,8 @@
 //! produces its frames on the GPU). Thesis anchors (Table 10.1, 1080p, GTX 470): 1x 1.02 ms, T2x 1.32 ms,
 //! S2x 2.04 ms, 4x 2.34 ms (S2x/4x without the MSAA rendering overhead). Medians of RUNS runs, min–max printed.
 //! Frames: the procedural moving scene (`rtbake::runtime::moving_scene`), frame 1 (temporal modes have history).
-//! The SMAA passes take the shape `RTBAKE_AA_PASSES` names (`compute`, the default, or `fragment`, the full-screen
-//! passes before them; printed first): `scripts/gpu_bench.sh` runs this benchmark once per shape.
+//! The passes (SMAA per sample, the S2x average, the temporal resolve) take the shape `RTBAKE_AA_PASSES` names
+//! (`compute`, the default, or `fragment`, the full-screen passes before them; printed first): `scripts/gpu_bench.sh` runs this benchmark once per shape.
 
 use rtbake::runtime::aa::three_pass::PassShape;
 use rtbake::runtime::cpu::smaa_modes::SmaaModesCpu;

@@ -120,14 +120,16 @@ fn smaa_subsample_slices_gpu_matches_cpu() {
 
 /// The compute and fragment shapes of the SMAA and MLAA passes (`runtime::aa::three_pass::PassShape`) write the same
 /// bytes: edges, blending weights and output, on the shapes scene (odd size: partial workgroups and an odd last
-/// edge pair), the moving scene's textured frame (edges almost everywhere), with colour edges (another detector
-/// feeding the compute weights pass) and with a mask.
+/// edge pair), the moving scene's textured frame (edges almost everywhere), with every edge detector (colour, depth,
+/// predicated luma and colour: the other detectors' compute edge passes feeding the compute weights pass) and with a
+/// mask (alone and with depth edges); the compute shape records no render pass.
 #[test]
 fn compute_and_fragment_passes_write_the_same_bytes() {
-    use rtbake::runtime::aa::edges::{AaInputs, EdgeDetector, EdgeSettings};
+    use rtbake::runtime::aa::edges::{AaInputs, EdgeDetector, EdgeSettings, Predication};
     use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
     use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
     use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
+    use rtbake::runtime::scene::render_shapes_depth;
     use rtbake::runtime::smaa::SmaaOptions;
     let g = gpu();
     let (luts, map) = (baked_smaa(), MlaaAreaMap::new(33, baked_mlaa(33)).unwrap());
@@ -136,18 +138,28 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
         let out = p.run_with(&g.device, &g.queue, img, inputs).unwrap();
         [read(p.edges()), read(p.weights()), out]
     };
-    let colour = EdgeSettings { detector: EdgeDetector::Color, ..Default::default() };
+    let detector = |detector, predication| EdgeSettings { detector, predication, ..Default::default() };
+    let pred = Some(Predication::SMAA);
     let (w, h) = (301u32, 173u32);
     let mask: Vec<u8> = (0..w * h).map(|i| if (i % w) < w / 2 { 255 } else { 0 }).collect();
+    let depth = render_shapes_depth(w, h);
     let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
-    let cases: [(&str, Vec<u8>, EdgeSettings, bool); 4] = [
-        ("shapes", render_shapes(w, h, 1), EdgeSettings::default(), false),
-        ("moving scene", moving, EdgeSettings::default(), false),
-        ("colour edges", render_shapes(w, h, 1), colour, false),
-        ("masked", render_shapes(w, h, 1), EdgeSettings::default(), true),
+    let shapes = render_shapes(w, h, 1);
+    let cases: [(&str, &[u8], EdgeSettings, bool); 8] = [
+        ("shapes", &shapes, EdgeSettings::default(), false),
+        ("moving scene", &moving, EdgeSettings::default(), false),
+        ("colour edges", &shapes, detector(EdgeDetector::Color, None), false),
+        ("depth edges", &shapes, detector(EdgeDetector::Depth, None), false),
+        ("predicated luma", &shapes, detector(EdgeDetector::Luma, pred), false),
+        ("predicated colour", &moving, detector(EdgeDetector::Color, pred), false),
+        ("masked", &shapes, EdgeSettings::default(), true),
+        ("masked depth edges", &shapes, detector(EdgeDetector::Depth, None), true),
     ];
     for (name, img, edges, masked) in &cases {
-        let inputs = AaInputs { depth: None, mask: masked.then_some(mask.as_slice()) };
+        let inputs = AaInputs {
+            depth: edges.needs_depth().then_some(depth.as_slice()),
+            mask: masked.then_some(mask.as_slice()),
+        };
         let (smaa_options, mlaa_options) = (
             SmaaOptions { edges: *edges, masked: *masked, ..Default::default() },
             MlaaOptions { edges: *edges, masked: *masked },
@@ -157,13 +169,58 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
         let (sc, sf) = (smaa(PassShape::Compute), smaa(PassShape::Fragment));
         assert_eq!((sc.shape(), sf.shape()), (PassShape::Compute, PassShape::Fragment));
         let (mc, mf) = (mlaa(PassShape::Compute), mlaa(PassShape::Fragment));
+        let fragment_passes = 3 + !edges.is_plain_luma() as u32 + *masked as u32;
         for (pass, c, f) in [("SMAA", &*sc, &*sf), ("MLAA", &*mc, &*mf)] {
+            assert_eq!((c.render_passes(), f.render_passes()), (0, fragment_passes), "{pass} {name}");
             let (a, b) = (images(c, img, &inputs), images(f, img, &inputs));
             assert!(b[1].iter().any(|v| *v > 0), "{pass} {name}: the scene must produce blending weights");
+            if *masked {
+                let outside =
+                    |o: &[u8]| o.chunks(4).zip(img.chunks(4)).zip(&mask).all(|((o, i), m)| *m >= 128 || o == i);
+                assert!(outside(&a[2]), "{pass} {name}: pixels outside the mask must leave the pass unchanged");
+            }
             for (k, what) in ["edges", "weights", "output"].iter().enumerate() {
                 let differ = a[k].iter().zip(&b[k]).filter(|(x, y)| x != y).count();
                 assert_eq!(differ, 0, "{pass} {name}: {what} differ in {differ} bytes between compute and fragment");
             }
+        }
+    }
+}
+
+/// SMAA S2x, T2x and 4x (and 1x through the modes) write the same bytes in both pass shapes, frame after frame
+/// (the per-sample SMAA passes, the S2x average and the temporal resolve, reprojected and plain), at an odd size;
+/// the compute shape records no render pass.
+#[test]
+fn smaa_modes_compute_and_fragment_passes_write_the_same_bytes() {
+    use rtbake::runtime::aa::three_pass::PassShape;
+    use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
+    use rtbake::runtime::smaa_modes::{scene_frame, ModeFrame, SmaaMode, SmaaModes, TemporalResolve};
+    let g = gpu();
+    let luts = baked_smaa();
+    let (w, h) = (133u32, 75u32);
+    let scene = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap();
+    let runs = SmaaMode::ALL
+        .map(|m| (m, TemporalResolve::default()))
+        .into_iter()
+        .chain([(SmaaMode::T2x, TemporalResolve::Plain)]);
+    for (mode, resolve) in runs {
+        let build = |shape| SmaaModes::with_shape(&g.device, &g.queue, (w, h), &luts, (mode, resolve), shape).unwrap();
+        let (mut c, mut f) = (build(PassShape::Compute), build(PassShape::Fragment));
+        assert_eq!((c.shape(), f.shape()), (PassShape::Compute, PassShape::Fragment));
+        let fragment_passes =
+            3 * mode.samples_per_frame() as u32 + (mode.samples_per_frame() == 2) as u32 + mode.is_temporal() as u32;
+        assert_eq!((c.render_passes(), f.render_passes()), (0, fragment_passes), "{mode:?}");
+        for frame in 0..3 {
+            let (samples, velocity_px) = scene_frame(&scene, mode, frame);
+            let input = ModeFrame { samples: &samples, velocity_px: &velocity_px };
+            let a = c.run_frame(&g.device, &g.queue, &input).unwrap();
+            let b = f.run_frame(&g.device, &g.queue, &input).unwrap();
+            assert!(b != samples[0], "{mode:?} frame {frame}: the pass must change the frame");
+            let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+            assert_eq!(
+                differ, 0,
+                "{mode:?} {resolve:?} frame {frame}: {differ} bytes differ between compute and fragment"
+            );
         }
     }
 }

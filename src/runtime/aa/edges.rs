@@ -17,13 +17,17 @@
 //!   `T' = scale · T · (1 − strength · [|D − D_n| ≥ T_pred])`; SMAA's defaults: `T_pred` 0.01, scale 2.0,
 //!   strength 0.4.
 //! - **Matte / stencil masking**: pixels whose mask byte is below 128 leave the pass exactly as they came in; the
-//!   passes run everywhere, so pixels inside the matte still blend with their neighbours outside it (a fourth,
-//!   untimed full-screen pass selects per pixel).
+//!   passes run everywhere, so pixels inside the matte still blend with their neighbours outside it (the fragment
+//!   shape selects per pixel in a fourth, untimed pass; the compute shape in its blending pass).
+//!
+//! Every detector exists as a fragment pass and as a compute pass (the two `PassShape`s of
+//! [`crate::runtime::aa::three_pass`]), both calling the same per-pixel WGSL functions: the same bytes.
 //!
 //! The luma detector without predication stays the passes' own (`fs_edges` of `smaa.wgsl` / `mlaa.wgsl`), so
 //! default runs are unchanged.
 
 use crate::error::{check_range, InvalidInput};
+use crate::runtime::aa::three_pass::{dispatch, grid, ShapedPass};
 use crate::runtime::gpu;
 
 /// SMAA's luma / colour threshold (SMAA.hlsl `SMAA_THRESHOLD`, preset HIGH; MLAA's listings use the same 0.1).
@@ -185,29 +189,51 @@ struct Params {
     pred: [f32; 4],
 }
 
-const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("srgb.wgsl"), include_str!("edges.wgsl"));
+const SHADER: &str = concat!(
+    include_str!("../fullscreen.wgsl"),
+    include_str!("srgb.wgsl"),
+    include_str!("edges.wgsl"),
+    include_str!("edge_rows.wgsl")
+);
 
-/// The GPU side of this module for one pass: the depth and mask textures, the edge pipeline replacing the pass's
-/// luma detector (unless plain luma) and the mask composite (when masked).
+/// Where [`EdgeStage::encode_edges`] writes: the fragment shape's edges target (with the timer slot of the edges
+/// pass) or the compute shape's edge rows (with the beginning timestamp of the edges slot).
+pub(crate) enum EdgeOut<'a> {
+    Render(&'a wgpu::TextureView, Option<(&'a gpu::GpuTimer, u32)>),
+    Rows(Option<wgpu::ComputePassTimestampWrites<'a>>),
+}
+
+/// What the compute shape's edge pass writes (`edge_rows.wgsl`): the edge rows
+/// [`ThreePass`](super::three_pass::ThreePass) copies into the edges texture, the list of edge pixels the weights
+/// pass runs on (count first) and the weights texture it zeroes.
+pub(crate) struct EdgeOutputs<'a> {
+    pub rows: &'a wgpu::Buffer,
+    pub list: &'a wgpu::Buffer,
+    pub weights: &'a wgpu::TextureView,
+}
+
+/// The GPU side of this module for one pass: the depth and mask textures, the edge pass replacing the pass's
+/// luma detector (unless plain luma) and, in the fragment shape, the mask composite (when masked); the edge pass as a
+/// fragment or compute pass (the frame's [`PassShape`](super::three_pass::PassShape); same bytes).
 pub(crate) struct EdgeStage {
     settings: EdgeSettings,
     size: (u32, u32),
     depth: Option<wgpu::Texture>,
     mask: Option<wgpu::Texture>,
-    edges: Option<(wgpu::RenderPipeline, wgpu::BindGroup)>,
-    composite: Option<(wgpu::RenderPipeline, wgpu::BindGroup, wgpu::Texture, wgpu::TextureView)>,
+    edges: Option<ShapedPass>,
+    composite: Option<(ShapedPass, wgpu::Texture, wgpu::TextureView)>,
 }
 
 impl EdgeStage {
     /// `color` is the pass's input view, `aa_output` its blended output; `lca` the local contrast adaptation
-    /// factor (0: none, MLAA).
+    /// factor (0: none, MLAA). `compute`: what the compute shape's edge pass writes; `None` for the fragment
+    /// shape, whose edge pass renders into the edges texture.
     pub(crate) fn new(
         device: &wgpu::Device,
         (width, height): (u32, u32),
         (color, aa_output): (&wgpu::TextureView, &wgpu::TextureView),
-        settings: &EdgeSettings,
-        lca: f32,
-        masked: bool,
+        (settings, lca, masked): (&EdgeSettings, f32, bool),
+        compute: Option<EdgeOutputs<'_>>,
     ) -> Result<Self, InvalidInput> {
         settings.validate()?;
         use wgpu::TextureFormat as F;
@@ -224,15 +250,15 @@ impl EdgeStage {
         let module = needs_module.then(|| gpu::shader(device, "smaa_edges.wgsl", SHADER));
         let ubo = gpu::uniform_buffer(device, "aa edge params", bytemuck::bytes_of(&params));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let prefix = if compute.is_some() { "cs" } else { "fs" };
         use wgpu::BindingResource as R;
         let edges = match (&module, settings.is_plain_luma()) {
             (Some(module), false) => {
                 let entry = match (settings.detector, settings.predication.is_some()) {
-                    (EdgeDetector::Depth, _) => "fs_edges_depth",
-                    (_, true) => "fs_edges_color_predicated",
-                    (_, false) => "fs_edges_color",
+                    (EdgeDetector::Depth, _) => "edges_depth",
+                    (_, true) => "edges_color_predicated",
+                    (_, false) => "edges_color",
                 };
-                let pipe = gpu::fullscreen_pipeline(device, entry, module, entry, F::Rg8Unorm);
                 let dv = depth.as_ref().map(view);
                 let mut entries = vec![(0, ubo.as_entire_binding())];
                 if settings.detector != EdgeDetector::Depth {
@@ -241,24 +267,22 @@ impl EdgeStage {
                 if let Some(dv) = &dv {
                     entries.push((2, R::TextureView(dv)));
                 }
-                let bg = gpu::bind_group(device, entry, &pipe.get_bind_group_layout(0), &entries);
-                Some((pipe, bg))
+                if let Some(out) = &compute {
+                    let rows = (8, out.rows.as_entire_binding());
+                    entries.extend([rows, (9, R::TextureView(out.weights)), (11, out.list.as_entire_binding())]);
+                }
+                Some(ShapedPass::new(device, module, &format!("{prefix}_{entry}"), F::Rg8Unorm, &entries))
             }
             _ => None,
         };
-        let composite = match (&module, &mask) {
-            (Some(module), Some(mask)) => {
+        // The compute shape blends and masks in one pass (`cs_blend_masked` of three_pass.wgsl, [`Self::mask`]).
+        let composite = match (&module, &mask, &compute) {
+            (Some(module), Some(mask), None) => {
                 let out = gpu::texture(device, "aa masked output", width, height, F::Rgba8Unorm);
-                let pipe = gpu::fullscreen_pipeline(device, "aa mask", module, "fs_mask", F::Rgba8Unorm);
-                let mv = view(mask);
-                let bg = gpu::bind_group(
-                    device,
-                    "aa mask",
-                    &pipe.get_bind_group_layout(0),
-                    &[(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))],
-                );
-                let ov = view(&out);
-                Some((pipe, bg, out, ov))
+                let (mv, ov) = (view(mask), view(&out));
+                let entries = [(1, R::TextureView(color)), (3, R::TextureView(aa_output)), (4, R::TextureView(&mv))];
+                let pass = ShapedPass::new(device, module, "fs_mask", F::Rgba8Unorm, &entries);
+                Some((pass, out, ov))
             }
             _ => None,
         };
@@ -278,32 +302,44 @@ impl EdgeStage {
         Ok(())
     }
 
-    /// Records the edge pass into `target` and returns true, or returns false when the pass's own luma detector
-    /// is to run.
-    pub(crate) fn encode_edges(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        slot: Option<(&gpu::GpuTimer, u32)>,
-    ) -> bool {
-        match &self.edges {
-            Some((pipe, bg)) => {
-                gpu::draw_fullscreen(enc, "aa edges", pipe, bg, target, slot);
-                true
+    /// Records the edge pass into `out` and returns true, or returns false when the pass's own luma detector is to
+    /// run. The compute shape writes the edge rows (two pixels per thread); its caller copies them into the edges
+    /// texture.
+    pub(crate) fn encode_edges(&self, enc: &mut wgpu::CommandEncoder, out: EdgeOut<'_>) -> bool {
+        let (w, h) = self.size;
+        match (&self.edges, out) {
+            (Some(ShapedPass::Draw(pipe, bg)), EdgeOut::Render(target, slot)) => {
+                gpu::draw_fullscreen(enc, "aa edges", pipe, bg, target, slot)
             }
-            None => false,
+            (Some(ShapedPass::Dispatch(pipe, bg)), EdgeOut::Rows(writes)) => {
+                dispatch(enc, "aa edges", pipe, bg, grid(w.div_ceil(2), h), writes)
+            }
+            (None, _) => return false,
+            _ => unreachable!("the edge stage is built in the frame's shape"),
         }
+        true
     }
 
     /// Records the mask composite (nothing when unmasked).
     pub(crate) fn encode_mask(&self, enc: &mut wgpu::CommandEncoder) {
-        if let Some((pipe, bg, _, view)) = &self.composite {
-            gpu::draw_fullscreen(enc, "aa mask", pipe, bg, view, None);
+        if let Some((pass, _, view)) = &self.composite {
+            pass.encode(enc, "aa mask", view, self.size, None);
         }
     }
 
-    /// The masked output, when masked.
+    /// Render passes this stage records (the edge detector and the mask in the fragment shape).
+    pub(crate) fn render_passes(&self) -> u32 {
+        let mask = self.composite.as_ref().map(|c| &c.0);
+        self.edges.iter().chain(mask).map(ShapedPass::render_passes).sum()
+    }
+
+    /// The mask texture, when masked (the compute shape's blending pass reads it).
+    pub(crate) fn mask(&self) -> Option<&wgpu::Texture> {
+        self.mask.as_ref()
+    }
+
+    /// The fragment shape's masked output, when masked (the compute shape masks in its blending pass).
     pub(crate) fn masked_output(&self) -> Option<&wgpu::Texture> {
-        self.composite.as_ref().map(|c| &c.2)
+        self.composite.as_ref().map(|c| &c.1)
     }
 }

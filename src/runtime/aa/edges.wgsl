@@ -7,7 +7,13 @@
 // Outputs as the passes' own `fs_edges`: R = edge on the left boundary, G = edge on the top boundary, 0 or 1.
 // Pixel positions are integer texel coordinates, loads clamp to the edge.
 //
-// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl).
+// Each detector is a per-pixel function (`*_px`) called by a fragment entry point (`fs_*`, the fragment shape of
+// three_pass.rs) and a compute one (`cs_*`, its compute shape: two pixels per thread into the edge rows of
+// edge_rows.wgsl, which also zeroes the weights and lists the edge pixels), so both shapes write the same bytes.
+// The compute shape masks in its blending pass (`cs_blend_masked` of three_pass.wgsl, the same selection as
+// `mask_px`).
+//
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl); appended: edge_rows.wgsl.
 
 struct Params {
     // (1/width, 1/height, width, height)
@@ -47,14 +53,14 @@ fn contrast(a: vec3<f32>, b: vec3<f32>) -> f32 {
 
 // Luma or colour edges against `threshold` (left, top), then eq. 10.1's local contrast adaptation when
 // P.cfg.y > 0: an edge survives if P.cfg.y times its contrast reaches the largest of the neighbouring edges'.
-fn color_edges(p: vec2<i32>, threshold: vec2<f32>) -> vec4<f32> {
+fn color_edges(p: vec2<i32>, threshold: vec2<f32>) -> vec2<f32> {
     let c = color_at(p);
     let c_left = color_at(p + vec2<i32>(-1, 0));
     let c_top = color_at(p + vec2<i32>(0, -1));
     let delta = vec2<f32>(contrast(c, c_left), contrast(c, c_top));
     var edges = step(threshold, delta);
     if (edges.x + edges.y == 0.0 || P.cfg.y <= 0.0) {
-        return vec4<f32>(edges, 0.0, 0.0);
+        return edges;
     }
     let c_right = color_at(p + vec2<i32>(1, 0));
     let c_bottom = color_at(p + vec2<i32>(0, 1));
@@ -63,19 +69,15 @@ fn color_edges(p: vec2<i32>, threshold: vec2<f32>) -> vec4<f32> {
     let c_toptop = color_at(p + vec2<i32>(0, -2));
     max_delta = max(max_delta, vec2<f32>(contrast(c_left, c_leftleft), contrast(c_top, c_toptop)));
     let final_delta = max(max_delta.x, max_delta.y);
-    edges = edges * step(vec2<f32>(final_delta), P.cfg.y * delta);
-    return vec4<f32>(edges, 0.0, 0.0);
+    return edges * step(vec2<f32>(final_delta), P.cfg.y * delta);
 }
 
-@fragment
-fn fs_edges_color(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    return color_edges(vec2<i32>(floor(pos.xy)), vec2<f32>(P.cfg.x));
+fn color_edges_px(p: vec2<i32>) -> vec2<f32> {
+    return color_edges(p, vec2<f32>(P.cfg.x));
 }
 
 // Predicated thresholding: T' = scale · T · (1 − strength · [depth edge]) per boundary.
-@fragment
-fn fs_edges_color_predicated(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+fn color_edges_predicated_px(p: vec2<i32>) -> vec2<f32> {
     let d = depth_at(p);
     let d_delta = abs(vec2<f32>(d - depth_at(p + vec2<i32>(-1, 0)), d - depth_at(p + vec2<i32>(0, -1))));
     let pred_edges = step(vec2<f32>(P.pred.x), d_delta);
@@ -84,20 +86,58 @@ fn fs_edges_color_predicated(@builtin(position) pos: vec4<f32>) -> @location(0) 
 }
 
 // Listing 9.1 (MLAA's depth variant; also SMAA's depth detector): |D − D_left|, |D − D_top| against the threshold.
-@fragment
-fn fs_edges_depth(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+fn depth_edges_px(p: vec2<i32>) -> vec2<f32> {
     let d = depth_at(p);
     let delta = abs(vec2<f32>(d - depth_at(p + vec2<i32>(-1, 0)), d - depth_at(p + vec2<i32>(0, -1))));
-    return vec4<f32>(step(vec2<f32>(P.pred.w), delta), 0.0, 0.0);
+    return step(vec2<f32>(P.pred.w), delta);
 }
 
 // Matte / stencil: inside the mask (≥ 128/255) the antialiased pixel, outside the input pixel unchanged.
-@fragment
-fn fs_mask(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+fn mask_px(p: vec2<i32>) -> vec4<f32> {
     if (textureLoad(mask_tex, p, 0).r >= 0.5) {
         return textureLoad(aa_tex, p, 0);
     }
     return textureLoad(color_tex, p, 0);
+}
+
+fn frag_px(pos: vec4<f32>) -> vec2<i32> {
+    return vec2<i32>(floor(pos.xy));
+}
+
+@fragment
+fn fs_edges_color(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(color_edges_px(frag_px(pos)), 0.0, 0.0);
+}
+
+@fragment
+fn fs_edges_color_predicated(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(color_edges_predicated_px(frag_px(pos)), 0.0, 0.0);
+}
+
+@fragment
+fn fs_edges_depth(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(depth_edges_px(frag_px(pos)), 0.0, 0.0);
+}
+
+@fragment
+fn fs_mask(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return mask_px(frag_px(pos));
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_edges_color(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, color_edges_px(p), color_edges_px(p + vec2<i32>(1, 0)));
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_edges_color_predicated(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, color_edges_predicated_px(p), color_edges_predicated_px(p + vec2<i32>(1, 0)));
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_edges_depth(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let p = edge_pair_origin(id.xy);
+    emit_edge_pair(id.xy, li, depth_edges_px(p), depth_edges_px(p + vec2<i32>(1, 0)));
 }

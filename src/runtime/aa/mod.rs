@@ -4,7 +4,7 @@
 //! - [`mlaa`] (`mlaa.wgsl`, [`mlaa_cpu`]): Jimenez's MLAA, GPU Pro 2, 2011 (Listings 9.1–9.5);
 //! - [`edges`] (`edges.wgsl`, [`edges_cpu`]): the colour/depth edge detectors, predication and masks both share;
 //! - [`modes`] (`modes.wgsl`, [`modes_cpu`]): SMAA S2x/T2x/4x over [`smaa::Smaa::with_subsample`];
-//! - [`three_pass`]: the textures and the three full-screen passes SMAA and MLAA share;
+//! - [`three_pass`]: the textures and the three passes SMAA and MLAA share, in either shape (compute or fragment);
 //! - [`scene`], [`moving_scene`]: procedural test scenes with supersampled ground truth (CPU only).
 
 pub mod edges;

@@ -25,10 +25,14 @@
 //! sample position), which for SMAA is equivalent to a 2× multisampled colour buffer separated into its samples
 //! (SMAA's own "separate" pass does exactly that); no multisampled texture is created. The CPU twin is
 //! [`crate::runtime::aa::modes_cpu`]; the WGSL is `aa/modes.wgsl`.
+//!
+//! Every pass takes the frame's [`PassShape`] (the SMAA passes per sample, the S2x average and the temporal resolve:
+//! compute passes by default, full-screen fragment passes with `RTBAKE_AA_PASSES=fragment`); the bytes are the same.
 
 use crate::error::InvalidInput;
 use crate::runtime::aa::moving_scene::MovingScene;
-use crate::runtime::aa::smaa::{Smaa, SmaaTextures, SubsampleIndices, SMAA_PASSES};
+use crate::runtime::aa::smaa::{Smaa, SmaaOptions, SmaaTextures, SubsampleIndices, SMAA_PASSES};
+use crate::runtime::aa::three_pass::{frame_texture, PassShape, ShapedPass};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
 
@@ -254,7 +258,7 @@ const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("s
 /// The SMAA passes of one frame slot and, for two samples, their S2x average.
 struct Slot {
     passes: Vec<Smaa>,
-    average: Option<(wgpu::Texture, wgpu::TextureView, wgpu::BindGroup)>,
+    average: Option<(wgpu::Texture, wgpu::TextureView, ShapedPass)>,
 }
 
 impl Slot {
@@ -276,13 +280,13 @@ pub struct SmaaModes {
     slots: Vec<Slot>,
     velocity: wgpu::Texture,
     ubo: wgpu::Buffer,
-    /// Temporal modes: the resolve target, its pipeline and one bind group per slot (current = that slot).
-    temporal: Option<(wgpu::Texture, wgpu::TextureView, wgpu::RenderPipeline, Vec<wgpu::BindGroup>)>,
-    pipe_average: wgpu::RenderPipeline,
+    /// Temporal modes: the resolve target and its pass per slot (current = that slot).
+    temporal: Option<(wgpu::Texture, wgpu::TextureView, Vec<ShapedPass>)>,
     frame: u64,
 }
 
 impl SmaaModes {
+    /// The passes in the shape `RTBAKE_AA_PASSES` names ([`PassShape::from_env`]).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -292,65 +296,96 @@ impl SmaaModes {
         mode: SmaaMode,
         resolve: TemporalResolve,
     ) -> Result<Self, RuntimeError> {
+        let shape = PassShape::from_env()?;
+        Self::with_shape(device, queue, (width, height), luts, (mode, resolve), shape)
+    }
+
+    /// As [`Self::new`] in the given [`PassShape`] (same output bytes).
+    pub fn with_shape(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (width, height): (u32, u32),
+        luts: &SmaaTextures,
+        (mode, resolve): (SmaaMode, TemporalResolve),
+        shape: PassShape,
+    ) -> Result<Self, RuntimeError> {
         gpu::check_frame(device, width, height, 8)?;
         resolve.validate()?;
+        use wgpu::BindingResource as R;
         use wgpu::TextureFormat as F;
         let module = gpu::shader(device, "smaa_temporal.wgsl", SHADER);
-        let pipe_average = gpu::fullscreen_pipeline(device, "smaa s2x average", &module, "fs_average", F::Rgba8Unorm);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let mut slots = Vec::new();
-        for s in 0..mode.slots() {
-            let passes = mode
-                .samples(s as u64)
-                .into_iter()
-                .map(|m| Smaa::with_subsample(device, queue, width, height, luts, m.subsample))
-                .collect::<Result<Vec<_>, _>>()?;
-            let average = (passes.len() == 2).then(|| {
-                let t = gpu::texture(device, "smaa s2x resolve", width, height, F::Rgba8Unorm);
-                let v = view(&t);
-                let bg = gpu::bind_group(
-                    device,
-                    "smaa s2x average",
-                    &pipe_average.get_bind_group_layout(0),
-                    &[
-                        (1, wgpu::BindingResource::TextureView(&view(passes[0].output()))),
-                        (2, wgpu::BindingResource::TextureView(&view(passes[1].output()))),
-                    ],
-                );
-                (t, v, bg)
-            });
-            slots.push(Slot { passes, average });
-        }
-        let velocity = gpu::data_texture(device, "smaa velocity", width, height, F::Rg32Float);
         let (k, plain) = resolve.uniform();
         let params = Params {
             rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
             resolve: [k, plain, 0.0, 0.0],
         };
         let ubo = gpu::uniform_buffer(device, "smaa temporal params", bytemuck::bytes_of(&params));
+        let mut slots = Vec::new();
+        // The shape the SMAA passes took (a frame too large for the compute shape's buffers takes the fragment one).
+        let mut shape = shape;
+        for s in 0..mode.slots() {
+            let passes = mode
+                .samples(s as u64)
+                .into_iter()
+                .map(|m| {
+                    let options = SmaaOptions { subsample: m.subsample, ..Default::default() };
+                    Smaa::with_shape(device, queue, (width, height), luts, &options, shape)
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            shape = passes[0].shape();
+            let average = (passes.len() == 2).then(|| {
+                let t = frame_texture(device, "smaa s2x resolve", (width, height), shape);
+                let v = view(&t);
+                let (a, b) = (view(passes[0].output()), view(passes[1].output()));
+                let mut entries = vec![(1, R::TextureView(&a)), (2, R::TextureView(&b))];
+                if shape == PassShape::Compute {
+                    entries.extend([(0, ubo.as_entire_binding()), (4, R::TextureView(&v))]);
+                }
+                let entry = if shape == PassShape::Compute { "cs_average" } else { "fs_average" };
+                let pass = ShapedPass::new(device, &module, entry, F::Rgba8Unorm, &entries);
+                (t, v, pass)
+            });
+            slots.push(Slot { passes, average });
+        }
+        let velocity = gpu::data_texture(device, "smaa velocity", width, height, F::Rg32Float);
         let temporal = mode.is_temporal().then(|| {
-            let out = gpu::texture(device, "smaa temporal resolve", width, height, F::Rgba8Unorm);
+            let out = frame_texture(device, "smaa temporal resolve", (width, height), shape);
             let out_view = view(&out);
-            let pipe = gpu::fullscreen_pipeline(device, "smaa temporal resolve", &module, "fs_resolve", F::Rgba8Unorm);
             let vel_view = view(&velocity);
-            let bgs = (0..2)
+            let passes = (0..2)
                 .map(|s| {
-                    gpu::bind_group(
-                        device,
-                        "smaa temporal resolve",
-                        &pipe.get_bind_group_layout(0),
-                        &[
-                            (0, ubo.as_entire_binding()),
-                            (1, wgpu::BindingResource::TextureView(&view(slots[s].result()))),
-                            (2, wgpu::BindingResource::TextureView(&view(slots[1 - s].result()))),
-                            (3, wgpu::BindingResource::TextureView(&vel_view)),
-                        ],
-                    )
+                    let (cur, prev) = (view(slots[s].result()), view(slots[1 - s].result()));
+                    let mut entries = vec![
+                        (0, ubo.as_entire_binding()),
+                        (1, R::TextureView(&cur)),
+                        (2, R::TextureView(&prev)),
+                        (3, R::TextureView(&vel_view)),
+                    ];
+                    if shape == PassShape::Compute {
+                        entries.push((4, R::TextureView(&out_view)));
+                    }
+                    let entry = if shape == PassShape::Compute { "cs_resolve" } else { "fs_resolve" };
+                    ShapedPass::new(device, &module, entry, F::Rgba8Unorm, &entries)
                 })
                 .collect();
-            (out, out_view, pipe, bgs)
+            (out, out_view, passes)
         });
-        Ok(Self { mode, resolve, width, height, slots, velocity, ubo, temporal, pipe_average, frame: 0 })
+        Ok(Self { mode, resolve, width, height, slots, velocity, ubo, temporal, frame: 0 })
+    }
+
+    /// The shape the passes were built in.
+    pub fn shape(&self) -> PassShape {
+        self.slots[0].passes[0].shape()
+    }
+
+    /// Render (fragment) passes one frame records: none in the compute shape.
+    pub fn render_passes(&self) -> u32 {
+        let slot = &self.slots[self.slot()];
+        let smaa: u32 = slot.passes.iter().map(|p| p.render_passes()).sum();
+        let average = slot.average.as_ref().map_or(0, |a| a.2.render_passes());
+        let temporal = self.temporal.as_ref().map_or(0, |t| t.2[self.slot()].render_passes());
+        smaa + average + temporal
     }
 
     pub fn mode(&self) -> SmaaMode {
@@ -385,7 +420,7 @@ impl SmaaModes {
     /// velocity).
     pub fn output(&self) -> &wgpu::Texture {
         match &self.temporal {
-            Some((t, _, _, _)) => t,
+            Some((t, _, _)) => t,
             None => self.slots[0].result(),
         }
     }
@@ -415,12 +450,13 @@ impl SmaaModes {
             k += SMAA_PASSES;
         }
         let at = |k: u32| timer.map(|(t, first)| (t, first + k));
-        if let Some((_, v, bg)) = &slot.average {
-            gpu::draw_fullscreen(enc, "smaa s2x average", &self.pipe_average, bg, v, at(k));
+        let size = (self.width, self.height);
+        if let Some((_, v, pass)) = &slot.average {
+            pass.encode(enc, "smaa s2x average", v, size, at(k));
             k += 1;
         }
-        if let Some((_, v, pipe, bgs)) = &self.temporal {
-            gpu::draw_fullscreen(enc, "smaa temporal resolve", pipe, &bgs[self.slot()], v, at(k));
+        if let Some((_, v, passes)) = &self.temporal {
+            passes[self.slot()].encode(enc, "smaa temporal resolve", v, size, at(k));
         }
     }
 

@@ -7,6 +7,8 @@
 //   alpha like colour, propagates velocity to the antialiased pixels, as the thesis prescribes); or the plain 50/50
 //   blend without reprojection.
 // Written for rtbake from the thesis' equations; the CPU twin is `runtime/aa/modes_cpu.rs` (keep in sync).
+// Each resolve is a per-pixel function (`average_px`, `resolve_px`) called by a fragment entry point (`fs_*`) and a
+// compute one (`cs_*`, 8×8 workgroups into a storage texture): the two pass shapes of three_pass.rs, same bytes.
 // Colour textures are Rgba8Unorm holding sRGB-encoded values; the velocity texture is Rg32Float (px/frame).
 //
 // Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), srgb_to_linear and linear_to_srgb (srgb.wgsl).
@@ -23,6 +25,7 @@ struct Params {
 @group(0) @binding(1) var a_tex: texture_2d<f32>;
 @group(0) @binding(2) var b_tex: texture_2d<f32>;
 @group(0) @binding(3) var velocity_tex: texture_2d<f32>;
+@group(0) @binding(4) var out_tex: texture_storage_2d<rgba8unorm, write>;
 
 fn lin(c: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(srgb_to_linear(c.rgb), c.a);
@@ -34,15 +37,13 @@ fn blend(cur: vec4<f32>, prev: vec4<f32>, w: f32) -> vec4<f32> {
     return vec4<f32>(linear_to_srgb(c.rgb), c.a);
 }
 
-@fragment
-fn fs_average(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+// The S2x resolve at pixel `p`.
+fn average_px(p: vec2<i32>) -> vec4<f32> {
     return blend(textureLoad(a_tex, p, 0), textureLoad(b_tex, p, 0), 0.5);
 }
 
-@fragment
-fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let p = vec2<i32>(floor(pos.xy));
+// The temporal resolve at pixel `p` (whose centre is p + 0.5, the fragment position).
+fn resolve_px(p: vec2<i32>) -> vec4<f32> {
     let cur = textureLoad(a_tex, p, 0);
     if (P.resolve.z < 0.5) {
         return cur;
@@ -52,9 +53,34 @@ fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     }
     let v = textureLoad(velocity_tex, p, 0).xy;
     let size = vec2<i32>(P.rt.zw);
-    let q = clamp(vec2<i32>(floor(pos.xy - v)), vec2<i32>(0, 0), size - vec2<i32>(1, 1));
+    let centre = vec2<f32>(p) + vec2<f32>(0.5, 0.5);
+    let q = clamp(vec2<i32>(floor(centre - v)), vec2<i32>(0, 0), size - vec2<i32>(1, 1));
     let prev = textureLoad(b_tex, q, 0);
     let delta = abs(cur.a * cur.a - prev.a * prev.a) / 5.0;
     let w = 0.5 * clamp(1.0 - P.resolve.x * sqrt(delta), 0.0, 1.0);
     return blend(cur, prev, w);
+}
+
+@fragment
+fn fs_average(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return average_px(vec2<i32>(floor(pos.xy)));
+}
+
+@fragment
+fn fs_resolve(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    return resolve_px(vec2<i32>(floor(pos.xy)));
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_average(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (all(id.xy < vec2<u32>(P.rt.zw))) {
+        textureStore(out_tex, id.xy, average_px(vec2<i32>(id.xy)));
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (all(id.xy < vec2<u32>(P.rt.zw))) {
+        textureStore(out_tex, id.xy, resolve_px(vec2<i32>(id.xy)));
+    }
 }

@@ -4,20 +4,25 @@
 //! module, uniform buffer and look-up tables (`PassSpec`); `ThreePass::build` makes the rest.
 //!
 //! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
-//! 8×8-thread workgroups, then the weights on edge pixels only, listed by a pass that also zeroes the others and
-//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace.
+//! 8×8-thread workgroups, which also zero the weights and list the edge pixels (`edge_rows.wgsl`), then the weights on
+//! the listed pixels only, dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment
+//! passes they replace. The other edge detectors and the mask (`EdgeStage`) take the same shape.
 //! Both call the same per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes
 //! (tested); the compute shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline
 //! spans (on an NVIDIA H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment`
 //! selects the fragment shape for the default constructors, so one benchmark binary measures both.
 
 use crate::error::InvalidInput;
-use crate::runtime::aa::edges::{AaInputs, EdgeSettings, EdgeStage};
+use crate::runtime::aa::edges::{AaInputs, EdgeOut, EdgeOutputs, EdgeSettings, EdgeStage};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
 
-/// The compute entry points appended after `smaa.wgsl` or `mlaa.wgsl`.
-pub(crate) const COMPUTE_WGSL: &str = include_str!("three_pass.wgsl");
+/// The compute entry points appended after `smaa.wgsl` or `mlaa.wgsl`, after the edge rows they share with the other
+/// detectors' compute edge passes (`edge_rows.wgsl`).
+pub(crate) const COMPUTE_WGSL: &str = concat!(include_str!("edge_rows.wgsl"), include_str!("three_pass.wgsl"));
+
+/// The passes every three-pass frame records (edges, weights, blending).
+const SMAA_OR_MLAA_PASSES: u32 = 3;
 
 /// Threads per workgroup side of the compute shape (`@workgroup_size(8, 8)` in `three_pass.wgsl`).
 const WORKGROUP: u32 = 8;
@@ -73,16 +78,15 @@ pub(crate) struct PassSpec<'a> {
 pub(crate) enum Passes {
     /// Render targets: the edges, weights and output views.
     Fragment { pipes: [wgpu::RenderPipeline; 3], groups: [wgpu::BindGroup; 3], views: [wgpu::TextureView; 3] },
-    /// Edges, edge list, dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
-    /// edges texture), the edge list (count first), the weights pass's indirect arguments and the edges view another
-    /// detector renders into.
+    /// Edges (which list the edge pixels), dispatch arguments, weights on the list, blending; the edge rows buffer (copied into the
+    /// edges texture; another detector's compute pass writes it too), the edge list (count first) and the weights
+    /// pass's indirect arguments.
     Compute {
-        pipes: [wgpu::ComputePipeline; 5],
-        groups: [wgpu::BindGroup; 5],
+        pipes: [wgpu::ComputePipeline; 4],
+        groups: [wgpu::BindGroup; 4],
         edge_rows: wgpu::Buffer,
         edge_list: wgpu::Buffer,
         weights_args: wgpu::Buffer,
-        edges_view: wgpu::TextureView,
     },
 }
 
@@ -105,8 +109,81 @@ fn edge_row_bytes(width: u32) -> u32 {
     (2 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
 }
 
-/// A frame texture the passes write: a render target and, for the compute shape, a storage texture.
-fn frame_texture(device: &wgpu::Device, label: &str, (w, h): (u32, u32), shape: PassShape) -> wgpu::Texture {
+/// Workgroups of 8×8 threads covering `threads_x` × `threads_y` threads.
+pub(crate) fn grid(threads_x: u32, threads_y: u32) -> (u32, u32) {
+    (threads_x.div_ceil(WORKGROUP), threads_y.div_ceil(WORKGROUP))
+}
+
+/// Records one compute pass: `pipe` with bind group 0 `group` over `groups` workgroups, optional timestamps.
+pub(crate) fn dispatch(
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipe: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+    (x, y): (u32, u32),
+    writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+) {
+    let mut pass =
+        enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: writes });
+    pass.set_pipeline(pipe);
+    pass.set_bind_group(0, group, &[]);
+    pass.dispatch_workgroups(x, y, 1);
+}
+
+/// A pass with one output in either shape: a full-screen draw into a render target or a compute dispatch over
+/// 8×8-thread workgroups writing a storage texture (the edge, mask and SMAA mode passes beside the three).
+pub(crate) enum ShapedPass {
+    Draw(wgpu::RenderPipeline, wgpu::BindGroup),
+    Dispatch(wgpu::ComputePipeline, wgpu::BindGroup),
+}
+
+impl ShapedPass {
+    /// `entry` of `module` (`cs_*`: a compute pass; else a fragment entry drawn into a `format` target), with its
+    /// bind group from `entries`.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        format: wgpu::TextureFormat,
+        entries: &[(u32, wgpu::BindingResource<'_>)],
+    ) -> Self {
+        if entry.starts_with("cs_") {
+            let pipe = gpu::compute_pipeline(device, module, entry);
+            let bg = gpu::bind_group(device, entry, &pipe.get_bind_group_layout(0), entries);
+            Self::Dispatch(pipe, bg)
+        } else {
+            let pipe = gpu::fullscreen_pipeline(device, entry, module, entry, format);
+            let bg = gpu::bind_group(device, entry, &pipe.get_bind_group_layout(0), entries);
+            Self::Draw(pipe, bg)
+        }
+    }
+
+    /// 1 for a draw, 0 for a dispatch.
+    pub(crate) fn render_passes(&self) -> u32 {
+        matches!(self, Self::Draw(..)) as u32
+    }
+
+    /// Records the pass over a `w`×`h` frame (one thread per pixel): a draw into `target`, or a dispatch (whose
+    /// bind group holds the storage view of the output); `slot` receives its timestamps.
+    pub(crate) fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        label: &str,
+        target: &wgpu::TextureView,
+        (w, h): (u32, u32),
+        slot: Option<(&GpuTimer, u32)>,
+    ) {
+        match self {
+            Self::Draw(pipe, bg) => gpu::draw_fullscreen(enc, label, pipe, bg, target, slot),
+            Self::Dispatch(pipe, bg) => {
+                dispatch(enc, label, pipe, bg, grid(w, h), slot.map(|(t, i)| t.compute_pass_writes(i)))
+            }
+        }
+    }
+}
+
+/// A frame texture (`Rgba8Unorm`) the passes write: a render target and, for the compute shape, a storage texture.
+pub(crate) fn frame_texture(device: &wgpu::Device, label: &str, (w, h): (u32, u32), shape: PassShape) -> wgpu::Texture {
     use wgpu::TextureUsages as U;
     let storage = if shape == PassShape::Compute { U::STORAGE_BINDING } else { U::empty() };
     device.create_texture(&wgpu::TextureDescriptor {
@@ -191,9 +268,21 @@ impl ThreePass {
         let group = |stage: &str, layout: &wgpu::BindGroupLayout, entries: &[(u32, R<'_>)]| {
             gpu::bind_group(device, &label(stage), layout, entries)
         };
-        let extra = EdgeStage::new(device, size, (&cv, &ov), edge_settings, lca, masked)?;
-        let passes = match shape {
-            PassShape::Fragment => {
+        let buffer = |what: &str, size: u64, usage: wgpu::BufferUsages| {
+            let usage = usage | wgpu::BufferUsages::STORAGE;
+            let desc = wgpu::BufferDescriptor { label: Some(&label(what)), size, usage, mapped_at_creation: false };
+            device.create_buffer(&desc)
+        };
+        use wgpu::BufferUsages as B;
+        // The compute shape's edge rows, edge list and indirect arguments of the weights pass.
+        let buffers = (shape == PassShape::Compute).then(|| {
+            let rows = buffer("edge rows", rows_bytes, B::COPY_SRC);
+            (rows, buffer("edge list", list_bytes, B::COPY_DST), buffer("weights dispatch", 12, B::INDIRECT))
+        });
+        let outputs = buffers.as_ref().map(|(rows, list, _)| EdgeOutputs { rows, list, weights: &wv });
+        let extra = EdgeStage::new(device, size, (&cv, &ov), (edge_settings, lca, masked), outputs)?;
+        let passes = match buffers {
+            None => {
                 let pipes =
                     [("edges", "fs_edges", true), ("weights", "fs_weights", false), ("blend", "fs_blend", false)].map(
                         |(stage, entry, rg)| {
@@ -206,31 +295,24 @@ impl ThreePass {
                 let groups = [0, 1, 2].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
                 Passes::Fragment { pipes, groups, views: [ev.clone(), wv.clone(), ov.clone()] }
             }
-            PassShape::Compute => {
-                let buffer = |what: &str, size: u64, usage: wgpu::BufferUsages| {
-                    let usage = usage | wgpu::BufferUsages::STORAGE;
-                    let desc =
-                        wgpu::BufferDescriptor { label: Some(&label(what)), size, usage, mapped_at_creation: false };
-                    device.create_buffer(&desc)
-                };
-                use wgpu::BufferUsages as B;
-                let edge_rows = buffer("edge rows", rows_bytes, B::COPY_SRC);
-                let edge_list = buffer("edge list", list_bytes, B::COPY_DST);
-                let weights_args = buffer("weights dispatch", 12, B::INDIRECT);
+            Some((edge_rows, edge_list, weights_args)) => {
+                let mask_view = extra.mask().map(|t| t.create_view(&Default::default()));
+                let mask_entry: Vec<_> = mask_view.iter().map(|v| (13, R::TextureView(v))).collect();
                 let [edges_entries, mut weights_entries, blend_entries] = entries;
                 let list = || (11, edge_list.as_entire_binding());
-                weights_entries.extend([(9, R::TextureView(&wv)), list()]);
+                let weights_out = || (9, R::TextureView(&wv));
+                weights_entries.extend([weights_out(), list()]);
                 let entries = [
-                    [edges_entries, vec![(8, edge_rows.as_entire_binding())]].concat(),
-                    vec![ubo(), (2, R::TextureView(&ev)), (9, R::TextureView(&wv)), list()],
+                    [edges_entries, vec![(8, edge_rows.as_entire_binding()), weights_out(), list()]].concat(),
                     vec![list(), (12, weights_args.as_entire_binding())],
                     weights_entries,
-                    [blend_entries, vec![(10, R::TextureView(&ov))]].concat(),
+                    [blend_entries, vec![(10, R::TextureView(&ov))], mask_entry].concat(),
                 ];
-                let stages = ["cs_edges", "cs_edge_list", "cs_edge_args", "cs_weights_list", "cs_blend"];
+                let blend = if masked { "cs_blend_masked" } else { "cs_blend" };
+                let stages = ["cs_edges", "cs_edge_args", "cs_weights_list", blend];
                 let pipes = stages.map(|e| gpu::compute_pipeline(device, spec.module, e));
-                let groups = [0, 1, 2, 3, 4].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
-                Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view: ev.clone() }
+                let groups = [0, 1, 2, 3].map(|k| group(stages[k], &pipes[k].get_bind_group_layout(0), &entries[k]));
+                Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args }
             }
         };
         Ok(Self { width, height, color, edges, weights, output, passes, extra, name })
@@ -244,33 +326,35 @@ impl ThreePass {
         }
     }
 
+    /// Render (fragment) passes [`Self::encode`] records: the three of the fragment shape and the edge detector's and
+    /// mask's in that shape; none in the compute shape.
+    pub fn render_passes(&self) -> u32 {
+        let own = match self.passes {
+            Passes::Fragment { .. } => SMAA_OR_MLAA_PASSES,
+            Passes::Compute { .. } => 0,
+        };
+        own + self.extra.render_passes()
+    }
+
     /// Records the three passes; `timer` slots `first..first+3` receive their timestamps (in the compute shape the
-    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the edge
-    /// list, the dispatch arguments and the weights).
+    /// edges slot spans its pass and the copy of the edge rows into the edges texture, the weights slot the
+    /// dispatch arguments and the weights).
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder, timer: Option<(&GpuTimer, u32)>) {
         let slot = |k: u32| timer.map(|(t, first)| (t, first + k));
         match &self.passes {
             Passes::Fragment { pipes, groups, views } => {
                 for k in 0..3 {
-                    if k == 0 && self.extra.encode_edges(enc, &views[0], slot(0)) {
+                    if k == 0 && self.extra.encode_edges(enc, EdgeOut::Render(&views[0], slot(0))) {
                         continue;
                     }
                     let label = format!("{} {}", self.name, ["edges", "weights", "blend"][k]);
                     gpu::draw_fullscreen(enc, &label, &pipes[k], &groups[k], &views[k], slot(k as u32));
                 }
             }
-            Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args, edges_view } => {
+            Passes::Compute { pipes, groups, edge_rows, edge_list, weights_args } => {
                 let (w, h) = (self.width, self.height);
-                // One compute pass of pipeline `k`: a grid of `groups_xy` workgroups, or the indirect arguments.
-                let dispatch = |enc: &mut wgpu::CommandEncoder, k: usize, groups_xy: Option<(u32, u32)>, writes| {
-                    let desc = wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: writes };
-                    let mut pass = enc.begin_compute_pass(&desc);
-                    pass.set_pipeline(&pipes[k]);
-                    pass.set_bind_group(0, &groups[k], &[]);
-                    match groups_xy {
-                        Some((x, y)) => pass.dispatch_workgroups(x, y, 1),
-                        None => pass.dispatch_workgroups_indirect(weights_args, 0),
-                    }
+                let run = |enc: &mut wgpu::CommandEncoder, k: usize, groups_xy, writes| {
+                    dispatch(enc, self.name, &pipes[k], &groups[k], groups_xy, writes)
                 };
                 // The begin (or end) timestamp of slot `k` alone: a slot spanning several passes.
                 let half = |k: u32, begin: bool| {
@@ -280,34 +364,38 @@ impl ThreePass {
                         end_of_pass_write_index: (!begin).then_some(2 * i + 1),
                     })
                 };
-                let grid = |threads_x: u32| Some((threads_x.div_ceil(WORKGROUP), h.div_ceil(WORKGROUP)));
                 enc.clear_buffer(edge_list, 0, Some(4));
-                if !self.extra.encode_edges(enc, edges_view, slot(0)) {
-                    dispatch(enc, 0, grid(w.div_ceil(2)), half(0, true));
-                    enc.copy_buffer_to_texture(
-                        wgpu::TexelCopyBufferInfo {
-                            buffer: edge_rows,
-                            layout: wgpu::TexelCopyBufferLayout {
-                                offset: 0,
-                                bytes_per_row: Some(edge_row_bytes(w)),
-                                rows_per_image: None,
-                            },
-                        },
-                        self.edges.as_image_copy(),
-                        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                    );
-                    // An empty pass closes the edges slot after the copy.
-                    if let Some(writes) = half(0, false) {
-                        drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                            label: Some("edges copied"),
-                            timestamp_writes: Some(writes),
-                        }));
-                    }
+                if !self.extra.encode_edges(enc, EdgeOut::Rows(half(0, true))) {
+                    run(enc, 0, grid(w.div_ceil(2), h), half(0, true));
                 }
-                dispatch(enc, 1, grid(w), half(1, true));
-                dispatch(enc, 2, Some((1, 1)), None);
-                dispatch(enc, 3, None, half(1, false));
-                dispatch(enc, 4, grid(w), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
+                enc.copy_buffer_to_texture(
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: edge_rows,
+                        layout: wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(edge_row_bytes(w)),
+                            rows_per_image: None,
+                        },
+                    },
+                    self.edges.as_image_copy(),
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                );
+                // An empty pass closes the edges slot after the copy.
+                if let Some(writes) = half(0, false) {
+                    drop(enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("edges copied"),
+                        timestamp_writes: Some(writes),
+                    }));
+                }
+                run(enc, 1, (1, 1), half(1, true));
+                {
+                    let desc = wgpu::ComputePassDescriptor { label: Some(self.name), timestamp_writes: half(1, false) };
+                    let mut pass = enc.begin_compute_pass(&desc);
+                    pass.set_pipeline(&pipes[2]);
+                    pass.set_bind_group(0, &groups[2], &[]);
+                    pass.dispatch_workgroups_indirect(weights_args, 0);
+                }
+                run(enc, 3, grid(w, h), slot(2).map(|(t, i)| t.compute_pass_writes(i)));
             }
         }
         self.extra.encode_mask(enc);
