@@ -736,7 +736,18 @@ mod one_encoder {
         let cam = s.camera();
         let (w, h) = (s.width, s.height);
         let n = w as u64 * h as u64;
-        let job = FrameGeometryJob { mesh: heads, camera: cam, width: w, height: h, melanin: s.melanin, rig_pose };
+        // One sample, no surface maps, no wrinkle pass: the frames this path takes (`render_with`).
+        let job = FrameGeometryJob {
+            mesh: heads,
+            camera: cam,
+            width: w,
+            height: h,
+            melanin: s.melanin,
+            rig_pose,
+            msaa: 1,
+            surface_maps: None,
+            wrinkles: None,
+        };
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // 1. The frame's geometry, skin inputs and unblurred diffuse layer.
