@@ -55,8 +55,15 @@ pub struct DeviceOptions {
 /// Creates a headless device on the adapter selected by `WGPU_BACKEND` / `WGPU_ADAPTER_NAME` (else the default
 /// adapter of any enabled backend). Fails with [`RuntimeError::NoAdapter`] when none is found.
 pub fn create_headless(opts: &DeviceOptions) -> Result<Gpu, RuntimeError> {
+    // One thread at a time: choosing an adapter enumerates every enabled backend, and wgpu's GL backend makes its
+    // EGL context current on the calling thread; two threads doing so at once panic inside wgpu-hal (EGL
+    // `BadAccess`, seen on an NVIDIA H100 with the test suite's threads and once on llvmpipe).
+    let _one_at_a_time = ADAPTER_CHOICE.lock().unwrap_or_else(|e| e.into_inner());
     pollster::block_on(create_headless_async(opts))
 }
+
+/// Held while an adapter and a device are chosen ([`create_headless`]).
+static ADAPTER_CHOICE: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// The process's one wgpu instance and its backends. Devices of one instance have distinct ids while alive, which
 /// the per-device object cache of [`crate::runtime::gpu::cached`] keys on (ids of two instances may coincide).
