@@ -27,7 +27,7 @@
 //! default runs are unchanged.
 
 use crate::error::{check_range, InvalidInput};
-use crate::runtime::aa::three_pass::{dispatch, grid, ShapedPass};
+use crate::runtime::aa::pass_shape::{dispatch, grid, ShapedPass};
 use crate::runtime::gpu;
 
 /// SMAA's luma / colour threshold (SMAA.hlsl `SMAA_THRESHOLD`, preset HIGH; MLAA's listings use the same 0.1).
@@ -214,7 +214,7 @@ pub(crate) struct EdgeOutputs<'a> {
 
 /// The GPU side of this module for one pass: the depth and mask textures, the edge pass replacing the pass's
 /// luma detector (unless plain luma) and, in the fragment shape, the mask composite (when masked); the edge pass as a
-/// fragment or compute pass (the frame's [`PassShape`](super::three_pass::PassShape); same bytes).
+/// fragment or compute pass (the frame's [`PassShape`](super::pass_shape::PassShape); same bytes).
 pub(crate) struct EdgeStage {
     settings: EdgeSettings,
     size: (u32, u32),

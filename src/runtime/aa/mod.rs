@@ -14,6 +14,7 @@ pub mod mlaa_cpu;
 pub mod modes;
 pub mod modes_cpu;
 pub mod moving_scene;
+pub mod pass_shape;
 pub mod scene;
 pub mod smaa;
 pub mod smaa_cpu;

@@ -31,8 +31,8 @@
 
 use crate::error::InvalidInput;
 use crate::runtime::aa::moving_scene::MovingScene;
+use crate::runtime::aa::pass_shape::{frame_texture, PassShape, ShapedPass};
 use crate::runtime::aa::smaa::{Smaa, SmaaOptions, SmaaTextures, SubsampleIndices, SMAA_PASSES};
-use crate::runtime::aa::three_pass::{frame_texture, PassShape, ShapedPass};
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
 
