@@ -28,8 +28,9 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     set_pass_profiling(false);
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
-    // Recording order: the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS passes, bloom (one
-    // level at 32 rows) and the tone map; spans where other work lies between two chain recordings.
+    // Recording order: the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
+    // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
     let expected = [
         "frame start → frame geometry: main",

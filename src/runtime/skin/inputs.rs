@@ -416,7 +416,7 @@ mod tests {
     fn case() -> (SkinLuts, RigScaleBiasMaps, SkinFrame) {
         let (lw, lh) = (5u32, 4u32);
         let albedo = (0..lw * lh).map(|i| [0.1 + 0.03 * i as f32, 0.7 - 0.02 * i as f32, 0.3 + 0.01 * (i % 3) as f32]);
-        let transmittance = (0..7).map(|i| [(-0.5 * i as f32).exp(), (-1.0 * i as f32).exp(), (-2.0 * i as f32).exp()]);
+        let transmittance = (0..7).map(|i| [(-0.5 * i as f32).exp(), (-(i as f32)).exp(), (-2.0 * i as f32).exp()]);
         let luts = SkinLuts {
             albedo_size: (lw, lh),
             albedo: albedo.collect(),
