@@ -1,7 +1,8 @@
 //! Per-pass GPU profiling of `run skin`'s frame (`runtime::gpu::set_pass_profiling`): a profiled frame is the same
 //! frame, its passes come back in recording order with the spans between them, GPU times where the device has
 //! timestamp queries, and each compute-chain pass's bytes moved equal a hand count of the buffers it reads and
-//! writes (`shade_frame.wgsl`: each storage buffer an entry point reads, and each it writes, counted whole, once).
+//! writes (`inputs_compute.wgsl`, `shade_frame.wgsl`: each storage buffer an entry point reads, and each it
+//! writes, counted whole, once).
 
 use crate::support::baked_dir;
 use rtbake::mesh::head::default_head;
@@ -27,8 +28,9 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     set_pass_profiling(false);
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
-    // Recording order: the device geometry, the rig at uv, the shading chain around the SSS passes, bloom (one
-    // level at 32 rows) and the tone map; spans where other work lies between two chain recordings.
+    // Recording order: the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
+    // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
     let expected = [
         "frame start → frame geometry: main",
@@ -36,7 +38,9 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
         "frame geometry: main → mesh skin inputs: main",
         "mesh skin inputs: main",
         "mesh skin inputs: into_skin_maps",
-        "mesh skin inputs: into_skin_maps → skin frame: lit",
+        "mesh skin inputs: into_skin_maps → skin inputs: main",
+        "skin inputs: main",
+        "skin inputs: main → skin frame: lit",
         "skin frame: lit",
         "skin frame: pack",
         "skin frame: pack → skin frame: composite",
@@ -61,6 +65,15 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     let n = (width * height) as u64;
     let (skin16, geo, diffuse, sss16, hdr, bloomed, rgba) = (16 * n, 32 * n, 16 * n, 8 * n, 16 * n, 16 * n, 4 * n);
     let bytes = |label: &str| profile.iter().find(|p| p.label == label).and_then(|p| p.bytes);
+    // skin inputs: reads the geometry's maps and normals (one vec4 per pixel each, 64 × 16 bytes = a padded row),
+    // the rig (two halves per texel per target: the screen-space frame's neutral rig, 2×2 texels, one target),
+    // the albedo LUT and the T(s) table (Rgba16Float), writes skin16.
+    let (maps, normals, rig) = (16 * n, 16 * n, 4 * 4);
+    let (lw, lh) = assets.luts.albedo_size;
+    let (lut, t_table) = (8 * (lw * lh) as u64, 8 * assets.luts.transmittance.len() as u64);
+    let round16 = |b: u64| b.div_ceil(16) * 16;
+    let tables = round16(rig) + round16(lut) + round16(t_table);
+    assert_eq!(bytes("skin inputs: main"), Some(maps + normals + tables + skin16));
     // lit: reads skin16 (albedo, transmitted) and geo, writes diffuse.
     assert_eq!(bytes("skin frame: lit"), Some(skin16 + geo + diffuse));
     // pack: reads diffuse, writes sss16.

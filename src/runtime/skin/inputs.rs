@@ -2,10 +2,14 @@
 //! Model for Dynamic Facial Color", SIGGRAPH Asia 2010; thesis eq. 7.6), albedo from the melanin × hemoglobin LUT
 //! (eq. 7.7, normalised index u = cbrt(Cm/0.5), v = cbrt(Chd/0.32), node-inclusive), and transmittance T(s)·E
 //! through thin regions (Jimenez et al., "Real-Time Realistic Skin Translucency", IEEE CG&A 2010; thesis eq.
-//! 5.12–5.13, E = max(0.3 + dot(−N, L), 0)). One fragment pass, two `Rgba16Float` targets. CPU twin
+//! 5.12–5.13, E = max(0.3 + dot(−N, L), 0)). One fragment pass, two `Rgba16Float` targets ([`SkinInputs::encode`],
+//! the per-pass path), or the same arithmetic (`inputs_common.wgsl`) as a compute pass over storage buffers
+//! recorded through `compute_chain::record` ([`SkinInputs::record_compute`], the one-encoder frames: no copies in
+//! or out of textures, and on GPUs with few raster units no full-screen fragment pass). CPU twin
 //! [`crate::runtime::skin::inputs_cpu`].
 
 use crate::error::InvalidInput;
+use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
@@ -105,9 +109,12 @@ struct Params {
     lut: [f32; 4],
     cfg: [f32; 4],
     weights: [[f32; 4]; 2],
+    rows: [f32; 4],
 }
 
-const SHADER: &str = concat!(include_str!("../fullscreen.wgsl"), include_str!("inputs.wgsl"));
+const SHADER: &str =
+    concat!(include_str!("../fullscreen.wgsl"), include_str!("inputs_common.wgsl"), include_str!("inputs.wgsl"));
+const COMPUTE: &str = concat!(include_str!("inputs_common.wgsl"), include_str!("inputs_compute.wgsl"));
 
 fn f16_bytes(v: impl Iterator<Item = f32>) -> Vec<u8> {
     let h: Vec<half::f16> = v.map(half::f16::from_f32).collect();
@@ -131,6 +138,8 @@ pub struct SkinInputs {
     transmitted_view: wgpu::TextureView,
     pipe: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
+    /// The compute pass's copies of the rig, the albedo LUT and the T(s) table: the half floats of the textures.
+    tables: [wgpu::Buffer; 3],
     ubo: wgpu::Buffer,
     params: Params,
 }
@@ -182,7 +191,9 @@ impl SkinInputs {
         let k = rig.targets.len() as u32;
         // At least two layers: the GL backend cannot view a one-layer texture as a 2D array.
         let rig_tex = data_texture(device, "skin rig", rig.width, rig.height, k.max(2), F::Rg16Float);
+        let mut rig_halves = Vec::new();
         for (i, t) in rig.targets.iter().enumerate() {
+            let halves = f16_bytes(t.iter().flatten().copied());
             queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &rig_tex,
@@ -190,7 +201,7 @@ impl SkinInputs {
                     origin: wgpu::Origin3d { x: 0, y: 0, z: i as u32 },
                     aspect: wgpu::TextureAspect::All,
                 },
-                &f16_bytes(t.iter().flatten().copied()),
+                &halves,
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(rig.width * 4),
@@ -198,13 +209,20 @@ impl SkinInputs {
                 },
                 wgpu::Extent3d { width: rig.width, height: rig.height, depth_or_array_layers: 1 },
             );
+            rig_halves.extend_from_slice(&halves);
         }
         let (lw, lh) = luts.albedo_size;
         let lut_tex = gpu::texture(device, "skin albedo LUT", lw, lh, F::Rgba16Float);
-        gpu::upload(queue, &lut_tex, &f16_bytes(luts.albedo.iter().flat_map(|c| [c[0], c[1], c[2], 1.0])));
+        let lut_halves = f16_bytes(luts.albedo.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
+        gpu::upload(queue, &lut_tex, &lut_halves);
         let nt = luts.transmittance.len() as u32;
         let t_tex = gpu::texture(device, "skin T(s)", nt, 1, F::Rgba16Float);
-        gpu::upload(queue, &t_tex, &f16_bytes(luts.transmittance.iter().flat_map(|c| [c[0], c[1], c[2], 1.0])));
+        let t_halves = f16_bytes(luts.transmittance.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
+        gpu::upload(queue, &t_tex, &t_halves);
+        let what = "skin inputs";
+        compute_chain::check_buffers(device, what, &[rig_halves.len() as u64])?;
+        let table = |b: &[u8]| compute_chain::storage_buffer(device, what, b.len() as u64, Some(b));
+        let tables = [table(&rig_halves), table(&lut_halves), table(&t_halves)];
         let albedo = gpu::texture(device, "skin albedo", width, height, F::Rgba16Float);
         let transmitted = gpu::texture(device, "skin transmitted", width, height, F::Rgba16Float);
         let params = Params {
@@ -213,13 +231,18 @@ impl SkinInputs {
             lut: [lw as f32, lh as f32, nt as f32, luts.s_max_mm],
             cfg: [k as f32, 0.0, 0.0, 0.0],
             weights: [[0.0; 4]; 2],
+            rows: [
+                (gpu::padded_row_bytes(&maps) / 16) as f32,
+                (gpu::padded_row_bytes(&albedo) / 4) as f32,
+                rig.width as f32,
+                rig.height as f32,
+            ],
         };
         let ubo = gpu::uniform_buffer(device, "skin params", bytemuck::bytes_of(&params));
         let module = gpu::shader(device, "skin_inputs.wgsl", SHADER);
         let target = |f| Some(wgpu::ColorTargetState { format: f, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let targets = [target(F::Rgba16Float), target(F::Rgba16Float)];
         let pipe = gpu::fullscreen_pipeline_with(device, "skin inputs", &module, "fs_skin", &targets);
-        let lin = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let rig_view = rig_tex.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -238,7 +261,6 @@ impl SkinInputs {
                 (3, R::TextureView(&rig_view)),
                 (4, R::TextureView(&lv)),
                 (5, R::TextureView(&tv)),
-                (6, R::Sampler(&lin)),
             ],
         );
         let (albedo_view, transmitted_view) = (view(&albedo), view(&transmitted));
@@ -253,6 +275,7 @@ impl SkinInputs {
             transmitted_view,
             pipe,
             group,
+            tables,
             ubo,
             params,
         })
@@ -271,11 +294,6 @@ impl SkinInputs {
     /// computes H on the device writes it there ([`MapsFrom::Device`]).
     pub(crate) fn maps(&self) -> &wgpu::Texture {
         &self.maps
-    }
-
-    /// The normals texture the pass reads, (normal, 0) per pixel, `Rgba32Float`.
-    pub(crate) fn normals(&self) -> &wgpu::Texture {
-        &self.normals
     }
 
     /// Uploads a frame and the per-frame rig weights and light direction (unit, towards the light); the maps
@@ -351,6 +369,24 @@ impl SkinInputs {
         pass.draw(0..3, 0..1);
     }
 
+    /// Records the pass as a compute pass through `compute_chain::record` (`inputs_compute.wgsl`, the fragment
+    /// pass's arithmetic) over `maps` (Cm, H0, thickness mm, 0) and `normals` (normal, 0), Rgba32Float rows padded
+    /// as [`Self::maps`]'s, writing albedo + H then T(s)·E + E into `out` as two Rgba16Float images with rows padded
+    /// as [`Self::albedo`]'s (the layout a texture-to-buffer copy of the two targets gives). The buffers are
+    /// [`compute_chain::STORAGE_USAGE`] and at least that large; the rig weights and light are the last uploaded.
+    pub(crate) fn record_compute(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        [maps, normals]: [&wgpu::Buffer; 2],
+        out: &wgpu::Buffer,
+    ) {
+        let [rig, lut, t] = &self.tables;
+        let bound = [maps, normals, rig, lut, t, out];
+        let stages = [Stage::new("main", compute_chain::groups_8x8(self.width, self.height))];
+        compute_chain::record(device, enc, "skin inputs", COMPUTE, bytemuck::bytes_of(&self.params), &bound, &stages);
+    }
+
     /// Uploads, runs and reads back (albedo+H, T·E+E) as RGBA f32.
     pub fn run(
         &mut self,
@@ -367,5 +403,100 @@ impl SkinInputs {
         let mut read = gpu::read_textures(device, queue, enc, &[&self.albedo, &self.transmitted])?;
         let transmitted = gpu::f16_to_f32(&read.pop().expect("two targets"));
         Ok((gpu::f16_to_f32(&read.pop().expect("two targets")), transmitted))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::runtime::device::{create_headless, DeviceOptions};
+
+    /// A 20×12 frame (rows padded on both sides) with a 5×4 LUT, a 7-texel T(s) and a 3×2 rig of three targets,
+    /// values spread so every bilinear weight and clamp occurs.
+    fn case() -> (SkinLuts, RigScaleBiasMaps, SkinFrame) {
+        let (lw, lh) = (5u32, 4u32);
+        let albedo = (0..lw * lh).map(|i| [0.1 + 0.03 * i as f32, 0.7 - 0.02 * i as f32, 0.3 + 0.01 * (i % 3) as f32]);
+        let transmittance = (0..7).map(|i| [(-0.5 * i as f32).exp(), (-(i as f32)).exp(), (-2.0 * i as f32).exp()]);
+        let luts = SkinLuts {
+            albedo_size: (lw, lh),
+            albedo: albedo.collect(),
+            transmittance: transmittance.collect(),
+            s_max_mm: 5.0,
+        };
+        let target = |k: f32| (0..6).map(|i| [0.8 + 0.1 * k + 0.05 * i as f32, 0.02 * k + 0.01 * i as f32]).collect();
+        let rig = RigScaleBiasMaps { width: 3, height: 2, targets: vec![target(0.0), target(1.0), target(2.0)] };
+        let (w, h) = (20u32, 12u32);
+        let n = (w * h) as usize;
+        let at = |i: usize| ((i % w as usize) as f32 / w as f32, (i / w as usize) as f32 / h as f32);
+        let frame = SkinFrame {
+            width: w,
+            height: h,
+            melanin: (0..n).map(|i| 0.6 * at(i).0).collect(),
+            h0: (0..n).map(|i| 0.3 * at(i).1 - 0.02).collect(),
+            thickness_mm: (0..n).map(|i| 6.0 * at(i).0 * at(i).1).collect(),
+            normals: (0..n)
+                .map(|i| {
+                    let a = 6.0 * at(i).0 + at(i).1;
+                    [a.cos(), 0.0, a.sin()]
+                })
+                .collect(),
+        };
+        (luts, rig, frame)
+    }
+
+    /// The compute pass over storage buffers writes the fragment pass's two Rgba16Float images in the padded-row
+    /// layout a texture-to-buffer copy of the targets gives: the same f32 arithmetic (`inputs_common.wgsl`), so
+    /// every value within one half-float ulp (the render target's conversion and `pack2x16float` may round the
+    /// same f32 differently; on llvmpipe about half the albedo values differ by one ulp).
+    #[test]
+    fn the_compute_pass_writes_the_fragment_pass_half_floats_within_one_ulp() {
+        let g = create_headless(&DeviceOptions::default()).expect("an adapter (lavapipe)");
+        let (device, queue) = (&g.device, &g.queue);
+        let (luts, rig, frame) = case();
+        let (weights, light) = ([0.5f32, 0.3, 0.2], [0.0f32, 0.6, -0.8]);
+        let mut pass = SkinInputs::new(device, queue, frame.width, frame.height, &luts, &rig).unwrap();
+        let (albedo, transmitted) = pass.run(device, queue, &frame, &weights, light).unwrap();
+
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let (row32, row16) = (gpu::padded_row_bytes(&pass.maps) as usize, gpu::padded_row_bytes(&pass.albedo) as usize);
+        assert!(row32 > 16 * w && row16 > 8 * w, "rows are padded on both sides");
+        let padded = |texels: Vec<[f32; 4]>| {
+            let mut out = vec![0.0f32; row32 / 4 * h];
+            for (y, row) in texels.chunks_exact(w).enumerate() {
+                out[y * row32 / 4..][..4 * w].copy_from_slice(bytemuck::cast_slice(row));
+            }
+            compute_chain::storage_buffer(device, "test", (4 * out.len()) as u64, Some(bytemuck::cast_slice(&out)))
+        };
+        let maps = padded(maps_texels(&frame));
+        let normals = padded(frame.normals.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect());
+        let out_bytes = (2 * row16 * h) as u64;
+        let out = compute_chain::storage_buffer(device, "test", out_bytes, None);
+        let mut enc = device.create_command_encoder(&Default::default());
+        pass.record_compute(device, &mut enc, [&maps, &normals], &out);
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: out_bytes,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        enc.copy_buffer_to_buffer(&out, 0, &readback, 0, out_bytes);
+        gpu::submit(queue, enc.finish());
+        let got = gpu::map_read(device, &readback).unwrap();
+
+        for (k, want) in [albedo, transmitted].iter().enumerate() {
+            let mut image = Vec::with_capacity(8 * w * h);
+            for y in 0..h {
+                image.extend_from_slice(&got[(k * h + y) * row16..][..8 * w]);
+            }
+            let image = gpu::f16_to_f32(&image);
+            let ulps = |a: f32, b: f32| {
+                let bits = |v: f32| half::f16::from_f32(v).to_bits() as i32;
+                (bits(a) - bits(b)).abs()
+            };
+            let worst = image.iter().zip(want).map(|(a, b)| ulps(*a, *b)).max().unwrap_or(0);
+            let at = image.iter().zip(want).position(|(a, b)| ulps(*a, *b) == worst).unwrap_or(0);
+            assert!(worst <= 1, "image {k}: {worst} half-float ulps at {at}: {} vs {}", image[at], want[at]);
+            assert!(want.iter().any(|v| *v > 0.05), "image {k} is not blank");
+        }
     }
 }

@@ -9,8 +9,11 @@
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
 //! and read back on its own, for inspection and for texture-space diffusion): `render_geometry` picks one.
 //!
-//! Where a texture pass and a buffer pass meet, the data is converted on the device: the skin-inputs targets
-//! (`Rgba16Float`) and the SSS pass's output are copied into buffers with padded rows and unpacked by
+//! With the geometry on the device, the skin-inputs pass is a compute pass (`SkinInputs::record_compute`) that
+//! reads the geometry's maps and normals buffers and writes its two `Rgba16Float` images straight into the buffer
+//! `shade_frame.wgsl` reads. Where a texture pass and a buffer pass meet, the data is converted on the device: with
+//! the host's geometry the skin-inputs targets (`Rgba16Float`), and the SSS pass's output, are copied into buffers
+//! with padded rows and unpacked by
 //! `shade_frame.wgsl`, which also packs the lit layer as the SSS pass's half-float input (a buffer-to-texture copy).
 //! `shade_frame.wgsl` runs through `compute_chain::record`, bloom through `bloom::record`.
 
@@ -166,6 +169,9 @@ pub(crate) fn shade(
         None => None,
     };
     let (light, weights) = (assets.lights.back_view, &assets.rig_weights);
+    // The skin-inputs maps and normals as buffers (the device's geometry: the compute pass reads them), or None
+    // (the host's: uploaded into the fragment pass's textures).
+    let mut maps_normals = None;
     let (geo_buf, coverage) = match source {
         FrameSource::Host(geo) => {
             match (&geo.rig_at_uv, &assets.baked_rig) {
@@ -207,8 +213,7 @@ pub(crate) fn shade(
                     d.vec4_row,
                 )?;
             }
-            gpu::encode_buffer_to_texture(&mut enc, &d.skin_maps, 0, inputs.maps());
-            gpu::encode_buffer_to_texture(&mut enc, &d.normals, 0, inputs.normals());
+            maps_normals = Some((d.skin_maps, d.normals));
             if let Some(b) = &blur {
                 gpu::encode_buffer_to_texture(&mut enc, &d.depth, 0, b.depth());
             }
@@ -248,9 +253,14 @@ pub(crate) fn shade(
     let groups = compute_chain::groups_8x8(w, h);
     let stages = |names: &[&'static str]| names.iter().map(|e| Stage::new(e, groups)).collect::<Vec<_>>();
     let uniform = bytemuck::bytes_of(&params);
-    inputs.encode(&mut enc);
-    gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
-    gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row * h as u64);
+    match &maps_normals {
+        Some((maps, normals)) => inputs.record_compute(device, &mut enc, [maps, normals], &skin16),
+        None => {
+            inputs.encode(&mut enc);
+            gpu::encode_texture_to_buffer(&mut enc, inputs.albedo(), &skin16, 0);
+            gpu::encode_texture_to_buffer(&mut enc, inputs.transmitted(), &skin16, row * h as u64);
+        }
+    }
     match &blur {
         Some(b) => {
             compute_chain::record(device, &mut enc, what, SOURCE, uniform, &bound, &stages(&["lit", "pack"]));

@@ -643,23 +643,6 @@ mod one_encoder {
         })
     }
 
-    /// Records the skin-inputs pass of `inputs` over the maps (Cm, H0, thickness) and normals in `maps_normals`
-    /// (padded rows, copied into its textures) and copies its albedo and transmitted light into `out` (two
-    /// Rgba16Float images, padded rows).
-    fn record_skin_inputs(
-        enc: &mut wgpu::CommandEncoder,
-        inputs: &SkinInputs,
-        [maps, normals]: [&wgpu::Buffer; 2],
-        out: &wgpu::Buffer,
-    ) {
-        gpu::encode_buffer_to_texture(enc, maps, 0, inputs.maps());
-        gpu::encode_buffer_to_texture(enc, normals, 0, inputs.normals());
-        inputs.encode(enc);
-        let image_bytes = gpu::padded_row_bytes(inputs.albedo()) as u64 * inputs.albedo().height() as u64;
-        gpu::encode_texture_to_buffer(enc, inputs.albedo(), out, 0);
-        gpu::encode_texture_to_buffer(enc, inputs.transmitted(), out, image_bytes);
-    }
-
     /// The per-frame buffers of one irradiance-map size (heads of the same size reuse them, one after the other).
     struct MapBuffers {
         inputs: SkinInputs,
@@ -782,7 +765,7 @@ mod one_encoder {
             Some(b) => (b.0[0].clone(), b.0[3].clone()),
             None => (storage_buffer(device, what, sizes[1], None), unused()),
         };
-        record_skin_inputs(&mut enc, &inputs, [&d.skin_maps, &d.normals], &skin16);
+        inputs.record_compute(device, &mut enc, [&d.skin_maps, &d.normals], &skin16);
         let key = assets.lights.key_view;
         let bloom_on = bloom_buffers.is_some() as u8 as f32;
         let shade_params = |width: u32, height: u32, row16: u64| ShadeParams {
@@ -850,7 +833,7 @@ mod one_encoder {
                 compute_chain::record(device, enc, what, FRAME_SOURCE, uniform, &bound, &stages);
             };
             record_stage(&mut enc, "texels", groups_8x8(size, size));
-            record_skin_inputs(&mut enc, &m.inputs, [&m.maps, &m.normals], &m.skin16);
+            m.inputs.record_compute(device, &mut enc, [&m.maps, &m.normals], &m.skin16);
             let [a, b, c, e] = &texel_unused;
             let texel_bound = [&m.skin16, &m.geo, &m.chain, a, b, c, e];
             shade(&mut enc, &shade_params(size, size, m.row16), &texel_bound, "lit", groups_8x8(size, size));
