@@ -201,18 +201,17 @@ pub(crate) fn shade(
         FrameSource::Device(job) => {
             let d = frame_geometry::record(device, &mut enc, job, assets)?;
             inputs.upload_lights(queue, weights, light)?;
-            if let (Some(pose), Some(r)) = (&job.rig_pose, &assets.baked_rig) {
-                let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose };
-                mesh_inputs::record_into_skin_map_buffer(
-                    device,
-                    &mut enc,
-                    (w, h),
-                    &maps,
-                    &d.uvc,
-                    &d.skin_maps,
-                    d.vec4_row,
-                )?;
-            }
+            let (pose, rig) = (job.rig_pose.as_ref(), assets.baked_rig.as_ref());
+            mesh_inputs::record_pose_into_skin_map_buffer(
+                device,
+                &mut enc,
+                (w, h),
+                pose,
+                rig,
+                &d.uvc,
+                &d.skin_maps,
+                d.vec4_row,
+            )?;
             maps_normals = Some((d.skin_maps, d.normals));
             if let Some(b) = &blur {
                 gpu::encode_buffer_to_texture(&mut enc, &d.depth, 0, b.depth());
