@@ -32,6 +32,79 @@ thread_local! {
     static PIPELINES_CREATED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
     static SUBMISSIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
     static READ_BACKS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    static BUFFERS_UPLOADED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Buffers of a frame's per-mesh and per-map data (vertices, indices, a scan's surface maps) created and filled on
+/// the calling thread since it started: the uploads the [`Kept`] caches avoid after the first frame.
+pub fn buffers_uploaded_on_this_thread() -> u64 {
+    BUFFERS_UPLOADED.with(|c| c.get())
+}
+
+/// Counts one upload in [`buffers_uploaded_on_this_thread`].
+pub(crate) fn count_buffer_upload() {
+    BUFFERS_UPLOADED.with(|c| c.set(c.get() + 1));
+}
+
+/// A small cache of per-frame work kept across frames: the last `keep` values, found by comparing the whole key
+/// (no hash stands for it), the most recently used kept. A key naming a `wgpu::Device` keeps that device alive
+/// while its entry is kept. With [`object_cache_enabled`] off every call builds its value again, as before the
+/// caches existed (benchmarks measure the difference).
+pub struct Kept<K, V> {
+    entries: Mutex<Vec<(K, V)>>,
+    keep: usize,
+}
+
+impl<K: PartialEq, V: Clone> Kept<K, V> {
+    /// An empty cache keeping at most `keep` values.
+    pub const fn new(keep: usize) -> Self {
+        Kept { entries: Mutex::new(Vec::new()), keep }
+    }
+
+    /// The value of `key`: built by `make` the first time, a clone of it while it is kept. The lock is not held
+    /// while `make` runs; two threads racing build it twice and the first kept wins.
+    pub fn get_or_try_insert_with<E>(&self, key: K, make: impl FnOnce() -> Result<V, E>) -> Result<V, E> {
+        if !object_cache_enabled() {
+            return make();
+        }
+        {
+            let mut kept = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(i) = kept.iter().position(|(k, _)| *k == key) {
+                let entry = kept.remove(i);
+                let v = entry.1.clone();
+                kept.push(entry);
+                return Ok(v);
+            }
+        }
+        let v = make()?;
+        let mut kept = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, first)) = kept.iter().find(|(k, _)| *k == key) {
+            return Ok(first.clone());
+        }
+        if kept.len() >= self.keep {
+            kept.remove(0);
+        }
+        kept.push((key, v.clone()));
+        Ok(v)
+    }
+
+    /// [`Kept::get_or_try_insert_with`] for a `make` that cannot fail.
+    pub fn get_or_insert_with(&self, key: K, make: impl FnOnce() -> V) -> V {
+        match self.get_or_try_insert_with(key, || Ok::<V, std::convert::Infallible>(make())) {
+            Ok(v) => v,
+            Err(never) => match never {},
+        }
+    }
+
+    /// Number of values kept.
+    pub fn len(&self) -> usize {
+        self.entries.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+
+    /// Whether nothing is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// Queue submissions made through [`submit`] on the calling thread since it started (every submission of the

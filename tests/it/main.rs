@@ -59,6 +59,7 @@ mod readme_commands;
 mod report_cli;
 mod runtime_cli;
 mod runtime_device_limits;
+mod runtime_frame_caches;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
 mod runtime_importance_sss;

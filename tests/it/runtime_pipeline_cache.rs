@@ -123,8 +123,8 @@ fn synthetic_surface_maps() -> rtbake::runtime::skin::surface_maps::SurfaceMaps 
         [a / l, b / l, 1.0 / l, 0.0]
     });
     SurfaceMaps {
-        albedo: Some(SurfaceMap { width: 48, height: 48, texels: albedo.collect() }),
-        normal: Some(SurfaceMap { width: 40, height: 40, texels: ripple.collect() }),
+        albedo: Some(SurfaceMap { width: 48, height: 48, texels: albedo.collect::<Vec<_>>().into() }),
+        normal: Some(SurfaceMap { width: 40, height: 40, texels: ripple.collect::<Vec<_>>().into() }),
     }
 }
 

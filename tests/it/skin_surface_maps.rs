@@ -41,8 +41,8 @@ fn albedo_map(black: impl Fn(f32, f32) -> bool) -> SurfaceMap {
                 [0.6, 0.4, 0.3, 0.0]
             }
         })
-        .collect();
-    SurfaceMap { width: s, height: s, texels }
+        .collect::<Vec<_>>();
+    SurfaceMap { width: s, height: s, texels: texels.into() }
 }
 
 /// A 32×32 tangent-space normal map of bumps (unit vectors, tilted ±0.4 in x and y).
@@ -55,8 +55,8 @@ fn bump_map() -> SurfaceMap {
             let l = (a * a + b * b + 1.0).sqrt();
             [a / l, b / l, 1.0 / l, 0.0]
         })
-        .collect();
-    SurfaceMap { width: s, height: s, texels }
+        .collect::<Vec<_>>();
+    SurfaceMap { width: s, height: s, texels: texels.into() }
 }
 
 fn maps() -> SurfaceMaps {
@@ -98,7 +98,7 @@ fn surface_map_pass_gpu_matches_cpu_and_a_flat_map_keeps_the_normals() {
     // A flat map (0, 0, 1) is the G-buffer's normal.
     let flat = SurfaceMaps {
         albedo: None,
-        normal: Some(SurfaceMap { width: 4, height: 4, texels: vec![[0.0, 0.0, 1.0, 0.0]; 16] }),
+        normal: Some(SurfaceMap { width: 4, height: 4, texels: vec![[0.0, 0.0, 1.0, 0.0]; 16].into() }),
     };
     for backend in [Some(&g), None] {
         let p = surface_pixels_for(backend, &gb, &flat).unwrap();

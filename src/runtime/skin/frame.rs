@@ -356,7 +356,7 @@ mod limits_tests {
     fn a_mapped_frame_whose_g_buffer_copy_is_over_the_storage_limit_is_refused() {
         use crate::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
         let l = limits();
-        let map = SurfaceMap { width: 2, height: 2, texels: vec![[0.0, 0.0, 1.0, 0.0]; 4] };
+        let map = SurfaceMap { width: 2, height: 2, texels: vec![[0.0, 0.0, 1.0, 0.0]; 4].into() };
         let mapped =
             SkinPasses { surface_maps: Some(SurfaceMaps { albedo: None, normal: Some(map) }), ..SkinPasses::none() };
         // 3 targets × 8 bytes × 2880×1620 = 111974400 bytes fit in 128 MiB; 3840×2160 (199065600) does not.

@@ -23,12 +23,14 @@ use crate::runtime::gpu;
 use crate::runtime::skin::heads::light_camera;
 use crate::runtime::skin::lighting::{DemoAssets, KEY_LIGHT_INTENSITY};
 use crate::runtime::skin::mesh_inputs::RigPose;
-use crate::runtime::skin::mesh_raster::{self, RasterJob};
+use crate::runtime::skin::mesh_raster::{self, MeshBuffers, RasterJob};
 use crate::runtime::skin::passes::Wrinkles;
 use crate::runtime::skin::settings::{SHADOW_MAP_SIZE, SHADOW_SHRINK_MM, WORLD_UNITS_PER_M};
 use crate::runtime::skin::surface_maps::SurfaceMaps;
+use crate::runtime::skin::texture_space::mesh_key;
 use crate::runtime::skin::{surface_maps, wrinkles};
 use crate::runtime::RuntimeError;
+use std::sync::Arc;
 
 /// What the device geometry of a frame needs: the heads' mesh seen by `camera` at `width`×`height` with `msaa`
 /// samples per pixel (1 or 4), the melanin of every covered pixel, the pose of the baked rig whose hemoglobin the
@@ -83,6 +85,49 @@ struct Params {
 
 const SOURCE: &str = include_str!("frame_geometry.wgsl");
 
+/// A mesh as the frame rasterises it: its tangents ([`crate::mesh::tangents::vertex_tangents`]) or, for a
+/// normal-mapped view, the MikkTSpace split (`split`) and its tangents
+/// ([`crate::mesh::tangents::mikktspace_tangents`]).
+struct PreparedMesh {
+    split: Option<Mesh>,
+    tangents: Vec<[f32; 4]>,
+}
+
+/// Prepared meshes kept across frames, keyed by (the mesh's content hash, MikkTSpace split or not): the tangents
+/// and the split read only the mesh, never the camera, the lights or the pose.
+static PREPARED: gpu::Kept<(u64, bool), Arc<PreparedMesh>> = gpu::Kept::new(MESHES_KEPT);
+/// Uploaded meshes kept across frames, keyed by (device, the mesh's content hash, MikkTSpace split or not): room
+/// for a few devices (a test process renders on several at once).
+static UPLOADED: gpu::Kept<(wgpu::Device, u64, bool), MeshBuffers> = gpu::Kept::new(4 * MESHES_KEPT);
+/// Meshes kept (a frame uses one, split for the view when it has a normal map; a benchmark or test a few).
+const MESHES_KEPT: usize = 4;
+
+/// `mesh` (content hash `key`) prepared for the rasterisers, split for MikkTSpace or not: once per mesh while kept,
+/// every frame while [`gpu::object_cache_enabled`] is off.
+fn prepared_mesh(mesh: &Mesh, key: u64, mikktspace: bool) -> Arc<PreparedMesh> {
+    PREPARED.get_or_insert_with((key, mikktspace), || {
+        Arc::new(if mikktspace {
+            let (split, tangents) = crate::mesh::tangents::mikktspace_tangents(mesh);
+            PreparedMesh { split: Some(split), tangents }
+        } else {
+            PreparedMesh { split: None, tangents: crate::mesh::tangents::vertex_tangents(mesh) }
+        })
+    })
+}
+
+/// The vertex and index buffers of `job`, whose mesh and tangents are [`prepared_mesh`]`(mesh, key, mikktspace)`,
+/// on `device`: uploaded once per device and prepared mesh while kept.
+fn mesh_buffers(
+    device: &wgpu::Device,
+    job: &RasterJob<'_>,
+    key: u64,
+    mikktspace: bool,
+) -> Result<MeshBuffers, RuntimeError> {
+    UPLOADED.get_or_try_insert_with((device.clone(), key, mikktspace), || {
+        mesh_raster::upload_mesh(device, job.mesh, job.tangents)
+    })
+}
+
 /// Bytes of one padded row of a `width`-texel image of `bytes_per_texel` in a texture copy.
 fn padded_row(width: u32, bytes_per_texel: u32) -> u32 {
     (width * bytes_per_texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
@@ -98,19 +143,27 @@ pub(crate) fn record(
 ) -> Result<DeviceGeometry, RuntimeError> {
     let (w, h, s) = (job.width, job.height, SHADOW_MAP_SIZE);
     let light = light_camera(&job.camera, assets.lights.back_view);
-    let tangents = crate::mesh::tangents::vertex_tangents(job.mesh);
+    let key = mesh_key(job.mesh);
+    let plain = prepared_mesh(job.mesh, key, false);
     // A normal map is baked in MikkTSpace: the view sees the mesh split where its corners' frames disagree, with
     // those tangents (as the host's `heads::geometry`); the shadow map needs no tangents.
-    let mikk = job.surface_maps.map(|_| crate::mesh::tangents::mikktspace_tangents(job.mesh));
-    let (split, view_tangents) = match &mikk {
-        Some((m, t)) => (m, t.as_slice()),
-        None => (job.mesh, tangents.as_slice()),
+    let mikk = job.surface_maps.map(|_| prepared_mesh(job.mesh, key, true));
+    let view_mesh = mikk.as_ref().unwrap_or(&plain);
+    let split = view_mesh.split.as_ref().unwrap_or(job.mesh);
+    let view_job = RasterJob {
+        mesh: split,
+        tangents: &view_mesh.tangents,
+        camera: &job.camera,
+        width: w,
+        height: h,
+        samples: job.msaa,
     };
-    let view_job =
-        RasterJob { mesh: split, tangents: view_tangents, camera: &job.camera, width: w, height: h, samples: job.msaa };
-    let view = mesh_raster::record(device, enc, &view_job)?;
-    let shadow_job = RasterJob { mesh: job.mesh, tangents: &tangents, camera: &light, width: s, height: s, samples: 1 };
-    let shadow = mesh_raster::record(device, enc, &shadow_job)?;
+    let view =
+        mesh_raster::record_uploaded(device, enc, &view_job, &mesh_buffers(device, &view_job, key, mikk.is_some())?)?;
+    let tangents = &plain.tangents;
+    let shadow_job = RasterJob { mesh: job.mesh, tangents, camera: &light, width: s, height: s, samples: 1 };
+    let shadow =
+        mesh_raster::record_uploaded(device, enc, &shadow_job, &mesh_buffers(device, &shadow_job, key, false)?)?;
     let what = "frame geometry";
     let (view_row, shadow_row) = (gpu::padded_row_bytes(&view[0]) as u64, gpu::padded_row_bytes(&shadow[0]) as u64);
     let (vec4_row, depth_row) = (padded_row(w, 16), padded_row(w, 4));
@@ -247,17 +300,17 @@ mod tests {
         use crate::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
         let albedo = (0..24 * 24u32)
             .map(|i| if (i % 24) % 6 < 2 { [0.25, 0.12, 0.08, 0.0] } else { [0.6, 0.4, 0.3, 0.0] })
-            .collect();
+            .collect::<Vec<_>>();
         let bumps = (0..32 * 32u32)
             .map(|i| {
                 let (a, b) = (0.4 * ((i % 32) as f32 * 0.8).sin(), 0.4 * ((i / 32) as f32 * 0.6).cos());
                 let l = (a * a + b * b + 1.0).sqrt();
                 [a / l, b / l, 1.0 / l, 0.0]
             })
-            .collect();
+            .collect::<Vec<_>>();
         SurfaceMaps {
-            albedo: Some(SurfaceMap { width: 24, height: 24, texels: albedo }),
-            normal: Some(SurfaceMap { width: 32, height: 32, texels: bumps }),
+            albedo: Some(SurfaceMap { width: 24, height: 24, texels: albedo.into() }),
+            normal: Some(SurfaceMap { width: 32, height: 32, texels: bumps.into() }),
         }
     }
 

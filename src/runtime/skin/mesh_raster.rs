@@ -140,13 +140,61 @@ pub fn rasterise_jobs(
         .collect())
 }
 
+/// A mesh's vertices (position, normal, uv, tangent: 12 f32 each) and its triangles' indices on the device.
+#[derive(Clone)]
+pub(crate) struct MeshBuffers {
+    pub(crate) vertices: wgpu::Buffer,
+    pub(crate) indices: wgpu::Buffer,
+}
+
+/// Uploads `mesh` with its per-vertex `tangents` (counted in [`gpu::buffers_uploaded_on_this_thread`]), refusing a
+/// mesh over the adapter's buffer limit.
+pub(crate) fn upload_mesh(
+    device: &wgpu::Device,
+    mesh: &Mesh,
+    tangents: &[[f32; 4]],
+) -> Result<MeshBuffers, RuntimeError> {
+    let vertex_bytes = mesh.positions.len() as u64 * 48;
+    if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
+        return Err(InvalidInput::new(
+            "mesh",
+            format!("{vertex_bytes} bytes of vertices exceed the adapter's buffer limit"),
+        )
+        .into());
+    }
+    let mut vertices = Vec::with_capacity(mesh.positions.len() * 12);
+    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(tangents) {
+        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1], tg[0], tg[1], tg[2], tg[3]]);
+    }
+    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("mesh vertices"),
+        contents: bytemuck::cast_slice(&vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("mesh indices"),
+        contents: bytemuck::cast_slice(&mesh.indices),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    gpu::count_buffer_upload();
+    gpu::count_buffer_upload();
+    Ok(MeshBuffers { vertices, indices })
+}
+
 /// Records the G-buffer pass of `job` into `enc`; returns its three targets (normal + depth, uv + coverage,
-/// tangent; resolved when multisampled).
+/// tangent; resolved when multisampled). The mesh is uploaded here; [`record_uploaded`] takes it uploaded.
 pub(crate) fn record(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
     job: &RasterJob<'_>,
 ) -> Result<[wgpu::Texture; 3], RuntimeError> {
+    check_job(device, job)?;
+    let buffers = upload_mesh(device, job.mesh, job.tangents)?;
+    record_uploaded(device, enc, job, &buffers)
+}
+
+/// Refuses what the device cannot rasterise of `job` (tangents, sample count, camera, image size) before any work.
+fn check_job(device: &wgpu::Device, job: &RasterJob<'_>) -> Result<(), RuntimeError> {
     let RasterJob { mesh, tangents, camera, width, height, samples } = *job;
     check_raster_inputs(mesh, tangents, samples)?;
     if samples > 1 {
@@ -161,28 +209,18 @@ pub(crate) fn record(
     }
     camera.validate()?;
     crate::runtime::device::check_image_fits(device, width, height, GBUFFER_BYTES_PER_TEXEL)?;
-    let vertex_bytes = mesh.positions.len() as u64 * 48;
-    if vertex_bytes.max(mesh.indices.len() as u64 * 4) > device.limits().max_buffer_size {
-        return Err(InvalidInput::new(
-            "mesh",
-            format!("{vertex_bytes} bytes of vertices exceed the adapter's buffer limit"),
-        )
-        .into());
-    }
-    let mut vertices = Vec::with_capacity(mesh.positions.len() * 12);
-    for (((p, n), t), tg) in mesh.positions.iter().zip(&mesh.normals).zip(&mesh.uvs).zip(tangents) {
-        vertices.extend_from_slice(&[p[0], p[1], p[2], n[0], n[1], n[2], t[0], t[1], tg[0], tg[1], tg[2], tg[3]]);
-    }
-    let vbuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("mesh vertices"),
-        contents: bytemuck::cast_slice(&vertices),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let ibuf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("mesh indices"),
-        contents: bytemuck::cast_slice(&mesh.indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
+    Ok(())
+}
+
+/// [`record`] with `job`'s mesh and tangents already on the device in `buffers` ([`upload_mesh`] of them).
+pub(crate) fn record_uploaded(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    job: &RasterJob<'_>,
+    buffers: &MeshBuffers,
+) -> Result<[wgpu::Texture; 3], RuntimeError> {
+    check_job(device, job)?;
+    let RasterJob { mesh, camera, width, height, samples, .. } = *job;
     let ubuf =
         gpu::uniform_buffer(device, "mesh camera", bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)));
     let module = gpu::shader(device, "mesh_raster", include_str!("mesh_raster.wgsl"));
@@ -312,8 +350,8 @@ pub(crate) fn record(
         });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.set_vertex_buffer(0, vbuf.slice(..));
-        pass.set_index_buffer(ibuf.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_vertex_buffer(0, buffers.vertices.slice(..));
+        pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..mesh.indices.len() as u32, 0, 0..1);
     }
     Ok([g0, g1, g2])

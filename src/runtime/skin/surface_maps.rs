@@ -22,22 +22,25 @@
 
 use crate::error::InvalidInput;
 use crate::image_buf::ImageF32;
-use crate::runtime::compute_chain::Buffer;
+use crate::runtime::compute_chain::{self, Buffer};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
 use crate::runtime::skin::view_frame;
-use crate::runtime::RuntimeError;
+use crate::runtime::{gpu, RuntimeError};
+use std::sync::Arc;
 
 /// The parameter of the albedo map (its flag is in the CLI's table).
 pub const ALBEDO_PARAM: &str = "albedo_map";
 /// The parameter of the tangent-space normal map (its flag is in the CLI's table).
 pub const NORMAL_MAP_PARAM: &str = "normal_map";
 
-/// One decoded map: `width`×`height` texels of (x, y, z, 0), row-major, top row first.
+/// One decoded map: `width`×`height` texels of (x, y, z, 0), row-major, top row first. The texels are shared
+/// (`Arc`): a frame's device keeps their upload for as long as it holds the same allocation ([`record`]), and
+/// changing them (`Arc::make_mut`) while an upload is kept copies them into a new one.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfaceMap {
     pub width: u32,
     pub height: u32,
-    pub texels: Vec<[f32; 4]>,
+    pub texels: Arc<Vec<[f32; 4]>>,
 }
 
 impl SurfaceMap {
@@ -46,7 +49,7 @@ impl SurfaceMap {
         if img.channels != 3 || img.data.len() != (img.width * img.height * 3) as usize || img.width == 0 {
             return Err(InvalidInput::new(param, "needs a decoded 3-channel map of its stated size"));
         }
-        let texels = img.data.chunks_exact(3).map(|c| [c[0], c[1], c[2], 0.0]).collect();
+        let texels = Arc::new(img.data.chunks_exact(3).map(|c| [c[0], c[1], c[2], 0.0]).collect());
         Ok(SurfaceMap { width: img.width, height: img.height, texels })
     }
 
@@ -130,9 +133,12 @@ struct Params {
     normal: [f32; 4],
 }
 
-/// The stand-in the pass binds for an absent map: one texel, (0, 0, 1).
+/// The stand-in the pass binds for an absent map: one texel, (0, 0, 1) (one allocation, so that its upload is kept
+/// with the present map's).
 fn flat_map() -> SurfaceMap {
-    SurfaceMap { width: 1, height: 1, texels: vec![[0.0, 0.0, 1.0, 0.0]] }
+    static FLAT: std::sync::LazyLock<SurfaceMap> =
+        std::sync::LazyLock::new(|| SurfaceMap { width: 1, height: 1, texels: Arc::new(vec![[0.0, 0.0, 1.0, 0.0]]) });
+    FLAT.clone()
 }
 
 /// The uniform block of a `width`×`height` frame and the two maps the pass binds (`flat` for an absent one).
@@ -173,7 +179,10 @@ pub fn surface_pixels(
         SOURCE,
         bytemuck::bytes_of(&params),
         g,
-        [Buffer::Data(bytemuck::cast_slice(&a.texels)), Buffer::Data(bytemuck::cast_slice(&nm.texels))],
+        [
+            Buffer::Data(bytemuck::cast_slice(a.texels.as_slice())),
+            Buffer::Data(bytemuck::cast_slice(nm.texels.as_slice())),
+        ],
         largest_buffer_bytes(g.width, g.height),
     )?;
     let f: &[f32] = bytemuck::cast_slice(&out);
@@ -184,10 +193,41 @@ pub fn surface_pixels(
 
 const SOURCE: &str = include_str!("surface_maps.wgsl");
 
+/// The texels of the two maps a frame binds, compared by allocation: two keys are equal only while they hold the
+/// same `Arc`s, which the kept entry itself holds, so an allocation cannot be freed and reused by other maps while
+/// its upload is kept, and texels changed through `Arc::make_mut` move to a new allocation. Hashing the content
+/// instead would read both maps every frame (2 × 16 MB for the scan's 1024² maps), the cost the cache avoids.
+struct MapsKey(wgpu::Device, [Arc<Vec<[f32; 4]>>; 2]);
+
+impl PartialEq for MapsKey {
+    fn eq(&self, other: &Self) -> bool {
+        self.0 == other.0 && self.1.iter().zip(&other.1).all(|(a, b)| Arc::ptr_eq(a, b))
+    }
+}
+
+/// Uploaded map pairs kept across frames (a command renders one scan; a benchmark or a test a few).
+static MAP_BUFFERS: gpu::Kept<MapsKey, [wgpu::Buffer; 2]> = gpu::Kept::new(MAPS_KEPT);
+/// Map pairs kept, per process.
+const MAPS_KEPT: usize = 6;
+
+/// The two maps on `device` (`flat` for an absent one), uploaded once while the same texels are kept
+/// ([`MAP_BUFFERS`]), every frame while [`gpu::object_cache_enabled`] is off; each upload counted in
+/// [`gpu::buffers_uploaded_on_this_thread`].
+fn map_buffers(device: &wgpu::Device, a: &SurfaceMap, nm: &SurfaceMap) -> [wgpu::Buffer; 2] {
+    let key = MapsKey(device.clone(), [a.texels.clone(), nm.texels.clone()]);
+    MAP_BUFFERS.get_or_insert_with(key, || {
+        [a, nm].map(|m| {
+            gpu::count_buffer_upload();
+            let bytes: &[u8] = bytemuck::cast_slice(m.texels.as_slice());
+            compute_chain::storage_buffer(device, "surface maps", bytes.len() as u64, Some(bytes))
+        })
+    })
+}
+
 /// Records the pass into a frame's command encoder over the device's per-pixel `frame` of a `size` frame
 /// ((u, v, covered, coverage), view normal, view tangent: [`view_frame::record`]), writing per pixel (mapped
-/// normal, 0), (linear albedo, 0) into `out` (2 vec4 of f32 per pixel): the maps are uploaded, nothing is read
-/// back.
+/// normal, 0), (linear albedo, 0) into `out` (2 vec4 of f32 per pixel): the maps are uploaded on their first
+/// frame and kept ([`map_buffers`]), nothing is read back.
 pub(crate) fn record(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
@@ -200,6 +240,6 @@ pub(crate) fn record(
     let flat = flat_map();
     let (params, a, nm) = pass_inputs(size.0, size.1, maps, &flat);
     let params = bytemuck::bytes_of(&params);
-    let maps = [bytemuck::cast_slice(&a.texels), bytemuck::cast_slice(&nm.texels)];
-    view_frame::record(device, enc, "surface maps", SOURCE, params, size, frame, maps, out)
+    let [a, b] = map_buffers(device, a, nm);
+    view_frame::record_with_maps(device, enc, "surface maps", SOURCE, params, size, frame, [&a, &b], out)
 }

@@ -71,7 +71,7 @@ type KeptUvMap = ((u64, u32), Arc<UvMap>);
 const UV_MAPS_KEPT: usize = 8;
 
 /// A 64-bit hash of everything [`rasterise_uv`] reads of `mesh`.
-fn mesh_key(mesh: &Mesh) -> u64 {
+pub(crate) fn mesh_key(mesh: &Mesh) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     let bits =
         |v: &[f32], h: &mut std::collections::hash_map::DefaultHasher| v.iter().for_each(|x| x.to_bits().hash(h));

@@ -58,10 +58,27 @@ pub(crate) fn record(
     maps: [&[u8]; 2],
     out: &wgpu::Buffer,
 ) -> Result<(), RuntimeError> {
-    let sizes = [frame[0].size(), frame[1].size(), frame[2].size(), maps[0].len() as u64, maps[1].len() as u64];
-    compute_chain::check_buffers(device, what, &sizes)?;
+    compute_chain::check_buffers(device, what, &[maps[0].len() as u64, maps[1].len() as u64])?;
     let [a, b] = maps.map(|m| compute_chain::storage_buffer(device, what, m.len() as u64, Some(m)));
-    let bound = [frame[0], frame[1], frame[2], &a, &b, out];
+    record_with_maps(device, enc, what, pass_wgsl, params, (width, height), frame, [&a, &b], out)
+}
+
+/// [`record`] with the pass's two maps already on the device (kept across frames by the caller).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn record_with_maps(
+    device: &wgpu::Device,
+    enc: &mut wgpu::CommandEncoder,
+    what: &str,
+    pass_wgsl: &str,
+    params: &[u8],
+    (width, height): (u32, u32),
+    frame: [&wgpu::Buffer; 3],
+    [a, b]: [&wgpu::Buffer; 2],
+    out: &wgpu::Buffer,
+) -> Result<(), RuntimeError> {
+    let sizes = [frame[0].size(), frame[1].size(), frame[2].size(), a.size(), b.size()];
+    compute_chain::check_buffers(device, what, &sizes)?;
+    let bound = [frame[0], frame[1], frame[2], a, b, out];
     let stages = [Stage::new("main", compute_chain::groups_8x8(width, height))];
     compute_chain::record(device, enc, what, &[PRELUDES, pass_wgsl].concat(), params, &bound, &stages);
     Ok(())
