@@ -2,7 +2,7 @@
 //! default passes: bloom on) per shader, its passes recorded into one command encoder as `run skin` records them,
 //! profiled by `rtbake::runtime::gpu::set_pass_profiling` (timestamps around each compute pass of the frame's
 //! compute chains: frame geometry, the rig at uv, lit layer, composite, bloom's down/up levels and combine, tone
-//! map; the work between them — the G-buffer and shadow-map raster, the skin-inputs render pass, the SSS passes,
+//! map; the work between them — the G-buffer and shadow-map raster (each its own span), the SSS passes,
 //! the texture/buffer copies — as spans between the timed points).
 //!
 //!     cargo run --release --example bench_frame_passes [-- WIDTH HEIGHT FRAMES]     # 1920 1080 7
@@ -34,8 +34,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn span_holds(label: &str) -> &'static str {
     let to = label.rsplit(" → ").next().unwrap_or("");
     match to {
-        "frame geometry: main" => "G-buffer + shadow-map raster, texture-to-buffer copies",
-        "skin frame: lit" => "skin-inputs render pass, copies",
+        "view G-buffer rasterised" => "the view's G-buffer raster (render pass; uploads and clears before it)",
+        "shadow map rasterised" => "the 512² shadow-map raster (render pass)",
+        "frame geometry: main" => "the G-buffer and shadow map copied into the geometry pass's buffers",
+        "skin frame: lit" => "copies",
         "skin frame: composite" => "SSS passes, copies",
         _ => "whatever lies between the two chain recordings (barriers, copies)",
     }

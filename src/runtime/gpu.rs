@@ -873,7 +873,18 @@ pub fn take_pass_profile(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<V
     let mut after_mark = false;
     for (Recorded { passes, mark, .. }, t) in recorded.iter().zip(&ticks) {
         if *mark {
-            last = Some((t.as_ref().map(|t| t[0]), passes[0].0.clone()));
+            let here = t.as_ref().map(|t| t[0]);
+            // A mark after a mark or a chain closes the span since that point.
+            if let (true, Some((from, from_label))) = (after_mark, &last) {
+                let gpu_ms = from.zip(here).map(|(from, here)| ms(from, here));
+                out.push(PassTime {
+                    label: format!("{from_label} → {}", passes[0].0),
+                    gpu_ms,
+                    bytes: None,
+                    span: true,
+                });
+            }
+            last = Some((here, passes[0].0.clone()));
             after_mark = true;
             continue;
         }

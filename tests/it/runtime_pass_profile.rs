@@ -33,7 +33,9 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
     let expected = [
-        "frame start → frame geometry: main",
+        "frame start → view G-buffer rasterised",
+        "view G-buffer rasterised → shadow map rasterised",
+        "shadow map rasterised → frame geometry: main",
         "frame geometry: main",
         "frame geometry: main → mesh skin inputs: main",
         "mesh skin inputs: main",

@@ -160,10 +160,12 @@ pub(crate) fn record(
     };
     let view =
         mesh_raster::record_uploaded(device, enc, &view_job, &mesh_buffers(device, &view_job, key, mikk.is_some())?)?;
+    gpu::profile_mark(device, enc, "view G-buffer rasterised");
     let tangents = &plain.tangents;
     let shadow_job = RasterJob { mesh: job.mesh, tangents, camera: &light, width: s, height: s, samples: 1 };
     let shadow =
         mesh_raster::record_uploaded(device, enc, &shadow_job, &mesh_buffers(device, &shadow_job, key, false)?)?;
+    gpu::profile_mark(device, enc, "shadow map rasterised");
     let what = "frame geometry";
     let (view_row, shadow_row) = (gpu::padded_row_bytes(&view[0]) as u64, gpu::padded_row_bytes(&shadow[0]) as u64);
     let (vec4_row, depth_row) = (padded_row(w, 16), padded_row(w, 4));
