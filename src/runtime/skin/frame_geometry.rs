@@ -22,7 +22,7 @@ use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::gpu;
 use crate::runtime::skin::heads::light_camera;
 use crate::runtime::skin::lighting::{DemoAssets, KEY_LIGHT_INTENSITY};
-use crate::runtime::skin::mesh_inputs::RigPose;
+use crate::runtime::skin::mesh_inputs::{self, RigPose};
 use crate::runtime::skin::mesh_raster::{self, MeshBuffers, RasterJob};
 use crate::runtime::skin::passes::Wrinkles;
 use crate::runtime::skin::settings::{SHADOW_MAP_SIZE, SHADOW_SHRINK_MM, WORLD_UNITS_PER_M};
@@ -131,6 +131,23 @@ fn mesh_buffers(
 /// Bytes of one padded row of a `width`-texel image of `bytes_per_texel` in a texture copy.
 fn padded_row(width: u32, bytes_per_texel: u32) -> u32 {
     (width * bytes_per_texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
+}
+
+impl DeviceGeometry {
+    /// The rig at uv (eq. 7.6 with `job`'s pose, thesis §7.7) into this frame's skin-inputs maps: the screen-space
+    /// and the texture-space frame's step 3; nothing without a pose or without `assets`' baked rig.
+    pub(crate) fn record_rig_at_uv(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        job: &FrameGeometryJob<'_>,
+        assets: &DemoAssets,
+    ) -> Result<(), RuntimeError> {
+        let (Some(pose), Some(r)) = (&job.rig_pose, &assets.baked_rig) else { return Ok(()) };
+        let maps = mesh_inputs::RigAtUv { rig: &r.rig, h0: &r.h0, pose };
+        let size = (job.width, job.height);
+        mesh_inputs::record_into_skin_map_buffer(device, enc, size, &maps, &self.uvc, &self.skin_maps, self.vec4_row)
+    }
 }
 
 /// Records the G-buffer, the shadow map and the geometry pass of `job` into `enc`, with `assets`' lights and

@@ -239,25 +239,6 @@ pub(crate) fn record_into_skin_maps(
     Ok(())
 }
 
-/// The rig at uv of a device frame (the screen-space and the texture-space frame's step 3): with a `pose` and a
-/// baked `rig`, [`record_into_skin_map_buffer`] over the frame geometry's `uvc` and `skin_maps` (rows of `stride`
-/// texels); nothing without either.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn record_pose_into_skin_map_buffer(
-    device: &wgpu::Device,
-    enc: &mut wgpu::CommandEncoder,
-    size: (u32, u32),
-    pose: Option<&RigPose>,
-    rig: Option<&BakedRig>,
-    uvc: &wgpu::Buffer,
-    skin_maps: &wgpu::Buffer,
-    stride: u32,
-) -> Result<(), RuntimeError> {
-    let (Some(pose), Some(r)) = (pose, rig) else { return Ok(()) };
-    let maps = RigAtUv { rig: &r.rig, h0: &r.h0, pose };
-    record_into_skin_map_buffer(device, enc, size, &maps, uvc, skin_maps, stride)
-}
-
 /// Records the pass into `enc` over GPU buffers: (u, v, covered, 0) per pixel of the `size` frame in `uvc`, H
 /// written into the hemoglobin channel of `skin_maps` (vec4 texels, rows of `stride` texels).
 pub(crate) fn record_into_skin_map_buffer(

@@ -201,17 +201,7 @@ pub(crate) fn shade(
         FrameSource::Device(job) => {
             let d = frame_geometry::record(device, &mut enc, job, assets)?;
             inputs.upload_lights(queue, weights, light)?;
-            let (pose, rig) = (job.rig_pose.as_ref(), assets.baked_rig.as_ref());
-            mesh_inputs::record_pose_into_skin_map_buffer(
-                device,
-                &mut enc,
-                (w, h),
-                pose,
-                rig,
-                &d.uvc,
-                &d.skin_maps,
-                d.vec4_row,
-            )?;
+            d.record_rig_at_uv(device, &mut enc, job, assets)?;
             maps_normals = Some((d.skin_maps, d.normals));
             if let Some(b) = &blur {
                 gpu::encode_buffer_to_texture(&mut enc, &d.depth, 0, b.depth());

@@ -567,7 +567,7 @@ mod one_encoder {
     use crate::runtime::skin::heads::{light_camera, BACKGROUND};
     use crate::runtime::skin::inputs::SkinInputs;
     use crate::runtime::skin::lighting::{DemoAssets, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
-    use crate::runtime::skin::mesh_inputs::{self, RigPose};
+    use crate::runtime::skin::mesh_inputs::RigPose;
     use crate::runtime::skin::settings::{
         SkinRenderSettings, TsSettings, HEAD_SPACING_M, SHADOW_MAP_SIZE, SHADOW_SHRINK_MM, WORLD_UNITS_PER_M,
     };
@@ -737,17 +737,7 @@ mod one_encoder {
         let d = frame_geometry::record(device, &mut enc, &job, assets)?;
         let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
         inputs.upload_lights(queue, &assets.rig_weights, assets.lights.back_view)?;
-        let (pose, rig) = (job.rig_pose.as_ref(), assets.baked_rig.as_ref());
-        mesh_inputs::record_pose_into_skin_map_buffer(
-            device,
-            &mut enc,
-            (w, h),
-            pose,
-            rig,
-            &d.uvc,
-            &d.skin_maps,
-            d.vec4_row,
-        )?;
+        d.record_rig_at_uv(device, &mut enc, &job, assets)?;
         let row16 = gpu::padded_row_bytes(inputs.albedo()) as u64;
         let bloom_buffers = match &assets.bloom {
             Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
