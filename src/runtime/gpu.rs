@@ -787,7 +787,7 @@ pub struct PassTime {
     /// GPU milliseconds between the pass's (span's) begin and end timestamps; None where the device has no
     /// timestamp queries.
     pub gpu_ms: Option<f64>,
-    /// Bytes the pass must move ([`crate::runtime::compute_chain`]'s rule); None for a span, whose work is not a
+    /// Bytes the pass must move (`runtime::compute_chain`'s rule); None for a span, whose work is not a
     /// chain's.
     pub bytes: Option<u64>,
     /// Whether this is a span (the work between two timed points) rather than a chain pass.

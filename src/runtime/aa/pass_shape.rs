@@ -1,6 +1,6 @@
 //! The two shapes an anti-aliasing pass takes on the GPU ([`PassShape`]: compute dispatches over 8×8-thread
 //! workgroups, or full-screen fragment passes into render targets; the same bytes either way) and what the passes
-//! of both shapes share: a one-output pass in either shape ([`ShapedPass`]: the edge detectors, the mask, the SMAA
+//! of both shapes share: a one-output pass in either shape (`ShapedPass`: the edge detectors, the mask, the SMAA
 //! modes' resolves), the workgroup grid and the frame textures. [`crate::runtime::aa::three_pass`] builds the
 //! three passes of SMAA 1x and MLAA (thesis ch. 9–10) on it; [`crate::runtime::aa::edges`] and
 //! [`crate::runtime::aa::modes`] build theirs.

@@ -4,7 +4,7 @@
 //! through thin regions (Jimenez et al., "Real-Time Realistic Skin Translucency", IEEE CG&A 2010; thesis eq.
 //! 5.12–5.13, E = max(0.3 + dot(−N, L), 0)). One fragment pass, two `Rgba16Float` targets ([`SkinInputs::encode`],
 //! the per-pass path), or the same arithmetic (`inputs_common.wgsl`) as a compute pass over storage buffers
-//! recorded through `compute_chain::record` ([`SkinInputs::record_compute`], the one-encoder frames: no copies in
+//! recorded through `compute_chain::record` (`SkinInputs::record_compute`, the one-encoder frames: no copies in
 //! or out of textures, and on GPUs with few raster units no full-screen fragment pass). CPU twin
 //! [`crate::runtime::skin::inputs_cpu`].
 

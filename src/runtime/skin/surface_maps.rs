@@ -34,7 +34,7 @@ pub const ALBEDO_PARAM: &str = "albedo_map";
 pub const NORMAL_MAP_PARAM: &str = "normal_map";
 
 /// One decoded map: `width`×`height` texels of (x, y, z, 0), row-major, top row first. The texels are shared
-/// (`Arc`): a frame's device keeps their upload for as long as it holds the same allocation ([`record`]), and
+/// (`Arc`): a frame's device keeps their upload for as long as it holds the same allocation (`record`), and
 /// changing them (`Arc::make_mut`) while an upload is kept copies them into a new one.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfaceMap {
