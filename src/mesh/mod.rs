@@ -183,6 +183,21 @@ impl Mesh {
         self
     }
 
+    /// A 64-bit hash of everything the mesh holds (positions, normals and uvs bit for bit, indices, the unit): the
+    /// key of the renderers' per-mesh caches (a different mesh, even by one bit, gets another key but for a
+    /// 2⁻⁶⁴ collision).
+    pub fn content_key(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for v in self.positions.iter().chain(&self.normals) {
+            v.iter().for_each(|x| x.to_bits().hash(&mut h));
+        }
+        self.uvs.iter().for_each(|t| t.iter().for_each(|x| x.to_bits().hash(&mut h)));
+        self.indices.hash(&mut h);
+        self.mm_per_unit.to_bits().hash(&mut h);
+        h.finish()
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }

@@ -27,7 +27,6 @@ use crate::runtime::skin::mesh_raster::{self, MeshBuffers, RasterJob};
 use crate::runtime::skin::passes::Wrinkles;
 use crate::runtime::skin::settings::{SHADOW_MAP_SIZE, SHADOW_SHRINK_MM, WORLD_UNITS_PER_M};
 use crate::runtime::skin::surface_maps::SurfaceMaps;
-use crate::runtime::skin::texture_space::mesh_key;
 use crate::runtime::skin::{surface_maps, wrinkles};
 use crate::runtime::RuntimeError;
 use std::sync::Arc;
@@ -160,7 +159,7 @@ pub(crate) fn record(
 ) -> Result<DeviceGeometry, RuntimeError> {
     let (w, h, s) = (job.width, job.height, SHADOW_MAP_SIZE);
     let light = light_camera(&job.camera, assets.lights.back_view);
-    let key = mesh_key(job.mesh);
+    let key = job.mesh.content_key();
     let plain = prepared_mesh(job.mesh, key, false);
     // A normal map is baked in MikkTSpace: the view sees the mesh split where its corners' frames disagree, with
     // those tangents (as the host's `heads::geometry`); the shadow map needs no tangents.

@@ -58,7 +58,6 @@ use crate::shading::texture_space::{
 };
 use nalgebra::{Vector3, Vector4};
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::sync::{Arc, LazyLock, Mutex};
 use wgpu::util::DeviceExt;
 
@@ -70,17 +69,9 @@ type KeptUvMap = ((u64, u32), Arc<UvMap>);
 /// UV maps kept (a depth-sized frame of several heads uses a few sizes of one mesh).
 const UV_MAPS_KEPT: usize = 8;
 
-/// A 64-bit hash of everything [`rasterise_uv`] reads of `mesh`.
+/// A 64-bit hash of everything [`rasterise_uv`] reads of `mesh` (all of it: [`Mesh::content_key`]).
 pub(crate) fn mesh_key(mesh: &Mesh) -> u64 {
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    let bits =
-        |v: &[f32], h: &mut std::collections::hash_map::DefaultHasher| v.iter().for_each(|x| x.to_bits().hash(h));
-    mesh.positions.iter().for_each(|p| bits(p, &mut h));
-    mesh.normals.iter().for_each(|n| bits(n, &mut h));
-    mesh.uvs.iter().for_each(|t| bits(t, &mut h));
-    mesh.indices.hash(&mut h);
-    mesh.mm_per_unit.to_bits().hash(&mut h);
-    h.finish()
+    mesh.content_key()
 }
 
 /// `mesh` rasterised at its texture coordinates into a `size`² map, once per mesh and size (every time while
