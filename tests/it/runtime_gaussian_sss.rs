@@ -10,24 +10,41 @@ use rtbake::runtime::sss::PassShape;
 /// Two striped discs (skin, alpha 1): one near (depth ≈ 2), one far (depth ≈ 20, where the narrow Gaussians
 /// are skipped by eq. 4.6), on a background (alpha 0).
 fn scene(w: u32, h: u32) -> (Vec<f32>, Vec<f32>) {
-    let (mut color, mut depth) = (vec![0.0f32; (w * h * 4) as usize], vec![100.0f32; (w * h) as usize]);
     let discs = [
         (0.3 * w as f32, 0.5 * h as f32, 0.25 * w as f32, 2.0f32),
         (0.75 * w as f32, 0.5 * h as f32, 0.15 * w as f32, 20.0),
     ];
+    let look = Stripes { period: (5, 7), dark: 0.1, alpha: |_| 1.0, depth: |d0, z| d0 - 0.2 * z };
+    striped_discs(w, h, &discs, &look)
+}
+
+/// How [`striped_discs`] draws its discs: stripes of `period` texels (x, y), the dark stripes at `dark`, alpha and
+/// depth from the disc's depth d0 and the sphere's height z (1 at the centre, 0 at the rim).
+struct Stripes {
+    period: (u32, u32),
+    dark: f32,
+    alpha: fn(f32) -> f32,
+    depth: fn(f32, f32) -> f32,
+}
+
+/// A `w`×`h` frame (colour RGBA, depth) of striped, sphere-lit skin discs (cx, cy, r, d0) on a background of alpha
+/// 0 at depth 100.
+fn striped_discs(w: u32, h: u32, discs: &[(f32, f32, f32, f32)], look: &Stripes) -> (Vec<f32>, Vec<f32>) {
+    let (mut color, mut depth) = (vec![0.0f32; (w * h * 4) as usize], vec![100.0f32; (w * h) as usize]);
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
             color[4 * i..4 * i + 4].copy_from_slice(&[0.1, 0.2, 0.3, 0.0]);
-            for &(cx, cy, r, d0) in &discs {
+            for &(cx, cy, r, d0) in discs {
                 let (dx, dy) = (x as f32 + 0.5 - cx, y as f32 + 0.5 - cy);
                 let d2 = dx * dx + dy * dy;
                 if d2 < r * r {
                     let z = (r * r - d2).sqrt() / r;
-                    let stripe = if (x / 5 + y / 7) % 2 == 0 { 1.0 } else { 0.1 };
+                    let stripe =
+                        if (x / look.period.0 + y / look.period.1).is_multiple_of(2) { 1.0 } else { look.dark };
                     let lit = (0.3 + 0.7 * z) * stripe;
-                    color[4 * i..4 * i + 4].copy_from_slice(&[0.9 * lit, 0.6 * lit, 0.5 * lit, 1.0]);
-                    depth[i] = d0 - 0.2 * z;
+                    color[4 * i..4 * i + 4].copy_from_slice(&[0.9 * lit, 0.6 * lit, 0.5 * lit, (look.alpha)(z)]);
+                    depth[i] = (look.depth)(d0, z);
                 }
             }
         }
@@ -86,29 +103,14 @@ fn gaussian_sss_gpu_matches_cpu() {
 #[test]
 fn compute_chain_matches_cpu_across_tile_seams_and_beyond_the_apron() {
     let (w, h) = (301u32, 187u32);
-    let (mut color, mut depth) = (vec![0.0f32; (w * h * 4) as usize], vec![100.0f32; (w * h) as usize]);
     let discs = [
         (150.0f32, 93.0f32, 60.0f32, 0.4f32),
         (250.0, 60.0, 40.0, 2.0),
         (40.0, 140.0, 35.0, 20.0),
         (35.0, 30.0, 15.0, 200.0),
     ];
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            color[4 * i..4 * i + 4].copy_from_slice(&[0.1, 0.2, 0.3, 0.0]);
-            for &(cx, cy, r, d0) in &discs {
-                let (dx, dy) = (x as f32 + 0.5 - cx, y as f32 + 0.5 - cy);
-                if dx * dx + dy * dy < r * r {
-                    let z = (r * r - dx * dx - dy * dy).sqrt() / r;
-                    let stripe = if (x / 3 + y / 4) % 2 == 0 { 1.0 } else { 0.05 };
-                    let lit = (0.3 + 0.7 * z) * stripe;
-                    color[4 * i..4 * i + 4].copy_from_slice(&[0.9 * lit, 0.6 * lit, 0.5 * lit, 0.5 + 0.5 * z]);
-                    depth[i] = d0 - 0.1 * d0 * z;
-                }
-            }
-        }
-    }
+    let look = Stripes { period: (3, 4), dark: 0.05, alpha: |z| 0.5 + 0.5 * z, depth: |d0, z| d0 - 0.1 * d0 * z };
+    let (color, depth) = striped_discs(w, h, &discs, &look);
     let g = gpu();
     let p = GaussianSssParams::default();
     // d'Eon's six (five blurs: the running sum ping-pongs an odd number of times) and a sharp pair whose one wide

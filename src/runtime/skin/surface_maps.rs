@@ -241,5 +241,5 @@ pub(crate) fn record(
     let (params, a, nm) = pass_inputs(size.0, size.1, maps, &flat);
     let params = bytemuck::bytes_of(&params);
     let [a, b] = map_buffers(device, a, nm);
-    view_frame::record_with_maps(device, enc, "surface maps", SOURCE, params, size, frame, [&a, &b], out)
+    view_frame::record(device, enc, "surface maps", SOURCE, params, size, frame, [&a, &b], out)
 }

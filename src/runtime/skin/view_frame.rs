@@ -45,27 +45,10 @@ pub(crate) fn run(
 
 /// Records the view-frame pass `what` (`pass_wgsl`) into `enc` over the device's per-pixel `frame` buffers of a
 /// `width`×`height` frame ((u, v, covered, coverage), (view normal, 0), view tangent: one vec4 of f32 each per
-/// pixel) with the uniform block `params` and the pass's two `maps` (uploaded here), writing `out`.
+/// pixel) with the uniform block `params` and the pass's two maps `[a, b]` on the device (uploaded by the pass, or
+/// kept across frames by its caller), writing `out`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn record(
-    device: &wgpu::Device,
-    enc: &mut wgpu::CommandEncoder,
-    what: &str,
-    pass_wgsl: &str,
-    params: &[u8],
-    (width, height): (u32, u32),
-    frame: [&wgpu::Buffer; 3],
-    maps: [&[u8]; 2],
-    out: &wgpu::Buffer,
-) -> Result<(), RuntimeError> {
-    compute_chain::check_buffers(device, what, &[maps[0].len() as u64, maps[1].len() as u64])?;
-    let [a, b] = maps.map(|m| compute_chain::storage_buffer(device, what, m.len() as u64, Some(m)));
-    record_with_maps(device, enc, what, pass_wgsl, params, (width, height), frame, [&a, &b], out)
-}
-
-/// [`record`] with the pass's two maps already on the device (kept across frames by the caller).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn record_with_maps(
     device: &wgpu::Device,
     enc: &mut wgpu::CommandEncoder,
     what: &str,

@@ -196,8 +196,11 @@ pub(crate) fn record(
 ) -> Result<(), RuntimeError> {
     maps.validate()?;
     let (params, masks) = pass_inputs(size.0, size.1, maps, weights);
-    let bytes = [bytemuck::cast_slice(&maps.pd), bytemuck::cast_slice(&masks)];
-    view_frame::record(device, enc, "wrinkle pass", SOURCE, bytemuck::bytes_of(&params), size, frame, bytes, out)
+    let what = "wrinkle pass";
+    let bytes: [&[u8]; 2] = [bytemuck::cast_slice(&maps.pd), bytemuck::cast_slice(&masks)];
+    compute_chain::check_buffers(device, what, &bytes.map(|m| m.len() as u64))?;
+    let [a, b] = bytes.map(|m| compute_chain::storage_buffer(device, what, m.len() as u64, Some(m)));
+    view_frame::record(device, enc, what, SOURCE, bytemuck::bytes_of(&params), size, frame, [&a, &b], out)
 }
 
 #[cfg(test)]
