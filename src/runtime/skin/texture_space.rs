@@ -23,15 +23,17 @@
 //!
 //! The UV rasterisation runs on the host once per mesh and map size ([`uv_map_of`]). On a device the frame is
 //! recorded into one command encoder, submitted once and read back once (the RGBA8 frame and the per-head counts of
-//! [`TsStats`]) under the conditions of the screen-space shaders' one-encoder frame (one sample, no wrinkle pass, no
-//! scan surface maps; `one_encoder`): the G-buffer, the shadow map and the per-pixel
-//! geometry of `frame_geometry`, the UV map uploaded once per device, culling, clipping, the texels' thickness and
-//! lighting, the 12 blur passes, the gather at each pixel's uv, the specular layer, bloom and the tone map all on the
-//! device. Otherwise, and with [`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off (the per-pass
-//! path, for A/B comparison), culling and clipping run on the host (counted, not timed, by the Table 3.1 figures:
-//! [`TsStats`]) and each pass is submitted and read back on its own: the G-buffer and shadow map, the rig at uv,
-//! the frame's skin inputs, per head the texels' skin inputs and the blurs with the gather, bloom (6 submissions for
-//! one head with bloom).
+//! [`TsStats`]), with the passes of the screen-space shaders' one-encoder frame (a scan's surface maps, the wrinkle
+//! pass, `--msaa 4`; `one_encoder`): the G-buffer, the shadow map and the per-pixel geometry of `frame_geometry`
+//! (the surface maps, wrinkles and MSAA resolve recorded there), the UV map uploaded once per device, culling,
+//! clipping, the texels' normal map (the surface-map pass over the texels' MikkTSpace frame), thickness and
+//! lighting, the 12 blur passes, the gather at each pixel's uv, the specular layer, post-scatter albedo, bloom, the
+//! tone map and the MSAA coverage blend all on the device. With
+//! [`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off (the per-pass path, for A/B comparison),
+//! culling, clipping and the texels' normal map run on the host (counted, not timed, by the Table 3.1 figures:
+//! [`TsStats`]) and each pass is submitted and read back on its own: the G-buffer and shadow map, the surface maps,
+//! the wrinkle pass, the rig at uv, the frame's skin inputs, per head the texels' skin inputs and the blurs with the
+//! gather, bloom (6 submissions for one head with bloom and no maps).
 //!
 //! `d_ref` of eq. 3.1 ("dependent of both model scale and frame resolution", thesis §3.3) is taken as the distance
 //! at which one pixel of the frame covers four texels of the `T_max` map ([`d_ref_m`]).
@@ -186,13 +188,12 @@ pub fn render_with<'g>(
     s.validate()?;
     ts.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let one_encoder = passes.msaa == 1 && passes.wrinkles.is_none() && passes.surface_maps.is_none();
-    if one_encoder && shades_in_one_encoder(gpu) {
+    if shades_in_one_encoder(gpu) {
         let rig_pose =
             assets.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
         let frame_assets = frame_assets(assets, passes);
         let key = mesh_key(mesh);
-        let on_device = |g| one_encoder::render(g, mesh, key, &heads, s, ts, rig_pose, &frame_assets);
+        let on_device = |g| one_encoder::render(g, mesh, key, &heads, s, ts, passes, rig_pose, &frame_assets);
         if let Some(frame) = gpu.run(on_device, || Ok(None))? {
             return Ok(frame);
         }
@@ -532,20 +533,28 @@ mod one_encoder {
     //! A texture-space diffusion frame ([`crate::runtime::skin::texture_space`]; d'Eon, Luebke and Enderton 2007, thesis
     //! ch. 3) recorded into **one** command encoder, submitted once, with one read-back: the RGBA8 frame and, after it,
     //! the per-head counts of [`TsStats`]. The stages and their arithmetic are those of the per-pass path
-    //! (`texture_space::render_with`, each pass submitted and read back on its own, which stays the reference, the CPU
-    //! twin and the path for MSAA, the wrinkle pass and a scan's surface maps):
+    //! (`texture_space::render_with`, each pass submitted and read back on its own, which stays the reference and the
+    //! CPU twin):
     //!
-    //! 1. The frame's geometry on the device (`frame_geometry`, as the screen-space shaders' default frame): the G-buffer,
-    //!    the back light's shadow map, per pixel (u, v, covered), the skin-inputs maps with the rig's hemoglobin at the
-    //!    mesh's uv, the normals, the specular layer and the view depth; then the frame's skin-inputs pass and its
-    //!    unblurred diffuse layer (`shade_frame.wgsl`'s `lit`, post-scatter: irradiance alone).
+    //! 1. The frame's geometry on the device (`frame_geometry`, as the screen-space shaders' frame): the G-buffer (with
+    //!    `--msaa 4` multisampled and resolved), the back light's shadow map, a scan's surface maps and the wrinkle
+    //!    pass on the pixels' normals, per pixel (u, v, covered, coverage), the skin-inputs maps with the rig's
+    //!    hemoglobin at the mesh's uv, the normals, the albedo map, the specular layer and the view depth; then the
+    //!    frame's skin-inputs pass and its unblurred diffuse layer (`shade_frame.wgsl`'s `lit`, post-scatter:
+    //!    irradiance alone).
     //! 2. Per head, its irradiance map of `T`×`T` texels (`T` from eq. 3.1–3.2 with the depth-based optimisation): the UV
     //!    map's positions, normals and coverage (rasterised on the host once per mesh and size, uploaded once per device:
     //!    [`crate::runtime::gpu::cached`]) give each texel its view normal, its culling (Listing 3.2) and clipping (eq.
-    //!    3.3–3.4) and its thickness through the shadow map (Listing 5.1) (`texture_space_frame.wgsl`'s `texels`); the
-    //!    skin-inputs pass and `lit` light the texels as the frame's pixels; the 12 chained blurs accumulate the weighted
-    //!    sum (`texture_space.wgsl`); `gather` samples it at the uv of each of the head's pixels.
-    //! 3. `shade_frame.wgsl`'s `composite` (post-scatter albedo, the unblurred specular layer), bloom and `tonemap`.
+    //!    3.3–3.4) and its thickness through the shadow map (Listing 5.1) (`texture_space_frame.wgsl`'s `texels`); with
+    //!    a normal map the texels' normals are first bent by the surface-map pass (`surface_maps::record`, the
+    //!    pixels' pass) run over the texels as its frame — (texel centre uv, covered), the UV map's normal and the
+    //!    MikkTSpace tangent of the split mesh rasterised at the texels, uploaded once per device, mesh and size — in
+    //!    world space (the frame is a rotation of the view's, which the mapping commutes with); the skin-inputs pass
+    //!    and `lit` light the texels as the frame's pixels; the 12 chained blurs accumulate the weighted sum
+    //!    (`texture_space.wgsl`); `gather` samples it at the uv of each of the head's pixels.
+    //! 3. `shade_frame.wgsl`'s `composite` (post-scatter albedo: the albedo map's where the frame has one, the unblurred
+    //!    specular layer), bloom, `tonemap` and, with MSAA, `coverage` (partly covered pixels blended with the
+    //!    background, as the host's `blend_coverage`).
 
     use super::{d_ref_m, uv_map_of, TextureSpaceDiffusion, TsHeadStats, TsStats};
     use crate::image_buf::Image;
@@ -559,12 +568,15 @@ mod one_encoder {
     use crate::runtime::skin::inputs::SkinInputs;
     use crate::runtime::skin::lighting::{DemoAssets, KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY};
     use crate::runtime::skin::mesh_inputs::RigPose;
+    use crate::runtime::skin::passes::SkinPasses;
     use crate::runtime::skin::settings::{
         SkinRenderSettings, TsSettings, HEAD_SPACING_M, SHADOW_MAP_SIZE, SHADOW_SHRINK_MM, WORLD_UNITS_PER_M,
     };
+    use crate::runtime::skin::surface_maps;
     use crate::runtime::RuntimeError;
     use crate::shading::texture_space::{
-        depth_sized_map, frustum_planes_eye, nearest_corner_distance, normalised_weights, CULL_ANGLE_DEG,
+        depth_sized_map, frustum_planes_eye, nearest_corner_distance, normalised_weights, rasterise_uv_attribute,
+        CULL_ANGLE_DEG,
     };
     use std::collections::HashMap;
 
@@ -573,18 +585,20 @@ mod one_encoder {
     /// `texture_space_frame.wgsl` with the bilinear taps it samples the blurred map with.
     const FRAME_SOURCE: &str = concat!(include_str!("bilinear_taps.wgsl"), include_str!("texture_space_frame.wgsl"));
     /// Storage buffers `texture_space_frame.wgsl` binds.
-    const FRAME_BUFFERS: u32 = 10;
+    const FRAME_BUFFERS: u32 = 11;
     /// Counts per head in the read-back (covered, culled, clipped, shaded texels, pixels).
     const COUNTS: usize = 5;
 
     /// `shade_frame.wgsl`'s uniform block: width, height, u32 per padded Rgba16Float row, post-scatter albedo; the key
-    /// light, albedo map (0: the skin LUT's); key and back-light intensities, bloom, SSS (0: none).
+    /// light, albedo map (0: the skin LUT's); key and back-light intensities, bloom, SSS (0: none); the background,
+    /// coverage blend (0: none).
     #[repr(C)]
     #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
     struct ShadeParams {
         size: [f32; 4],
         key: [f32; 4],
         cfg: [f32; 4],
+        cover: [f32; 4],
     }
 
     /// `texture_space_frame.wgsl`'s uniform block (field by field as there).
@@ -602,6 +616,7 @@ mod one_encoder {
         head: [f32; 4],
         flags: [f32; 4],
         rows: [f32; 4],
+        maps: [f32; 4],
     }
 
     /// Bytes of a padded row of `width` texels of `bytes_per_texel` in a texture copy.
@@ -634,6 +649,28 @@ mod one_encoder {
         })
     }
 
+    /// The texels of `mesh`'s UV map at `size` as the surface-map pass's frame (`view_frame.wgsl`): per texel (u, v
+    /// of its centre, covered, 1), (the UV map's normal, 0) and the MikkTSpace tangent and handedness of the split
+    /// mesh rasterised there (the host's per-pass loop reads the same), world space; built once per device, mesh
+    /// and size.
+    fn device_texel_frame(device: &wgpu::Device, mesh: &Mesh, mesh_key: u64, size: u32) -> [wgpu::Buffer; 3] {
+        gpu::cached(device, "texture-space texel frame", &(mesh_key, size), || {
+            let uv = uv_map_of(mesh, size);
+            let (split, tangents) = crate::mesh::tangents::mikktspace_tangents(mesh);
+            let tangents = rasterise_uv_attribute(&split, &tangents, size);
+            let centre = |k: u32| (k as f32 + 0.5) / size as f32;
+            let uvc: Vec<[f32; 4]> = (0..size * size)
+                .map(|t| [centre(t % size), centre(t / size), uv.covered[t as usize] as u8 as f32, 1.0])
+                .collect();
+            let normals: Vec<[f32; 4]> = uv.normal.iter().map(|n| [n[0], n[1], n[2], 0.0]).collect();
+            let what = "texture-space texel frame";
+            [uvc, normals, tangents].map(|v| {
+                let bytes: &[u8] = bytemuck::cast_slice(&v);
+                storage_buffer(device, what, bytes.len() as u64, Some(bytes))
+            })
+        })
+    }
+
     /// The per-frame buffers of one irradiance-map size (heads of the same size reuse them, one after the other).
     struct MapBuffers {
         inputs: SkinInputs,
@@ -649,13 +686,24 @@ mod one_encoder {
         chain: wgpu::Buffer,
         temp: wgpu::Buffer,
         sum: wgpu::Buffer,
+        /// With a normal map: the texels as the surface-map pass's frame and its output (the bent normal, the
+        /// albedo per texel); without: None and a 16-byte stand-in.
+        texel_frame: Option<[wgpu::Buffer; 3]>,
+        mapped: wgpu::Buffer,
         /// Bytes per padded row of an Rgba32Float and of an Rgba16Float image of the map.
         row32: u64,
         row16: u64,
     }
 
     impl MapBuffers {
-        fn new(g: &Gpu, mesh: &Mesh, mesh_key: u64, size: u32, assets: &DemoAssets) -> Result<Self, RuntimeError> {
+        fn new(
+            g: &Gpu,
+            mesh: &Mesh,
+            mesh_key: u64,
+            size: u32,
+            normal_map: bool,
+            assets: &DemoAssets,
+        ) -> Result<Self, RuntimeError> {
             let (device, queue) = (&g.device, &g.queue);
             let mut inputs = SkinInputs::new(device, queue, size, size, &assets.luts, &assets.rig)?;
             inputs.upload_lights(queue, &assets.rig_weights, assets.lights.back_view)?;
@@ -666,6 +714,7 @@ mod one_encoder {
             compute_chain::check_buffers(device, what, &sizes)?;
             let make = |bytes| storage_buffer(device, what, bytes, None);
             let (uv_map, stretch) = device_uv_map(device, mesh, mesh_key, size);
+            let texel_frame = normal_map.then(|| device_texel_frame(device, mesh, mesh_key, size));
             Ok(Self {
                 inputs,
                 uv_map,
@@ -677,15 +726,18 @@ mod one_encoder {
                 chain: make(sizes[3]),
                 temp: make(sizes[3]),
                 sum: make(sizes[3]),
+                texel_frame,
+                mapped: make(if normal_map { sizes[1] } else { 16 }),
                 row32,
                 row16,
             })
         }
     }
 
-    /// `texture_space::render_with`'s frame of `mesh` (the row `heads` of it) on `g` in one command encoder: see the
-    /// module doc; None where the device binds too few or too small storage buffers for it. `assets` are the frame's (neutral rig, post-scatter albedo, the passes' bloom); `rig_pose` the baked
-    /// rig's pose when the bake has one.
+    /// `texture_space::render_with`'s frame of `mesh` (the row `heads` of it) on `g` in one command encoder, with
+    /// `passes`' MSAA, wrinkle pass and surface maps: see the module doc; None where the device binds too few or too
+    /// small storage buffers for it. `assets` are the frame's (neutral rig, post-scatter albedo, the passes' bloom);
+    /// `rig_pose` the baked rig's pose when the bake has one.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn render(
         g: &Gpu,
@@ -694,12 +746,14 @@ mod one_encoder {
         heads: &Mesh,
         s: &SkinRenderSettings,
         ts: TsSettings,
+        passes: &SkinPasses,
         rig_pose: Option<RigPose>,
         assets: &DemoAssets,
     ) -> Result<Option<(Image<u8>, TsStats)>, RuntimeError> {
         let (device, queue) = (&g.device, &g.queue);
         let limits = device.limits();
         // Every texel map's largest buffer, (normal, shaded), (0) per texel, within a storage binding.
+        // (With a normal map also the surface-map pass's output over the texels.)
         let largest = 32 * ts.map_size as u64 * ts.map_size as u64;
         if limits.max_storage_buffers_per_shader_stage < FRAME_BUFFERS
             || largest > limits.max_storage_buffer_binding_size
@@ -710,7 +764,7 @@ mod one_encoder {
         let cam = s.camera();
         let (w, h) = (s.width, s.height);
         let n = w as u64 * h as u64;
-        // One sample, no surface maps, no wrinkle pass: the frames this path takes (`render_with`).
+        // The pixels' passes as the screen-space shaders' frame records them.
         let job = FrameGeometryJob {
             mesh: heads,
             camera: cam,
@@ -718,10 +772,12 @@ mod one_encoder {
             height: h,
             melanin: s.melanin,
             rig_pose,
-            msaa: 1,
-            surface_maps: None,
-            wrinkles: None,
+            msaa: passes.msaa,
+            surface_maps: passes.surface_maps.as_ref(),
+            wrinkles: passes.wrinkles.as_ref(),
         };
+        // The texels' normals bent by the normal map (the albedo map waits for the pixels: post-scatter).
+        let normal_map = passes.surface_maps.as_ref().filter(|m| m.normal.is_some());
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // 1. The frame's geometry, skin inputs and unblurred diffuse layer.
@@ -747,19 +803,32 @@ mod one_encoder {
         };
         inputs.record_compute(device, &mut enc, [&d.skin_maps, &d.normals], &skin16);
         let key = assets.lights.key_view;
-        let bloom_on = bloom_buffers.is_some() as u8 as f32;
+        let flag = |b: bool| b as u8 as f32;
+        let bloom_on = flag(bloom_buffers.is_some());
+        // The texels: no albedo map (post-scatter), no coverage blend.
         let shade_params = |width: u32, height: u32, row16: u64| ShadeParams {
             size: [width as f32, height as f32, (row16 / 4) as f32, 1.0],
             key: [key[0], key[1], key[2], 0.0],
             cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, bloom_on, 0.0],
+            cover: [0.0; 4],
         };
         let shade = |enc: &mut wgpu::CommandEncoder, p: &ShadeParams, bound: &[&wgpu::Buffer], entry: &str, size| {
             let stages = [Stage::new(entry, size)];
             compute_chain::record(device, enc, what, SHADE_SOURCE, bytemuck::bytes_of(p), bound, &stages);
         };
-        let screen = shade_params(w, h, row16);
+        // The frame: the albedo map's albedo where it has one, MSAA's partly covered pixels blended after the tone
+        // map (`coverage` reads `uvc`'s coverage).
+        let blend_coverage = job.msaa > 1;
+        let screen = ShadeParams {
+            key: [key[0], key[1], key[2], flag(job.has_albedo_map())],
+            cover: {
+                let bg = BACKGROUND.map(|c| c as f32 / 255.0);
+                [bg[0], bg[1], bg[2], flag(blend_coverage)]
+            },
+            ..shade_params(w, h, row16)
+        };
         let sss16 = unused();
-        let frame_bound = [&skin16, &d.texels, &diffuse, &sss16, &hdr, &bloomed, &rgba];
+        let frame_bound = [&skin16, &d.texels, &diffuse, &sss16, &hdr, &bloomed, &rgba, &d.uvc];
         shade(&mut enc, &screen, &frame_bound, "lit", groups_8x8(w, h));
         // 2. Per head, its irradiance map lit, blurred and gathered.
         let view = cam.view();
@@ -778,8 +847,7 @@ mod one_encoder {
         let counts = storage_buffer(device, what, (4 * COUNTS) as u64 * s.heads as u64, None);
         let shadow_row = padded_row(SHADOW_MAP_SIZE, 8);
         let depth_row = padded_row(w, 4);
-        let flag = |b: bool| b as u8 as f32;
-        let texel_unused = [unused(), unused(), unused(), unused()];
+        let texel_unused = [unused(), unused(), unused(), unused(), unused()];
         let mut maps: HashMap<u32, MapBuffers> = HashMap::new();
         let mut stats = TsStats { heads: Vec::new(), d_ref_m };
         for k in 0..s.heads {
@@ -789,7 +857,12 @@ mod one_encoder {
             let size = if ts.depth_sized { depth_sized_map(ts.map_size, d_ref_m, distance_m) } else { ts.map_size };
             stats.heads.push(TsHeadStats { map_size: size, distance_m, ..Default::default() });
             if let std::collections::hash_map::Entry::Vacant(e) = maps.entry(size) {
-                e.insert(MapBuffers::new(g, mesh, mesh_key, size, assets)?);
+                let m = e.insert(MapBuffers::new(g, mesh, mesh_key, size, normal_map.is_some(), assets)?);
+                // The texels' normals bent by the normal map, once per size (a head's offset is a translation).
+                if let (Some(maps), Some(frame)) = (normal_map, &m.texel_frame) {
+                    let frame = [&frame[0], &frame[1], &frame[2]];
+                    surface_maps::record(device, &mut enc, (size, size), frame, maps, &m.mapped)?;
+                }
             }
             let m = &maps[&size];
             let params = FrameParams {
@@ -804,9 +877,12 @@ mod one_encoder {
                 head: [dx, spacing, centre, (s.heads - 1) as f32],
                 flags: [flag(ts.cull), flag(ts.clip), CULL_ANGLE_DEG.to_radians().cos(), WORLD_UNITS_PER_M],
                 rows: [(m.row32 / 16) as f32, (depth_row / 4) as f32, SHADOW_MAP_SIZE as f32, (shadow_row / 4) as f32],
+                maps: [flag(normal_map.is_some()), 0.0, 0.0, 0.0],
             };
-            let bound =
-                [&m.uv_map, &d.shadow, &m.maps, &m.normals, &m.geo, &counts, &d.uvc, &d.depth, &m.sum, &diffuse];
+            let bound = [
+                &m.uv_map, &d.shadow, &m.maps, &m.normals, &m.geo, &counts, &d.uvc, &d.depth, &m.sum, &diffuse,
+                &m.mapped,
+            ];
             let uniform = bytemuck::bytes_of(&params);
             let record_stage = |enc: &mut wgpu::CommandEncoder, entry, groups| {
                 let stages = [Stage { entry, groups, args: [k, 0, 0, 0] }];
@@ -814,8 +890,8 @@ mod one_encoder {
             };
             record_stage(&mut enc, "texels", groups_8x8(size, size));
             m.inputs.record_compute(device, &mut enc, [&m.maps, &m.normals], &m.skin16);
-            let [a, b, c, e] = &texel_unused;
-            let texel_bound = [&m.skin16, &m.geo, &m.chain, a, b, c, e];
+            let [a, b, c, e, f] = &texel_unused;
+            let texel_bound = [&m.skin16, &m.geo, &m.chain, a, b, c, e, f];
             shade(&mut enc, &shade_params(size, size, m.row16), &texel_bound, "lit", groups_8x8(size, size));
             enc.clear_buffer(&m.sum, 0, None);
             blurs.record_blurs(device, &mut enc, [&m.chain, &m.temp, &m.sum], &m.stretch, size, sigmas, &weights);
@@ -827,6 +903,9 @@ mod one_encoder {
             bloom::record(device, &mut enc, w, h, p, b);
         }
         shade(&mut enc, &screen, &frame_bound, "tonemap", groups_8x8(w, h));
+        if blend_coverage {
+            shade(&mut enc, &screen, &frame_bound, "coverage", groups_8x8(w, h));
+        }
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: rgba.size() + counts.size(),

@@ -1,9 +1,9 @@
 // Texture-space diffusion recorded into the frame's command encoder (runtime/skin/texture_space.rs
 // `one_encoder::render`; d'Eon et al. 2007, thesis ch. 3). Two entry points around the skin-inputs pass, the lit
 // stage (shade_frame.wgsl) and the blurs (texture_space.wgsl) of one head:
-// - `texels`: each texel of the head's irradiance map as those passes read it: its view-space normal and the
-//   thickness the back light crosses to reach its surface point (Listing 5.1, the shadow map of the frame's
-//   geometry), alpha 1 on shaded texels and 0 on uncovered, culled (N·V < cos 105°, Listing 3.2) and clipped (outside
+// - `texels`: each texel of the head's irradiance map as those passes read it: its view-space normal (with a scan's
+//   normal map, the one surface_maps.wgsl bent in the texel's MikkTSpace frame) and the thickness the back light
+//   crosses to reach its surface point (Listing 5.1, the shadow map of the frame's geometry), alpha 1 on shaded texels and 0 on uncovered, culled (N·V < cos 105°, Listing 3.2) and clipped (outside
 //   the view frustum, eq. 3.3–3.4) ones, with the counts of each;
 // - `gather`: the head's weighted sum of blurs at each of its pixels' uv (bilinear, normalised by alpha) replaces
 //   the pixel's unblurred diffuse where a shaded texel is in reach.
@@ -32,6 +32,8 @@ struct Params {
     // vec4 per padded row of the texel maps, f32 per padded row of the SSS depth, shadow-map size, u32 per
     // padded row of the shadow map
     rows: vec4<f32>,
+    // x: the texels' normals bent by a normal map, read from `mapped` (1), or the UV map's (0); 0, 0, 0
+    maps: vec4<f32>,
     // x: the head's index
     stage: vec4<u32>,
 };
@@ -54,6 +56,9 @@ struct Params {
 // The head's weighted sum of blurs, premultiplied RGBA per texel; the frame's diffuse layer (RGBA per pixel).
 @group(0) @binding(9) var<storage, read_write> sum_map: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> diffuse: array<vec4<f32>>;
+// With a normal map: per texel (normal bent by the map, world space, 0), (albedo, 0), surface_maps.wgsl's output
+// over the texels (culling and clipping keep the UV map's normal, as the host does).
+@group(0) @binding(11) var<storage, read_write> mapped: array<vec4<f32>>;
 
 // Texel (x, y) of the shadow map's image starting at word `words`: two u32 of packed halves.
 fn shadow_texel(words: u32, x: u32, y: u32) -> vec4<f32> {
@@ -117,10 +122,14 @@ fn texels(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     atomicAdd(&counts[counted + 3u], 1u);
-    let nv = (p.view * vec4<f32>(nw, 0.0)).xyz;
+    var ns = nw;
+    if (p.maps.x > 0.5) {
+        ns = mapped[2u * t].xyz;
+    }
+    let nv = (p.view * vec4<f32>(ns, 0.0)).xyz;
     // The texels' albedo is not used: under post-scatter texturing each pixel's own albedo multiplies what it
     // gathers, so the texel's melanin and H0 only feed the skin-inputs pass's unused albedo output.
-    texel_maps[row] = vec4<f32>(p.cfg.z, 0.0, min(back_light_thickness_mm(pw, nw), p.cfg.w), 0.0);
+    texel_maps[row] = vec4<f32>(p.cfg.z, 0.0, min(back_light_thickness_mm(pw, ns), p.cfg.w), 0.0);
     texel_normals[row] = vec4<f32>(nv, 0.0);
     texel_geo[2u * t] = vec4<f32>(nv, 1.0);
 }
