@@ -7,13 +7,16 @@
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom] [mesh=SCAN.glb
-//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]]]   # 1280 720 7
+//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]] [only=ROW]]   # 1280 720 7
 //!
 //! With `mesh=` (a glTF or OBJ head, framed as `run skin --mesh-units auto --distance near` frames it) and its maps
 //! (`albedo=`, `normal=`: sRGB albedo, OpenGL-green tangent-space normal map), the scanned head's frame follows:
-//! each screen-space shader with the maps, and separable SSS with the maps and `--msaa 4` — e.g. the Lee Perry-Smith
-//! scan of `../shared/reference/heads/lee-perry-smith/` (CC BY 3.0; its texture coordinates need
-//! `uv-origin=bottom-left`, as `run skin` needs `--uv-origin bottom-left`).
+//! each screen-space shader with the maps, separable SSS with the maps and `--msaa 4`, and texture-space diffusion
+//! (the 1024² irradiance map of `run skin` and `run tap-grid`) with the maps — the reference frames of TAP's
+//! experiment — and with the maps and `--msaa 4` — e.g. the Lee Perry-Smith scan of
+//! `../shared/reference/heads/lee-perry-smith/` (CC BY 3.0; its texture coordinates need `uv-origin=bottom-left`,
+//! as `run skin` needs `--uv-origin bottom-left`). `only=ROW` keeps the rows whose name starts with ROW, `_` for a
+//! space (`only=scan_ts`: the scan's two TS rows).
 //!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
 //! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
@@ -142,8 +145,14 @@ fn main() {
         for (n, sh) in &shaders[..4] {
             rows.push((format!("scan {n}"), mesh.clone(), distance, *sh, mapped.clone()));
         }
-        let msaa = SkinPasses { msaa: 4, ..mapped };
-        rows.push(("scan sep 4x".to_string(), mesh, distance, SkinShader::Separable, msaa));
+        let msaa = SkinPasses { msaa: 4, ..mapped.clone() };
+        rows.push(("scan sep 4x".to_string(), mesh.clone(), distance, SkinShader::Separable, msaa.clone()));
+        let (_, ts) = shaders[4];
+        rows.push(("scan ts".to_string(), mesh.clone(), distance, ts, mapped));
+        rows.push(("scan ts 4x".to_string(), mesh, distance, ts, msaa));
+    }
+    if let Some(only) = arg("only") {
+        rows.retain(|(name, ..)| name.starts_with(&only.replace('_', " ")));
     }
     for (name, head, distance_m, shader, passes) in &rows {
         let (shader, distance_m) = (*shader, *distance_m);
