@@ -162,9 +162,11 @@ fn synthetic_surface_maps() -> SurfaceMaps {
     }
 }
 
+/// A frame's (submissions, read-backs) and the frame with its counts.
+type Counted = ((u64, u64), (Image<u8>, TsStats));
+
 /// The frame of `passes` on `g` after a first frame that builds the pipelines and uploads the maps, with the
 /// (submissions, read-backs) of the second; then the per-pass path's frame with its counts.
-type Counted = ((u64, u64), (Image<u8>, TsStats));
 fn one_encoder_and_per_pass(
     g: &Gpu,
     head: &Mesh,
@@ -238,7 +240,7 @@ fn texture_space_frames_with_surface_maps_wrinkles_and_msaa_submit_once() {
             melanin: 0.02,
             stretch: StretchPreset::Thesis,
         };
-        let ((counts, (one, one_stats)), ((counts_p, (per_pass, per_pass_stats)))) =
+        let ((counts, (one, one_stats)), (counts_p, (per_pass, per_pass_stats))) =
             one_encoder_and_per_pass(&g, &head, &s, ts, passes, &assets);
         assert_eq!(counts, (1, 1), "{name}: (submissions, read-backs)");
         let shaded_heads = per_pass_stats.heads.iter().filter(|h| h.shaded_texels > 0).count() as u64;
