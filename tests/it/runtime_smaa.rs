@@ -12,7 +12,7 @@ fn gpu_vs_cpu(w: u32, h: u32) {
     let img = render_shapes(w, h, 1);
     let pass = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
     let out = pass.run(&g.device, &g.queue, &img).unwrap();
-    let edges = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.edges()).unwrap();
+    let edges = pass.read_edges(&g.device, &g.queue).unwrap();
     let weights = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.weights()).unwrap();
     let c = cpu::smaa::smaa(&img, w, h, &luts, precision(&g));
     let (fe, me) = within(&edges, &c.edges, 0);
@@ -122,11 +122,19 @@ fn smaa_subsample_slices_gpu_matches_cpu() {
 /// bytes: edges, blending weights and output, on the shapes scene (odd size: partial workgroups and an odd last
 /// edge pair), the moving scene's textured frame (edges almost everywhere), with every edge detector (colour, depth,
 /// predicated luma and colour: the other detectors' compute edge passes feeding the compute weights pass) and with a
-/// mask (alone and with depth edges); the compute shape records no render pass.
+/// mask (alone and with depth edges); the compute shape records no render pass. The compute shape writes its
+/// edges texture in both forms (`EdgeFormat`): the device's (`Rg8Unorm` where the adapter allows it as a storage
+/// texture, as lavapipe does) and the portable `Rgba8Unorm`.
 #[test]
 fn compute_and_fragment_passes_write_the_same_bytes() {
+    for portable in [false, true] {
+        compute_and_fragment_bytes(portable);
+    }
+}
+
+fn compute_and_fragment_bytes(portable: bool) {
     use rtbake::runtime::aa::edges::{AaInputs, EdgeDetector, EdgeSettings, Predication};
-    use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
+    use rtbake::runtime::aa::three_pass::{set_portable_edges, EdgeFormat, PassShape, ThreePass};
     use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
     use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
     use rtbake::runtime::scene::render_shapes_depth;
@@ -136,7 +144,7 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
     let read = |t: &wgpu::Texture| rtbake::runtime::gpu::read_texture(&g.device, &g.queue, t).unwrap();
     let images = |p: &ThreePass, img: &[u8], inputs: &AaInputs| {
         let out = p.run_with(&g.device, &g.queue, img, inputs).unwrap();
-        [read(p.edges()), read(p.weights()), out]
+        [p.read_edges(&g.device, &g.queue).unwrap(), read(p.weights()), out]
     };
     let detector = |detector, predication| EdgeSettings { detector, predication, ..Default::default() };
     let pred = Some(Predication::SMAA);
@@ -166,9 +174,17 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
         );
         let smaa = |s| Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &smaa_options, s).unwrap();
         let mlaa = |s| Mlaa::with_shape(&g.device, &g.queue, (w, h), &map, &mlaa_options, s).unwrap();
+        set_portable_edges(portable);
         let (sc, sf) = (smaa(PassShape::Compute), smaa(PassShape::Fragment));
         assert_eq!((sc.shape(), sf.shape()), (PassShape::Compute, PassShape::Fragment));
         let (mc, mf) = (mlaa(PassShape::Compute), mlaa(PassShape::Fragment));
+        let format = EdgeFormat::for_device(&g.device);
+        set_portable_edges(false);
+        assert_eq!(format == EdgeFormat::Rgba8, portable || EdgeFormat::for_device(&g.device) == EdgeFormat::Rgba8);
+        for p in [&*sc, &*mc] {
+            assert_eq!(p.edges().format(), format.texture_format(), "{name}: the compute shape's edges texture");
+        }
+        assert_eq!(sf.edges().format(), wgpu::TextureFormat::Rg8Unorm);
         let fragment_passes = 3 + !edges.is_plain_luma() as u32 + *masked as u32;
         for (pass, c, f) in [("SMAA", &*sc, &*sf), ("MLAA", &*mc, &*mf)] {
             assert_eq!((c.render_passes(), f.render_passes()), (0, fragment_passes), "{pass} {name}");
@@ -181,7 +197,10 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
             }
             for (k, what) in ["edges", "weights", "output"].iter().enumerate() {
                 let differ = a[k].iter().zip(&b[k]).filter(|(x, y)| x != y).count();
-                assert_eq!(differ, 0, "{pass} {name}: {what} differ in {differ} bytes between compute and fragment");
+                assert_eq!(
+                    differ, 0,
+                    "{pass} {name}: {what} differ in {differ} bytes between compute ({format:?} edges) and fragment"
+                );
             }
         }
     }
