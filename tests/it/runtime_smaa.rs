@@ -282,3 +282,79 @@ fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
     assert!(wc == wf, "weights differ in {} bytes", wc.iter().zip(&wf).filter(|(a, b)| a != b).count());
     assert!(oc == of, "outputs differ in {} bytes", oc.iter().zip(&of).filter(|(a, b)| a != b).count());
 }
+
+/// SMAA and MLAA recorded into a caller's encoder over a frame already on the device (packed RGBA8 in a storage
+/// buffer, as the skin frame's compute chains leave it: `chain::record_antialias`, `ThreePass::encode_on_buffer`)
+/// write the bytes of the stand-alone passes (`chain::antialias`: upload, own submission, read-back) in both pass
+/// shapes, at an odd size, with one submission and one read-back for the whole encoder; a buffer too small for the
+/// frame is refused naming it.
+#[test]
+fn antialiasing_recorded_on_a_device_frame_writes_the_bytes_of_the_standalone_pass() {
+    use rtbake::image_buf::Image;
+    use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
+    use rtbake::runtime::chain::{antialias, record_antialias, Antialiasing};
+    use rtbake::runtime::gpu::{map_read, read_backs_on_this_thread, submissions_on_this_thread, submit};
+    use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
+    use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
+    use rtbake::runtime::smaa::SmaaOptions;
+    use wgpu::util::DeviceExt;
+    let g = gpu();
+    let (w, h) = (203u32, 117u32);
+    let (luts, map) = (baked_smaa(), MlaaAreaMap::new(33, baked_mlaa(33)).unwrap());
+    let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
+    // Records `record` over `img` uploaded to a storage buffer, copies the buffer out and submits once: the bytes,
+    // submissions and read-backs.
+    let on_device = |img: &[u8], record: &dyn Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer)| {
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let desc = wgpu::util::BufferInitDescriptor { label: Some("frame"), contents: img, usage };
+        let frame = g.device.create_buffer_init(&desc);
+        let readback = g.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame readback"),
+            size: frame.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        record(&mut enc, &frame);
+        enc.copy_buffer_to_buffer(&frame, 0, &readback, 0, frame.size());
+        submit(&g.queue, enc.finish());
+        let bytes = map_read(&g.device, &readback).unwrap();
+        (bytes, submissions_on_this_thread() - sub, read_backs_on_this_thread() - read)
+    };
+    for (scene, img) in [("shapes", render_shapes(w, h, 1)), ("moving scene", moving)] {
+        let image = Image::from_vec(w, h, 4, img.clone());
+        for (name, aa) in [("SMAA", Antialiasing::Smaa(luts.clone())), ("MLAA", Antialiasing::Mlaa(map.clone()))] {
+            let want = antialias(Some(&g), &image, &aa).unwrap().data;
+            assert_ne!(want, img, "{name} {scene}: the pass must change the frame");
+            let (got, sub, read) =
+                on_device(&img, &|enc, frame| record_antialias(&g, enc, frame, (w, h), &aa).unwrap());
+            assert_eq!((sub, read), (1, 1), "{name} {scene}: one submission and one read-back");
+            let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+            assert_eq!(differ, 0, "{name} {scene}: {differ} bytes differ from the stand-alone pass");
+            for shape in [PassShape::Compute, PassShape::Fragment] {
+                let pass: Box<dyn std::ops::Deref<Target = ThreePass>> = match name {
+                    "SMAA" => Box::new(
+                        Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), shape).unwrap(),
+                    ),
+                    _ => Box::new(
+                        Mlaa::with_shape(&g.device, &g.queue, (w, h), &map, &MlaaOptions::default(), shape).unwrap(),
+                    ),
+                };
+                let (got, ..) = on_device(&img, &|enc, frame| pass.encode_on_buffer(&g.device, enc, frame).unwrap());
+                assert!(got == want, "{name} {scene} {shape:?}: the recorded pass must write the stand-alone bytes");
+            }
+        }
+    }
+    let small = g.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("small"),
+        size: 4 * (w * h - 1) as u64,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let pass = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
+    let err = pass.encode_on_buffer(&g.device, &mut g.device.create_command_encoder(&Default::default()), &small);
+    let err = err.unwrap_err();
+    assert_eq!(err.param, "frame");
+    assert!(err.message.contains(&format!("{}", 4 * w * h)), "{err}");
+}

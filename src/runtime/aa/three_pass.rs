@@ -129,7 +129,8 @@ impl ThreePass {
         let size = (width, height);
         let edge_format = EdgeFormat::for_device(device);
         let module = gpu::shader(device, spec.source.0, &edge_format.in_source(spec.source.1));
-        let color = gpu::texture(device, &label("colour"), width, height, wgpu::TextureFormat::Rgba8Unorm);
+        // A storage texture too in either shape: `encode_on_buffer` unpacks a frame into it.
+        let color = frame_texture(device, &label("colour"), size, PassShape::Compute);
         let edges = match shape {
             PassShape::Fragment => gpu::texture(device, &label("edges"), width, height, wgpu::TextureFormat::Rg8Unorm),
             PassShape::Compute => {
@@ -263,6 +264,42 @@ impl ThreePass {
             }
         }
         self.extra.encode_mask(enc);
+    }
+
+    /// Records the passes over the frame in `frame`, a storage buffer of packed RGBA8 pixels (`width·height` u32, R in
+    /// the low byte, sRGB-encoded, top row first: as the skin frame's compute chains leave it) and writes the
+    /// antialiased frame back into it, all into `enc`: a compute pass unpacks the buffer into the input texture
+    /// (instead of [`Self::upload`]), the passes run as [`Self::encode`] records them, and a compute pass packs the
+    /// output back (`frame_buffer.wgsl`; both conversions exact). A frame shaded on the device is so antialiased
+    /// in its own submission and read back once; the bytes are those of [`Self::run`] on the same pixels (tested).
+    pub fn encode_on_buffer(
+        &self,
+        device: &wgpu::Device,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &wgpu::Buffer,
+    ) -> Result<(), InvalidInput> {
+        let (w, h) = (self.width, self.height);
+        let need = 4 * w as u64 * h as u64;
+        if frame.size() < need || !frame.usage().contains(wgpu::BufferUsages::STORAGE) {
+            return Err(InvalidInput::new(
+                "frame",
+                format!("must be a storage buffer of at least {w}x{h}x4 = {need} bytes, got {}", frame.size()),
+            ));
+        }
+        let module = gpu::shader(device, "frame_buffer.wgsl", include_str!("frame_buffer.wgsl"));
+        use wgpu::BindingResource as R;
+        let (input, output) =
+            (self.color.create_view(&Default::default()), self.output().create_view(&Default::default()));
+        let frame_binding = || (0, frame.as_entire_binding());
+        let pass = |enc: &mut wgpu::CommandEncoder, entry: &str, entries: &[(u32, R<'_>)]| {
+            let pipe = gpu::compute_pipeline(device, &module, entry);
+            let group = gpu::bind_group(device, entry, &pipe.get_bind_group_layout(0), entries);
+            dispatch(enc, entry, &pipe, &group, grid(w, h), None);
+        };
+        pass(enc, "cs_unpack", &[frame_binding(), (1, R::TextureView(&input))]);
+        self.encode(enc, None);
+        pass(enc, "cs_pack", &[frame_binding(), (2, R::TextureView(&output))]);
+        Ok(())
     }
 
     /// Validates and uploads the depth and mask the options read (named `--depth`/`--mask`).
