@@ -244,14 +244,10 @@ fn aa_shapes(
     scene: &str,
     bw: f64,
 ) {
-    let px = w as u64 * h as u64;
-    // Edges: colour RGBA8 in, edges out at the edges texture's format (RG8, or RGBA8 in the portable compute form);
-    // weights: edges in, weights RGBA8 out; blend: colour + weights in, RGBA8 out. The look-up tables, the texels
-    // the searches read twice, the edge list and the zeroed weights are left out: a bound, not a model.
-    let aa_bytes = |edges: &wgpu::Texture| {
-        let e = rtbake::runtime::gpu::bytes_per_texel(edges.format()) as u64;
-        [(4 + e) * px, (e + 4) * px, 12 * px]
-    };
+    // Bytes per pass (`ThreePass::pass_bytes`): edges: colour RGBA8 in, edges out at the edges texture's format
+    // (RG8, or RGBA8 in the portable compute form); weights: edges in, weights RGBA8 out; blend: colour + weights in,
+    // RGBA8 out. The look-up tables, the texels the searches read twice, the edge list and the zeroed weights are
+    // left out: a bound, not a model.
     let names = ["edges", "weights", "blend"];
     let forms = [(PassShape::Fragment, false), (PassShape::Compute, true), (PassShape::Compute, false)];
     let form_name = |shape: PassShape, edges: &wgpu::Texture| format!("{}, {:?} edges", shape.name(), edges.format());
@@ -265,7 +261,7 @@ fn aa_shapes(
         let (pp, wall) = time_passes(g, 3, &|e, t| smaa.encode(e, t));
         let name = format!("SMAA 1x {w}x{h} {scene}, {}", form_name(shape, smaa.edges()));
         print_line(&name, &pp, wall, "thesis 1.02 ms @1080p GTX 470; goal 0.2 ms @1080p H100");
-        let bytes = aa_bytes(smaa.edges());
+        let bytes = smaa.pass_bytes();
         print_bounds(&names, &pp, wall, &bytes, bw);
         if !portable {
             totals.push(("SMAA 1x", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>()));
@@ -279,7 +275,7 @@ fn aa_shapes(
         let (pp, wall) = time_passes(g, 3, &|e, t| mlaa.encode(e, t));
         let name = format!("MLAA N={} {w}x{h} {scene}, {}", map.n, form_name(shape, mlaa.edges()));
         print_line(&name, &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
-        let bytes = aa_bytes(mlaa.edges());
+        let bytes = mlaa.pass_bytes();
         print_bounds(&names, &pp, wall, &bytes, bw);
         if !portable {
             totals.push(("MLAA", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>()));

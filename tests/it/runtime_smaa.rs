@@ -286,8 +286,8 @@ fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
 /// SMAA and MLAA recorded into a caller's encoder over a frame already on the device (packed RGBA8 in a storage
 /// buffer, as the skin frame's compute chains leave it: `chain::record_antialias`, `ThreePass::encode_on_buffer`)
 /// write the bytes of the stand-alone passes (`chain::antialias`: upload, own submission, read-back) in both pass
-/// shapes, at an odd size, with one submission and one read-back for the whole encoder; a buffer too small for the
-/// frame is refused naming it.
+/// shapes, at an odd size, with one submission and one read-back for the whole encoder; profiled, its passes come
+/// back with the bytes of their bounds in either edge format; a buffer too small for the frame is refused naming it.
 #[test]
 fn antialiasing_recorded_on_a_device_frame_writes_the_bytes_of_the_standalone_pass() {
     use rtbake::image_buf::Image;
@@ -345,6 +345,30 @@ fn antialiasing_recorded_on_a_device_frame_writes_the_bytes_of_the_standalone_pa
                 assert!(got == want, "{name} {scene} {shape:?}: the recorded pass must write the stand-alone bytes");
             }
         }
+    }
+    // With per-pass profiling on, the three passes come back labelled with their bytes (each image whole and once
+    // at its format): 6, 6 and 12 bytes a pixel with `Rg8Unorm` edges, 8, 8 and 12 with `Rgba8Unorm`.
+    use rtbake::runtime::gpu::{set_pass_profiling, take_pass_profile};
+    let px = (w * h) as u64;
+    let fragment = Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), PassShape::Fragment);
+    assert_eq!(fragment.unwrap().pass_bytes(), [6 * px, 6 * px, 12 * px], "Rg8Unorm edges");
+    for portable in [false, true] {
+        rtbake::runtime::aa::three_pass::set_portable_edges(portable);
+        let pass = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
+        rtbake::runtime::aa::three_pass::set_portable_edges(false);
+        let e = match pass.edges().format() {
+            wgpu::TextureFormat::Rg8Unorm => 2,
+            wgpu::TextureFormat::Rgba8Unorm => 4,
+            f => panic!("edges in {f:?}"),
+        };
+        assert_eq!(e == 4, portable || pass.edges().format() == wgpu::TextureFormat::Rgba8Unorm);
+        set_pass_profiling(true);
+        on_device(&render_shapes(w, h, 1), &|enc, frame| pass.encode_on_buffer(&g.device, enc, frame).unwrap());
+        let profile = take_pass_profile(&g.device, &g.queue).unwrap();
+        set_pass_profiling(false);
+        let got: Vec<_> = profile.iter().map(|p| (p.label.as_str(), p.bytes)).collect();
+        let want = [("mlaa: edges", (4 + e) * px), ("mlaa: weights", (e + 4) * px), ("mlaa: blend", 12 * px)];
+        assert_eq!(got, want.map(|(l, b)| (l, Some(b))), "portable {portable}");
     }
     let small = g.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("small"),

@@ -334,6 +334,18 @@ impl EdgeStage {
         self.edges.iter().chain(mask).map(ShapedPass::render_passes).sum()
     }
 
+    /// Bytes per pixel the edge pass reads (each input image once at its format): the colour (RGBA8) unless the
+    /// detector reads depth alone, the depth (`R32Float`) when it reads depth.
+    pub(crate) fn edge_input_bytes_per_pixel(&self) -> u64 {
+        let colour = if self.settings.detector == EdgeDetector::Depth { 0 } else { 4 };
+        colour + if self.settings.needs_depth() { 4 } else { 0 }
+    }
+
+    /// Bytes per pixel of the mask (`R8Unorm`) the blending (or the composite) reads, 0 when unmasked.
+    pub(crate) fn mask_bytes_per_pixel(&self) -> u64 {
+        self.mask.is_some() as u64
+    }
+
     /// The mask texture, when masked (the compute shape's blending pass reads it).
     pub(crate) fn mask(&self) -> Option<&wgpu::Texture> {
         self.mask.as_ref()

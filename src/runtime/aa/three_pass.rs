@@ -98,6 +98,22 @@ impl ThreePass {
         &self.weights
     }
 
+    /// The bytes each pass (edges, weights, blending) must move, the figure its bytes-moved bound divides by the
+    /// copy bandwidth: every image it reads and writes counted whole and once at its texture's format — edges: the
+    /// detector's inputs ([`EdgeStage`]: colour RGBA8 and/or depth `R32Float`) in, the edges out (2 or 4 bytes a
+    /// pixel, [`EdgeFormat`]); weights: the edges in, the weights (RGBA8) out; blending: the colour and the weights
+    /// in, the output out (and the mask, `R8Unorm`, when masked). The look-up tables, the texels the searches read
+    /// again, the edge list and the weights the compute edge pass zeroes are left out: a bound, not a model.
+    pub fn pass_bytes(&self) -> [u64; 3] {
+        let px = self.width as u64 * self.height as u64;
+        let edges = gpu::bytes_per_texel(self.edges.format()) as u64;
+        [
+            (self.extra.edge_input_bytes_per_pixel() + edges) * px,
+            (edges + 4) * px,
+            (12 + self.extra.mask_bytes_per_pixel()) * px,
+        ]
+    }
+
     /// Uploads one frame (`width·height·4` bytes, RGBA8, sRGB-encoded, top row first).
     pub fn upload(&self, queue: &wgpu::Queue, rgba: &[u8]) -> Result<(), InvalidInput> {
         let want = self.width as usize * self.height as usize * 4;
@@ -297,7 +313,18 @@ impl ThreePass {
             dispatch(enc, entry, &pipe, &group, grid(w, h), None);
         };
         pass(enc, "cs_unpack", &[frame_binding(), (1, R::TextureView(&input))]);
-        self.encode(enc, None);
+        // With per-pass profiling on (`gpu::set_pass_profiling`), the three passes come back timed beside their
+        // bytes ([`Self::pass_bytes`]); the unpack and pack passes fall in the spans around them.
+        match gpu::profile_timer(device, SMAA_OR_MLAA_PASSES) {
+            Some(timer) => {
+                self.encode(enc, timer.as_ref().map(|t| (t, 0)));
+                let stages = ["edges", "weights", "blend"];
+                let labels = stages.map(|s| format!("{}: {s}", self.name));
+                let passes = labels.into_iter().zip(self.pass_bytes()).map(|(l, b)| (l, Some(b))).collect();
+                gpu::profile_passes(timer, passes);
+            }
+            None => self.encode(enc, None),
+        }
         pass(enc, "cs_pack", &[frame_binding(), (2, R::TextureView(&output))]);
         Ok(())
     }
