@@ -6,11 +6,12 @@
 //! Two shapes of the same arithmetic ([`PassShape`]): compute passes (`three_pass.wgsl`, the default: edges over
 //! 8×8-thread workgroups, written straight into the edges texture the weights pass filters ([`EdgeFormat`]), which
 //! also zero the weights and list the edge pixels (`edge_store.wgsl`), then the weights on the listed pixels only,
-//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace. The other edge detectors and the mask (`EdgeStage`) take the same shape.
-//! Both call the same per-pixel WGSL functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes
-//! (tested); the compute shape exists because a fragment pass reaches only the part of a GPU its graphics pipeline
-//! spans (on an NVIDIA H100/H200, two TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment`
-//! selects the fragment shape for the default constructors, so one benchmark binary measures both.
+//! dispatched indirectly, then blending over 8×8 workgroups) or the three full-screen fragment passes they replace.
+//! The other edge detectors and the mask (`EdgeStage`) take the same shape. Both call the same per-pixel WGSL
+//! functions (`edges_px`, `weights_px`, `blend_px`) and write the same bytes (tested); the compute shape exists
+//! because a fragment pass reaches only the part of a GPU its graphics pipeline spans (on an NVIDIA H100/H200, two
+//! TPCs), while a compute pass runs on every SM. `RTBAKE_AA_PASSES=fragment` selects the fragment shape for the
+//! default constructors, so one benchmark binary measures both.
 
 use crate::error::InvalidInput;
 use crate::runtime::aa::edges::{AaInputs, EdgeOut, EdgeOutputs, EdgeSettings, EdgeStage};
@@ -102,15 +103,16 @@ impl ThreePass {
     /// copy bandwidth: every image it reads and writes counted whole and once at its texture's format — edges: the
     /// detector's inputs ([`EdgeStage`]: colour RGBA8 and/or depth `R32Float`) in, the edges out (2 or 4 bytes a
     /// pixel, [`EdgeFormat`]); weights: the edges in, the weights (RGBA8) out; blending: the colour and the weights
-    /// in, the output out (and the mask, `R8Unorm`, when masked). The look-up tables, the texels the searches read
-    /// again, the edge list and the weights the compute edge pass zeroes are left out: a bound, not a model.
+    /// in, the output out (and, masked, the compute shape's mask, `R8Unorm`; the fragment shape masks in a fourth
+    /// pass). The look-up tables, the texels the searches read again, the edge list and the weights the compute edge
+    /// pass zeroes are left out: a bound, not a model.
     pub fn pass_bytes(&self) -> [u64; 3] {
         let px = self.width as u64 * self.height as u64;
         let edges = gpu::bytes_per_texel(self.edges.format()) as u64;
         [
             (self.extra.edge_input_bytes_per_pixel() + edges) * px,
             (edges + 4) * px,
-            (12 + self.extra.mask_bytes_per_pixel()) * px,
+            (12 + if self.shape() == PassShape::Compute { self.extra.mask_bytes_per_pixel() } else { 0 }) * px,
         ]
     }
 
