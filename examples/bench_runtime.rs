@@ -11,9 +11,11 @@
 //! bandwidth, measured first in the same run with buffer-to-buffer copies (read + write bytes per second), and
 //! the ratio time / bound.
 //!
-//! SMAA 1x and MLAA run twice, in their fragment shape (three full-screen fragment passes, as before) and their
-//! compute shape (three compute passes, the default; `rtbake::runtime::aa::three_pass::PassShape`), and a line per
-//! pass gives the speed-up and time/bound of both. On a GPU (exact command, from the repository root):
+//! SMAA 1x and MLAA run three times, in their fragment shape (three full-screen fragment passes, as before) and their
+//! compute shape (three compute passes, the default; `rtbake::runtime::aa::three_pass::PassShape`) with its edges
+//! texture written as the portable `Rgba8Unorm` and as the device's format (`Rg8Unorm` where the adapter allows it
+//! as a storage texture; `EdgeFormat`), each pass beside the bound of its own bytes, and a line per pass gives the
+//! speed-up and time/bound of the fragment and the device's compute shape. On a GPU (exact command, from the repository root):
 //!
 //!     cargo build --release --example bench_runtime --example bench_smaa_modes && \
 //!         scripts/gpu_bench.sh target/release/examples 1920x1080
@@ -30,7 +32,7 @@
 //! Tables: the committed bake (`baked/` beside the crate, or $RTBAKE_BAKED_DIR) through the manifest-checked
 //! loader: SMAA area/search, MLAA AreaMap33 v1.4, the published 17-tap separable kernel, d'Eon's 6 Gaussians.
 
-use rtbake::runtime::aa::three_pass::PassShape;
+use rtbake::runtime::aa::three_pass::{set_portable_edges, PassShape};
 use rtbake::runtime::cpu::{self, FilterPrecision, Tex8};
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gaussian_sss::GaussianSss;
@@ -230,7 +232,9 @@ fn sss_shapes(
 }
 
 /// SMAA 1x and MLAA on `img` in the fragment shape (three full-screen fragment passes, before) and the compute shape
-/// (three compute passes, after; the same output bytes), each pass beside its bytes-moved bound, then the speed-up.
+/// (three compute passes, after; the same output bytes) with its edges texture in both forms (`EdgeFormat`: the
+/// portable `Rgba8Unorm`, then the device's, `Rg8Unorm` where the adapter allows it as a storage texture), each pass
+/// beside its bytes-moved bound, then the speed-up of the device's compute shape over the fragment shape.
 fn aa_shapes(
     g: &rtbake::runtime::device::Gpu,
     luts: &rtbake::runtime::smaa::SmaaTextures,
@@ -240,41 +244,56 @@ fn aa_shapes(
     scene: &str,
     bw: f64,
 ) {
-    let px = w as u64 * h as u64;
-    // Edges: colour RGBA8 in, edges RG8 out; weights: edges in, weights RGBA8 out; blend: colour + weights in, RGBA8
-    // out. The look-up tables and the texels the searches read twice are left out: a bound, not a model.
-    let aa_bytes = [6 * px, 6 * px, 12 * px];
+    // Bytes per pass (`ThreePass::pass_bytes`): edges: colour RGBA8 in, edges out at the edges texture's format
+    // (RG8, or RGBA8 in the portable compute form); weights: edges in, weights RGBA8 out; blend: colour + weights in,
+    // RGBA8 out. The look-up tables, the texels the searches read twice, the edge list and the zeroed weights are
+    // left out: a bound, not a model.
     let names = ["edges", "weights", "blend"];
+    let forms = [(PassShape::Fragment, false), (PassShape::Compute, true), (PassShape::Compute, false)];
+    let form_name = |shape: PassShape, edges: &wgpu::Texture| format!("{}, {:?} edges", shape.name(), edges.format());
+    // (pass, time, wall, bytes) of the fragment shape and the device's compute shape.
     let mut totals = Vec::new();
-    for shape in [PassShape::Fragment, PassShape::Compute] {
+    for (shape, portable) in forms {
+        set_portable_edges(portable);
         let smaa = Smaa::with_shape(&g.device, &g.queue, (w, h), luts, &SmaaOptions::default(), shape).unwrap();
+        set_portable_edges(false);
         smaa.upload(&g.queue, img).unwrap();
         let (pp, wall) = time_passes(g, 3, &|e, t| smaa.encode(e, t));
-        let name = format!("SMAA 1x {w}x{h} {scene}, {}", shape.name());
+        let name = format!("SMAA 1x {w}x{h} {scene}, {}", form_name(shape, smaa.edges()));
         print_line(&name, &pp, wall, "thesis 1.02 ms @1080p GTX 470; goal 0.2 ms @1080p H100");
-        print_bounds(&names, &pp, wall, &aa_bytes, bw);
-        totals.push(("SMAA 1x", total_ms(&pp, wall), wall));
+        let bytes = smaa.pass_bytes();
+        print_bounds(&names, &pp, wall, &bytes, bw);
+        if !portable {
+            totals.push(("SMAA 1x", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>()));
+        }
     }
-    for shape in [PassShape::Fragment, PassShape::Compute] {
+    for (shape, portable) in forms {
+        set_portable_edges(portable);
         let mlaa = Mlaa::with_shape(&g.device, &g.queue, (w, h), map, &MlaaOptions::default(), shape).unwrap();
+        set_portable_edges(false);
         mlaa.upload(&g.queue, img).unwrap();
         let (pp, wall) = time_passes(g, 3, &|e, t| mlaa.encode(e, t));
-        let name = format!("MLAA N={} {w}x{h} {scene}, {}", map.n, shape.name());
+        let name = format!("MLAA N={} {w}x{h} {scene}, {}", map.n, form_name(shape, mlaa.edges()));
         print_line(&name, &pp, wall, "thesis 0.44 ms @720p 9800 GTX+");
-        print_bounds(&names, &pp, wall, &aa_bytes, bw);
-        totals.push(("MLAA", total_ms(&pp, wall), wall));
+        let bytes = mlaa.pass_bytes();
+        print_bounds(&names, &pp, wall, &bytes, bw);
+        if !portable {
+            totals.push(("MLAA", total_ms(&pp, wall), wall, bytes.iter().sum::<u64>()));
+        }
     }
     // Software adapters do not time compute passes faithfully (their timestamps miss the work): the wall times of
     // submit + wait are printed beside the timestamp sums, and on such an adapter only they compare.
-    let bound = aa_bytes.iter().sum::<u64>() as f64 / bw * 1e3;
+    let bound = |b: u64| b as f64 / bw * 1e3;
     for pair in totals.chunks(2) {
-        let ((pass, old, old_wall), (_, new, new_wall)) = (pair[0], pair[1]);
+        let ((pass, old, old_wall, old_b), (_, new, new_wall, new_b)) = (pair[0], pair[1]);
         println!(
-            "{pass} {w}x{h} {scene}: fragment {old:.3} ms -> compute {new:.3} ms ({:.2}x); bound {bound:.4} ms, \
+            "{pass} {w}x{h} {scene}: fragment {old:.3} ms -> compute {new:.3} ms ({:.2}x); bound {:.4} -> {:.4} ms, \
              time/bound {:.1} -> {:.1}; wall {old_wall:.3} -> {new_wall:.3} ms ({:.2}x)",
             old / new,
-            old / bound,
-            new / bound,
+            bound(old_b),
+            bound(new_b),
+            old / bound(old_b),
+            new / bound(new_b),
             old_wall / new_wall
         );
     }

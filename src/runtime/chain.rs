@@ -78,6 +78,25 @@ pub fn antialias<'g>(
     Ok(Image::from_vec(w, h, 4, data))
 }
 
+/// Records `aa` into `enc` over a frame already on the device, leaving the antialiased frame in its place: `frame`
+/// holds `w`×`h` packed RGBA8 pixels (sRGB-encoded, top row first; see
+/// [`ThreePass::encode_on_buffer`](crate::runtime::aa::three_pass::ThreePass::encode_on_buffer)). The device form of
+/// [`antialias`] (the same bytes) for a frame shaded in `enc`: no submission and no read-back of its own.
+pub fn record_antialias(
+    g: &Gpu,
+    enc: &mut wgpu::CommandEncoder,
+    frame: &wgpu::Buffer,
+    (w, h): (u32, u32),
+    aa: &Antialiasing,
+) -> Result<(), RuntimeError> {
+    crate::error::check_size("input", w as u64, h as u64)?;
+    match aa {
+        Antialiasing::Smaa(t) => Smaa::new(&g.device, &g.queue, w, h, t)?.encode_on_buffer(&g.device, enc, frame)?,
+        Antialiasing::Mlaa(m) => Mlaa::new(&g.device, &g.queue, w, h, m)?.encode_on_buffer(&g.device, enc, frame)?,
+    }
+    Ok(())
+}
+
 /// As [`antialias`] with an edge detector other than luma, predicated thresholding and/or a matte/stencil mask
 /// ([`crate::runtime::aa::edges`]): `inputs.depth` when `edges` need it, `inputs.mask` (one byte per pixel, ≥ 128 = inside)
 /// masks the pass when present.

@@ -105,7 +105,12 @@ async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError
     };
     let info = adapter.get_info();
     let timestamps = opts.timestamps && adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-    let required_features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+    let mut required_features = if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+    // The adapter's own format features where they let the antialiasing's edge pass write its `Rg8Unorm` edges as
+    // a storage texture (`runtime::aa::pass_shape::EdgeFormat`; else it writes the portable `Rgba8Unorm`).
+    if writes_rg8_storage(&adapter) {
+        required_features |= wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+    }
     let (device, queue) = adapter
         .request_device(&wgpu::DeviceDescriptor {
             label: Some("rtbake runtime"),
@@ -118,6 +123,14 @@ async fn create_headless_async(opts: &DeviceOptions) -> Result<Gpu, RuntimeError
         .await
         .map_err(|e| RuntimeError::NoAdapter(format!("{}: cannot create a device: {e}", info.name)))?;
     Ok(Gpu { device, queue, adapter_info: info, timestamps })
+}
+
+/// Whether `adapter` lets a compute pass write `Rg8Unorm` as a storage texture (through its own format features).
+fn writes_rg8_storage(adapter: &wgpu::Adapter) -> bool {
+    let f = adapter.get_texture_format_features(wgpu::TextureFormat::Rg8Unorm);
+    adapter.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+        && f.allowed_usages.contains(wgpu::TextureUsages::STORAGE_BINDING)
+        && f.flags.contains(wgpu::TextureFormatFeatureFlags::STORAGE_WRITE_ONLY)
 }
 
 /// Bytes of a read-back buffer of a `width`×`height` image of `bytes_per_texel`-byte texels, rows padded to

@@ -11,7 +11,7 @@ fn gpu_vs_cpu(w: u32, h: u32, n: u32) {
     let img = render_shapes(w, h, 1);
     let pass = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
     let out = pass.run(&g.device, &g.queue, &img).unwrap();
-    let edges = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.edges()).unwrap();
+    let edges = pass.read_edges(&g.device, &g.queue).unwrap();
     let weights = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.weights()).unwrap();
     let c = cpu::mlaa::mlaa(&img, w, h, &map, precision(&g));
     let (fe, _) = within(&edges, &c.edges, 0);

@@ -12,7 +12,7 @@ fn gpu_vs_cpu(w: u32, h: u32) {
     let img = render_shapes(w, h, 1);
     let pass = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
     let out = pass.run(&g.device, &g.queue, &img).unwrap();
-    let edges = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.edges()).unwrap();
+    let edges = pass.read_edges(&g.device, &g.queue).unwrap();
     let weights = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.weights()).unwrap();
     let c = cpu::smaa::smaa(&img, w, h, &luts, precision(&g));
     let (fe, me) = within(&edges, &c.edges, 0);
@@ -122,11 +122,19 @@ fn smaa_subsample_slices_gpu_matches_cpu() {
 /// bytes: edges, blending weights and output, on the shapes scene (odd size: partial workgroups and an odd last
 /// edge pair), the moving scene's textured frame (edges almost everywhere), with every edge detector (colour, depth,
 /// predicated luma and colour: the other detectors' compute edge passes feeding the compute weights pass) and with a
-/// mask (alone and with depth edges); the compute shape records no render pass.
+/// mask (alone and with depth edges); the compute shape records no render pass. The compute shape writes its
+/// edges texture in both forms (`EdgeFormat`): the device's (`Rg8Unorm` where the adapter allows it as a storage
+/// texture, as lavapipe does) and the portable `Rgba8Unorm`.
 #[test]
 fn compute_and_fragment_passes_write_the_same_bytes() {
+    for portable in [false, true] {
+        compute_and_fragment_bytes(portable);
+    }
+}
+
+fn compute_and_fragment_bytes(portable: bool) {
     use rtbake::runtime::aa::edges::{AaInputs, EdgeDetector, EdgeSettings, Predication};
-    use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
+    use rtbake::runtime::aa::three_pass::{set_portable_edges, EdgeFormat, PassShape, ThreePass};
     use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
     use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
     use rtbake::runtime::scene::render_shapes_depth;
@@ -136,7 +144,7 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
     let read = |t: &wgpu::Texture| rtbake::runtime::gpu::read_texture(&g.device, &g.queue, t).unwrap();
     let images = |p: &ThreePass, img: &[u8], inputs: &AaInputs| {
         let out = p.run_with(&g.device, &g.queue, img, inputs).unwrap();
-        [read(p.edges()), read(p.weights()), out]
+        [p.read_edges(&g.device, &g.queue).unwrap(), read(p.weights()), out]
     };
     let detector = |detector, predication| EdgeSettings { detector, predication, ..Default::default() };
     let pred = Some(Predication::SMAA);
@@ -166,9 +174,17 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
         );
         let smaa = |s| Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &smaa_options, s).unwrap();
         let mlaa = |s| Mlaa::with_shape(&g.device, &g.queue, (w, h), &map, &mlaa_options, s).unwrap();
+        set_portable_edges(portable);
         let (sc, sf) = (smaa(PassShape::Compute), smaa(PassShape::Fragment));
         assert_eq!((sc.shape(), sf.shape()), (PassShape::Compute, PassShape::Fragment));
         let (mc, mf) = (mlaa(PassShape::Compute), mlaa(PassShape::Fragment));
+        let format = EdgeFormat::for_device(&g.device);
+        set_portable_edges(false);
+        assert_eq!(format == EdgeFormat::Rgba8, portable || EdgeFormat::for_device(&g.device) == EdgeFormat::Rgba8);
+        for p in [&*sc, &*mc] {
+            assert_eq!(p.edges().format(), format.texture_format(), "{name}: the compute shape's edges texture");
+        }
+        assert_eq!(sf.edges().format(), wgpu::TextureFormat::Rg8Unorm);
         let fragment_passes = 3 + !edges.is_plain_luma() as u32 + *masked as u32;
         for (pass, c, f) in [("SMAA", &*sc, &*sf), ("MLAA", &*mc, &*mf)] {
             assert_eq!((c.render_passes(), f.render_passes()), (0, fragment_passes), "{pass} {name}");
@@ -181,7 +197,10 @@ fn compute_and_fragment_passes_write_the_same_bytes() {
             }
             for (k, what) in ["edges", "weights", "output"].iter().enumerate() {
                 let differ = a[k].iter().zip(&b[k]).filter(|(x, y)| x != y).count();
-                assert_eq!(differ, 0, "{pass} {name}: {what} differ in {differ} bytes between compute and fragment");
+                assert_eq!(
+                    differ, 0,
+                    "{pass} {name}: {what} differ in {differ} bytes between compute ({format:?} edges) and fragment"
+                );
             }
         }
     }
@@ -262,4 +281,104 @@ fn the_compute_edge_list_handles_no_edges_and_more_than_one_dispatch_row() {
     assert!(wf.iter().any(|v| *v > 0), "the checkerboard must produce blending weights");
     assert!(wc == wf, "weights differ in {} bytes", wc.iter().zip(&wf).filter(|(a, b)| a != b).count());
     assert!(oc == of, "outputs differ in {} bytes", oc.iter().zip(&of).filter(|(a, b)| a != b).count());
+}
+
+/// SMAA and MLAA recorded into a caller's encoder over a frame already on the device (packed RGBA8 in a storage
+/// buffer, as the skin frame's compute chains leave it: `chain::record_antialias`, `ThreePass::encode_on_buffer`)
+/// write the bytes of the stand-alone passes (`chain::antialias`: upload, own submission, read-back) in both pass
+/// shapes, at an odd size, with one submission and one read-back for the whole encoder; profiled, its passes come
+/// back with the bytes of their bounds in either edge format; a buffer too small for the frame is refused naming it.
+#[test]
+fn antialiasing_recorded_on_a_device_frame_writes_the_bytes_of_the_standalone_pass() {
+    use rtbake::image_buf::Image;
+    use rtbake::runtime::aa::three_pass::{PassShape, ThreePass};
+    use rtbake::runtime::chain::{antialias, record_antialias, Antialiasing};
+    use rtbake::runtime::gpu::{map_read, read_backs_on_this_thread, submissions_on_this_thread, submit};
+    use rtbake::runtime::mlaa::{Mlaa, MlaaAreaMap, MlaaOptions};
+    use rtbake::runtime::moving_scene::{MovingScene, SceneMotion};
+    use rtbake::runtime::smaa::SmaaOptions;
+    use wgpu::util::DeviceExt;
+    let g = gpu();
+    let (w, h) = (203u32, 117u32);
+    let (luts, map) = (baked_smaa(), MlaaAreaMap::new(33, baked_mlaa(33)).unwrap());
+    let moving = MovingScene::new(w, h, SceneMotion::DEFAULT).unwrap().render(1.0, [0.0, 0.0]);
+    // Records `record` over `img` uploaded to a storage buffer, copies the buffer out and submits once: the bytes,
+    // submissions and read-backs.
+    let on_device = |img: &[u8], record: &dyn Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer)| {
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let desc = wgpu::util::BufferInitDescriptor { label: Some("frame"), contents: img, usage };
+        let frame = g.device.create_buffer_init(&desc);
+        let readback = g.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame readback"),
+            size: frame.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
+        let mut enc = g.device.create_command_encoder(&Default::default());
+        record(&mut enc, &frame);
+        enc.copy_buffer_to_buffer(&frame, 0, &readback, 0, frame.size());
+        submit(&g.queue, enc.finish());
+        let bytes = map_read(&g.device, &readback).unwrap();
+        (bytes, submissions_on_this_thread() - sub, read_backs_on_this_thread() - read)
+    };
+    for (scene, img) in [("shapes", render_shapes(w, h, 1)), ("moving scene", moving)] {
+        let image = Image::from_vec(w, h, 4, img.clone());
+        for (name, aa) in [("SMAA", Antialiasing::Smaa(luts.clone())), ("MLAA", Antialiasing::Mlaa(map.clone()))] {
+            let want = antialias(Some(&g), &image, &aa).unwrap().data;
+            assert_ne!(want, img, "{name} {scene}: the pass must change the frame");
+            let (got, sub, read) =
+                on_device(&img, &|enc, frame| record_antialias(&g, enc, frame, (w, h), &aa).unwrap());
+            assert_eq!((sub, read), (1, 1), "{name} {scene}: one submission and one read-back");
+            let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+            assert_eq!(differ, 0, "{name} {scene}: {differ} bytes differ from the stand-alone pass");
+            for shape in [PassShape::Compute, PassShape::Fragment] {
+                let pass: Box<dyn std::ops::Deref<Target = ThreePass>> = match name {
+                    "SMAA" => Box::new(
+                        Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), shape).unwrap(),
+                    ),
+                    _ => Box::new(
+                        Mlaa::with_shape(&g.device, &g.queue, (w, h), &map, &MlaaOptions::default(), shape).unwrap(),
+                    ),
+                };
+                let (got, ..) = on_device(&img, &|enc, frame| pass.encode_on_buffer(&g.device, enc, frame).unwrap());
+                assert!(got == want, "{name} {scene} {shape:?}: the recorded pass must write the stand-alone bytes");
+            }
+        }
+    }
+    // With per-pass profiling on, the three passes come back labelled with their bytes (each image whole and once
+    // at its format): 6, 6 and 12 bytes a pixel with `Rg8Unorm` edges, 8, 8 and 12 with `Rgba8Unorm`.
+    use rtbake::runtime::gpu::{set_pass_profiling, take_pass_profile};
+    let px = (w * h) as u64;
+    let fragment = Smaa::with_shape(&g.device, &g.queue, (w, h), &luts, &SmaaOptions::default(), PassShape::Fragment);
+    assert_eq!(fragment.unwrap().pass_bytes(), [6 * px, 6 * px, 12 * px], "Rg8Unorm edges");
+    for portable in [false, true] {
+        rtbake::runtime::aa::three_pass::set_portable_edges(portable);
+        let pass = Mlaa::new(&g.device, &g.queue, w, h, &map).unwrap();
+        rtbake::runtime::aa::three_pass::set_portable_edges(false);
+        let e = match pass.edges().format() {
+            wgpu::TextureFormat::Rg8Unorm => 2,
+            wgpu::TextureFormat::Rgba8Unorm => 4,
+            f => panic!("edges in {f:?}"),
+        };
+        assert_eq!(e == 4, portable || pass.edges().format() == wgpu::TextureFormat::Rgba8Unorm);
+        set_pass_profiling(true);
+        on_device(&render_shapes(w, h, 1), &|enc, frame| pass.encode_on_buffer(&g.device, enc, frame).unwrap());
+        let profile = take_pass_profile(&g.device, &g.queue).unwrap();
+        set_pass_profiling(false);
+        let got: Vec<_> = profile.iter().map(|p| (p.label.as_str(), p.bytes)).collect();
+        let want = [("mlaa: edges", (4 + e) * px), ("mlaa: weights", (e + 4) * px), ("mlaa: blend", 12 * px)];
+        assert_eq!(got, want.map(|(l, b)| (l, Some(b))), "portable {portable}");
+    }
+    let small = g.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("small"),
+        size: 4 * (w * h - 1) as u64,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let pass = Smaa::new(&g.device, &g.queue, w, h, &luts).unwrap();
+    let err = pass.encode_on_buffer(&g.device, &mut g.device.create_command_encoder(&Default::default()), &small);
+    let err = err.unwrap_err();
+    assert_eq!(err.param, "frame");
+    assert!(err.message.contains(&format!("{}", 4 * w * h)), "{err}");
 }

@@ -45,7 +45,7 @@ fn smaa_gpu_vs_cpu(
     let luts = baked_smaa();
     let pass = Smaa::with_options(&g.device, &g.queue, w, h, &luts, options).unwrap();
     let out = pass.run_with(&g.device, &g.queue, img, inputs).unwrap();
-    let edges = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.edges()).unwrap();
+    let edges = pass.read_edges(&g.device, &g.queue).unwrap();
     let c = cpu::smaa::smaa_with_options(img, (w, h), &luts, precision(&g), options, inputs).unwrap();
     let (fe, me) = within(&edges, &c.edges, 0);
     let (fo, mo) = within(&out, &c.output, 1);
@@ -66,7 +66,7 @@ fn mlaa_gpu_vs_cpu((w, h): (u32, u32), img: &[u8], options: &MlaaOptions, inputs
     let map = MlaaAreaMap::new(33, baked_mlaa(33)).unwrap();
     let pass = Mlaa::with_options(&g.device, &g.queue, w, h, &map, options).unwrap();
     let out = pass.run_with(&g.device, &g.queue, img, inputs).unwrap();
-    let edges = rtbake::runtime::gpu::read_texture(&g.device, &g.queue, pass.edges()).unwrap();
+    let edges = pass.read_edges(&g.device, &g.queue).unwrap();
     let c = cpu::mlaa::mlaa_with_options(img, (w, h), &map, precision(&g), options, inputs).unwrap();
     let (fe, _) = within(&edges, &c.edges, 0);
     let (fo, mo) = within(&out, &c.output, 1);

@@ -27,7 +27,7 @@
 //! default runs are unchanged.
 
 use crate::error::{check_range, InvalidInput};
-use crate::runtime::aa::pass_shape::{dispatch, grid, ShapedPass};
+use crate::runtime::aa::pass_shape::{dispatch, grid, EdgeFormat, ShapedPass};
 use crate::runtime::gpu;
 
 /// SMAA's luma / colour threshold (SMAA.hlsl `SMAA_THRESHOLD`, preset HIGH; MLAA's listings use the same 0.1).
@@ -193,21 +193,21 @@ const SHADER: &str = concat!(
     include_str!("../fullscreen.wgsl"),
     include_str!("srgb.wgsl"),
     include_str!("edges.wgsl"),
-    include_str!("edge_rows.wgsl")
+    include_str!("edge_store.wgsl")
 );
 
 /// Where [`EdgeStage::encode_edges`] writes: the fragment shape's edges target (with the timer slot of the edges
-/// pass) or the compute shape's edge rows (with the beginning timestamp of the edges slot).
+/// pass) or the compute shape's edges storage texture (with the timestamps of the edges slot).
 pub(crate) enum EdgeOut<'a> {
     Render(&'a wgpu::TextureView, Option<(&'a gpu::GpuTimer, u32)>),
-    Rows(Option<wgpu::ComputePassTimestampWrites<'a>>),
+    Texture(Option<wgpu::ComputePassTimestampWrites<'a>>),
 }
 
-/// What the compute shape's edge pass writes (`edge_rows.wgsl`): the edge rows
-/// [`ThreePass`](super::three_pass::ThreePass) copies into the edges texture, the list of edge pixels the weights
-/// pass runs on (count first) and the weights texture it zeroes.
+/// What the compute shape's edge pass writes (`edge_store.wgsl`): the edges texture (in `format`) the weights pass
+/// filters, the list of edge pixels the weights pass runs on (count first) and the weights texture it zeroes.
 pub(crate) struct EdgeOutputs<'a> {
-    pub rows: &'a wgpu::Buffer,
+    pub edges: &'a wgpu::TextureView,
+    pub format: EdgeFormat,
     pub list: &'a wgpu::Buffer,
     pub weights: &'a wgpu::TextureView,
 }
@@ -247,7 +247,9 @@ impl EdgeStage {
             pred: [pred.threshold, pred.scale, pred.strength, settings.depth_threshold],
         };
         let needs_module = !settings.is_plain_luma() || masked;
-        let module = needs_module.then(|| gpu::shader(device, "smaa_edges.wgsl", SHADER));
+        // The fragment shape never binds the edges storage texture: any valid declaration of it will do.
+        let format = compute.as_ref().map_or(EdgeFormat::Rgba8, |c| c.format);
+        let module = needs_module.then(|| gpu::shader(device, "smaa_edges.wgsl", &format.in_source(SHADER)));
         let ubo = gpu::uniform_buffer(device, "aa edge params", bytemuck::bytes_of(&params));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let prefix = if compute.is_some() { "cs" } else { "fs" };
@@ -268,8 +270,8 @@ impl EdgeStage {
                     entries.push((2, R::TextureView(dv)));
                 }
                 if let Some(out) = &compute {
-                    let rows = (8, out.rows.as_entire_binding());
-                    entries.extend([rows, (9, R::TextureView(out.weights)), (11, out.list.as_entire_binding())]);
+                    let edges = (8, R::TextureView(out.edges));
+                    entries.extend([edges, (9, R::TextureView(out.weights)), (11, out.list.as_entire_binding())]);
                 }
                 Some(ShapedPass::new(device, module, &format!("{prefix}_{entry}"), F::Rg8Unorm, &entries))
             }
@@ -303,15 +305,14 @@ impl EdgeStage {
     }
 
     /// Records the edge pass into `out` and returns true, or returns false when the pass's own luma detector is to
-    /// run. The compute shape writes the edge rows (two pixels per thread); its caller copies them into the edges
-    /// texture.
+    /// run. The compute shape writes the edges texture (two pixels per thread).
     pub(crate) fn encode_edges(&self, enc: &mut wgpu::CommandEncoder, out: EdgeOut<'_>) -> bool {
         let (w, h) = self.size;
         match (&self.edges, out) {
             (Some(ShapedPass::Draw(pipe, bg)), EdgeOut::Render(target, slot)) => {
                 gpu::draw_fullscreen(enc, "aa edges", pipe, bg, target, slot)
             }
-            (Some(ShapedPass::Dispatch(pipe, bg)), EdgeOut::Rows(writes)) => {
+            (Some(ShapedPass::Dispatch(pipe, bg)), EdgeOut::Texture(writes)) => {
                 dispatch(enc, "aa edges", pipe, bg, grid(w.div_ceil(2), h), writes)
             }
             (None, _) => return false,
@@ -331,6 +332,18 @@ impl EdgeStage {
     pub(crate) fn render_passes(&self) -> u32 {
         let mask = self.composite.as_ref().map(|c| &c.0);
         self.edges.iter().chain(mask).map(ShapedPass::render_passes).sum()
+    }
+
+    /// Bytes per pixel the edge pass reads (each input image once at its format): the colour (RGBA8) unless the
+    /// detector reads depth alone, the depth (`R32Float`) when it reads depth.
+    pub(crate) fn edge_input_bytes_per_pixel(&self) -> u64 {
+        let colour = if self.settings.detector == EdgeDetector::Depth { 0 } else { 4 };
+        colour + if self.settings.needs_depth() { 4 } else { 0 }
+    }
+
+    /// Bytes per pixel of the mask (`R8Unorm`) the blending (or the composite) reads, 0 when unmasked.
+    pub(crate) fn mask_bytes_per_pixel(&self) -> u64 {
+        self.mask.is_some() as u64
     }
 
     /// The mask texture, when masked (the compute shape's blending pass reads it).

@@ -8,12 +8,12 @@
 // Pixel positions are integer texel coordinates, loads clamp to the edge.
 //
 // Each detector is a per-pixel function (`*_px`) called by a fragment entry point (`fs_*`, the fragment shape of
-// three_pass.rs) and a compute one (`cs_*`, its compute shape: two pixels per thread into the edge rows of
-// edge_rows.wgsl, which also zeroes the weights and lists the edge pixels), so both shapes write the same bytes.
+// three_pass.rs) and a compute one (`cs_*`, its compute shape: two pixels per thread into the edges texture of
+// edge_store.wgsl, which also zeroes the weights and lists the edge pixels), so both shapes write the same bytes.
 // The compute shape masks in its blending pass (`cs_blend_masked` of three_pass.wgsl, the same selection as
 // `mask_px`).
 //
-// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl); appended: edge_rows.wgsl.
+// Prepended by the host module: vs_fullscreen (../fullscreen.wgsl), LUMA (srgb.wgsl); appended: edge_store.wgsl.
 
 struct Params {
     // (1/width, 1/height, width, height)

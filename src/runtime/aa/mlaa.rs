@@ -128,12 +128,11 @@ impl Mlaa {
             cfg: [map.n as f32, map.search_steps() as f32, MLAA_THRESHOLD, 0.0],
         };
         let ubo = gpu::uniform_buffer(device, "mlaa params", bytemuck::bytes_of(&params));
-        let module = gpu::shader(device, "mlaa.wgsl", &SHADER);
         let (lin, pnt) = (gpu::linear_clamp_sampler(device), gpu::nearest_clamp_sampler(device));
         let av = area.create_view(&Default::default());
         use wgpu::BindingResource as R;
         let weight_luts = vec![(3, R::TextureView(&av)), (6, R::Sampler(&lin)), (7, R::Sampler(&pnt))];
-        let spec = PassSpec { name: "mlaa", module: &module, ubo: &ubo, weight_luts };
+        let spec = PassSpec { name: "mlaa", source: ("mlaa.wgsl", &SHADER), ubo: &ubo, weight_luts };
         let edges = (&options.edges, 0.0, options.masked);
         Ok(Self(ThreePass::build(device, (width, height), spec, shape, edges)?))
     }

@@ -1,9 +1,9 @@
 //! The two shapes an anti-aliasing pass takes on the GPU ([`PassShape`]: compute dispatches over 8×8-thread
 //! workgroups, or full-screen fragment passes into render targets; the same bytes either way) and what the passes
 //! of both shapes share: a one-output pass in either shape (`ShapedPass`: the edge detectors, the mask, the SMAA
-//! modes' resolves), the workgroup grid and the frame textures. [`crate::runtime::aa::three_pass`] builds the
-//! three passes of SMAA 1x and MLAA (thesis ch. 9–10) on it; [`crate::runtime::aa::edges`] and
-//! [`crate::runtime::aa::modes`] build theirs.
+//! modes' resolves), the workgroup grid, the frame textures and the format of the compute shape's edges
+//! ([`EdgeFormat`]). [`crate::runtime::aa::three_pass`] builds the three passes of SMAA 1x and MLAA (thesis
+//! ch. 9–10) on it; [`crate::runtime::aa::edges`] and [`crate::runtime::aa::modes`] build theirs.
 
 use crate::error::InvalidInput;
 use crate::runtime::gpu::{self, GpuTimer};
@@ -44,6 +44,74 @@ impl PassShape {
     /// [`Self::ENV`] when set ([`Self::parse`]), else [`PassShape::Compute`].
     pub fn from_env() -> Result<Self, InvalidInput> {
         std::env::var(Self::ENV).map_or(Ok(Self::default()), |v| Self::parse(&v))
+    }
+}
+
+/// The format of the compute shape's edges texture, which its edge pass writes as a storage texture
+/// (`textureStore`, no buffer and no copy) and the weights pass filters bilinearly (.rg): `Rg8Unorm`, 2 bytes a
+/// pixel, where the device lets a compute pass write it (an adapter-specific format feature,
+/// `wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, which `runtime::device` requests where the adapter
+/// allows it), else `Rgba8Unorm`, 4 bytes a pixel with B and A zero (a storage format every WebGPU device has). The
+/// edge values are exactly 0 or 1, so R and G are the bytes the fragment shape renders into its `Rg8Unorm` target
+/// either way (tested in both formats).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeFormat {
+    Rg8,
+    Rgba8,
+}
+
+thread_local! {
+    static PORTABLE_EDGES: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Makes the compute-shape passes built on the calling thread write their edges as `Rgba8Unorm` even where the
+/// device allows `Rg8Unorm` (true), or pick by the device (false, the default): tests and benchmarks compare the
+/// two forms on one device.
+pub fn set_portable_edges(on: bool) {
+    PORTABLE_EDGES.with(|c| c.set(on));
+}
+
+impl EdgeFormat {
+    /// The texture format.
+    pub fn texture_format(self) -> wgpu::TextureFormat {
+        match self {
+            Self::Rg8 => wgpu::TextureFormat::Rg8Unorm,
+            Self::Rgba8 => wgpu::TextureFormat::Rgba8Unorm,
+        }
+    }
+
+    /// The storage format's WGSL name.
+    fn wgsl(self) -> &'static str {
+        match self {
+            Self::Rg8 => "rg8unorm",
+            Self::Rgba8 => "rgba8unorm",
+        }
+    }
+
+    /// The format passes built on `device` from the calling thread write ([`set_portable_edges`] aside): `Rg8` where
+    /// the device has the adapter's own format features and an `Rg8Unorm` storage texture can be created on it
+    /// (probed once per device), else `Rgba8`.
+    pub fn for_device(device: &wgpu::Device) -> Self {
+        if PORTABLE_EDGES.with(|c| c.get())
+            || !device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+        {
+            return Self::Rgba8;
+        }
+        gpu::cached(device, "rg8unorm storage probe", &(), || {
+            let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+            drop(gpu::storage_texture(device, "rg8unorm storage probe", 1, 1, wgpu::TextureFormat::Rg8Unorm));
+            match pollster::block_on(scope.pop()) {
+                None => Self::Rg8,
+                Some(_) => Self::Rgba8,
+            }
+        })
+    }
+
+    /// `source` (a module that includes `edge_store.wgsl`) with its edges texture declared in this format.
+    pub(crate) fn in_source(self, source: &str) -> String {
+        const DECL: &str = "var edges_out: texture_storage_2d<rg8unorm, write>;";
+        debug_assert!(source.contains(DECL), "the module includes edge_store.wgsl");
+        source.replace(DECL, &DECL.replace("rg8unorm", self.wgsl()))
     }
 }
 

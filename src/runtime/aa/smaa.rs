@@ -220,14 +220,13 @@ impl Smaa {
             subsample: subsample.as_f32(),
         };
         let ubo = gpu::uniform_buffer(device, "smaa params", bytemuck::bytes_of(&params));
-        let module = gpu::shader(device, "smaa.wgsl", shader_source());
         let sampler = gpu::linear_clamp_sampler(device);
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (area_view, search_view) = (view(&area), view(&search));
         use wgpu::BindingResource as R;
         let weight_luts =
             vec![(3, R::TextureView(&area_view)), (4, R::TextureView(&search_view)), (6, R::Sampler(&sampler))];
-        let spec = PassSpec { name: "smaa", module: &module, ubo: &ubo, weight_luts };
+        let spec = PassSpec { name: "smaa", source: ("smaa.wgsl", shader_source()), ubo: &ubo, weight_luts };
         let edges = (&options.edges, SMAA_LOCAL_CONTRAST_ADAPTATION, options.masked);
         Ok(Self(ThreePass::build(device, (width, height), spec, shape, edges)?))
     }

@@ -7,8 +7,8 @@
 // Why compute: on GPUs whose graphics pipeline reaches only part of the chip (NVIDIA H100/H200: two TPCs of the
 // whole GPU run pixel shaders), a full-screen fragment pass runs on a few SMs, a compute pass on all of them.
 //
-// Edges: two pixels per thread into the edge rows of edge_rows.wgsl (prepended with this file), which also zeroes
-// the weights and lists the edge pixels for the weights pass.
+// Edges: two pixels per thread into the edges texture of edge_store.wgsl (prepended with this file), which also
+// zeroes the weights and lists the edge pixels for the weights pass.
 
 @group(0) @binding(10) var color_out: texture_storage_2d<rgba8unorm, write>;
 
@@ -18,7 +18,7 @@ fn cs_edges(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocat
     emit_edge_pair(id.xy, li, edges_px(p), edges_px(p + vec2<i32>(1, 0)));
 }
 
-// Weights on the edge pixels the edges pass listed (edge_rows.wgsl): one thread turns the count into the indirect
+// Weights on the edge pixels the edges pass listed (edge_store.wgsl): one thread turns the count into the indirect
 // dispatch, and `cs_weights_list` runs `weights_px` on the listed pixels, packed 64 to a workgroup, so no lane waits
 // on a pixel without an edge.
 @group(0) @binding(12) var<storage, read_write> weights_args: array<u32, 3>;

@@ -1,18 +1,12 @@
-// The edge rows the compute edge passes write (`cs_edges` of three_pass.wgsl, `cs_edges_*` of edges.wgsl), included
-// by both. `Rg8Unorm` is not a storage format WebGPU guarantees, so each thread detects the edges of two adjacent
-// pixels and writes them as one u32 (bytes R0 G0 R1 G1, the texture's layout) into a buffer with rows of
-// `edge_row_bytes` (256-byte aligned), which the host copies into the `Rg8Unorm` edges texture the weights pass
-// filters. Edge values are exactly 0 or 1, so the bytes are those the fragment pass renders.
+// The edge texture the compute edge passes write (`cs_edges` of three_pass.wgsl, `cs_edges_*` of edges.wgsl),
+// included by both: the texture the weights pass then filters, written with `textureStore`, no buffer and no copy.
+// Its format is `rg8unorm` where the adapter allows it as a storage texture, else `rgba8unorm` (WebGPU's portable
+// storage format; B and A written 0 and never read): the host substitutes the format in the declaration below
+// (`runtime/aa/three_pass.rs`, `EdgeFormat`). Edge values are exactly 0 or 1, so R and G hold the bytes the fragment
+// pass renders into its `Rg8Unorm` target. Each thread detects the edges of two adjacent pixels.
 // The including shader declares `P` with `rt` = (1/width, 1/height, width, height).
 
-@group(0) @binding(8) var<storage, read_write> edge_rows: array<u32>;
-
-// Bytes per row of the edge buffer: 2 bytes per pixel, rounded up to the 256 bytes a buffer-to-texture copy needs
-// (the host's `edge_row_bytes`).
-fn edge_row_words() -> u32 {
-    let w = u32(P.rt.z);
-    return ((2u * w + 255u) / 256u) * 256u / 4u;
-}
+@group(0) @binding(8) var edges_out: texture_storage_2d<rg8unorm, write>;
 
 // The same pass zeroes the weights of its pixels and lists its edge pixels for the weights pass (the compute form
 // of the stencil SMAA's weights pass runs under, thesis §9.3), so the edges are never read back for it: one global
@@ -31,8 +25,8 @@ var<workgroup> group_count: atomic<u32>;
 var<workgroup> group_base: u32;
 
 // Writes the edges `e0`, `e1` of thread `id`'s pixel pair (x = 2·id.x and the pixel right of it; a pixel beyond
-// the frame is skipped, its bytes in the row padding are zero and never copied), zeroes their weights and lists the
-// edge pixels. Every thread of the 8×8 workgroup (`li` its index) calls it from uniform control flow (barriers).
+// the frame is skipped), zeroes their weights and lists the edge pixels. Every thread of the 8×8 workgroup (`li`
+// its index) calls it from uniform control flow (barriers).
 fn emit_edge_pair(id: vec2<u32>, li: u32, e0: vec2<f32>, e1: vec2<f32>) {
     let size = vec2<u32>(P.rt.zw);
     let x0 = 2u * id.x;
@@ -41,11 +35,11 @@ fn emit_edge_pair(id: vec2<u32>, li: u32, e0: vec2<f32>, e1: vec2<f32>) {
     let edge0 = in0 && (e0.x > 0.0 || e0.y > 0.0);
     let edge1 = in1 && (e1.x > 0.0 || e1.y > 0.0);
     if (in0) {
-        let right = select(vec2<f32>(0.0), e1, in1);
-        edge_rows[id.y * edge_row_words() + id.x] = pack4x8unorm(vec4<f32>(e0, right));
+        textureStore(edges_out, vec2<u32>(x0, id.y), vec4<f32>(e0, 0.0, 0.0));
         textureStore(weights_out, vec2<u32>(x0, id.y), vec4<f32>(0.0));
     }
     if (in1) {
+        textureStore(edges_out, vec2<u32>(x0 + 1u, id.y), vec4<f32>(e1, 0.0, 0.0));
         textureStore(weights_out, vec2<u32>(x0 + 1u, id.y), vec4<f32>(0.0));
     }
     if (li == 0u) {
