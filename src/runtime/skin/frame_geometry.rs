@@ -20,6 +20,7 @@ use crate::mesh::camera::Camera;
 use crate::mesh::Mesh;
 use crate::runtime::compute_chain::{self, Stage};
 use crate::runtime::gpu;
+use crate::runtime::skin::compute_raster::{self, RasterShape};
 use crate::runtime::skin::heads::light_camera;
 use crate::runtime::skin::lighting::{DemoAssets, KEY_LIGHT_INTENSITY};
 use crate::runtime::skin::mesh_inputs::{self, RigPose};
@@ -174,16 +175,14 @@ pub(crate) fn record(
         height: h,
         samples: job.msaa,
     };
-    let view =
-        mesh_raster::record_uploaded(device, enc, &view_job, &mesh_buffers(device, &view_job, key, mikk.is_some())?)?;
-    gpu::profile_mark(device, enc, "view G-buffer rasterised");
     let tangents = &plain.tangents;
     let shadow_job = RasterJob { mesh: job.mesh, tangents, camera: &light, width: s, height: s, samples: 1 };
-    let shadow =
-        mesh_raster::record_uploaded(device, enc, &shadow_job, &mesh_buffers(device, &shadow_job, key, false)?)?;
-    gpu::profile_mark(device, enc, "shadow map rasterised");
+    mesh_raster::check_job(device, &view_job)?;
+    mesh_raster::check_job(device, &shadow_job)?;
+    let view_mesh = mesh_buffers(device, &view_job, key, mikk.is_some())?;
+    let shadow_mesh = mesh_buffers(device, &shadow_job, key, false)?;
     let what = "frame geometry";
-    let (view_row, shadow_row) = (gpu::padded_row_bytes(&view[0]) as u64, gpu::padded_row_bytes(&shadow[0]) as u64);
+    let (view_row, shadow_row) = (padded_row(w, 8) as u64, padded_row(s, 8) as u64);
     let (vec4_row, depth_row) = (padded_row(w, 16), padded_row(w, 4));
     let n = w as u64 * h as u64;
     // The surface and wrinkle passes read the tangent target and the per-pixel normals too.
@@ -203,11 +202,40 @@ pub(crate) fn record(
     // Bindings 1..=8 of frame_geometry.wgsl: view_g, shadow_g, uvc, skin_maps, normals, geo, depth, nrm.
     let bufs: Vec<wgpu::Buffer> = sizes.iter().map(|&b| compute_chain::storage_buffer(device, what, b, None)).collect();
     let (uvc, normals, texels, nrm) = (&bufs[2], &bufs[4], &bufs[5], &bufs[7]);
-    for (k, target) in view.iter().take(view_targets as usize).enumerate() {
-        gpu::encode_texture_to_buffer(enc, target, &bufs[0], k as u64 * view_row * h as u64);
+    // The G-buffer and the shadow map in bufs[0] and bufs[1]: rasterised there by compute, or by the render pass
+    // and copied.
+    let compute = RasterShape::current()? == RasterShape::Compute
+        && compute_raster::fits(device, &view_job, &view_mesh)
+        && compute_raster::fits(device, &shadow_job, &shadow_mesh);
+    if compute {
+        let rows = |buffer, row: u64, targets| compute_raster::GBufferRows { buffer, row_bytes: row as u32, targets };
+        compute_raster::record(
+            device,
+            enc,
+            "view raster",
+            &view_job,
+            &view_mesh,
+            &rows(&bufs[0], view_row, view_targets as u32),
+        )?;
+        compute_raster::record(
+            device,
+            enc,
+            "shadow raster",
+            &shadow_job,
+            &shadow_mesh,
+            &rows(&bufs[1], shadow_row, 2),
+        )?;
+    } else {
+        let view = mesh_raster::record_uploaded(device, enc, &view_job, &view_mesh)?;
+        gpu::profile_mark(device, enc, "view G-buffer rasterised");
+        let shadow = mesh_raster::record_uploaded(device, enc, &shadow_job, &shadow_mesh)?;
+        gpu::profile_mark(device, enc, "shadow map rasterised");
+        for (k, target) in view.iter().take(view_targets as usize).enumerate() {
+            gpu::encode_texture_to_buffer(enc, target, &bufs[0], k as u64 * view_row * h as u64);
+        }
+        gpu::encode_texture_to_buffer(enc, &shadow[0], &bufs[1], 0);
+        gpu::encode_texture_to_buffer(enc, &shadow[1], &bufs[1], shadow_row * s as u64);
     }
-    gpu::encode_texture_to_buffer(enc, &shadow[0], &bufs[1], 0);
-    gpu::encode_texture_to_buffer(enc, &shadow[1], &bufs[1], shadow_row * s as u64);
     let inv_view = job.camera.view().try_inverse().expect("a look-at view is invertible");
     let light_view = light.view();
     let mat = |m: nalgebra::Matrix4<f32>| -> [f32; 16] { m.as_slice().try_into().expect("4x4") };

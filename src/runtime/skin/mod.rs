@@ -12,6 +12,7 @@
 
 pub mod bloom;
 pub mod bloom_cpu;
+pub mod compute_raster;
 pub mod demo;
 pub mod frame;
 mod frame_geometry;
