@@ -404,4 +404,56 @@ mod tests {
         eprintln!("near plane vs render {r:?}");
         assert!(r.coverage <= 4 && r.other_surface <= 4, "against the render pass: {r:?}");
     }
+
+    /// A whole `run skin` frame (separable SSS, bloom, the committed bake's rig; 160×96) through both shapes: the
+    /// compute shape records its three dispatches per G-buffer and no render pass (the profile's labels), the
+    /// render shape its two marks, and the frames agree within 2/255 on 99 % of the channels, the tolerance the
+    /// device frame keeps against its CPU twin (`tests/it/runtime_pipeline_cache.rs`).
+    #[test]
+    fn a_run_skin_frame_is_the_same_frame_through_either_shape() {
+        use crate::runtime::skin::frame::render_with;
+        use crate::runtime::skin::lighting::DemoAssets;
+        use crate::runtime::skin::passes::SkinPasses;
+        use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, StretchPreset};
+        let (_turn, g) = device();
+        let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/baked"));
+        let assets = DemoAssets::load(dir).unwrap();
+        let s = SkinRenderSettings {
+            shader: SkinShader::Separable,
+            heads: 1,
+            distance_m: 0.6,
+            width: 160,
+            height: 96,
+            melanin: 0.02,
+            stretch: StretchPreset::Tap2009,
+        };
+        let head = default_head();
+        let frame = |shape| {
+            RasterShape::set_on_this_thread(Some(shape));
+            gpu::set_pass_profiling(true);
+            let img = render_with(Some(&g), &head, &s, &SkinPasses::default(), &assets);
+            let profile = gpu::take_pass_profile(&g.device, &g.queue).unwrap();
+            gpu::set_pass_profiling(false);
+            RasterShape::set_on_this_thread(None);
+            let labels: Vec<String> = profile.into_iter().map(|p| p.label).collect();
+            (img.unwrap(), labels)
+        };
+        let ((compute, c_labels), (render, r_labels)) = (frame(RasterShape::Compute), frame(RasterShape::Render));
+        for (labels, ours, theirs) in [
+            (&c_labels, "view raster: resolve", "view G-buffer rasterised"),
+            (&r_labels, "view G-buffer rasterised", "view raster: resolve"),
+        ] {
+            assert!(labels.iter().any(|l| l.ends_with(ours)), "{labels:?}");
+            assert!(!labels.iter().any(|l| l.contains(theirs)), "{labels:?}");
+        }
+        for pass in ["view raster: depth", "view raster: visible", "shadow raster: depth", "shadow raster: resolve"] {
+            assert!(c_labels.iter().any(|l| l == pass), "{pass} in {c_labels:?}");
+        }
+        let close = compute.data.iter().zip(&render.data).filter(|(a, b)| a.abs_diff(**b) <= 2).count();
+        assert!(
+            close as f64 >= 0.99 * compute.data.len() as f64,
+            "{close} of {} channels within 2/255",
+            compute.data.len()
+        );
+    }
 }
