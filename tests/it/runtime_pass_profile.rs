@@ -28,14 +28,21 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     set_pass_profiling(false);
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
-    // Recording order: the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // Recording order: the compute rasteriser's three passes for the view's G-buffer and for the shadow map
+    // (`runtime::skin::compute_raster`, the default `RTBAKE_RASTER=compute`), the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
     // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
     // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
     let expected = [
-        "frame start → view G-buffer rasterised",
-        "view G-buffer rasterised → shadow map rasterised",
-        "shadow map rasterised → frame geometry: main",
+        "frame start → view raster: depth",
+        "view raster: depth",
+        "view raster: visible",
+        "view raster: resolve",
+        "view raster: resolve → shadow raster: depth",
+        "shadow raster: depth",
+        "shadow raster: visible",
+        "shadow raster: resolve",
+        "shadow raster: resolve → frame geometry: main",
         "frame geometry: main",
         "frame geometry: main → mesh skin inputs: main",
         "mesh skin inputs: main",
@@ -84,4 +91,17 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     assert_eq!(bytes("skin frame: composite"), Some(geo + rgba + diffuse + sss16 + skin16 + hdr));
     // tonemap: reads hdr, bloomed, geo and rgba, writes rgba.
     assert_eq!(bytes("skin frame: tonemap"), Some(hdr + bloomed + geo + rgba + rgba));
+
+    // The rasteriser's passes over the mesh (48-byte vertices, u32 indices), a u32 depth key and a u32 triangle
+    // key per pixel, and the G-buffer's two f16 targets in rows padded to 256 bytes (the view: 64 × 8 = 512 bytes
+    // a row; the 512² shadow map: 4096): depth reads the mesh and reads and writes the depth keys (atomicMax);
+    // visible reads the mesh and the depth keys and reads and writes the triangle keys; resolve reads the mesh and
+    // the triangle keys and writes the G-buffer.
+    let mesh = 48 * head.positions.len() as u64 + 4 * head.indices.len() as u64;
+    for (what, pixels, row) in [("view", n, 512), ("shadow", 512 * 512, 4096)] {
+        let (keys, gbuffer) = (4 * pixels, 2 * row * pixels / (row / 8));
+        assert_eq!(bytes(&format!("{what} raster: depth")), Some(mesh + 2 * keys), "{what}");
+        assert_eq!(bytes(&format!("{what} raster: visible")), Some(mesh + 3 * keys), "{what}");
+        assert_eq!(bytes(&format!("{what} raster: resolve")), Some(mesh + keys + gbuffer), "{what}");
+    }
 }
