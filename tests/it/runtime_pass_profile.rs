@@ -9,6 +9,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gpu::{set_pass_profiling, take_pass_profile};
+use rtbake::runtime::skin::compute_raster::RasterShape;
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader};
 
@@ -20,16 +21,21 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     let s = SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width, height, melanin: 0.02, stretch };
     let head = default_head();
     let passes = SkinPasses::default();
+    RasterShape::set_on_this_thread(Some(RasterShape::Compute));
     let plain = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+    RasterShape::set_on_this_thread(None);
     assert!(take_pass_profile(&g.device, &g.queue).unwrap().is_empty(), "profiling is off by default");
     set_pass_profiling(true);
+    // The compute rasteriser, which a GPU takes by default (a software adapter the render pass).
+    RasterShape::set_on_this_thread(Some(RasterShape::Compute));
     let profiled = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+    RasterShape::set_on_this_thread(None);
     let profile = take_pass_profile(&g.device, &g.queue).unwrap();
     set_pass_profiling(false);
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
     // Recording order: the compute rasteriser's three passes for the view's G-buffer and for the shadow map
-    // (`runtime::skin::compute_raster`, the default `RTBAKE_RASTER=compute`), the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // (`runtime::skin::compute_raster`, `RTBAKE_RASTER=compute`, a GPU's default), the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
     // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
     // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();

@@ -204,7 +204,8 @@ pub(crate) fn record(
     let (uvc, normals, texels, nrm) = (&bufs[2], &bufs[4], &bufs[5], &bufs[7]);
     // The G-buffer and the shadow map in bufs[0] and bufs[1]: rasterised there by compute, or by the render pass
     // and copied.
-    let compute = RasterShape::current()? == RasterShape::Compute
+    let software = device.adapter_info().device_type == wgpu::DeviceType::Cpu;
+    let compute = RasterShape::current(software)? == RasterShape::Compute
         && compute_raster::fits(device, &view_job, &view_mesh)
         && compute_raster::fits(device, &shadow_job, &shadow_mesh);
     if compute {
