@@ -412,6 +412,45 @@ mod tests {
         assert!(r.coverage <= 4 && r.other_surface <= 4, "against the render pass: {r:?}");
     }
 
+    /// Two squares facing the camera with edges through pixel centres (x = 0 and y = 0 project onto the centres
+    /// of column 32 and row 24 of a 65×49 frame): one right of and above x = y = 0, one left of and below. The
+    /// top-left rule gives a centre on a left or top edge to the triangle and on a right or bottom edge to none:
+    /// column 32 is the first square's (its left edge), not the second's (its right edge); row 24 the second's
+    /// (its top edge), not the first's (its bottom edge) — as the render pass draws it, where the CPU twin, which
+    /// draws every centre on an edge, covers both.
+    #[test]
+    fn edges_through_pixel_centres_follow_the_top_left_rule() {
+        let (_turn, g) = device();
+        let cam = Camera::facing(1.0).unwrap();
+        let q = 0.1;
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [q, 0.0, 0.0],
+            [q, q, 0.0],
+            [0.0, q, 0.0],
+            [-q, -q, 0.0],
+            [0.0, -q, 0.0],
+            [0.0, 0.0, 0.0],
+            [-q, 0.0, 0.0],
+        ];
+        let indices = vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7];
+        let mesh =
+            Mesh::new("squares", positions, vec![[0.0, 0.0, 1.0]; 8], vec![[0.5, 0.5]; 8], indices, 1000.0).unwrap();
+        let (w, h) = (65, 49);
+        let compute = compute_gbuffer(&g, &mesh, &cam, w, h);
+        let render = mesh_raster::rasterise(&g.device, &g.queue, &mesh, &cam, w, h).unwrap();
+        let cpu = mesh_raster_cpu::rasterise(&mesh, &cam, w, h);
+        let at = |gb: &MeshGBuffer, x: u32, y: u32| gb.covered[(y * w + x) as usize];
+        // (pixel, covered): on the first square's left edge, its bottom edge; the second's right edge, top edge.
+        let on_edges = [((32, 20), true), ((35, 24), false), ((32, 28), false), ((29, 24), true)];
+        for ((x, y), covered) in on_edges {
+            assert_eq!(at(&compute, x, y), covered, "compute, pixel ({x}, {y})");
+            assert!(at(&cpu, x, y), "the CPU twin draws ({x}, {y})");
+        }
+        assert!(at(&compute, 34, 20) && at(&compute, 30, 28), "inside the squares");
+        assert_eq!(compute.covered, render.covered, "against the render pass");
+    }
+
     /// A whole `run skin` frame (separable SSS, bloom, the committed bake's rig; 160×96) through both shapes: the
     /// compute shape records its three dispatches per G-buffer and no render pass (the profile's labels), the
     /// render shape its two marks, and the frames agree within 2/255 on 99 % of the channels, the tolerance the
