@@ -211,8 +211,12 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     let row = p.out.x;
     let target_words = row * p.size.y;
     let o = id.y * row + 2u * id.x;
-    for (var k = 0u; k < p.out.y; k++) {
-        gbuffer[k * target_words + o] = pack(g[k].xy);
-        gbuffer[k * target_words + o + 1u] = pack(g[k].zw);
+    gbuffer[o] = pack(g[0].xy);
+    gbuffer[o + 1u] = pack(g[0].zw);
+    gbuffer[target_words + o] = pack(g[1].xy);
+    gbuffer[target_words + o + 1u] = pack(g[1].zw);
+    if (p.out.y > 2u) {
+        gbuffer[2u * target_words + o] = pack(g[2].xy);
+        gbuffer[2u * target_words + o + 1u] = pack(g[2].zw);
     }
 }
