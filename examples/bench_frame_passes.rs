@@ -5,7 +5,14 @@
 //! map; the work between them — the G-buffer and shadow-map raster (each its own span), the SSS passes,
 //! the texture/buffer copies — as spans between the timed points).
 //!
-//!     cargo run --release --example bench_frame_passes [-- WIDTH HEIGHT FRAMES]     # 1920 1080 7
+//!     cargo run --release --example bench_frame_passes [-- WIDTH HEIGHT FRAMES [both|compute|render]]
+//!                                                                 # 1920 1080 7 both
+//!
+//! The last argument picks how the one-sample G-buffer and shadow map are rasterised
+//! (`rtbake::runtime::skin::compute_raster::RasterShape`, `RTBAKE_RASTER` in `run skin`): `both` (the default)
+//! prints every shader's table first with the compute rasteriser (its three passes per G-buffer timed with their
+//! bounds, written straight into the geometry pass's buffers), then with the render pass and its copies (the shape
+//! before), so the two are compared in one run on one adapter.
 //!
 //! Printed: the adapter, the copy bandwidth (buffer-to-buffer copies in the same run,
 //! `rtbake::runtime::gpu::copy_bandwidth`), then per shader and pass the median GPU ms over FRAMES frames after one
@@ -20,6 +27,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gpu::{copy_bandwidth, set_pass_profiling, take_pass_profile, PassTime};
+use rtbake::runtime::skin::compute_raster::RasterShape;
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset, TsSettings};
 use std::path::PathBuf;
@@ -30,12 +38,15 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// What a span between two timed points of the frame holds, named by the pass it ends at.
+/// What a span between two timed points of the frame holds, named by the passes it lies between.
 fn span_holds(label: &str) -> &'static str {
-    let to = label.rsplit(" → ").next().unwrap_or("");
+    let (from, to) = label.split_once(" → ").unwrap_or(("", label));
     match to {
         "view G-buffer rasterised" => "the view's G-buffer raster (render pass; uploads and clears before it)",
         "shadow map rasterised" => "the 512² shadow-map raster (render pass)",
+        "view raster: depth" => "clearing the view raster's key buffers (uploads before it)",
+        "shadow raster: depth" => "clearing the shadow raster's key buffers",
+        "frame geometry: main" if from.starts_with("shadow raster") => "nothing (barrier)",
         "frame geometry: main" => "the G-buffer and shadow map copied into the geometry pass's buffers",
         "skin frame: lit" => "copies",
         "skin frame: composite" => "SSS passes, copies",
@@ -47,6 +58,10 @@ fn main() {
     let args: Vec<u32> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (width, height) = (args.first().copied().unwrap_or(1920), args.get(1).copied().unwrap_or(1080));
     let frames = args.get(2).copied().unwrap_or(7).max(1) as usize;
+    let shapes = match std::env::args().skip(1).find(|a| a.parse::<u32>().is_err()).as_deref() {
+        None | Some("both") => vec![RasterShape::Compute, RasterShape::Render],
+        Some(one) => vec![RasterShape::parse(one).expect("the last argument: both, compute or render")],
+    };
     let dir = std::env::var_os("RTBAKE_BAKED_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"));
@@ -80,7 +95,9 @@ fn main() {
     let ts = SkinShader::Ts(TsSettings::default());
     let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered, ts];
     let stretch = StretchPreset::default();
-    for (name, shader) in names.into_iter().zip(shaders) {
+    for (shape, (name, shader)) in shapes.iter().flat_map(|&r| names.into_iter().zip(shaders).map(move |n| (r, n))) {
+        RasterShape::set_on_this_thread(Some(shape));
+        let name = format!("{name} (raster: {})", shape.name());
         let s = SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width, height, melanin: 0.02, stretch };
         let mut profiles: Vec<Vec<PassTime>> = Vec::new();
         let mut wall = Vec::new();

@@ -9,6 +9,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gpu::{set_pass_profiling, take_pass_profile};
+use rtbake::runtime::skin::compute_raster::RasterShape;
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader};
 
@@ -20,22 +21,34 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     let s = SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width, height, melanin: 0.02, stretch };
     let head = default_head();
     let passes = SkinPasses::default();
+    RasterShape::set_on_this_thread(Some(RasterShape::Compute));
     let plain = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+    RasterShape::set_on_this_thread(None);
     assert!(take_pass_profile(&g.device, &g.queue).unwrap().is_empty(), "profiling is off by default");
     set_pass_profiling(true);
+    // The compute rasteriser, which a GPU takes by default (a software adapter the render pass).
+    RasterShape::set_on_this_thread(Some(RasterShape::Compute));
     let profiled = render_with(Some(&g), &head, &s, &passes, &assets).unwrap();
+    RasterShape::set_on_this_thread(None);
     let profile = take_pass_profile(&g.device, &g.queue).unwrap();
     set_pass_profiling(false);
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
-    // Recording order: the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // Recording order: the compute rasteriser's three passes for the view's G-buffer and for the shadow map
+    // (`runtime::skin::compute_raster`, `RTBAKE_RASTER=compute`, a GPU's default), the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
     // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
     // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
     let expected = [
-        "frame start → view G-buffer rasterised",
-        "view G-buffer rasterised → shadow map rasterised",
-        "shadow map rasterised → frame geometry: main",
+        "frame start → view raster: depth",
+        "view raster: depth",
+        "view raster: visible",
+        "view raster: resolve",
+        "view raster: resolve → shadow raster: depth",
+        "shadow raster: depth",
+        "shadow raster: visible",
+        "shadow raster: resolve",
+        "shadow raster: resolve → frame geometry: main",
         "frame geometry: main",
         "frame geometry: main → mesh skin inputs: main",
         "mesh skin inputs: main",
@@ -84,4 +97,17 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     assert_eq!(bytes("skin frame: composite"), Some(geo + rgba + diffuse + sss16 + skin16 + hdr));
     // tonemap: reads hdr, bloomed, geo and rgba, writes rgba.
     assert_eq!(bytes("skin frame: tonemap"), Some(hdr + bloomed + geo + rgba + rgba));
+
+    // The rasteriser's passes over the mesh (48-byte vertices, u32 indices), a u32 depth key and a u32 triangle
+    // key per pixel, and the G-buffer's two f16 targets in rows padded to 256 bytes (the view: 64 × 8 = 512 bytes
+    // a row; the 512² shadow map: 4096): depth reads the mesh and reads and writes the depth keys (atomicMax);
+    // visible reads the mesh and the depth keys and reads and writes the triangle keys; resolve reads the mesh and
+    // the triangle keys and writes the G-buffer.
+    let mesh = 48 * head.positions.len() as u64 + 4 * head.indices.len() as u64;
+    for (what, pixels, row) in [("view", n, 512), ("shadow", 512 * 512, 4096)] {
+        let (keys, gbuffer) = (4 * pixels, 2 * row * pixels / (row / 8));
+        assert_eq!(bytes(&format!("{what} raster: depth")), Some(mesh + 2 * keys), "{what}");
+        assert_eq!(bytes(&format!("{what} raster: visible")), Some(mesh + 3 * keys), "{what}");
+        assert_eq!(bytes(&format!("{what} raster: resolve")), Some(mesh + keys + gbuffer), "{what}");
+    }
 }

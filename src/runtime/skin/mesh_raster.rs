@@ -140,7 +140,8 @@ pub fn rasterise_jobs(
         .collect())
 }
 
-/// A mesh's vertices (position, normal, uv, tangent: 12 f32 each) and its triangles' indices on the device.
+/// A mesh's vertices (position, normal, uv, tangent: 12 f32 each) and its triangles' indices on the device, for
+/// the render pass (vertex and index buffers) and the compute rasteriser (storage buffers).
 #[derive(Clone)]
 pub(crate) struct MeshBuffers {
     pub(crate) vertices: wgpu::Buffer,
@@ -169,12 +170,12 @@ pub(crate) fn upload_mesh(
     let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("mesh vertices"),
         contents: bytemuck::cast_slice(&vertices),
-        usage: wgpu::BufferUsages::VERTEX,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
     });
     let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("mesh indices"),
         contents: bytemuck::cast_slice(&mesh.indices),
-        usage: wgpu::BufferUsages::INDEX,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
     });
     gpu::count_buffer_upload();
     gpu::count_buffer_upload();
@@ -194,7 +195,7 @@ pub(crate) fn record(
 }
 
 /// Refuses what the device cannot rasterise of `job` (tangents, sample count, camera, image size) before any work.
-fn check_job(device: &wgpu::Device, job: &RasterJob<'_>) -> Result<(), RuntimeError> {
+pub(crate) fn check_job(device: &wgpu::Device, job: &RasterJob<'_>) -> Result<(), RuntimeError> {
     let RasterJob { mesh, tangents, camera, width, height, samples } = *job;
     check_raster_inputs(mesh, tangents, samples)?;
     if samples > 1 {
@@ -358,7 +359,7 @@ pub(crate) fn record_uploaded(
 }
 
 /// The G-buffer from its three targets read back as f32 (see [`record`]).
-fn decode(width: u32, height: u32, samples: u32, a: &[f32], b: &[f32], c: &[f32]) -> MeshGBuffer {
+pub(crate) fn decode(width: u32, height: u32, samples: u32, a: &[f32], b: &[f32], c: &[f32]) -> MeshGBuffer {
     let mut g = MeshGBuffer::empty(width, height);
     if samples > 1 {
         resolve_coverage(&mut g, a, b, c);

@@ -1,7 +1,7 @@
 //! The skin renderer (thesis ch. 3–8, TAP 2009): the passes that make a frame of skin, each beside its WGSL and its
 //! CPU twin, and the frames built from them.
 //!
-//! Passes: [`mesh_raster`] (the G-buffer), [`inputs`] (albedo from the skin LUT, T(s)·E), [`mesh_inputs`] (the rig's
+//! Passes: [`mesh_raster`] (the G-buffer), [`compute_raster`] (the device frame's one-sample G-buffer by compute), [`inputs`] (albedo from the skin LUT, T(s)·E), [`mesh_inputs`] (the rig's
 //! eq. 7.6 at the mesh's uv), [`wrinkles`] (Listing 8.1), [`surface_maps`] (a scan's albedo and normal map at the mesh's uv), [`bloom`], [`texture_space`] (d'Eon et al.'s
 //! texture-space diffusion, TAP's "TS").
 //! Frames: [`lighting`] (the shared lighting and compositing every frame goes through: skin inputs → diffuse +
@@ -12,6 +12,7 @@
 
 pub mod bloom;
 pub mod bloom_cpu;
+pub mod compute_raster;
 pub mod demo;
 pub mod frame;
 mod frame_geometry;
