@@ -5,6 +5,7 @@
 //! follow-surface). Resources created once in [`SeparableSss::new`]; CPU twin [`crate::runtime::sss::separable_cpu`].
 
 use crate::error::{check_positive, InvalidInput};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
@@ -163,7 +164,7 @@ impl<B: SeparableForm> SssPass<B> {
 }
 
 impl SeparableForm for SeparableBlur {
-    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::texture;
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = frame_pool::target;
 
     fn build(
         device: &wgpu::Device,
