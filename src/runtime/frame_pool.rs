@@ -92,6 +92,8 @@ impl Resource {
 
 struct OpenFrame {
     device: wgpu::Device,
+    /// The queue the frame's uniform blocks are written through.
+    queue: wgpu::Queue,
     taken: Vec<Resource>,
 }
 
@@ -167,12 +169,14 @@ pub struct FrameScope {
 }
 
 impl FrameScope {
-    /// Opens a frame on `device` for the calling thread (a no-op scope with the pool off).
-    pub fn open(device: &wgpu::Device) -> Self {
+    /// Opens a frame on `device` for the calling thread (a no-op scope with the pool off); its uniform blocks
+    /// are written through `queue` ([`uniform_buffer`]).
+    pub fn open(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         if !frame_pool_enabled() {
             return FrameScope { device: None };
         }
-        OPEN.with(|o| o.borrow_mut().push(OpenFrame { device: device.clone(), taken: Vec::new() }));
+        let frame = OpenFrame { device: device.clone(), queue: queue.clone(), taken: Vec::new() };
+        OPEN.with(|o| o.borrow_mut().push(frame));
         FrameScope { device: Some(device.clone()) }
     }
 
@@ -264,17 +268,41 @@ pub fn texture(
     }
     TEXTURES_CREATED.with(|c| c.set(c.get() + 1));
     let t = make();
-    debug_assert_eq!(TextureKey::of(&t), key, "the texture `make` created is not the one described");
+    debug_assert_eq!(TextureKey::of(&t), key, "the texture made is not the one described");
     if pooled {
         note_taken(Resource::Texture(t.clone()));
     }
     t
 }
 
-/// A storage buffer of a frame's compute chain ([`crate::runtime::compute_chain::STORAGE_USAGE`]) of at least
-/// `bytes` (rounded up to 16 as `compute_chain::storage_buffer` rounds): see [`buffer`] (**not zero** when reused).
+/// The usages of a compute chain's storage buffers: bound, and copied from and to (other passes of a frame read
+/// them); `compute_chain::STORAGE_USAGE`.
+pub(crate) const STORAGE_BUFFER_USAGE: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_SRC).union(wgpu::BufferUsages::COPY_DST);
+
+/// A storage buffer of a frame's compute chain ([`STORAGE_BUFFER_USAGE`]) of at least `bytes` (rounded up to 16
+/// as `compute_chain::storage_buffer` rounds): see [`buffer`] (**not zero** when reused).
 pub(crate) fn storage_buffer(device: &wgpu::Device, what: &str, bytes: u64) -> wgpu::Buffer {
-    buffer(device, what, bytes.div_ceil(16).max(1) * 16, crate::runtime::compute_chain::STORAGE_USAGE)
+    buffer(device, what, bytes.div_ceil(16).max(1) * 16, STORAGE_BUFFER_USAGE)
+}
+
+/// A uniform buffer holding `bytes` for the frame: a pooled one written through the open frame's queue
+/// (`queue.write_buffer`, ordered after every earlier submission), or a new one initialised with `bytes` (as
+/// [`crate::runtime::gpu::uniform_buffer`]) when none is free, the pool is off or no frame is open on `device`.
+pub(crate) fn uniform_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    let queue = OPEN.with(|o| o.borrow().last().filter(|f| &f.device == device).map(|f| f.queue.clone()));
+    let size = bytes.len() as u64;
+    match queue.filter(|_| frame_pool_enabled() && size > 0 && size % wgpu::COPY_BUFFER_ALIGNMENT == 0) {
+        Some(queue) => {
+            let b = buffer(device, label, size, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+            queue.write_buffer(&b, 0, bytes);
+            b
+        }
+        None => {
+            BUFFERS_CREATED.with(|c| c.set(c.get() + 1));
+            crate::runtime::gpu::uniform_buffer(device, label, bytes)
+        }
+    }
 }
 
 /// A read-back buffer (copy destination, mapped for reading) of `bytes`: see [`buffer`].
@@ -336,42 +364,42 @@ mod tests {
         let usage = wgpu::BufferUsages::STORAGE;
         let created = buffers_created_on_this_thread;
         let (a, b) = {
-            let _f = FrameScope::open(d);
+            let _f = FrameScope::open(d, &g.queue);
             (buffer(d, "a", 256, usage), buffer(d, "b", 256, usage))
         };
         assert_ne!(a, b, "two takes in one frame alias");
         assert_eq!(free_resources(d), 2);
         let before = created();
         {
-            let _f = FrameScope::open(d);
+            let _f = FrameScope::open(d, &g.queue);
             let (c, e) = (buffer(d, "c", 256, usage), buffer(d, "e", 256, usage));
             assert!((c == a || c == b) && (e == a || e == b) && c != e, "the first frame's buffers are reused");
         }
         assert_eq!(created(), before, "a steady frame creates nothing");
         for _ in 0..KEEP_FRAMES {
-            let _f = FrameScope::open(d);
+            let _f = FrameScope::open(d, &g.queue);
             let _ = buffer(d, "other", 512, usage);
         }
         assert_eq!(free_resources(d), 1, "the 256-byte buffers unused for {KEEP_FRAMES} frames are evicted");
         let kept = {
-            let f = FrameScope::open(d);
+            let f = FrameScope::open(d, &g.queue);
             f.detach(buffer(d, "out", 512, usage))
         };
         {
-            let _f = FrameScope::open(d);
+            let _f = FrameScope::open(d, &g.queue);
             let other = buffer(d, "next", 512, usage);
             assert_ne!(&other, kept.buffer(), "a detached buffer was handed to another frame");
         }
         let kept_buffer = kept.buffer().clone();
         drop(kept);
         {
-            let _f = FrameScope::open(d);
+            let _f = FrameScope::open(d, &g.queue);
             let first = buffer(d, "x", 512, usage);
             let second = buffer(d, "y", 512, usage);
             assert!(first == kept_buffer || second == kept_buffer, "a dropped detached buffer returns to the pool");
         }
         let loose = buffer(d, "no frame", 512, usage);
-        let _f = FrameScope::open(d);
+        let _f = FrameScope::open(d, &g.queue);
         assert_ne!(buffer(d, "z", 1024, usage), loose);
     }
 }

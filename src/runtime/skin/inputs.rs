@@ -262,7 +262,7 @@ impl SkinInputs {
         gpu::upload(queue, &t_tex, &t_halves);
         let albedo = frame_pool::target(device, "skin albedo", width, height, F::Rgba16Float);
         let transmitted = frame_pool::target(device, "skin transmitted", width, height, F::Rgba16Float);
-        let ubo = gpu::uniform_buffer(device, "skin params", bytemuck::bytes_of(&pass.params));
+        let ubo = frame_pool::uniform_buffer(device, "skin params", bytemuck::bytes_of(&pass.params));
         let module = gpu::shader(device, "skin_inputs.wgsl", SHADER);
         let target = |f| Some(wgpu::ColorTargetState { format: f, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let targets = [target(F::Rgba16Float), target(F::Rgba16Float)];

@@ -16,6 +16,12 @@
 //! with padded rows and unpacked by
 //! `shade_frame.wgsl`, which also packs the lit layer as the SSS pass's half-float input (a buffer-to-texture copy).
 //! `shade_frame.wgsl` runs through `compute_chain::record`, bloom through `bloom::record`.
+//!
+//! The frame's buffers, textures and uniform blocks come from the device's frame pool
+//! ([`crate::runtime::frame_pool`]) and go back to it after the frame's submission and read-back, so a
+//! steady-state frame allocates nothing; a reused buffer holds a former frame's data, so every pass writes what it
+//! reads, and the RGBA8 frame starts as the uniform background colour filled on the device (an image background is
+//! uploaded). [`shade_on_device`] leaves the frame on the device ([`DeviceFrame`], read back on demand).
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
@@ -169,7 +175,7 @@ impl DeviceFrame {
     /// [`gpu::read_backs_on_this_thread`]).
     pub fn read_back(&self, g: &Gpu) -> Result<Image<u8>, RuntimeError> {
         let n = 4 * self.width as u64 * self.height as u64;
-        let _frame = crate::runtime::frame_pool::FrameScope::open(&g.device);
+        let _frame = crate::runtime::frame_pool::FrameScope::open(&g.device, &g.queue);
         let readback = crate::runtime::frame_pool::readback_buffer(&g.device, self.buffer().size());
         let mut enc = g.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
         enc.copy_buffer_to_buffer(self.buffer(), 0, &readback, 0, self.buffer().size());
@@ -212,7 +218,7 @@ pub(crate) fn shade(
     let (device, queue) = (&g.device, &g.queue);
     // The frame's buffers and textures come from the device's pool and go back to it when this closes, after
     // the read-back.
-    let _frame = crate::runtime::frame_pool::FrameScope::open(device);
+    let _frame = crate::runtime::frame_pool::FrameScope::open(device, queue);
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let (mut enc, rgba, (w, h)) = record(g, source, assets, sss, background)?;
     let readback = crate::runtime::frame_pool::readback_buffer(device, rgba.size());
@@ -243,7 +249,7 @@ pub(crate) fn shade_on_device(
 ) -> Result<DeviceFrame, RuntimeError> {
     let t0 = std::time::Instant::now();
     let (device, queue) = (&g.device, &g.queue);
-    let frame = crate::runtime::frame_pool::FrameScope::open(device);
+    let frame = crate::runtime::frame_pool::FrameScope::open(device, queue);
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let (enc, rgba, (width, height)) = record(g, source, assets, sss, background)?;
     gpu::submit(queue, enc.finish());

@@ -585,6 +585,8 @@ mod one_encoder {
         size: [f32; 4],
         key: [f32; 4],
         cfg: [f32; 4],
+        /// The coverage blend and the uniform background fill, unused here (zero).
+        unused: [[f32; 4]; 2],
     }
 
     /// `texture_space_frame.wgsl`'s uniform block (field by field as there).
@@ -752,6 +754,7 @@ mod one_encoder {
             size: [width as f32, height as f32, (row16 / 4) as f32, 1.0],
             key: [key[0], key[1], key[2], 0.0],
             cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, bloom_on, 0.0],
+            unused: [[0.0; 4]; 2],
         };
         let shade = |enc: &mut wgpu::CommandEncoder, p: &ShadeParams, bound: &[&wgpu::Buffer], entry: &str, size| {
             let stages = [Stage::new(entry, size)];

@@ -130,7 +130,7 @@ impl Params {
         fit: (&GaussianBlurs, &GaussianSssParams),
     ) -> Vec<[wgpu::Buffer; 2]> {
         let n = fit.0.sigma_mm.len();
-        let buffer = |label, block: Params| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block));
+        let buffer = |label, block: Params| frame_pool::uniform_buffer(device, label, bytemuck::bytes_of(&block));
         (1..n)
             .map(|i| {
                 let last = i + 1 == n;

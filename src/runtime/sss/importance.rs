@@ -169,7 +169,7 @@ impl ImportanceSss {
             if params.follow_surface { 1.0 } else { 0.0 },
             n as f32,
         ];
-        let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
+        let ubo = frame_pool::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
         let cv = inputs.color.create_view(&Default::default());
         let (output, blur) = match shape {
             PassShape::Fragment => {

@@ -100,7 +100,7 @@ impl Params {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
         let block = |dir| Self::new(width, height, kernel, params, dir);
-        let mk = |label, dir| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
+        let mk = |label, dir| frame_pool::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
         Ok([mk("sss h", [1.0, 0.0]), mk("sss v", [0.0, 1.0])])
     }
 }
