@@ -292,7 +292,7 @@ pub(crate) fn storage_buffer(device: &wgpu::Device, what: &str, bytes: u64) -> w
 pub(crate) fn uniform_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     let queue = OPEN.with(|o| o.borrow().last().filter(|f| &f.device == device).map(|f| f.queue.clone()));
     let size = bytes.len() as u64;
-    match queue.filter(|_| frame_pool_enabled() && size > 0 && size % wgpu::COPY_BUFFER_ALIGNMENT == 0) {
+    match queue.filter(|_| frame_pool_enabled() && size > 0 && size.is_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT)) {
         Some(queue) => {
             let b = buffer(device, label, size, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
             queue.write_buffer(&b, 0, bytes);
