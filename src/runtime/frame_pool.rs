@@ -170,7 +170,7 @@ pub struct FrameScope {
 
 impl FrameScope {
     /// Opens a frame on `device` for the calling thread (a no-op scope with the pool off); its uniform blocks
-    /// are written through `queue` ([`uniform_buffer`]).
+    /// are written through `queue` (`uniform_buffer`).
     pub fn open(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         if !frame_pool_enabled() {
             return FrameScope { device: None };

@@ -37,6 +37,8 @@
 //! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off), which submits and reads back each pass on its
 //! own, for A/B comparison. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) is one submission and one read-back under the same conditions.
+//! [`render_on_device_with`] renders a screen-space frame without the read-back ([`DeviceFrame`], read back on
+//! demand); the frame's buffers and textures come from the device's frame pool ([`crate::runtime::frame_pool`]).
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;

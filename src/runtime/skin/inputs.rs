@@ -127,9 +127,9 @@ pub(crate) fn maps_texels(frame: &SkinFrame) -> Vec<[f32; 4]> {
     (0..frame.melanin.len()).map(|i| [frame.melanin[i], frame.h0[i], frame.thickness_mm[i], 0.0]).collect()
 }
 
-/// Skin inputs for one frame size, LUTs and rig: the tables (kept per device and content, [`TABLES`]) and the
+/// Skin inputs for one frame size, LUTs and rig: the tables (kept per device and content, `TABLES`) and the
 /// uniform block; for the fragment pass ([`SkinInputs::new`]) also its targets, input textures and pipeline, which
-/// a compute-only frame ([`SkinInputs::for_compute`]) never creates.
+/// a compute-only frame (`SkinInputs::for_compute`) never creates.
 pub struct SkinInputs {
     width: u32,
     height: u32,

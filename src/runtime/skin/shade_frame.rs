@@ -21,7 +21,7 @@
 //! ([`crate::runtime::frame_pool`]) and go back to it after the frame's submission and read-back, so a
 //! steady-state frame allocates nothing; a reused buffer holds a former frame's data, so every pass writes what it
 //! reads, and the RGBA8 frame starts as the uniform background colour filled on the device (an image background is
-//! uploaded). [`shade_on_device`] leaves the frame on the device ([`DeviceFrame`], read back on demand).
+//! uploaded). `shade_on_device` leaves the frame on the device ([`DeviceFrame`], read back on demand).
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
