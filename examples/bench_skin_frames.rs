@@ -7,7 +7,9 @@
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom] [mesh=SCAN.glb
-//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]]]   # 1280 720 7
+//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]] [pool-only]]   # 1280 720 7
+//!
+//! `pool-only` prints the frame-pool table alone (below).
 //!
 //! With `mesh=` (a glTF or OBJ head, framed as `run skin --mesh-units auto --distance near` frames it) and its maps
 //! (`albedo=`, `normal=`: sRGB albedo, OpenGL-green tangent-space normal map), the scanned head's frame follows:
@@ -228,6 +230,8 @@ fn main() {
         let msaa = SkinPasses { msaa: 4, ..mapped };
         rows.push(("scan sep 4x".to_string(), mesh, distance, SkinShader::Separable, msaa));
     }
+    // `pool-only`: the frame-pool table alone.
+    let rows = if std::env::args().any(|a| a == "pool-only") { Vec::new() } else { rows };
     for (name, head, distance_m, shader, passes) in &rows {
         let (shader, distance_m) = (*shader, *distance_m);
         let s = SkinRenderSettings {
