@@ -7,7 +7,9 @@
 //! steady-state frame (`runtime::gpu::submissions_on_this_thread`, `read_backs_on_this_thread`).
 //!
 //!     cargo run --release --example bench_skin_frames [-- WIDTH HEIGHT FRAMES [no-bloom] [mesh=SCAN.glb
-//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]] [only=ROW]]   # 1280 720 7
+//!         albedo=ALBEDO.jpg normal=NORMAL.jpg [uv-origin=bottom-left]] [only=ROW] [pool-only]]   # 1280 720 7
+//!
+//! `pool-only` prints the frame-pool table alone (below).
 //!
 //! With `mesh=` (a glTF or OBJ head, framed as `run skin --mesh-units auto --distance near` frames it) and its maps
 //! (`albedo=`, `normal=`: sRGB albedo, OpenGL-green tangent-space normal map), the scanned head's frame follows:
@@ -18,6 +20,13 @@
 //! as `run skin` needs `--uv-origin bottom-left`). `only=ROW` keeps the rows whose name starts with ROW, `_` for a
 //! space (`only=scan_ts`: the scan's two TS rows).
 //!
+//! A second table compares the frame pool (`runtime::frame_pool`: the frame's buffers and textures kept across
+//! frames, as an engine keeps its render targets) on and off (`set_frame_pool_enabled`) on the one-encoder path,
+//! per screen-space shader: frame 1 on a fresh device and the median of frames 2..=N (the two alternating on one
+//! device), and the host's split of a steady-state frame with the pool on (medians): recording + submitting its
+//! commands, waiting for the GPU, copying the read-back out — and the same frame left on the device
+//! (`render_on_device_with`, no read-back; the wait is then a `device.poll`).
+//!
 //! The adapter is printed: figures from llvmpipe/lavapipe are CPU figures, not GPU figures (there a read-back is a
 //! copy within host memory). Each frame includes what `run skin` does per frame (uploads, the final read-back; on
 //! the per-pass path also the G-buffer read-back the host's geometry needs). Texture-space diffusion ("ts") has a one-encoder path too
@@ -27,9 +36,12 @@ use rtbake::mesh::head::default_head;
 use rtbake::mesh::Mesh;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, Gpu};
+use rtbake::runtime::frame_pool::set_frame_pool_enabled;
 use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
+use rtbake::runtime::skin::shade_frame::last_host_split;
 use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin_passes::SkinPasses;
+use rtbake::runtime::skin_render::render_on_device_with;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, TsSettings};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -97,6 +109,80 @@ fn scan() -> Option<(Mesh, f32, rtbake::runtime::skin::surface_maps::SurfaceMaps
     Some((mesh, distance, maps))
 }
 
+/// The frame pool on vs off per screen-space shader, and the host split of a steady-state frame with and without
+/// its read-back (see the module doc).
+fn pool_table(width: u32, height: u32, frames: usize, passes: &SkinPasses, assets: &DemoAssets) {
+    let g = create_headless(&Default::default()).expect("an adapter");
+    println!(
+        "\nframe pool, one encoder, {width}x{height}: frame 1 (fresh device) and the median of frames 2..={frames}, wall \
+         ms, pool on vs off; host split of a steady frame with the pool on, ms: record+submit / GPU wait / read-back \
+         copy, and left on the device: record+submit / GPU wait"
+    );
+    println!(
+        "{:<12} {:>9} {:>9} {:>9} {:>9} {:>7} {:>24} {:>17}",
+        "shader", "1st on", "1st off", "2..N on", "2..N off", "ratio", "split (read back)", "split (on device)"
+    );
+    let shaders = [
+        ("none", SkinShader::None),
+        ("ss-jittered", SkinShader::SsJittered),
+        ("ss-full", SkinShader::SsFull),
+        ("separable", SkinShader::Separable),
+    ];
+    set_shading_in_one_encoder(true);
+    for (name, shader) in shaders {
+        let s = SkinRenderSettings {
+            shader,
+            heads: 1,
+            distance_m: 0.6,
+            width,
+            height,
+            melanin: 0.02,
+            stretch: Default::default(),
+        };
+        let timed = |g: &Gpu, pool: bool| {
+            set_frame_pool_enabled(pool);
+            let t = Instant::now();
+            render_with(Some(g), &default_head(), &s, passes, assets).expect("render");
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            set_frame_pool_enabled(true);
+            ms
+        };
+        let first = [true, false].map(|pool| timed(&device(), pool));
+        let (mut on, mut off, mut split, mut resident) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..frames {
+            on.push(timed(&g, true));
+            split.push(last_host_split().expect("a one-encoder frame"));
+            off.push(timed(&g, false));
+            let frame = render_on_device_with(&g, &default_head(), &s, passes, assets).expect("render");
+            let record = last_host_split().expect("a one-encoder frame").record_submit_ms;
+            let t = Instant::now();
+            let _ = g.device.poll(wgpu::PollType::wait_indefinitely());
+            resident.push([record, t.elapsed().as_secs_f64() * 1e3]);
+            drop(frame);
+        }
+        let steady = |v: &[f64]| median(v[1..].to_vec());
+        let (o, f) = (steady(&on), steady(&off));
+        let part = |k: usize| match k {
+            0 => steady(&split.iter().map(|h| h.record_submit_ms).collect::<Vec<_>>()),
+            1 => steady(&split.iter().map(|h| h.wait_ms).collect::<Vec<_>>()),
+            _ => steady(&split.iter().map(|h| h.copy_ms).collect::<Vec<_>>()),
+        };
+        let res = |k: usize| steady(&resident.iter().map(|r| r[k]).collect::<Vec<_>>());
+        let split_text = format!("{:.1} / {:.1} / {:.1}", part(0), part(1), part(2));
+        let resident_text = format!("{:.1} / {:.1}", res(0), res(1));
+        println!(
+            "{name:<12} {:>9.1} {:>9.1} {o:>9.1} {f:>9.1} {:>6.2}x {split_text:>24} {resident_text:>17}",
+            first[0],
+            first[1],
+            f / o
+        );
+    }
+}
+
+fn device() -> Gpu {
+    create_headless(&Default::default()).expect("an adapter")
+}
+
 fn main() {
     let args: Vec<u32> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (width, height) = (args.first().copied().unwrap_or(1280), args.get(1).copied().unwrap_or(720));
@@ -106,7 +192,6 @@ fn main() {
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"));
     let assets = DemoAssets::load(&dir).expect("baked tables");
-    let device = || create_headless(&Default::default()).expect("an adapter");
     let g = device();
     println!("adapter: {}", g.describe());
     println!(
@@ -154,6 +239,8 @@ fn main() {
     if let Some(only) = arg("only") {
         rows.retain(|(name, ..)| name.starts_with(&only.replace('_', " ")));
     }
+    // `pool-only`: the frame-pool table alone.
+    let rows = if std::env::args().any(|a| a == "pool-only") { Vec::new() } else { rows };
     for (name, head, distance_m, shader, passes) in &rows {
         let (shader, distance_m) = (*shader, *distance_m);
         let s = SkinRenderSettings {
@@ -184,4 +271,5 @@ fn main() {
             counts(&one_enc)
         );
     }
+    pool_table(width, height, frames, &plain, &assets);
 }

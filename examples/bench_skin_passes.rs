@@ -95,7 +95,7 @@ fn main() {
     let defaults = frame(&SkinPasses::default());
     let all = frame(&SkinPasses {
         rig_pose: Some(pose.clone()),
-        wrinkles: Some(Wrinkles { maps: maps.clone(), zone_weights: zones }),
+        wrinkles: Some(Wrinkles { maps: maps.clone().into(), zone_weights: zones }),
         msaa: 4,
         ..Default::default()
     });

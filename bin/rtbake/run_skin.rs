@@ -278,7 +278,7 @@ fn passes(a: &SkinArgs, assets: &DemoAssets) -> anyhow::Result<SkinPasses> {
     if let Some(v) = &a.wrinkles {
         let zone_weights = parse_wrinkle_weights(v).map_err(usage)?;
         let maps = WrinkleMaps::load(&a.common.baked).map_err(|e| usage_msg(format!("--wrinkles: {e}")))?;
-        p.wrinkles = Some(Wrinkles { maps, zone_weights });
+        p.wrinkles = Some(Wrinkles { maps: maps.into(), zone_weights });
     }
     Ok(p)
 }

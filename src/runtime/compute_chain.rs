@@ -53,8 +53,7 @@ pub(crate) fn groups_8x8(w: u32, h: u32) -> [u32; 3] {
 }
 
 /// The usages of a chain's storage buffers: bound, and copied from and to (other passes of a frame read them).
-pub(crate) const STORAGE_USAGE: wgpu::BufferUsages =
-    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_SRC).union(wgpu::BufferUsages::COPY_DST);
+pub(crate) const STORAGE_USAGE: wgpu::BufferUsages = crate::runtime::frame_pool::STORAGE_BUFFER_USAGE;
 
 /// Checks `sizes` (bytes of each storage buffer) against the adapter's limits; `what` names the pass.
 pub(crate) fn check_buffers(device: &wgpu::Device, what: &str, sizes: &[u64]) -> Result<(), RuntimeError> {
@@ -170,7 +169,7 @@ pub(crate) fn record(
         block[k * stride..k * stride + uniform.len()].copy_from_slice(uniform);
         block[k * stride + common..k * stride + slice].copy_from_slice(bytemuck::cast_slice(&s.args));
     }
-    let ubo = gpu::uniform_buffer(device, what, &block);
+    let ubo = crate::runtime::frame_pool::uniform_buffer(device, what, &block);
     let binding = wgpu::BufferBinding { buffer: &ubo, offset: 0, size: wgpu::BufferSize::new(slice as u64) };
     let mut group_entries = vec![(0, wgpu::BindingResource::Buffer(binding))];
     group_entries.extend(buffers.iter().enumerate().map(|(i, b)| (i as u32 + 1, b.as_entire_binding())));

@@ -259,11 +259,11 @@ fn texture_with_usage(
 }
 
 /// The usages of [`texture`]: sampled, render target, copy source and destination.
-const TARGET_USAGE: U = U::TEXTURE_BINDING.union(U::RENDER_ATTACHMENT).union(U::COPY_DST).union(U::COPY_SRC);
+pub(crate) const TARGET_USAGE: U = U::TEXTURE_BINDING.union(U::RENDER_ATTACHMENT).union(U::COPY_DST).union(U::COPY_SRC);
 /// The usages of [`data_texture`]: sampled and uploaded to, nothing else.
-const DATA_USAGE: U = U::TEXTURE_BINDING.union(U::COPY_DST);
+pub(crate) const DATA_USAGE: U = U::TEXTURE_BINDING.union(U::COPY_DST);
 /// The usages of [`storage_texture`]: written by a compute pass, then sampled or copied.
-const STORAGE_USAGE: U = U::TEXTURE_BINDING.union(U::STORAGE_BINDING).union(U::COPY_SRC).union(U::COPY_DST);
+pub(crate) const STORAGE_USAGE: U = U::TEXTURE_BINDING.union(U::STORAGE_BINDING).union(U::COPY_SRC).union(U::COPY_DST);
 
 /// A 2D texture with one mip level, sampled + render target + copy source/destination. `format` is always an
 /// explicit non-sRGB format (the runtime never lets the hardware decode sRGB behind its back).

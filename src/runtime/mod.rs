@@ -19,6 +19,7 @@ pub mod backend;
 pub mod chain;
 pub(crate) mod compute_chain;
 pub mod device;
+pub mod frame_pool;
 pub mod gpu;
 pub mod loader;
 pub mod resolve_order;

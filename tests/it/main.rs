@@ -60,6 +60,7 @@ mod report_cli;
 mod runtime_cli;
 mod runtime_device_limits;
 mod runtime_frame_caches;
+mod runtime_frame_pool;
 mod runtime_gaussian_sss;
 mod runtime_golden_textures;
 mod runtime_importance_sss;

@@ -35,7 +35,8 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
     assert_eq!(plain.data, profiled.data, "profiling changed the frame's bytes");
 
     // Recording order: the compute rasteriser's three passes for the view's G-buffer and for the shadow map
-    // (`runtime::skin::compute_raster`, `RTBAKE_RASTER=compute`, a GPU's default), the device geometry, the rig at uv, the skin-inputs pass, the shading chain around the SSS
+    // (`runtime::skin::compute_raster`, `RTBAKE_RASTER=compute`, a GPU's default), the device geometry, the rig at
+    // uv, the background fill, the skin-inputs pass, the shading chain around the SSS
     // passes, bloom (one level at 32 rows) and the tone map; spans where other work lies between two chain
     // recordings.
     let labels: Vec<&str> = profile.iter().map(|p| p.label.as_str()).collect();
@@ -53,7 +54,9 @@ fn a_profiled_frame_is_the_same_frame_with_its_passes_in_order_and_their_bytes_c
         "frame geometry: main → mesh skin inputs: main",
         "mesh skin inputs: main",
         "mesh skin inputs: into_skin_maps",
-        "mesh skin inputs: into_skin_maps → skin inputs: main",
+        "mesh skin inputs: into_skin_maps → skin frame: background",
+        "skin frame: background",
+        "skin frame: background → skin inputs: main",
         "skin inputs: main",
         "skin inputs: main → skin frame: lit",
         "skin frame: lit",

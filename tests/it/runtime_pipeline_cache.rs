@@ -73,7 +73,7 @@ fn a_screen_space_frame_submits_its_shading_once_and_reads_back_only_the_final_f
     let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered];
     for shader in shaders {
         let joy = rtbake::runtime::skin_passes::Wrinkles {
-            maps: rtbake::runtime::wrinkle_pass::WrinkleMaps::load(&baked_dir()).unwrap(),
+            maps: rtbake::runtime::wrinkle_pass::WrinkleMaps::load(&baked_dir()).unwrap().into(),
             zone_weights: rtbake::runtime::wrinkle_pass::parse_wrinkle_weights("joy=1").unwrap(),
         };
         let wrinkled = SkinPasses { wrinkles: Some(joy), ..SkinPasses::default() };
@@ -164,7 +164,7 @@ fn surface_maps_wrinkles_and_msaa_frames_submit_once_and_agree_with_the_cpu_twin
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let head = default_head();
     let wrinkles = rtbake::runtime::skin_passes::Wrinkles {
-        maps: rtbake::runtime::wrinkle_pass::WrinkleMaps::load(&baked_dir()).unwrap(),
+        maps: rtbake::runtime::wrinkle_pass::WrinkleMaps::load(&baked_dir()).unwrap().into(),
         zone_weights: rtbake::runtime::wrinkle_pass::parse_wrinkle_weights("joy=1,surprise=1,anger=1").unwrap(),
     };
     let maps = SkinPasses { surface_maps: Some(synthetic_surface_maps()), ..SkinPasses::default() };

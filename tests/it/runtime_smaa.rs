@@ -382,3 +382,33 @@ fn antialiasing_recorded_on_a_device_frame_writes_the_bytes_of_the_standalone_pa
     assert_eq!(err.param, "frame");
     assert!(err.message.contains(&format!("{}", 4 * w * h)), "{err}");
 }
+
+/// `run demo` with SMAA or MLAA on a device: the shading and the antialiasing are recorded into one encoder, one
+/// submission and one read-back for the whole frame, and the frame is byte for byte the one of the shaded frame read
+/// back and then antialiased on its own (`chain::antialias`, its own upload, submission and read-back).
+#[test]
+fn the_antialiased_demo_frame_is_one_submission_with_the_bytes_of_antialiasing_after_the_shading() {
+    use rtbake::runtime::chain::{antialias, Antialiasing};
+    use rtbake::runtime::demo::{render, DemoAssets, SssMethod};
+    use rtbake::runtime::gpu::{read_backs_on_this_thread, submissions_on_this_thread};
+    use rtbake::runtime::mlaa::MlaaAreaMap;
+    let g = gpu();
+    let assets = DemoAssets::load(&baked_dir()).unwrap();
+    let (w, h) = (193, 108);
+    let aas = [
+        ("SMAA", Antialiasing::Smaa(baked_smaa())),
+        ("MLAA", Antialiasing::Mlaa(MlaaAreaMap::new(33, baked_mlaa(33)).unwrap())),
+    ];
+    for (name, aa) in &aas {
+        render(Some(&g), w, h, &assets, SssMethod::Separable, Some(aa)).unwrap();
+        let (sub, read) = (submissions_on_this_thread(), read_backs_on_this_thread());
+        let frame = render(Some(&g), w, h, &assets, SssMethod::Separable, Some(aa)).unwrap();
+        let (sub, read) = (submissions_on_this_thread() - sub, read_backs_on_this_thread() - read);
+        assert_eq!((sub, read), (1, 1), "{name}: {sub} submissions, {read} read-backs");
+        let shaded = render(Some(&g), w, h, &assets, SssMethod::Separable, None).unwrap();
+        let want = antialias(Some(&g), &shaded, aa).unwrap();
+        assert_ne!(want.data, shaded.data, "{name}: the demo frame has edges to antialias");
+        let differ = frame.data.iter().zip(&want.data).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{name}: {differ} bytes differ from the frame antialiased after its read-back");
+    }
+}

@@ -214,7 +214,7 @@ fn texture_space_frames_with_surface_maps_wrinkles_and_msaa_submit_once() {
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     let head = default_head();
     let wrinkles = Wrinkles {
-        maps: WrinkleMaps::load(&baked_dir()).unwrap(),
+        maps: WrinkleMaps::load(&baked_dir()).unwrap().into(),
         zone_weights: parse_wrinkle_weights("joy=1,surprise=1,anger=1").unwrap(),
     };
     let maps = SkinPasses { surface_maps: Some(synthetic_surface_maps()), ..SkinPasses::default() };

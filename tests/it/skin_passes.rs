@@ -89,7 +89,7 @@ fn rig_at_mesh_uv_gpu_matches_cpu_and_more_hemoglobin_reddens_the_skin() {
 
 fn wrinkles(spec: &str) -> Wrinkles {
     let maps = WrinkleMaps::load(&baked_dir()).unwrap();
-    Wrinkles { maps, zone_weights: parse_wrinkle_weights(spec).unwrap() }
+    Wrinkles { maps: maps.into(), zone_weights: parse_wrinkle_weights(spec).unwrap() }
 }
 
 #[test]

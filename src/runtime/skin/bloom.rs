@@ -149,7 +149,8 @@ impl BloomBuffers {
         p.validate()?;
         let bytes = storage_buffer_bytes(width, height, p);
         compute_chain::check_buffers(device, "bloom", &bytes)?;
-        Ok(Self(bytes.map(|b| compute_chain::storage_buffer(device, "bloom", b, None))))
+        // From the frame pool: every level's texels are written (`down`, `up`) before they are read.
+        Ok(Self(bytes.map(|b| crate::runtime::frame_pool::storage_buffer(device, "bloom", b))))
     }
 }
 

@@ -29,6 +29,7 @@
 
 use crate::error::InvalidInput;
 use crate::runtime::compute_chain::{self, Stage};
+use crate::runtime::frame_pool;
 use crate::runtime::skin::mesh_raster::{self, MeshBuffers, RasterJob};
 use crate::runtime::RuntimeError;
 use std::cell::Cell;
@@ -148,8 +149,8 @@ pub(crate) fn record(
     let pixels = width as u64 * height as u64 * VISIBILITY_BYTES_PER_PIXEL;
     let sizes = [buffers.vertices.size(), buffers.indices.size(), pixels, pixels, gbuffer.size()];
     compute_chain::check_buffers(device, what, &sizes)?;
-    let depth_keys = compute_chain::storage_buffer(device, what, pixels, None);
-    let tri_keys = compute_chain::storage_buffer(device, what, pixels, None);
+    let depth_keys = frame_pool::storage_buffer(device, what, pixels);
+    let tri_keys = frame_pool::storage_buffer(device, what, pixels);
     // Empty keys are 0: cleared here, so a buffer reused across frames starts empty too.
     enc.clear_buffer(&depth_keys, 0, None);
     enc.clear_buffer(&tri_keys, 0, None);

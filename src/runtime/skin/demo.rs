@@ -98,9 +98,9 @@ pub fn sss_inputs<'g>(
 }
 
 /// Renders the demo frame (RGBA8, sRGB-encoded) with `assets`. `aa` None leaves it aliased. On a device the shading
-/// (skin inputs, lit layer, SSS, composite, tone map) is recorded into one command encoder and read back once
-/// ([`crate::runtime::skin::shade_frame`], or each pass on its own with its `set_shading_in_one_encoder` off); the
-/// antialiasing runs on that frame after it, with its own submissions.
+/// (skin inputs, lit layer, SSS, composite, tone map) and the antialiasing are recorded into one command encoder and
+/// read back once ([`crate::runtime::skin::shade_frame`], [`crate::runtime::chain::record_antialias`]), or each pass
+/// runs on its own with its `set_shading_in_one_encoder` off (the antialiasing with its own submissions).
 pub fn render<'g>(
     gpu: impl Into<Backend<'g>>,
     w: u32,
@@ -113,11 +113,7 @@ pub fn render<'g>(
     crate::error::check_size("width/height", w as u64, h as u64)?;
     let geo = geometry(w, h, assets.baked_rig.as_ref());
     let background = crate::runtime::aa::scene::render_shapes(w, h, 1);
-    let frame = render_geometry(gpu, geo, assets, Some(method), background)?;
-    match aa {
-        Some(aa) => crate::runtime::chain::antialias(gpu, &frame, aa),
-        None => Ok(frame),
-    }
+    render_geometry(gpu, geo, assets, Some(method), background, aa)
 }
 
 /// Bytes per pixel of the demo frame's largest GPU image: the skin-inputs pass reads back albedo and T(s)·E as

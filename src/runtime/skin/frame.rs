@@ -37,19 +37,25 @@
 //! ([`crate::runtime::skin::shade_frame::set_shading_in_one_encoder`] off), which submits and reads back each pass on its
 //! own, for A/B comparison. Texture-space diffusion
 //! ([`crate::runtime::skin::texture_space`]) is one submission and one read-back under the same conditions.
+//! [`render_on_device_with`] renders a screen-space frame without the read-back ([`DeviceFrame`], read back on
+//! demand); the frame's buffers and textures come from the device's frame pool ([`crate::runtime::frame_pool`]).
 
 use crate::error::InvalidInput;
 use crate::image_buf::Image;
 use crate::mesh::Mesh;
 use crate::runtime::backend::Backend;
+use crate::runtime::device::Gpu;
 use crate::runtime::skin::frame_geometry::FrameGeometryJob;
 use crate::runtime::skin::heads::{blend_coverage, geometry, row_of_heads, BACKGROUND};
 use crate::runtime::skin::inputs::RigScaleBiasMaps;
+use crate::runtime::skin::lighting::subsurface_of;
 use crate::runtime::skin::lighting::{DemoAssets, SssMethod};
 use crate::runtime::skin::mesh_inputs::RigPose;
 use crate::runtime::skin::passes::SkinPasses;
 use crate::runtime::skin::settings::{SkinRenderSettings, SkinShader, WORLD_UNITS_PER_M};
-use crate::runtime::skin::shade_frame::{render_geometry, render_on_device, shades_in_one_encoder};
+pub use crate::runtime::skin::shade_frame::DeviceFrame;
+use crate::runtime::skin::shade_frame::{render_geometry, render_on_device, shade_on_device, shades_in_one_encoder};
+use crate::runtime::skin::shade_frame::{Background, FrameSource};
 use crate::runtime::sss::importance::{ImportanceSamples, ImportanceSssParams};
 use crate::runtime::RuntimeError;
 
@@ -240,9 +246,52 @@ pub fn render_with<'g>(
     if let SkinShader::Ts(ts) = s.shader {
         return crate::runtime::skin::texture_space::render_with(gpu, mesh, s, ts, passes, assets).map(|(img, _)| img);
     }
+    let (heads, assets_used, method) = screen_space_frame(mesh, s, passes, assets)?;
+    if shades_in_one_encoder(gpu) {
+        // The geometry computed on the device in the shading's encoder: the G-buffer is never read back.
+        let job = device_job(&heads, s, passes, assets);
+        return render_on_device(gpu, &job, &assets_used, method, Background::Uniform(BACKGROUND));
+    }
+    // The CPU twin, or the per-pass path on a device: the rig at uv evaluated with the geometry.
+    let background = BACKGROUND.repeat((s.width * s.height) as usize);
+    let (geo, g, _) = geometry(gpu, &heads, s, passes, assets, false)?;
+    let mut frame = render_geometry(gpu, geo, &assets_used, method, background, None)?;
+    blend_coverage(&mut frame, &g.coverage);
+    Ok(frame)
+}
+
+/// [`render_with`] on a device, its frame left there: the one-encoder frame submitted without a read-back, as an
+/// engine presents a frame it never copies to the host. [`DeviceFrame::read_back`] copies it out on demand (the
+/// same bytes as [`render_with`]'s). For the screen-space shaders (texture-space diffusion is refused, naming
+/// `shader`).
+pub fn render_on_device_with(
+    g: &Gpu,
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<DeviceFrame, RuntimeError> {
+    if let SkinShader::Ts(_) = s.shader {
+        let msg = "a frame left on the device is rendered by the screen-space shaders (none, ss-full, ss-jittered, \
+                   separable)";
+        return Err(InvalidInput::new("shader", msg).into());
+    }
+    let (heads, assets_used, method) = screen_space_frame(mesh, s, passes, assets)?;
+    let job = device_job(&heads, s, passes, assets);
+    let sss = subsurface_of(&assets_used, method)?;
+    shade_on_device(g, FrameSource::Device(&job), &assets_used, sss.as_ref(), Background::Uniform(BACKGROUND))
+}
+
+/// A screen-space frame's heads, the assets its shading uses (a neutral rig, the shader's parameters, the passes'
+/// bloom) and its SSS method.
+fn screen_space_frame(
+    mesh: &Mesh,
+    s: &SkinRenderSettings,
+    passes: &SkinPasses,
+    assets: &DemoAssets,
+) -> Result<(Mesh, DemoAssets, Option<SssMethod>), RuntimeError> {
     s.validate()?;
     let heads = row_of_heads(mesh, s.heads)?;
-    let original = assets;
     let mut assets = assets.clone();
     // A neutral rig (scale 1, bias 0): see the module doc.
     assets.rig = RigScaleBiasMaps { width: 2, height: 2, targets: vec![vec![[1.0, 0.0]; 4]] };
@@ -266,32 +315,31 @@ pub fn render_with<'g>(
             };
             Some(SssMethod::Importance)
         }
-        SkinShader::Ts(_) => unreachable!("texture-space diffusion returned above"),
+        SkinShader::Ts(_) => unreachable!("texture-space diffusion is rendered elsewhere"),
     };
-    let background = BACKGROUND.repeat((s.width * s.height) as usize);
-    let one_encoder = shades_in_one_encoder(gpu);
-    if one_encoder {
-        // The geometry computed on the device in the shading's encoder: the G-buffer is never read back.
-        let rig_pose =
-            original.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
-        let job = FrameGeometryJob {
-            mesh: &heads,
-            camera: s.camera(),
-            width: s.width,
-            height: s.height,
-            melanin: s.melanin,
-            rig_pose,
-            msaa: passes.msaa,
-            surface_maps: passes.surface_maps.as_ref(),
-            wrinkles: passes.wrinkles.as_ref(),
-        };
-        return render_on_device(gpu, &job, &assets, method, background);
+    Ok((heads, assets, method))
+}
+
+/// The device geometry of a frame of `heads` (the original `assets`' baked rig posed by `passes`).
+fn device_job<'a>(
+    heads: &'a Mesh,
+    s: &SkinRenderSettings,
+    passes: &'a SkinPasses,
+    assets: &DemoAssets,
+) -> FrameGeometryJob<'a> {
+    let rig_pose =
+        assets.baked_rig.as_ref().map(|r| passes.rig_pose.clone().unwrap_or(RigPose::neutral(r.names.len())));
+    FrameGeometryJob {
+        mesh: heads,
+        camera: s.camera(),
+        width: s.width,
+        height: s.height,
+        melanin: s.melanin,
+        rig_pose,
+        msaa: passes.msaa,
+        surface_maps: passes.surface_maps.as_ref(),
+        wrinkles: passes.wrinkles.as_ref(),
     }
-    // The CPU twin, or the per-pass path on a device: the rig at uv evaluated with the geometry.
-    let (geo, g, _) = geometry(gpu, &heads, s, passes, original, false)?;
-    let mut frame = render_geometry(gpu, geo, &assets, method, background)?;
-    blend_coverage(&mut frame, &g.coverage);
-    Ok(frame)
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 use crate::mesh::camera::Camera;
 use crate::mesh::Mesh;
 use crate::runtime::compute_chain::{self, Stage};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu;
 use crate::runtime::skin::compute_raster::{self, RasterShape};
 use crate::runtime::skin::heads::light_camera;
@@ -199,8 +200,9 @@ pub(crate) fn record(
         if per_pixel_frame { 16 * n } else { 16 },
     ];
     compute_chain::check_buffers(device, what, &sizes)?;
-    // Bindings 1..=8 of frame_geometry.wgsl: view_g, shadow_g, uvc, skin_maps, normals, geo, depth, nrm.
-    let bufs: Vec<wgpu::Buffer> = sizes.iter().map(|&b| compute_chain::storage_buffer(device, what, b, None)).collect();
+    // Bindings 1..=8 of frame_geometry.wgsl: view_g, shadow_g, uvc, skin_maps, normals, geo, depth, nrm; from the
+    // frame pool (not zero when reused: the copies below and `unpack`/`main` write every texel the passes read).
+    let bufs: Vec<wgpu::Buffer> = sizes.iter().map(|&b| frame_pool::storage_buffer(device, what, b)).collect();
     let (uvc, normals, texels, nrm) = (&bufs[2], &bufs[4], &bufs[5], &bufs[7]);
     // The G-buffer and the shadow map in bufs[0] and bufs[1]: rasterised there by compute, or by the render pass
     // and copied.
@@ -266,7 +268,7 @@ pub(crate) fn record(
             compute_chain::record(device, enc, what, SOURCE, uniform, &bound, &[Stage::new("take_normals", groups)]);
         }
         if let Some(wr) = job.wrinkles {
-            let out = compute_chain::storage_buffer(device, what, 16 * n, None);
+            let out = frame_pool::storage_buffer(device, what, 16 * n);
             wrinkles::record(device, enc, (w, h), frame, &wr.maps, &wr.zone_weights, &out)?;
             enc.copy_buffer_to_buffer(&out, 0, nrm, 0, 16 * n);
         }
@@ -376,7 +378,7 @@ mod tests {
         let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/baked"));
         let assets = DemoAssets::load(dir).unwrap();
         let wrinkles = Wrinkles {
-            maps: WrinkleMaps::load(dir).unwrap(),
+            maps: WrinkleMaps::load(dir).unwrap().into(),
             zone_weights: parse_wrinkle_weights("joy=1,surprise=1,anger=1").unwrap(),
         };
         let mapped = SkinPasses { surface_maps: Some(synthetic_maps()), ..SkinPasses::none() };

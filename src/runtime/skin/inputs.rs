@@ -10,6 +10,7 @@
 
 use crate::error::InvalidInput;
 use crate::runtime::compute_chain::{self, Stage};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 
@@ -126,10 +127,20 @@ pub(crate) fn maps_texels(frame: &SkinFrame) -> Vec<[f32; 4]> {
     (0..frame.melanin.len()).map(|i| [frame.melanin[i], frame.h0[i], frame.thickness_mm[i], 0.0]).collect()
 }
 
-/// Skin inputs for one frame size, LUTs and rig.
+/// Skin inputs for one frame size, LUTs and rig: the tables (kept per device and content, `TABLES`) and the
+/// uniform block; for the fragment pass ([`SkinInputs::new`]) also its targets, input textures and pipeline, which
+/// a compute-only frame (`SkinInputs::for_compute`) never creates.
 pub struct SkinInputs {
     width: u32,
     height: u32,
+    fragment: Option<FragmentPass>,
+    /// The compute pass's copies of the rig, the albedo LUT and the T(s) table: the half floats of the textures.
+    tables: [wgpu::Buffer; 3],
+    params: Params,
+}
+
+/// The fragment pass's textures, pipeline, bind group and uniform buffer.
+struct FragmentPass {
     maps: wgpu::Texture,
     normals: wgpu::Texture,
     albedo: wgpu::Texture,
@@ -138,10 +149,41 @@ pub struct SkinInputs {
     transmitted_view: wgpu::TextureView,
     pipe: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
-    /// The compute pass's copies of the rig, the albedo LUT and the T(s) table: the half floats of the textures.
-    tables: [wgpu::Buffer; 3],
     ubo: wgpu::Buffer,
-    params: Params,
+}
+
+/// The half floats of the rig (its layers one after the other), of the albedo LUT and of the T(s) table
+/// (Rgba16Float texels), as their textures and the compute pass's tables hold them.
+fn table_halves(luts: &SkinLuts, rig: &RigScaleBiasMaps) -> [Vec<u8>; 3] {
+    let rig_halves = rig.targets.iter().flat_map(|t| f16_bytes(t.iter().flatten().copied())).collect();
+    let lut_halves = f16_bytes(luts.albedo.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
+    let t_halves = f16_bytes(luts.transmittance.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
+    [rig_halves, lut_halves, t_halves]
+}
+
+/// A 64-bit hash of the tables' content: the key of [`TABLES`] (the LUTs and the rig are small; hashing them is
+/// far cheaper than uploading them).
+fn tables_key(luts: &SkinLuts, rig: &RigScaleBiasMaps) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let bits = |v: &mut dyn Iterator<Item = f32>, h: &mut std::collections::hash_map::DefaultHasher| {
+        v.for_each(|x| x.to_bits().hash(h))
+    };
+    (luts.albedo_size, luts.albedo.len(), luts.transmittance.len(), luts.s_max_mm.to_bits()).hash(&mut h);
+    bits(&mut luts.albedo.iter().flatten().copied(), &mut h);
+    bits(&mut luts.transmittance.iter().flatten().copied(), &mut h);
+    (rig.width, rig.height, rig.targets.len()).hash(&mut h);
+    bits(&mut rig.targets.iter().flatten().flatten().copied(), &mut h);
+    h.finish()
+}
+
+/// The compute pass's tables uploaded per (device, content): a command uses one set; a test process a few per
+/// device.
+static TABLES: gpu::Kept<(wgpu::Device, u64), [wgpu::Buffer; 3]> = gpu::Kept::new(8);
+
+/// Bytes of a padded row of a `width`-texel image of `bytes_per_texel` in a texture copy.
+fn padded_row_bytes(width: u32, bytes_per_texel: u32) -> u32 {
+    (width * bytes_per_texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
 }
 
 fn data_texture(
@@ -174,6 +216,8 @@ pub enum MapsFrom {
 }
 
 impl SkinInputs {
+    /// The pass with its fragment path (textures, pipeline): [`SkinInputs::encode`], [`SkinInputs::run`] and
+    /// the compute pass.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -182,18 +226,18 @@ impl SkinInputs {
         luts: &SkinLuts,
         rig: &RigScaleBiasMaps,
     ) -> Result<Self, RuntimeError> {
-        gpu::check_frame(device, width, height, 16)?;
-        luts.validate()?;
-        rig.validate()?;
+        let mut pass = Self::for_compute(device, width, height, luts, rig)?;
         use wgpu::TextureFormat as F;
-        let maps = data_texture(device, "skin maps", width, height, 1, F::Rgba32Float);
-        let normals = data_texture(device, "skin normals", width, height, 1, F::Rgba32Float);
+        // The per-pixel textures from the frame's pool when a frame is open (each fully written before it is read:
+        // the maps and normals uploaded or copied whole, the targets cleared by the pass).
+        let maps = frame_pool::data_target(device, "skin maps", width, height, F::Rgba32Float);
+        let normals = frame_pool::data_target(device, "skin normals", width, height, F::Rgba32Float);
         let k = rig.targets.len() as u32;
+        let [rig_halves, lut_halves, t_halves] = table_halves(luts, rig);
         // At least two layers: the GL backend cannot view a one-layer texture as a 2D array.
         let rig_tex = data_texture(device, "skin rig", rig.width, rig.height, k.max(2), F::Rg16Float);
-        let mut rig_halves = Vec::new();
-        for (i, t) in rig.targets.iter().enumerate() {
-            let halves = f16_bytes(t.iter().flatten().copied());
+        let layer_bytes = (4 * rig.width * rig.height) as usize;
+        for i in 0..k as usize {
             queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &rig_tex,
@@ -201,7 +245,7 @@ impl SkinInputs {
                     origin: wgpu::Origin3d { x: 0, y: 0, z: i as u32 },
                     aspect: wgpu::TextureAspect::All,
                 },
-                &halves,
+                &rig_halves[i * layer_bytes..(i + 1) * layer_bytes],
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(rig.width * 4),
@@ -209,36 +253,16 @@ impl SkinInputs {
                 },
                 wgpu::Extent3d { width: rig.width, height: rig.height, depth_or_array_layers: 1 },
             );
-            rig_halves.extend_from_slice(&halves);
         }
         let (lw, lh) = luts.albedo_size;
         let lut_tex = gpu::texture(device, "skin albedo LUT", lw, lh, F::Rgba16Float);
-        let lut_halves = f16_bytes(luts.albedo.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
         gpu::upload(queue, &lut_tex, &lut_halves);
         let nt = luts.transmittance.len() as u32;
         let t_tex = gpu::texture(device, "skin T(s)", nt, 1, F::Rgba16Float);
-        let t_halves = f16_bytes(luts.transmittance.iter().flat_map(|c| [c[0], c[1], c[2], 1.0]));
         gpu::upload(queue, &t_tex, &t_halves);
-        let what = "skin inputs";
-        compute_chain::check_buffers(device, what, &[rig_halves.len() as u64])?;
-        let table = |b: &[u8]| compute_chain::storage_buffer(device, what, b.len() as u64, Some(b));
-        let tables = [table(&rig_halves), table(&lut_halves), table(&t_halves)];
-        let albedo = gpu::texture(device, "skin albedo", width, height, F::Rgba16Float);
-        let transmitted = gpu::texture(device, "skin transmitted", width, height, F::Rgba16Float);
-        let params = Params {
-            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
-            light: [0.0, 0.0, 1.0, 0.0],
-            lut: [lw as f32, lh as f32, nt as f32, luts.s_max_mm],
-            cfg: [k as f32, 0.0, 0.0, 0.0],
-            weights: [[0.0; 4]; 2],
-            rows: [
-                (gpu::padded_row_bytes(&maps) / 16) as f32,
-                (gpu::padded_row_bytes(&albedo) / 4) as f32,
-                rig.width as f32,
-                rig.height as f32,
-            ],
-        };
-        let ubo = gpu::uniform_buffer(device, "skin params", bytemuck::bytes_of(&params));
+        let albedo = frame_pool::target(device, "skin albedo", width, height, F::Rgba16Float);
+        let transmitted = frame_pool::target(device, "skin transmitted", width, height, F::Rgba16Float);
+        let ubo = frame_pool::uniform_buffer(device, "skin params", bytemuck::bytes_of(&pass.params));
         let module = gpu::shader(device, "skin_inputs.wgsl", SHADER);
         let target = |f| Some(wgpu::ColorTargetState { format: f, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let targets = [target(F::Rgba16Float), target(F::Rgba16Float)];
@@ -264,36 +288,73 @@ impl SkinInputs {
             ],
         );
         let (albedo_view, transmitted_view) = (view(&albedo), view(&transmitted));
-        Ok(Self {
-            width,
-            height,
-            maps,
-            normals,
-            albedo,
-            transmitted,
-            albedo_view,
-            transmitted_view,
-            pipe,
-            group,
-            tables,
-            ubo,
-            params,
-        })
+        pass.fragment =
+            Some(FragmentPass { maps, normals, albedo, transmitted, albedo_view, transmitted_view, pipe, group, ubo });
+        Ok(pass)
+    }
+
+    /// The pass for a frame that runs it as a compute pass only ([`SkinInputs::record_compute`]): its tables
+    /// (uploaded once per device and content while kept) and uniform block, no texture, no pipeline.
+    pub(crate) fn for_compute(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        luts: &SkinLuts,
+        rig: &RigScaleBiasMaps,
+    ) -> Result<Self, RuntimeError> {
+        gpu::check_frame(device, width, height, 16)?;
+        luts.validate()?;
+        rig.validate()?;
+        let what = "skin inputs";
+        let rig_bytes = 4 * (rig.width * rig.height) as u64 * rig.targets.len() as u64;
+        compute_chain::check_buffers(device, what, &[rig_bytes])?;
+        let tables = TABLES.get_or_insert_with((device.clone(), tables_key(luts, rig)), || {
+            table_halves(luts, rig).map(|b| {
+                gpu::count_buffer_upload();
+                compute_chain::storage_buffer(device, what, b.len() as u64, Some(&b))
+            })
+        });
+        let (lw, lh) = luts.albedo_size;
+        let nt = luts.transmittance.len() as u32;
+        let params = Params {
+            rt: [1.0 / width as f32, 1.0 / height as f32, width as f32, height as f32],
+            light: [0.0, 0.0, 1.0, 0.0],
+            lut: [lw as f32, lh as f32, nt as f32, luts.s_max_mm],
+            cfg: [rig.targets.len() as f32, 0.0, 0.0, 0.0],
+            weights: [[0.0; 4]; 2],
+            rows: [
+                (padded_row_bytes(width, 16) / 16) as f32,
+                (padded_row_bytes(width, 8) / 4) as f32,
+                rig.width as f32,
+                rig.height as f32,
+            ],
+        };
+        Ok(Self { width, height, fragment: None, tables, params })
+    }
+
+    /// Bytes of a padded row of one of the compute pass's two Rgba16Float output images (the layout a
+    /// texture-to-buffer copy of [`Self::albedo`] gives).
+    pub(crate) fn half_row_bytes(&self) -> u64 {
+        padded_row_bytes(self.width, 8) as u64
+    }
+
+    fn fragment(&self) -> &FragmentPass {
+        self.fragment.as_ref().expect("the fragment pass's textures exist (SkinInputs::new)")
     }
 
     /// Albedo (rgb) and hemoglobin H (a), `Rgba16Float`.
     pub fn albedo(&self) -> &wgpu::Texture {
-        &self.albedo
+        &self.fragment().albedo
     }
     /// T(s)·E (rgb) and E (a), `Rgba16Float`.
     pub fn transmitted(&self) -> &wgpu::Texture {
-        &self.transmitted
+        &self.fragment().transmitted
     }
 
     /// The maps texture the pass reads, (Cm, H0, thickness mm, 0) per pixel, `Rgba32Float`: a frame that
     /// computes H on the device writes it there ([`MapsFrom::Device`]).
     pub(crate) fn maps(&self) -> &wgpu::Texture {
-        &self.maps
+        &self.fragment().maps
     }
 
     /// Uploads a frame and the per-frame rig weights and light direction (unit, towards the light); the maps
@@ -313,9 +374,9 @@ impl SkinInputs {
         }
         self.upload_lights(queue, rig_weights, light_dir)?;
         let normals: Vec<f32> = frame.normals.iter().flat_map(|v| [v[0], v[1], v[2], 0.0]).collect();
-        gpu::upload(queue, &self.normals, bytemuck::cast_slice(&normals));
+        gpu::upload(queue, &self.fragment().normals, bytemuck::cast_slice(&normals));
         if maps == MapsFrom::Frame {
-            gpu::upload(queue, &self.maps, bytemuck::cast_slice(&maps_texels(frame)));
+            gpu::upload(queue, &self.fragment().maps, bytemuck::cast_slice(&maps_texels(frame)));
         }
         Ok(())
     }
@@ -339,12 +400,15 @@ impl SkinInputs {
         }
         self.params.weights = w;
         self.params.light = [light_dir[0], light_dir[1], light_dir[2], 0.0];
-        queue.write_buffer(&self.ubo, 0, bytemuck::bytes_of(&self.params));
+        if let Some(f) = &self.fragment {
+            queue.write_buffer(&f.ubo, 0, bytemuck::bytes_of(&self.params));
+        }
         Ok(())
     }
 
     /// Records the pass.
     pub fn encode(&self, enc: &mut wgpu::CommandEncoder) {
+        let f = self.fragment();
         let att = |v| {
             Some(wgpu::RenderPassColorAttachment {
                 view: v,
@@ -358,14 +422,14 @@ impl SkinInputs {
         };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("skin inputs"),
-            color_attachments: &[att(&self.albedo_view), att(&self.transmitted_view)],
+            color_attachments: &[att(&f.albedo_view), att(&f.transmitted_view)],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipe);
-        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_pipeline(&f.pipe);
+        pass.set_bind_group(0, &f.group, &[]);
         pass.draw(0..3, 0..1);
     }
 
@@ -400,7 +464,7 @@ impl SkinInputs {
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("skin") });
         self.encode(&mut enc);
         // One submission, both targets read back with one wait.
-        let mut read = gpu::read_textures(device, queue, enc, &[&self.albedo, &self.transmitted])?;
+        let mut read = gpu::read_textures(device, queue, enc, &[self.albedo(), self.transmitted()])?;
         let transmitted = gpu::f16_to_f32(&read.pop().expect("two targets"));
         Ok((gpu::f16_to_f32(&read.pop().expect("two targets")), transmitted))
     }
@@ -458,7 +522,8 @@ mod tests {
         let (albedo, transmitted) = pass.run(device, queue, &frame, &weights, light).unwrap();
 
         let (w, h) = (frame.width as usize, frame.height as usize);
-        let (row32, row16) = (gpu::padded_row_bytes(&pass.maps) as usize, gpu::padded_row_bytes(&pass.albedo) as usize);
+        let (row32, row16) =
+            (gpu::padded_row_bytes(pass.maps()) as usize, gpu::padded_row_bytes(pass.albedo()) as usize);
         assert!(row32 > 16 * w && row16 > 8 * w, "rows are padded on both sides");
         let padded = |texels: Vec<[f32; 4]>| {
             let mut out = vec![0.0f32; row32 / 4 * h];

@@ -239,6 +239,18 @@ pub(crate) fn record_into_skin_maps(
     Ok(())
 }
 
+/// The rig's scale/bias texels and H0 uploaded per (device, content hash): a command uses one rig.
+static RIG_TABLES: gpu::Kept<(wgpu::Device, u64), [wgpu::Buffer; 2]> = gpu::Kept::new(8);
+
+/// A 64-bit hash of the rig's flattened texels and H0 (small maps: hashing them costs far less than an upload).
+fn tables_key(rig: &[f32], h0: &[f32]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (rig.len(), h0.len()).hash(&mut h);
+    rig.iter().chain(h0).for_each(|v| v.to_bits().hash(&mut h));
+    h.finish()
+}
+
 /// Records the pass into `enc` over GPU buffers: (u, v, covered, 0) per pixel of the `size` frame in `uvc`, H
 /// written into the hemoglobin channel of `skin_maps` (vec4 texels, rows of `stride` texels).
 pub(crate) fn record_into_skin_map_buffer(
@@ -256,9 +268,15 @@ pub(crate) fn record_into_skin_map_buffer(
     let n = width as u64 * height as u64;
     let sizes = [uvc.size(), 4 * rig.len() as u64, h0.len() as u64, 4 * n, skin_maps.size()];
     compute_chain::check_buffers(device, what, &sizes)?;
-    let rig_buf = compute_chain::storage_buffer(device, what, sizes[1], Some(bytemuck::cast_slice(&rig)));
-    let h0_buf = compute_chain::storage_buffer(device, what, sizes[2], Some(h0));
-    let hb = compute_chain::storage_buffer(device, what, sizes[3], None);
+    // The rig and H0 uploaded once per device and content while kept; H per pixel from the frame pool (`main`
+    // writes every pixel's before `into_skin_maps` reads it).
+    let [rig_buf, h0_buf] = RIG_TABLES.get_or_insert_with((device.clone(), tables_key(&rig, &maps.h0.data)), || {
+        [bytemuck::cast_slice::<f32, u8>(&rig), h0].map(|b| {
+            gpu::count_buffer_upload();
+            compute_chain::storage_buffer(device, what, b.len() as u64, Some(b))
+        })
+    });
+    let hb = crate::runtime::frame_pool::storage_buffer(device, what, sizes[3]);
     let groups = compute_chain::groups_8x8(width, height);
     let pack = Stage { entry: "into_skin_maps", groups, args: [stride, 0, 0, 0] };
     let bound = [uvc, &rig_buf, &h0_buf, &hb, skin_maps];

@@ -16,6 +16,7 @@
 use crate::error::InvalidInput;
 use crate::mesh::camera::Camera;
 use crate::mesh::Mesh;
+use crate::runtime::frame_pool;
 use crate::runtime::gpu;
 use crate::runtime::RuntimeError;
 use wgpu::util::DeviceExt;
@@ -222,8 +223,11 @@ pub(crate) fn record_uploaded(
 ) -> Result<[wgpu::Texture; 3], RuntimeError> {
     check_job(device, job)?;
     let RasterJob { mesh, camera, width, height, samples, .. } = *job;
-    let ubuf =
-        gpu::uniform_buffer(device, "mesh camera", bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)));
+    let ubuf = frame_pool::uniform_buffer(
+        device,
+        "mesh camera",
+        bytemuck::cast_slice(&camera_uniform(mesh, camera, width, height)),
+    );
     let module = gpu::shader(device, "mesh_raster", include_str!("mesh_raster.wgsl"));
     let gformat = GBUFFER_FORMAT;
     let pipeline = gpu::cached(device, "mesh g-buffer pipeline", &(&module, samples), || {
@@ -285,39 +289,34 @@ pub(crate) fn record_uploaded(
     });
     let bind =
         gpu::bind_group(device, "mesh camera", &pipeline.get_bind_group_layout(0), &[(0, ubuf.as_entire_binding())]);
-    let g0 = gpu::texture(device, "normal+depth", width, height, gformat);
-    let g1 = gpu::texture(device, "uv+cover", width, height, gformat);
-    let g2 = gpu::texture(device, "tangent", width, height, gformat);
-    let multisampled = |label, format| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
+    // Kept across frames by the frame pool when a frame is open (every texel is cleared by the pass's load op).
+    let g0 = frame_pool::target(device, "normal+depth", width, height, gformat);
+    let g1 = frame_pool::target(device, "uv+cover", width, height, gformat);
+    let g2 = frame_pool::target(device, "tangent", width, height, gformat);
+    let attachment = |label, format| {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        frame_pool::texture(device, ((width, height, 1), format, usage, samples), || {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
         })
     };
     let ms: Vec<wgpu::TextureView> = if samples > 1 {
         ["normal+depth ms", "uv+cover ms", "tangent ms"]
             .iter()
-            .map(|l| multisampled(*l, gformat).create_view(&Default::default()))
+            .map(|l| attachment(*l, gformat).create_view(&Default::default()))
             .collect()
     } else {
         Vec::new()
     };
-    let depth = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("mesh depth"),
-        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: samples,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Depth32Float,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+    let depth = attachment("mesh depth", wgpu::TextureFormat::Depth32Float);
     let (v0, v1, v2, vd) = (
         g0.create_view(&Default::default()),
         g1.create_view(&Default::default()),

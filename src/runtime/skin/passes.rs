@@ -11,7 +11,8 @@ use crate::runtime::skin::wrinkles::WrinkleMaps;
 /// The wrinkle pass's maps and zone weights (Table 8.1 columns, each in `0..=1`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Wrinkles {
-    pub maps: WrinkleMaps,
+    /// Shared: the frame uploads them once per device while the same `Arc` is kept (`wrinkles::record`).
+    pub maps: std::sync::Arc<WrinkleMaps>,
     pub zone_weights: [f32; 8],
 }
 

@@ -15,6 +15,8 @@ struct Params {
     cfg: vec4<f32>,
     // the background colour (sRGB-encoded, 0..1), coverage blend (1) or not (0)
     cover: vec4<f32>,
+    // The uniform background colour (sRGB, alpha) the `background` entry point fills the frame with.
+    fill: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
@@ -91,6 +93,17 @@ fn pack(@builtin(global_invocation_id) id: vec3<u32>) {
     let j = half_at(0u, id);
     sss16[j] = pack2x16float(v.xy);
     sss16[j + 1u] = pack2x16float(v.zw);
+}
+
+// The RGBA8 frame filled with the uniform background colour (the frame's buffer is reused across frames: it holds
+// a former frame until this runs).
+@compute @workgroup_size(8, 8, 1)
+fn background(@builtin(global_invocation_id) id: vec3<u32>) {
+    let px = pixel(id);
+    if (px.y == 0u) {
+        return;
+    }
+    rgba[px.x] = pack4x8unorm(p.fill);
 }
 
 fn background_linear(i: u32) -> vec3<f32> {

@@ -599,6 +599,8 @@ mod one_encoder {
         key: [f32; 4],
         cfg: [f32; 4],
         cover: [f32; 4],
+        /// The uniform background fill of `shade_frame.wgsl`'s `background` stage, unused here (zero).
+        fill: [f32; 4],
     }
 
     /// `texture_space_frame.wgsl`'s uniform block (field by field as there).
@@ -811,6 +813,7 @@ mod one_encoder {
             key: [key[0], key[1], key[2], 0.0],
             cfg: [KEY_LIGHT_INTENSITY, TRANSMITTANCE_INTENSITY, bloom_on, 0.0],
             cover: [0.0; 4],
+            fill: [0.0; 4],
         };
         let shade = |enc: &mut wgpu::CommandEncoder, p: &ShadeParams, bound: &[&wgpu::Buffer], entry: &str, size| {
             let stages = [Stage::new(entry, size)];

@@ -26,11 +26,13 @@ use crate::error::InvalidInput;
 use crate::facial::wrinkles::{zone_weights, TABLE_8_1};
 use crate::io::PixelFormat;
 use crate::runtime::compute_chain::{self, Buffer};
+use crate::runtime::gpu;
 use crate::runtime::loader::{BakedDir, LutError, LutSpec};
 use crate::runtime::skin::mesh_raster::MeshGBuffer;
 use crate::runtime::skin::view_frame;
 use crate::runtime::RuntimeError;
 use std::path::Path;
+use std::sync::Arc;
 
 /// The parameter of the wrinkle weights (its flag is in the CLI's table).
 pub const WRINKLES_PARAM: &str = "wrinkles";
@@ -150,12 +152,21 @@ fn pass_inputs(
     maps: &WrinkleMaps,
     weights: &[f32; 8],
 ) -> (compute_chain::MapParams, Vec<f32>) {
-    let params = compute_chain::MapParams {
+    (pass_params(width, height, maps, weights), pass_masks(maps))
+}
+
+/// The pass's uniform block: the frame's and the maps' sizes and the zone weights.
+fn pass_params(width: u32, height: u32, maps: &WrinkleMaps, weights: &[f32; 8]) -> compute_chain::MapParams {
+    compute_chain::MapParams {
         size: [width as f32, height as f32, maps.pd_size.0 as f32, maps.pd_size.1 as f32],
         cfg: [maps.mask_size.0 as f32, maps.mask_size.1 as f32, 0.0, 0.0],
         weights: [[weights[0], weights[1], weights[2], weights[3]], [weights[4], weights[5], weights[6], weights[7]]],
-    };
-    (params, maps.masks.iter().flatten().flatten().copied().collect())
+    }
+}
+
+/// The two zone masks one after the other, as the pass binds them.
+fn pass_masks(maps: &WrinkleMaps) -> Vec<f32> {
+    maps.masks.iter().flatten().flatten().copied().collect()
 }
 
 /// The wrinkled view-space normals of `g` (uncovered pixels keep theirs), on the GPU.
@@ -190,18 +201,39 @@ pub(crate) fn record(
     enc: &mut wgpu::CommandEncoder,
     size: (u32, u32),
     frame: [&wgpu::Buffer; 3],
-    maps: &WrinkleMaps,
+    maps: &Arc<WrinkleMaps>,
     weights: &[f32; 8],
     out: &wgpu::Buffer,
 ) -> Result<(), RuntimeError> {
     maps.validate()?;
-    let (params, masks) = pass_inputs(size.0, size.1, maps, weights);
     let what = "wrinkle pass";
-    let bytes: [&[u8]; 2] = [bytemuck::cast_slice(&maps.pd), bytemuck::cast_slice(&masks)];
-    compute_chain::check_buffers(device, what, &bytes.map(|m| m.len() as u64))?;
-    let [a, b] = bytes.map(|m| compute_chain::storage_buffer(device, what, m.len() as u64, Some(m)));
+    let mask_bytes = 4 * maps.masks.iter().map(|m| 4 * m.len() as u64).sum::<u64>();
+    compute_chain::check_buffers(device, what, &[8 * maps.pd.len() as u64, mask_bytes])?;
+    let params = pass_params(size.0, size.1, maps, weights);
+    let key = MapsKey(device.clone(), maps.clone());
+    let [a, b] = MAP_BUFFERS.get_or_insert_with(key, || {
+        let masks = pass_masks(maps);
+        let bytes: [&[u8]; 2] = [bytemuck::cast_slice(&maps.pd), bytemuck::cast_slice(&masks)];
+        bytes.map(|m| {
+            gpu::count_buffer_upload();
+            compute_chain::storage_buffer(device, what, m.len() as u64, Some(m))
+        })
+    });
     view_frame::record(device, enc, what, SOURCE, bytemuck::bytes_of(&params), size, frame, [&a, &b], out)
 }
+
+/// The maps a frame binds, compared by allocation (as the surface maps' cache compares theirs): equal only while
+/// they are the same `Arc`, which the kept entry holds, so the allocation cannot be reused by other maps.
+struct MapsKey(wgpu::Device, Arc<WrinkleMaps>);
+
+impl PartialEq for MapsKey {
+    fn eq(&self, other: &Self) -> bool {
+        self.0 == other.0 && Arc::ptr_eq(&self.1, &other.1)
+    }
+}
+
+/// Uploaded wrinkle maps kept across frames, per device and maps (a command uses one set).
+static MAP_BUFFERS: gpu::Kept<MapsKey, [wgpu::Buffer; 2]> = gpu::Kept::new(4);
 
 #[cfg(test)]
 mod tests {

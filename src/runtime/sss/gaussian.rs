@@ -14,6 +14,7 @@
 
 use crate::diffusion::sum_of_gaussians::SumOfGaussians;
 use crate::error::{check_non_negative, check_positive, InvalidInput};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::gaussian_tiled::TiledChain;
 use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
@@ -129,7 +130,7 @@ impl Params {
         fit: (&GaussianBlurs, &GaussianSssParams),
     ) -> Vec<[wgpu::Buffer; 2]> {
         let n = fit.0.sigma_mm.len();
-        let buffer = |label, block: Params| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block));
+        let buffer = |label, block: Params| frame_pool::uniform_buffer(device, label, bytemuck::bytes_of(&block));
         (1..n)
             .map(|i| {
                 let last = i + 1 == n;
@@ -238,9 +239,9 @@ impl FragmentChain {
         blurs: &GaussianBlurs,
     ) -> Self {
         use wgpu::TextureFormat as F;
-        let rt1 = gpu::texture(device, "gsss rt1", width, height, F::Rgba16Float);
-        let rt2 = gpu::texture(device, "gsss rt2", width, height, F::Rgba16Float);
-        let rtf = gpu::texture(device, "gsss rtf", width, height, F::Rgba16Float);
+        let rt1 = frame_pool::target(device, "gsss rt1", width, height, F::Rgba16Float);
+        let rt2 = frame_pool::target(device, "gsss rt2", width, height, F::Rgba16Float);
+        let rtf = frame_pool::target(device, "gsss rtf", width, height, F::Rgba16Float);
         let module = gpu::shader(device, "gaussian_sss.wgsl", SHADER);
         let pipe_h = gpu::fullscreen_pipeline(device, "gsss horizontal", &module, "fs_horizontal", F::Rgba16Float);
         let blend = wgpu::BlendState {

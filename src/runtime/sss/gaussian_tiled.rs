@@ -14,6 +14,7 @@
 //! a write of the next (ping-pong between two textures ending in the output); horizontal 20, vertical 36, the last
 //! vertical 28 (it writes no RT1): 56 per Gaussian, 272 for d'Eon's six.
 
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::SssInputs;
 use crate::runtime::RuntimeError;
@@ -48,7 +49,7 @@ impl TiledChain {
             [gpu::compute_pipeline(device, &module, "blur_h"), gpu::compute_pipeline(device, &module, "blur_v")];
         let storage = |name| {
             let label = format!("gsss {name}");
-            gpu::storage_texture(device, &label, width, height, wgpu::TextureFormat::Rgba16Float)
+            frame_pool::storage_target(device, &label, width, height, wgpu::TextureFormat::Rgba16Float)
         };
         let (rt1, rt2, sum, output) = (storage("rt1"), storage("rt2"), storage("sum"), storage("rtf"));
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());

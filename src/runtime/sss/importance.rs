@@ -24,6 +24,7 @@
 //! the normalised (w_r, w_g, w_b, 0).
 
 use crate::error::{check_positive, InvalidInput};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::{shape_from_env, PassShape, SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
@@ -168,18 +169,18 @@ impl ImportanceSss {
             if params.follow_surface { 1.0 } else { 0.0 },
             n as f32,
         ];
-        let ubo = gpu::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
+        let ubo = frame_pool::uniform_buffer(device, "isss params", bytemuck::bytes_of(&p));
         let cv = inputs.color.create_view(&Default::default());
         let (output, blur) = match shape {
             PassShape::Fragment => {
-                let output = gpu::texture(device, "isss output", width, height, F::Rgba16Float);
+                let output = frame_pool::target(device, "isss output", width, height, F::Rgba16Float);
                 let pipe = gpu::fullscreen_pipeline(device, "isss blur", &module, "fs_blur", F::Rgba16Float);
                 let group = inputs.blur_group(device, "isss", &pipe.get_bind_group_layout(0), (&ubo, &cv), &[]);
                 let target = output.create_view(&Default::default());
                 (output, ImportanceBlur::Fragment { pipe, group, target })
             }
             PassShape::Compute => {
-                let output = gpu::storage_texture(device, "isss output", width, height, F::Rgba16Float);
+                let output = frame_pool::storage_target(device, "isss output", width, height, F::Rgba16Float);
                 let pipe = gpu::compute_pipeline(device, &module, "cs_blur");
                 let ov = output.create_view(&Default::default());
                 let layout = pipe.get_bind_group_layout(0);

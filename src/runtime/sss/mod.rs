@@ -29,6 +29,7 @@ pub mod separable_cpu;
 pub mod separable_tiled;
 
 use crate::error::{check_range, InvalidInput};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::RuntimeError;
 
@@ -89,8 +90,8 @@ impl SssInputs {
     /// Creates the two textures, labelled `"{label} colour"` and `"{label} depth"`.
     pub(crate) fn new(device: &wgpu::Device, label: &str, width: u32, height: u32) -> Self {
         use wgpu::TextureFormat as F;
-        let color = gpu::texture(device, &format!("{label} colour"), width, height, F::Rgba16Float);
-        let depth = gpu::data_texture(device, &format!("{label} depth"), width, height, F::R32Float);
+        let color = frame_pool::target(device, &format!("{label} colour"), width, height, F::Rgba16Float);
+        let depth = frame_pool::data_target(device, &format!("{label} depth"), width, height, F::R32Float);
         Self { color, depth }
     }
 

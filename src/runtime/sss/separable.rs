@@ -5,6 +5,7 @@
 //! follow-surface). Resources created once in [`SeparableSss::new`]; CPU twin [`crate::runtime::sss::separable_cpu`].
 
 use crate::error::{check_positive, InvalidInput};
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
 use crate::runtime::RuntimeError;
@@ -99,7 +100,7 @@ impl Params {
         SssInputs::check_size(device, width, height)?;
         params.validate()?;
         let block = |dir| Self::new(width, height, kernel, params, dir);
-        let mk = |label, dir| gpu::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
+        let mk = |label, dir| frame_pool::uniform_buffer(device, label, bytemuck::bytes_of(&block(dir)));
         Ok([mk("sss h", [1.0, 0.0]), mk("sss v", [0.0, 1.0])])
     }
 }
@@ -163,7 +164,7 @@ impl<B: SeparableForm> SssPass<B> {
 }
 
 impl SeparableForm for SeparableBlur {
-    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::texture;
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = frame_pool::target;
 
     fn build(
         device: &wgpu::Device,

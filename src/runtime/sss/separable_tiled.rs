@@ -7,6 +7,7 @@
 //! line, so its bilinear fetch is a lerp of two neighbours), so a pass moves each texel in and out once. Taps beyond
 //! the apron read the textures. The result is written through a storage texture (`Rgba16Float`).
 
+use crate::runtime::frame_pool;
 use crate::runtime::gpu::{self, GpuTimer};
 use crate::runtime::sss::separable::{sealed, SeparableForm};
 use crate::runtime::sss::{SssBlur, SssInputs, SssPass};
@@ -33,7 +34,7 @@ pub struct TiledBlur {
 impl sealed::Sealed for TiledBlur {}
 
 impl SeparableForm for TiledBlur {
-    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = gpu::storage_texture;
+    const TARGET: fn(&wgpu::Device, &str, u32, u32, wgpu::TextureFormat) -> wgpu::Texture = frame_pool::storage_target;
 
     fn build(
         device: &wgpu::Device,
