@@ -16,6 +16,7 @@ use rtbake::runtime::frame_pool::{
 use rtbake::runtime::gpu::{
     buffers_uploaded_on_this_thread, pipelines_created_on_this_thread, read_backs_on_this_thread,
 };
+use rtbake::runtime::skin::compute_raster::RasterShape;
 use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
 use rtbake::runtime::skin_render::{render_on_device_with, render_with, SkinRenderSettings, SkinShader};
@@ -87,24 +88,35 @@ fn a_steady_state_frame_creates_and_uploads_nothing() {
         (SkinShader::SsJittered, SkinPasses::default()),
         (SkinShader::Separable, all),
     ];
-    for (shader, passes) in &cases {
-        // A fresh device: the first frame finds nothing pooled.
-        let g = gpu();
-        let s = settings(*shader, 1, 0.6);
-        let before = counts();
-        let first = frame(&g, &head, &s, passes, &assets);
-        let after_first = counts();
-        assert!(after_first[0] > before[0], "{shader:?}: the first frame creates its buffers");
-        // The SSS pass's textures (no SSS: none; the compute frame's skin inputs create no texture).
-        let sss = !matches!(shader, SkinShader::None);
-        assert_eq!(after_first[1] > before[1], sss, "{shader:?}: textures created by the first frame");
-        frame(&g, &head, &s, passes, &assets);
-        let before = counts();
-        let third = frame(&g, &head, &s, passes, &assets);
-        let made = counts().iter().zip(before).map(|(a, b)| a - b).collect::<Vec<_>>();
-        assert_eq!(made, [0, 0, 0, 0], "{shader:?}: buffers, textures, pipelines created and buffers uploaded");
-        assert_eq!(first, third, "{shader:?}: a frame from pooled resources differs");
+    // Both shapes of the G-buffer raster: the render pass's targets are textures, the compute rasteriser's
+    // buffers (4× MSAA always takes the render pass).
+    for shape in [RasterShape::Render, RasterShape::Compute] {
+        RasterShape::set_on_this_thread(Some(shape));
+        for (shader, passes) in &cases {
+            // A fresh device: the first frame finds nothing pooled.
+            let g = gpu();
+            let s = settings(*shader, 1, 0.6);
+            let before = counts();
+            let first = frame(&g, &head, &s, passes, &assets);
+            let after_first = counts();
+            assert!(after_first[0] > before[0], "{shader:?}: the first frame creates its buffers");
+            // The SSS pass's textures and the render pass's G-buffer (the compute frame's skin inputs and the compute
+            // rasteriser create no texture).
+            let textures = !matches!(shader, SkinShader::None) || shape == RasterShape::Render || passes.msaa > 1;
+            assert_eq!(
+                after_first[1] > before[1],
+                textures,
+                "{shader:?}, {shape:?}: textures created by the first frame"
+            );
+            frame(&g, &head, &s, passes, &assets);
+            let before = counts();
+            let third = frame(&g, &head, &s, passes, &assets);
+            let made = counts().iter().zip(before).map(|(a, b)| a - b).collect::<Vec<_>>();
+            assert_eq!(made, [0, 0, 0, 0], "{shader:?}, {shape:?}: buffers, textures, pipelines created and uploads");
+            assert_eq!(first, third, "{shader:?}, {shape:?}: a frame from pooled resources differs");
+        }
     }
+    RasterShape::set_on_this_thread(None);
 }
 
 /// Frame B after a different frame A on the same device (another shader, heads, camera, bloom on or off), from
@@ -132,20 +144,25 @@ fn a_frame_after_a_different_frame_is_the_frame_of_a_fresh_device() {
         ((settings(SkinShader::Separable, 2, 1.0), &none), (settings(SkinShader::SsJittered, 1, 0.6), &bloom)),
         ((settings(SkinShader::SsFull, 2, 0.8), &other_maps), (settings(SkinShader::Separable, 1, 0.6), &mapped)),
     ];
-    let g = gpu();
-    for ((sa, pa), (sb, pb)) in &cases {
-        let a = frame(&g, &head, sa, pa, &assets);
-        let before = buffers_created_on_this_thread();
-        let b = frame(&g, &head, sb, pb, &assets);
-        let reused = buffers_created_on_this_thread() - before;
-        let fresh_device = gpu();
-        set_frame_pool_enabled(false);
-        let fresh = frame(&fresh_device, &head, sb, pb, &assets);
-        set_frame_pool_enabled(true);
-        assert_ne!(a, b, "{:?} after {:?}: the two frames differ", sb.shader, sa.shader);
-        assert!(b == fresh, "{:?} after {:?}: B from A's pooled resources differs from B on a fresh device ({} of {} bytes; {reused} buffers created for B)",
+    // Both raster shapes (the compute rasteriser's key buffers must start empty in every frame).
+    for shape in [RasterShape::Render, RasterShape::Compute] {
+        RasterShape::set_on_this_thread(Some(shape));
+        let g = gpu();
+        for ((sa, pa), (sb, pb)) in &cases {
+            let a = frame(&g, &head, sa, pa, &assets);
+            let before = buffers_created_on_this_thread();
+            let b = frame(&g, &head, sb, pb, &assets);
+            let reused = buffers_created_on_this_thread() - before;
+            let fresh_device = gpu();
+            set_frame_pool_enabled(false);
+            let fresh = frame(&fresh_device, &head, sb, pb, &assets);
+            set_frame_pool_enabled(true);
+            assert_ne!(a, b, "{:?} after {:?}: the two frames differ", sb.shader, sa.shader);
+            assert!(b == fresh, "{:?} after {:?}, {shape:?}: B from A's pooled resources differs from B on a fresh device ({} of {} bytes; {reused} buffers created for B)",
             sb.shader, sa.shader, b.iter().zip(&fresh).filter(|(x, y)| x != y).count(), b.len());
+        }
     }
+    RasterShape::set_on_this_thread(None);
 }
 
 /// Two threads rendering different frames on one device at once, three frames each, give the bytes each frame has
