@@ -256,8 +256,12 @@ fn the_scanned_heads_frame_with_its_maps_is_one_submission() {
     .unwrap();
     let mut s = small_frame(SkinShader::Separable, StretchPreset::Tap2009);
     (s.width, s.height, s.distance_m) = (192, 108, 0.3);
+    // The one-encoder frame against the per-pass frame with the same rasteriser (the render pass; the per-pass
+    // path always takes it), then the compute rasteriser (a GPU's default) against the same per-pass frame.
+    use rtbake::runtime::skin::compute_raster::RasterShape;
     for msaa in [1, 4] {
         let passes = SkinPasses { surface_maps: Some(maps.clone()), msaa, ..SkinPasses::default() };
+        RasterShape::set_on_this_thread(Some(RasterShape::Render));
         let (counts, frame) = counted_frame(&g, &mesh, &s, &passes, &assets);
         assert_eq!(counts, (1, 1), "msaa {msaa}: (submissions, read-backs)");
         set_shading_in_one_encoder(false);
@@ -270,7 +274,6 @@ fn the_scanned_heads_frame_with_its_maps_is_one_submission() {
         if msaa == 1 {
             // The compute rasteriser (a GPU's default) has the CPU twin's arithmetic: its uv picks neighbouring
             // texels of the maps as the twin's do, so the twin's 95 % (measured 98.1 %).
-            use rtbake::runtime::skin::compute_raster::RasterShape;
             RasterShape::set_on_this_thread(Some(RasterShape::Compute));
             let (counts, compute) = counted_frame(&g, &mesh, &s, &passes, &assets);
             RasterShape::set_on_this_thread(None);

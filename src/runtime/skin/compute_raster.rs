@@ -399,7 +399,10 @@ mod tests {
         let compute = compute_gbuffer(&g, &all, &cam, w, h);
         let cpu = mesh_raster_cpu::rasterise(&all, &cam, w, h);
         let d = differences(&compute, &cpu);
-        assert_eq!((d.coverage, d.other_surface), (0, 0), "against the CPU twin: {d:?}");
+        // Pixels whose depth lies within rounding of the near-plane cut may fall either side of it: exact on
+        // lavapipe, 3 of 5181 covered pixels on an NVIDIA H200 (its fused multiply-adds round the plane's z
+        // differently from the twin's separate f32 operations). A wrong cut or depth compare moves hundreds.
+        assert!(d.coverage <= 8 && d.other_surface == 0, "against the CPU twin: {d:?}");
         // The near triangle shows in front of the square (view depth < 1000 mm), cut at the near plane (≥ 50 mm).
         let near: Vec<f32> =
             compute.depth_mm.iter().zip(&compute.covered).filter(|(&z, &c)| c && z < 900.0).map(|(&z, _)| z).collect();
