@@ -7,6 +7,11 @@
 //!
 //!     cargo run --release --example bench_frame_passes [-- WIDTH HEIGHT FRAMES [both|compute|render]]
 //!                                                                 # 1920 1080 7 both
+//!     cargo run --release --example bench_frame_passes -- 1920 1080 7 slices=4x1,16x4
+//!
+//! `slices=RxC,…` times the first shader's frame with the compute rasteriser once per slicing of the triangles'
+//! boxes (`rtbake::runtime::skin::compute_raster::Slices`: R row slices × C column slices per triangle; without
+//! it, the default slicing for the mesh's triangle count).
 //!
 //! The last argument picks how the one-sample G-buffer and shadow map are rasterised
 //! (`rtbake::runtime::skin::compute_raster::RasterShape`, `RTBAKE_RASTER` in `run skin`): `both` (the default)
@@ -27,7 +32,7 @@ use rtbake::mesh::head::default_head;
 use rtbake::runtime::demo::DemoAssets;
 use rtbake::runtime::device::{create_headless, DeviceOptions};
 use rtbake::runtime::gpu::{copy_bandwidth, set_pass_profiling, take_pass_profile, PassTime};
-use rtbake::runtime::skin::compute_raster::RasterShape;
+use rtbake::runtime::skin::compute_raster::{RasterShape, Slices};
 use rtbake::runtime::skin_passes::SkinPasses;
 use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset, TsSettings};
 use std::path::PathBuf;
@@ -58,10 +63,19 @@ fn main() {
     let args: Vec<u32> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let (width, height) = (args.first().copied().unwrap_or(1920), args.get(1).copied().unwrap_or(1080));
     let frames = args.get(2).copied().unwrap_or(7).max(1) as usize;
-    let shapes = match std::env::args().skip(1).find(|a| a.parse::<u32>().is_err()).as_deref() {
+    let word = |a: &String| a.parse::<u32>().is_err() && !a.starts_with("slices=");
+    let mut shapes = match std::env::args().skip(1).find(word).as_deref() {
         None | Some("both") => vec![RasterShape::Compute, RasterShape::Render],
         Some(one) => vec![RasterShape::parse(one).expect("the last argument: both, compute or render")],
     };
+    // `slices=RxC[,RxC…]`: the compute rasteriser's slicings of the triangle boxes compared on the first shader.
+    let slicings: Vec<Option<Slices>> = match std::env::args().skip(1).find(|a| a.starts_with("slices=")) {
+        Some(a) => a["slices=".len()..].split(',').map(|v| Some(Slices::parse(v).expect("slices=RxC,…"))).collect(),
+        None => vec![None],
+    };
+    if slicings[0].is_some() {
+        shapes = vec![RasterShape::Compute];
+    }
     let dir = std::env::var_os("RTBAKE_BAKED_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("baked"));
@@ -95,9 +109,16 @@ fn main() {
     let ts = SkinShader::Ts(TsSettings::default());
     let shaders = [SkinShader::None, SkinShader::Separable, SkinShader::SsFull, SkinShader::SsJittered, ts];
     let stretch = StretchPreset::default();
-    for (shape, (name, shader)) in shapes.iter().flat_map(|&r| names.into_iter().zip(shaders).map(move |n| (r, n))) {
+    let shader_count = if slicings[0].is_some() { 1 } else { names.len() };
+    let runs = shapes.iter().flat_map(|&r| slicings.iter().map(move |&c| (r, c)));
+    let runs = runs.flat_map(|(r, c)| names.into_iter().zip(shaders).take(shader_count).map(move |n| (r, c, n)));
+    for (shape, slicing, (name, shader)) in runs {
         RasterShape::set_on_this_thread(Some(shape));
-        let name = format!("{name} (raster: {})", shape.name());
+        Slices::set_on_this_thread(slicing);
+        let name = match slicing {
+            Some(c) => format!("{name} (raster: {}, slices {}x{})", shape.name(), c.rows, c.columns),
+            None => format!("{name} (raster: {})", shape.name()),
+        };
         let s = SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width, height, melanin: 0.02, stretch };
         let mut profiles: Vec<Vec<PassTime>> = Vec::new();
         let mut wall = Vec::new();

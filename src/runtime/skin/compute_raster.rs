@@ -88,9 +88,59 @@ impl RasterShape {
 
 const SOURCE: &str = include_str!("compute_raster.wgsl");
 
-/// Row slices of the triangle passes: thread (t, k) scans rows y0 + k, y0 + k + SLICES, … of triangle t's box, so
-/// a large triangle is spread over several threads (a small one leaves the extra threads idle after its set-up).
-const ROW_SLICES: u32 = 4;
+/// How the triangle passes spread a triangle's box over threads: thread (t, k) of triangle t takes rows
+/// y0 + k / columns + j·rows and columns x0 + k % columns + i·columns of its box (k < rows · columns), so a large
+/// triangle is spread over several threads and the dispatch has enough threads to fill a GPU (a small triangle
+/// leaves the extra threads idle after its set-up). The image is the same for any slicing (the keys are
+/// order-independent atomics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Slices {
+    pub rows: u32,
+    pub columns: u32,
+}
+
+thread_local! {
+    static SLICES_ON_THIS_THREAD: Cell<Option<Slices>> = const { Cell::new(None) };
+}
+
+impl Slices {
+    /// Threads the default slicing aims at: about two per thread slot of a large GPU (an H100 or H200 holds
+    /// 132 SMs × 2048).
+    const TARGET_THREADS: u32 = 1 << 19;
+
+    /// The slicing of the frames recorded on the calling thread from now on (None: [`Self::for_triangles`]), for
+    /// benchmarks that compare slicings in one process.
+    pub fn set_on_this_thread(slices: Option<Self>) {
+        SLICES_ON_THIS_THREAD.with(|s| s.set(slices));
+    }
+
+    /// The slicing of a mesh of `triangles`: [`Self::set_on_this_thread`]'s, else enough threads per triangle
+    /// (a power of two from 4 to 64) for [`Self::TARGET_THREADS`] in all, a quarter of them across columns from
+    /// 16 up.
+    pub fn for_triangles(triangles: u32) -> Self {
+        if let Some(s) = SLICES_ON_THIS_THREAD.with(|s| s.get()) {
+            return s;
+        }
+        let per_triangle = Self::TARGET_THREADS.div_ceil(triangles.max(1)).next_power_of_two().clamp(4, 64);
+        let columns = match per_triangle {
+            16.. => 4,
+            8 => 2,
+            _ => 1,
+        };
+        Slices { rows: per_triangle / columns, columns }
+    }
+
+    /// `ROWSxCOLUMNS`, both 1..=64 (a benchmark's argument).
+    pub fn parse(value: &str) -> Result<Self, InvalidInput> {
+        let bad = || InvalidInput::new("slices", format!("must be ROWSxCOLUMNS, each 1..=64, got {value:?}"));
+        let (r, c) = value.split_once('x').ok_or_else(bad)?;
+        let (rows, columns) = (r.parse::<u32>().map_err(|_| bad())?, c.parse::<u32>().map_err(|_| bad())?);
+        if !(1..=64).contains(&rows) || !(1..=64).contains(&columns) {
+            return Err(bad());
+        }
+        Ok(Slices { rows, columns })
+    }
+}
 /// Threads per workgroup of the triangle passes (`@workgroup_size(64, 1, 1)`).
 const TRIANGLES_PER_GROUP: u32 = 64;
 /// Bytes per pixel of the two visibility buffers (depth key, triangle key): below the geometry pass's per-pixel
@@ -157,9 +207,13 @@ pub(crate) fn record(
     let mut uniform = mesh_raster::camera_uniform(mesh, camera, width, height);
     uniform[33] = 0.5 * camera.near;
     let triangles = (mesh.indices.len() / 3) as u32;
-    let params =
-        Params { camera: uniform, size: [width, height, triangles, ROW_SLICES], out: [row_bytes / 4, targets, 0, 0] };
-    let tri_groups = [triangles.div_ceil(TRIANGLES_PER_GROUP), ROW_SLICES, 1];
+    let slices = Slices::for_triangles(triangles);
+    let params = Params {
+        camera: uniform,
+        size: [width, height, triangles, slices.rows],
+        out: [row_bytes / 4, targets, slices.columns, 0],
+    };
+    let tri_groups = [triangles.div_ceil(TRIANGLES_PER_GROUP), slices.rows * slices.columns, 1];
     let stages = [
         Stage::new("depth", tri_groups),
         Stage::new("visible", tri_groups),
@@ -293,6 +347,38 @@ mod tests {
     /// dot ≥ 0.9993; uv equal); against the render pass the coverage may differ on a few silhouette pixels (the
     /// hardware snaps vertices to 1/256 pixel; measured: none of 9 138), the attributes within the same tolerances
     /// (measured: uv 1/2048, tangents 2.4e-3).
+    /// The G-buffer is the same for every slicing of the triangles' boxes (one thread per triangle, rows only,
+    /// rows and columns, uneven counts) and the default slicing gives a power of two of 4 to 64 threads per
+    /// triangle; a bad slicing argument is refused naming it.
+    #[test]
+    fn every_slicing_of_the_triangle_boxes_gives_the_same_gbuffer() {
+        let (_turn, g) = device();
+        let head = default_head();
+        let cam = Camera::facing(0.6).unwrap();
+        let (w, h) = (160, 120);
+        let frames: Vec<MeshGBuffer> = [(1, 1), (4, 1), (16, 4), (3, 5)]
+            .into_iter()
+            .map(|(rows, columns)| {
+                Slices::set_on_this_thread(Some(Slices { rows, columns }));
+                let f = compute_gbuffer(&g, &head, &cam, w, h);
+                Slices::set_on_this_thread(None);
+                f
+            })
+            .collect();
+        assert!(frames[0].covered.iter().filter(|&&c| c).count() > 2000);
+        for f in &frames[1..] {
+            assert!(f == &frames[0], "a slicing changed the G-buffer");
+        }
+        for (triangles, threads) in [(1, 64), (6720, 64), (17684, 32), (100_000, 8), (1 << 20, 4)] {
+            let s = Slices::for_triangles(triangles);
+            assert_eq!(s.rows * s.columns, threads, "{triangles} triangles: {s:?}");
+        }
+        assert_eq!(Slices::parse("16x4").unwrap(), Slices { rows: 16, columns: 4 });
+        for bad in ["16", "0x4", "65x1", "ax2"] {
+            assert_eq!(Slices::parse(bad).unwrap_err().param, "slices", "{bad}");
+        }
+    }
+
     #[test]
     fn the_compute_gbuffer_matches_the_cpu_twin_and_the_render_pass() {
         let (_turn, g) = device();

@@ -1,5 +1,5 @@
 // The G-buffer of runtime/skin/mesh_raster.wgsl rasterised in compute (runtime/skin/compute_raster.rs): a
-// visibility buffer resolved in three dispatches. `depth`, one thread per (triangle, row slice): the nearest
+// visibility buffer resolved in three dispatches. `depth`, one thread per (triangle, slice of its box): the nearest
 // depth key of every covered pixel centre (atomicMax of the inverted f32 bits of NDC z); `visible`: the same
 // pixels again, the lowest triangle index whose key equals the stored one; `resolve`, one thread per pixel: the
 // winning triangle's attributes interpolated at the pixel centre, written as the render pass's Rgba16Float
@@ -14,7 +14,8 @@ struct Params {
     cam: vec4<f32>,
     // width, height (pixels), triangles, row slices of the triangle passes
     size: vec4<u32>,
-    // u32 words per G-buffer row, targets written (2: normal+depth, uv+cover; 3: and the tangent), 0, 0
+    // u32 words per G-buffer row, targets written (2: normal+depth, uv+cover; 3: and the tangent), column slices
+    // of the triangle passes, 0
     out: vec4<u32>,
 };
 
@@ -137,8 +138,9 @@ fn depth(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.ok) {
         return;
     }
-    for (var y = r.y0 + id.y; y < r.y1; y += p.size.w) {
-        for (var x = r.x0; x < r.x1; x++) {
+    // Slice id.y of the box: rows y0 + id.y / columns + j·rows, columns x0 + id.y % columns + i·columns.
+    for (var y = r.y0 + id.y / p.out.z; y < r.y1; y += p.size.w) {
+        for (var x = r.x0 + id.y % p.out.z; x < r.x1; x += p.out.z) {
             let key = depth_key(r, x, y);
             if (key != 0u) {
                 atomicMax(&depth_keys[y * p.size.x + x], key);
@@ -156,8 +158,9 @@ fn visible(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!r.ok) {
         return;
     }
-    for (var y = r.y0 + id.y; y < r.y1; y += p.size.w) {
-        for (var x = r.x0; x < r.x1; x++) {
+    // Slice id.y of the box: rows y0 + id.y / columns + j·rows, columns x0 + id.y % columns + i·columns.
+    for (var y = r.y0 + id.y / p.out.z; y < r.y1; y += p.size.w) {
+        for (var x = r.x0 + id.y % p.out.z; x < r.x1; x += p.out.z) {
             let key = depth_key(r, x, y);
             let i = y * p.size.x + x;
             // Of the triangles at the nearest depth, the first in index order (the render pass's less-than test).
