@@ -19,9 +19,14 @@ use rtbake::runtime::gpu::{
 use rtbake::runtime::skin::compute_raster::RasterShape;
 use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin_passes::{SkinPasses, Wrinkles};
-use rtbake::runtime::skin_render::{render_on_device_with, render_with, SkinRenderSettings, SkinShader};
+use rtbake::runtime::skin_render::{render_on_device_with, render_with, SkinRenderSettings, SkinShader, TsSettings};
 use rtbake::runtime::wrinkle_pass::{parse_wrinkle_weights, WrinkleMaps};
 use std::sync::Arc;
+
+/// Texture-space diffusion with `map_size`² irradiance maps.
+fn ts(map_size: u32) -> SkinShader {
+    SkinShader::Ts(TsSettings { map_size, ..Default::default() })
+}
 
 fn settings(shader: SkinShader, heads: u32, distance_m: f32) -> SkinRenderSettings {
     SkinRenderSettings { shader, heads, distance_m, width: 96, height: 64, melanin: 0.02, stretch: Default::default() }
@@ -86,7 +91,9 @@ fn a_steady_state_frame_creates_and_uploads_nothing() {
         (SkinShader::Separable, SkinPasses::default()),
         (SkinShader::SsFull, SkinPasses::default()),
         (SkinShader::SsJittered, SkinPasses::default()),
-        (SkinShader::Separable, all),
+        (SkinShader::Separable, all.clone()),
+        (ts(128), SkinPasses::default()),
+        (ts(128), all),
     ];
     // Both shapes of the G-buffer raster: the render pass's targets are textures, the compute rasteriser's
     // buffers (4× MSAA always takes the render pass).
@@ -102,7 +109,8 @@ fn a_steady_state_frame_creates_and_uploads_nothing() {
             assert!(after_first[0] > before[0], "{shader:?}: the first frame creates its buffers");
             // The SSS pass's textures and the render pass's G-buffer (the compute frame's skin inputs and the compute
             // rasteriser create no texture).
-            let textures = !matches!(shader, SkinShader::None) || shape == RasterShape::Render || passes.msaa > 1;
+            let sss = matches!(shader, SkinShader::Separable | SkinShader::SsFull | SkinShader::SsJittered);
+            let textures = sss || shape == RasterShape::Render || passes.msaa > 1;
             assert_eq!(
                 after_first[1] > before[1],
                 textures,
@@ -143,6 +151,10 @@ fn a_frame_after_a_different_frame_is_the_frame_of_a_fresh_device() {
         ((settings(SkinShader::SsJittered, 1, 0.4), &bloom), (settings(SkinShader::SsFull, 2, 0.7), &bloom)),
         ((settings(SkinShader::Separable, 2, 1.0), &none), (settings(SkinShader::SsJittered, 1, 0.6), &bloom)),
         ((settings(SkinShader::SsFull, 2, 0.8), &other_maps), (settings(SkinShader::Separable, 1, 0.6), &mapped)),
+        // Texture space: another map size, heads and camera; then with maps, wrinkles and MSAA after a
+        // screen-space frame.
+        ((settings(ts(64), 2, 0.9), &none), (settings(ts(128), 1, 0.6), &bloom)),
+        ((settings(SkinShader::SsFull, 2, 0.8), &bloom), (settings(ts(128), 1, 0.5), &mapped)),
     ];
     // Both raster shapes (the compute rasteriser's key buffers must start empty in every frame).
     for shape in [RasterShape::Render, RasterShape::Compute] {

@@ -421,7 +421,7 @@ impl TextureSpaceDiffusion {
                     sigma_mm: [*sigma, 0.0, 0.0, 0.0],
                     weight: [w[0], w[1], w[2], 0.0],
                 };
-                let ubuf = gpu::uniform_buffer(device, "ts blur", bytemuck::bytes_of(&p));
+                let ubuf = crate::runtime::frame_pool::uniform_buffer(device, "ts blur", bytemuck::bytes_of(&p));
                 let bind = gpu::bind_group(
                     device,
                     "ts blur",
@@ -561,6 +561,7 @@ mod one_encoder {
     use crate::mesh::Mesh;
     use crate::runtime::compute_chain::{self, groups_8x8, storage_buffer, Stage};
     use crate::runtime::device::Gpu;
+    use crate::runtime::frame_pool;
     use crate::runtime::gpu;
     use crate::runtime::skin::bloom::{self, BloomBuffers};
     use crate::runtime::skin::frame_geometry::{self, FrameGeometryJob};
@@ -707,14 +708,17 @@ mod one_encoder {
             assets: &DemoAssets,
         ) -> Result<Self, RuntimeError> {
             let (device, queue) = (&g.device, &g.queue);
-            let mut inputs = SkinInputs::new(device, queue, size, size, &assets.luts, &assets.rig)?;
+            let mut inputs = SkinInputs::for_compute(device, size, size, &assets.luts, &assets.rig)?;
             inputs.upload_lights(queue, &assets.rig_weights, assets.lights.back_view)?;
             let (row32, row16) = (padded_row(size, 16), padded_row(size, 8));
             let t = size as u64 * size as u64;
             let what = "ts_map_size";
             let sizes = [row32 * size as u64, 32 * t, 2 * row16 * size as u64, 16 * t];
             compute_chain::check_buffers(device, what, &sizes)?;
-            let make = |bytes| storage_buffer(device, what, bytes, None);
+            // From the frame pool (content left by a former frame): `texels` writes every texel of maps, normals
+            // and geo, the skin-inputs pass skin16, `lit` chain, the blurs temp, the frame clears sum, the
+            // surface-map pass every texel of mapped.
+            let make = |bytes| frame_pool::storage_buffer(device, what, bytes);
             let (uv_map, stretch) = device_uv_map(device, mesh, mesh_key, size);
             let texel_frame = normal_map.then(|| device_texel_frame(device, mesh, mesh_key, size));
             Ok(Self {
@@ -780,28 +784,33 @@ mod one_encoder {
         };
         // The texels' normals bent by the normal map (the albedo map waits for the pixels: post-scatter).
         let normal_map = passes.surface_maps.as_ref().filter(|m| m.normal.is_some());
+        // The frame's buffers come from the device's frame pool and go back to it after the read-back.
+        let _frame = frame_pool::FrameScope::open(device, queue);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // 1. The frame's geometry, skin inputs and unblurred diffuse layer.
         let d = frame_geometry::record(device, &mut enc, &job, assets)?;
-        let mut inputs = SkinInputs::new(device, queue, w, h, &assets.luts, &assets.rig)?;
+        let mut inputs = SkinInputs::for_compute(device, w, h, &assets.luts, &assets.rig)?;
         inputs.upload_lights(queue, &assets.rig_weights, assets.lights.back_view)?;
         d.record_rig_at_uv(device, &mut enc, &job, assets)?;
-        let row16 = gpu::padded_row_bytes(inputs.albedo()) as u64;
+        let row16 = inputs.half_row_bytes() as u64;
         let bloom_buffers = match &assets.bloom {
             Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
             None => None,
         };
         let sizes = [2 * row16 * h as u64, 16 * n, 4 * n];
         compute_chain::check_buffers(device, what, &sizes)?;
-        let skin16 = storage_buffer(device, what, sizes[0], None);
-        let diffuse = storage_buffer(device, what, sizes[1], None);
-        let rgba = storage_buffer(device, what, sizes[2], Some(&BACKGROUND.repeat(n as usize)));
+        // Pooled: skin16 and diffuse are written over the whole frame before they are read (the skin-inputs pass,
+        // `lit`), rgba is filled with the background by `background` below.
+        let skin16 = frame_pool::storage_buffer(device, what, sizes[0]);
+        let diffuse = frame_pool::storage_buffer(device, what, sizes[1]);
+        let rgba = frame_pool::storage_buffer(device, what, sizes[2]);
         // Bindings a stage does not read (no SSS pass; on the texels, nothing past the lit layer).
-        let unused = || storage_buffer(device, what, 16, None);
+        let unused = || frame_pool::storage_buffer(device, what, 16);
         let (hdr, bloomed) = match &bloom_buffers {
+            // Without bloom, hdr is written by `composite` over the whole frame.
             Some(b) => (b.0[0].clone(), b.0[3].clone()),
-            None => (storage_buffer(device, what, sizes[1], None), unused()),
+            None => (frame_pool::storage_buffer(device, what, sizes[1]), unused()),
         };
         inputs.record_compute(device, &mut enc, [&d.skin_maps, &d.normals], &skin16);
         let key = assets.lights.key_view;
@@ -828,10 +837,13 @@ mod one_encoder {
                 let bg = BACKGROUND.map(|c| c as f32 / 255.0);
                 [bg[0], bg[1], bg[2], flag(blend_coverage)]
             },
+            fill: BACKGROUND.map(|c| c as f32 / 255.0),
             ..shade_params(w, h, row16)
         };
         let sss16 = unused();
         let frame_bound = [&skin16, &d.texels, &diffuse, &sss16, &hdr, &bloomed, &rgba, &d.uvc];
+        // The uniform background filled on the device (the frame's buffer is pooled: no upload).
+        shade(&mut enc, &screen, &frame_bound, "background", groups_8x8(w, h));
         shade(&mut enc, &screen, &frame_bound, "lit", groups_8x8(w, h));
         // 2. Per head, its irradiance map lit, blurred and gathered.
         let view = cam.view();
@@ -847,7 +859,9 @@ mod one_encoder {
         let sigmas = &assets.blurs.incremental_sigma_mm;
         let (lo, hi) = mesh.bounds();
         let blurs = TextureSpaceDiffusion::new(device)?;
-        let counts = storage_buffer(device, what, (4 * COUNTS) as u64 * s.heads as u64, None);
+        let counts = frame_pool::storage_buffer(device, what, (4 * COUNTS) as u64 * s.heads as u64);
+        // Counted with atomics: zero at the frame's start.
+        enc.clear_buffer(&counts, 0, None);
         let shadow_row = padded_row(SHADOW_MAP_SIZE, 8);
         let depth_row = padded_row(w, 4);
         let texel_unused = [unused(), unused(), unused(), unused(), unused()];
@@ -909,12 +923,7 @@ mod one_encoder {
         if blend_coverage {
             shade(&mut enc, &screen, &frame_bound, "coverage", groups_8x8(w, h));
         }
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: rgba.size() + counts.size(),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+        let readback = frame_pool::readback_buffer(device, rgba.size() + counts.size());
         enc.copy_buffer_to_buffer(&rgba, 0, &readback, 0, rgba.size());
         enc.copy_buffer_to_buffer(&counts, 0, &readback, rgba.size(), counts.size());
         gpu::submit(queue, enc.finish());
