@@ -136,23 +136,33 @@ fn note_taken(r: Resource) {
 /// Puts `resources` back into `device`'s pool as returned by a frame that just ended, and evicts what the last
 /// [`KEEP_FRAMES`] frames did not use; keeps at most [`POOLED_DEVICES`] pools.
 fn give_back(device: &wgpu::Device, resources: Vec<Resource>, frame_ended: bool) {
-    let mut pools = pools();
-    let i = match pools.iter().position(|p| &p.device == device) {
-        Some(i) => i,
-        None => {
-            pools.push(DevicePool { device: device.clone(), frames_ended: 0, free: Vec::new() });
-            if pools.len() > POOLED_DEVICES {
-                pools.remove(0);
+    // What is evicted is dropped after the lock is released: dropping a wgpu resource (or a device's last
+    // handle) calls into the driver, which must never wait while this lock is held.
+    let mut evicted_pools = Vec::new();
+    let evicted;
+    {
+        let mut pools = pools();
+        let i = match pools.iter().position(|p| &p.device == device) {
+            Some(i) => i,
+            None => {
+                pools.push(DevicePool { device: device.clone(), frames_ended: 0, free: Vec::new() });
+                if pools.len() > POOLED_DEVICES {
+                    evicted_pools.push(pools.remove(0));
+                }
+                pools.len() - 1
             }
-            pools.len() - 1
-        }
-    };
-    let mut pool = pools.remove(i);
-    pool.frames_ended += frame_ended as u64;
-    let now = pool.frames_ended;
-    pool.free.extend(resources.into_iter().map(|r| (r, now)));
-    pool.free.retain(|(_, last)| last + KEEP_FRAMES > now);
-    pools.push(pool);
+        };
+        let mut pool = pools.remove(i);
+        pool.frames_ended += frame_ended as u64;
+        let now = pool.frames_ended;
+        pool.free.extend(resources.into_iter().map(|r| (r, now)));
+        let (kept, old): (Vec<_>, Vec<_>) = pool.free.drain(..).partition(|(_, last)| last + KEEP_FRAMES > now);
+        pool.free = kept;
+        evicted = old;
+        pools.push(pool);
+    }
+    drop(evicted);
+    drop(evicted_pools);
 }
 
 /// Number of free resources kept for `device` (for tests).

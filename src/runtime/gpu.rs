@@ -77,14 +77,16 @@ impl<K: PartialEq, V: Clone> Kept<K, V> {
             }
         }
         let v = make()?;
-        let mut kept = self.entries.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, first)) = kept.iter().find(|(k, _)| *k == key) {
-            return Ok(first.clone());
-        }
-        if kept.len() >= self.keep {
-            kept.remove(0);
-        }
-        kept.push((key, v.clone()));
+        // The evicted entry (GPU buffers, a device handle) is dropped after the lock is released.
+        let _evicted = {
+            let mut kept = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some((_, first)) = kept.iter().find(|(k, _)| *k == key) {
+                return Ok(first.clone());
+            }
+            let evicted = (kept.len() >= self.keep).then(|| kept.remove(0));
+            kept.push((key, v.clone()));
+            evicted
+        };
         Ok(v)
     }
 
@@ -181,16 +183,23 @@ pub fn cached<T: Clone + Send + Sync + 'static>(
         }
     }
     let v = make();
-    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-    let (map, devices) = &mut *guard;
-    if !devices.contains(device) {
-        devices.push(device.clone());
-        if devices.len() > CACHED_DEVICES {
-            let old = devices.remove(0);
-            map.retain(|key, _| key.0 != old);
+    // An evicted device's objects are dropped after the lock is released (dropping them calls into the driver).
+    let mut evicted = Vec::new();
+    {
+        let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        let (map, devices) = &mut *guard;
+        if !devices.contains(device) {
+            devices.push(device.clone());
+            if devices.len() > CACHED_DEVICES {
+                let old = devices.remove(0);
+                let keys: Vec<CacheKey> = map.keys().filter(|key| key.0 == old).cloned().collect();
+                evicted.extend(keys.iter().filter_map(|key| map.remove(key)));
+                evicted.push(Box::new(old));
+            }
         }
+        map.entry(k).or_insert_with(|| Box::new(v.clone()));
     }
-    map.entry(k).or_insert_with(|| Box::new(v.clone()));
+    drop(evicted);
     v
 }
 

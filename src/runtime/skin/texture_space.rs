@@ -793,7 +793,7 @@ mod one_encoder {
         let mut inputs = SkinInputs::for_compute(device, w, h, &assets.luts, &assets.rig)?;
         inputs.upload_lights(queue, &assets.rig_weights, assets.lights.back_view)?;
         d.record_rig_at_uv(device, &mut enc, &job, assets)?;
-        let row16 = inputs.half_row_bytes() as u64;
+        let row16 = inputs.half_row_bytes();
         let bloom_buffers = match &assets.bloom {
             Some(p) => Some(BloomBuffers::new(device, w, h, p)?),
             None => None,
