@@ -7,7 +7,7 @@
 //! and buffers from pass to pass on the device, and are submitted once; the host reads back only the final RGBA8
 //! frame. The stages, their order and their arithmetic are those of [`crate::runtime::skin::lighting`]
 //! (`lit_geometry`, `shade`, `composite`), which stays the CPU twin and the per-pass path (each pass submitted
-//! and read back on its own, for inspection and for texture-space diffusion): `render_geometry` picks one.
+//! and read back on its own, for inspection and A/B comparison): `render_geometry` picks one.
 //!
 //! With the geometry on the device, the skin-inputs pass is a compute pass (`SkinInputs::record_compute`) that
 //! reads the geometry's maps and normals buffers and writes its two `Rgba16Float` images straight into the buffer
