@@ -101,7 +101,7 @@ impl ThreePass {
 
     /// The bytes each pass (edges, weights, blending) must move, the figure its bytes-moved bound divides by the
     /// copy bandwidth: every image it reads and writes counted whole and once at its texture's format — edges: the
-    /// detector's inputs ([`EdgeStage`]: colour RGBA8 and/or depth `R32Float`) in, the edges out (2 or 4 bytes a
+    /// detector's inputs (`EdgeStage`: colour RGBA8 and/or depth `R32Float`) in, the edges out (2 or 4 bytes a
     /// pixel, [`EdgeFormat`]); weights: the edges in, the weights (RGBA8) out; blending: the colour and the weights
     /// in, the output out (and, masked, the compute shape's mask, `R8Unorm`; the fragment shape masks in a fourth
     /// pass). The look-up tables, the texels the searches read again, the edge list and the weights the compute edge

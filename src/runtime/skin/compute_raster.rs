@@ -115,7 +115,7 @@ impl Slices {
     }
 
     /// The slicing of a mesh of `triangles` over a `pixels`-pixel image: [`Self::set_on_this_thread`]'s, else
-    /// enough threads per triangle (a power of two from 4 to 64) for [`Self::TARGET_THREADS`] in all but no more
+    /// enough threads per triangle (a power of two from 4 to 64) for `TARGET_THREADS` (2¹⁹) in all but no more
     /// than a thread per 4 pixels (small triangles leave extra threads idle), 2 column slices from 8 threads a
     /// triangle and 4 at 64. Measured on an NVIDIA H200 (`bench_frame_passes 1920 1080 5 slices=…`, the default
     /// head's 6720 triangles): the 1080p view's depth and visible passes at 4.5× and 5.1× their bytes-moved bound

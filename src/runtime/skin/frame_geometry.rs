@@ -397,22 +397,27 @@ mod tests {
     /// within 0.5 mm (an f16 step at 600 mm), the specular layer within 2e-3 (measured: 3e-4) and the thickness
     /// within 1.05 mm on ≥ 99 % of the pixels the back light reaches: the shadow map, rasterised by compute too,
     /// stores the light's depth as f16, one step of which is 1 mm at 1–2 m (measured: up to 1.003 mm, most equal).
+    /// The tests' frame: the default head alone at 0.6 m, 320×192, no SSS.
+    fn frame_320x192() -> SkinRenderSettings {
+        SkinRenderSettings {
+            shader: SkinShader::None,
+            heads: 1,
+            distance_m: 0.6,
+            width: 320,
+            height: 192,
+            melanin: 0.02,
+            stretch: StretchPreset::Thesis,
+        }
+    }
+
     #[test]
     fn the_compute_raster_geometry_matches_the_render_pass_geometry() {
         let (_one_at_a_time, g) = device();
         let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/baked"));
         let assets = DemoAssets::load(dir).unwrap();
         let mesh = crate::mesh::head::default_head();
-        let (w, h) = (320, 192);
-        let s = SkinRenderSettings {
-            shader: SkinShader::None,
-            heads: 1,
-            distance_m: 0.6,
-            width: w,
-            height: h,
-            melanin: 0.02,
-            stretch: StretchPreset::Thesis,
-        };
+        let s = frame_320x192();
+        let (w, h) = (s.width, s.height);
         let rig_pose = assets.baked_rig.as_ref().map(|r| RigPose::neutral(r.names.len()));
         let job = FrameGeometryJob {
             mesh: &mesh,
@@ -472,16 +477,8 @@ mod tests {
         // rest of the geometry must agree exactly (the compute rasteriser is compared with it above).
         RasterShape::set_on_this_thread(Some(RasterShape::Render));
         let mesh = crate::mesh::head::default_head();
-        let (w, h) = (320, 192);
-        let s = SkinRenderSettings {
-            shader: SkinShader::None,
-            heads: 1,
-            distance_m: 0.6,
-            width: w,
-            height: h,
-            melanin: 0.02,
-            stretch: StretchPreset::Thesis,
-        };
+        let s = frame_320x192();
+        let (w, h) = (s.width, s.height);
         let (geo, gbuf, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, passes, assets, false).unwrap();
         // The normals without the passes on the normals, to see that they bend them.
         let unbent = SkinPasses { msaa: passes.msaa, ..SkinPasses::none() };
