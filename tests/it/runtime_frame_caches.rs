@@ -3,7 +3,7 @@
 //! `runtime::gpu::buffers_uploaded_on_this_thread`) and are the same frame; a different mesh, or maps whose texels
 //! changed, are uploaded again and give a different frame.
 
-use crate::support::{baked_dir, gpu};
+use crate::support::{baked_dir, gpu, head_frame_160x96};
 use rtbake::mesh::head::default_head;
 use rtbake::mesh::Mesh;
 use rtbake::runtime::demo::DemoAssets;
@@ -12,7 +12,7 @@ use rtbake::runtime::gpu::buffers_uploaded_on_this_thread;
 use rtbake::runtime::skin::shade_frame::set_shading_in_one_encoder;
 use rtbake::runtime::skin::surface_maps::{SurfaceMap, SurfaceMaps};
 use rtbake::runtime::skin_passes::SkinPasses;
-use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, StretchPreset};
+use rtbake::runtime::skin_render::{render_with, SkinShader, StretchPreset};
 use std::sync::Arc;
 
 /// A 2×2 albedo map of skin tones and a 24×24 tangent-space normal map of ripples (unit vectors tilted ±0.3).
@@ -35,15 +35,7 @@ fn maps() -> SurfaceMaps {
 /// and the buffers uploaded for it.
 fn frame(g: &Gpu, head: &Mesh, maps: &SurfaceMaps, assets: &DemoAssets) -> (Vec<u8>, u64) {
     set_shading_in_one_encoder(true);
-    let s = SkinRenderSettings {
-        shader: SkinShader::Separable,
-        heads: 1,
-        distance_m: 0.6,
-        width: 160,
-        height: 96,
-        melanin: 0.02,
-        stretch: StretchPreset::Thesis,
-    };
+    let s = head_frame_160x96(SkinShader::Separable, 1, 0.6, StretchPreset::Thesis);
     let passes = SkinPasses { surface_maps: Some(maps.clone()), ..SkinPasses::none() };
     let before = buffers_uploaded_on_this_thread();
     let img = render_with(Some(g), head, &s, &passes, assets).unwrap();

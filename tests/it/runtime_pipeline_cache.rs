@@ -11,7 +11,7 @@ use rtbake::runtime::skin_render::{render_with, SkinRenderSettings, SkinShader, 
 
 /// One head at 0.6 m in a 160×96 frame.
 fn small_frame(shader: SkinShader, stretch: StretchPreset) -> SkinRenderSettings {
-    SkinRenderSettings { shader, heads: 1, distance_m: 0.6, width: 160, height: 96, melanin: 0.02, stretch }
+    crate::support::head_frame_160x96(shader, 1, 0.6, stretch)
 }
 
 #[test]

@@ -7,7 +7,7 @@
 //! reference frames of TAP's experiment, where `../shared` is there). The procedural demo (`run demo`) shades in one
 //! submission too.
 
-use crate::support::{baked_dir, gpu, reference_file};
+use crate::support::{baked_dir, gpu, head_frame_160x96, reference_file};
 use rtbake::image_buf::Image;
 use rtbake::mesh::head::default_head;
 use rtbake::mesh::Mesh;
@@ -56,15 +56,7 @@ fn a_texture_space_frame_submits_once_and_reads_back_only_the_final_frame() {
     let assets = DemoAssets::load(&baked_dir()).unwrap();
     assert!(assets.baked_rig.is_some(), "the committed bake has the example rig");
     let head = default_head();
-    let frame = |shader, heads, distance_m| SkinRenderSettings {
-        shader,
-        heads,
-        distance_m,
-        width: 160,
-        height: 96,
-        melanin: 0.02,
-        stretch: StretchPreset::Thesis,
-    };
+    let frame = |shader, heads, distance_m| head_frame_160x96(shader, heads, distance_m, StretchPreset::Thesis);
     let plain = TsSettings { map_size: 128, ..Default::default() };
     // One head with bloom; three heads (the outer ones partly outside the frame) with every ch. 3 optimisation,
     // so that texels are culled and clipped and the pixels are shared between heads.
@@ -231,15 +223,7 @@ fn texture_space_frames_with_surface_maps_wrinkles_and_msaa_submit_once() {
         ("all three, 3 heads optimised", &all, optimised, 3, 0.45),
     ];
     for (name, passes, ts, heads, distance_m) in cases {
-        let s = SkinRenderSettings {
-            shader: SkinShader::Ts(ts),
-            heads,
-            distance_m,
-            width: 160,
-            height: 96,
-            melanin: 0.02,
-            stretch: StretchPreset::Thesis,
-        };
+        let s = head_frame_160x96(SkinShader::Ts(ts), heads, distance_m, StretchPreset::Thesis);
         let ((counts, (one, one_stats)), (counts_p, (per_pass, per_pass_stats))) =
             one_encoder_and_per_pass(&g, &head, &s, ts, passes, &assets);
         assert_eq!(counts, (1, 1), "{name}: (submissions, read-backs)");

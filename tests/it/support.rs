@@ -264,3 +264,21 @@ pub fn assert_gpu_matches_cpu(name: &str, ok: bool, what: &str, size: (u32, u32,
 pub fn unorm8_of(samples: &[f32]) -> Vec<u8> {
     samples.iter().map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8).collect()
 }
+
+/// The runtime tests' small `run skin` frame: `heads` of the default spacing at `distance_m`, 160×96, melanin 0.02.
+pub fn head_frame_160x96(
+    shader: rtbake::runtime::skin_render::SkinShader,
+    heads: u32,
+    distance_m: f32,
+    stretch: rtbake::runtime::skin_render::StretchPreset,
+) -> rtbake::runtime::skin_render::SkinRenderSettings {
+    rtbake::runtime::skin_render::SkinRenderSettings {
+        shader,
+        heads,
+        distance_m,
+        width: 160,
+        height: 96,
+        melanin: 0.02,
+        stretch,
+    }
+}

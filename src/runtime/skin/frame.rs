@@ -321,7 +321,7 @@ fn screen_space_frame(
 }
 
 /// The device geometry of a frame of `heads` (the original `assets`' baked rig posed by `passes`).
-fn device_job<'a>(
+pub(crate) fn device_job<'a>(
     heads: &'a Mesh,
     s: &SkinRenderSettings,
     passes: &'a SkinPasses,

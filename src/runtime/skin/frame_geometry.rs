@@ -418,18 +418,8 @@ mod tests {
         let mesh = crate::mesh::head::default_head();
         let s = frame_320x192();
         let (w, h) = (s.width, s.height);
-        let rig_pose = assets.baked_rig.as_ref().map(|r| RigPose::neutral(r.names.len()));
-        let job = FrameGeometryJob {
-            mesh: &mesh,
-            camera: s.camera(),
-            width: w,
-            height: h,
-            melanin: 0.02,
-            rig_pose,
-            msaa: 1,
-            surface_maps: None,
-            wrinkles: None,
-        };
+        let none = SkinPasses::none();
+        let job = crate::runtime::skin::frame::device_job(&mesh, &s, &none, &assets);
         let geometry = |shape| {
             RasterShape::set_on_this_thread(Some(shape));
             let mut enc = g.device.create_command_encoder(&Default::default());
@@ -483,18 +473,7 @@ mod tests {
         // The normals without the passes on the normals, to see that they bend them.
         let unbent = SkinPasses { msaa: passes.msaa, ..SkinPasses::none() };
         let (plain, _, _) = heads::geometry(Backend::Gpu(g), &mesh, &s, &unbent, assets, false).unwrap();
-        let rig_pose = assets.baked_rig.as_ref().map(|r| RigPose::neutral(r.names.len()));
-        let job = FrameGeometryJob {
-            mesh: &mesh,
-            camera: s.camera(),
-            width: w,
-            height: h,
-            melanin: 0.02,
-            rig_pose,
-            msaa: passes.msaa,
-            surface_maps: passes.surface_maps.as_ref(),
-            wrinkles: passes.wrinkles.as_ref(),
-        };
+        let job = crate::runtime::skin::frame::device_job(&mesh, &s, passes, assets);
         let mut enc = g.device.create_command_encoder(&Default::default());
         let d = record(&g.device, &mut enc, &job, assets).unwrap();
         if let (Some(r), Some(pose)) = (&assets.baked_rig, &job.rig_pose) {
